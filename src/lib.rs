@@ -1,1 +1,37 @@
+//! mjcf-forge: an arena-allocated MJCF (MuJoCo XML) document engine.
+//!
+//! The document tier: [`Document::load`] reads a model exactly as MuJoCo reads it
+//! (`<include>` expanded, default classes inlined into explicit attributes, file references
+//! absolute) into an arena with interned names, so that cloning, renaming and merging are
+//! flat passes. Writing is deterministic.
+//!
+//! ```
+//! use mjcf_forge::Document;
+//! let doc = Document::from_str(
+//!     r#"<mujoco><default><joint damping="2"/></default>
+//!        <worldbody><body><joint name="hinge"/><geom size="0.1"/></body></worldbody></mujoco>"#,
+//!     ".",
+//! )?;
+//! assert_eq!(
+//!     doc.to_xml_string(),
+//!     r#"<mujoco><worldbody><body><joint name="hinge" damping="2"/><geom size="0.1"/></body></worldbody></mujoco>"#
+//! );
+//! # Ok::<(), mjcf_forge::Errors>(())
+//! ```
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
 
+mod defaults;
+mod document;
+mod error;
+mod names;
+mod paths;
+mod read;
+mod tree;
+pub mod vocab;
+mod write;
+
+pub use document::{Document, Section};
+pub use error::{Error, ErrorKind, Errors, Location};
+pub use tree::Node;
+pub use write::write_atomic;

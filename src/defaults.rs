@@ -1,0 +1,839 @@
+//! Default classes resolved into explicit attributes, with MuJoCo's rules.
+//!
+//! MuJoCo keeps one complete set of "dummy" elements per class. A class starts as a copy of
+//! its parent (taken after the parent's own elements are read, before any nested class),
+//! then its elements are applied in order. A real element starts from its class's dummy and
+//! applies its own attributes. Applying means: an attribute replaces the dummy's value,
+//! except that a fixed-capacity numeric array given with fewer numbers overwrites only its
+//! first entries (`friction="0.7"` over `"1 0.1 0.01"` is `0.7 0.1 0.01`), and any one
+//! orientation attribute replaces the whole orientation of the dummy.
+//!
+//! Actuators share ONE dummy per class whatever shortcut wrote it; that is modelled in
+//! [`ActuatorSlot`]. Each class's slot remembers which element wrote it last, because a
+//! shortcut pre-reads its parameters (kp, kv, ...) only from a slot written with the same
+//! shortcut or with `general` of the matching gain type (looking up the class chain), while
+//! mechanical attributes (ctrlrange, gear, ...) are inherited from any slot.
+//!
+//! The active class of an element: its own `class`, else the `childclass` of the nearest
+//! ancestor (body, frame, replicate) that has one, else the top-level class `main`.
+
+use ahash::AHashMap;
+
+use crate::document::Document;
+use crate::error::{Error, ErrorKind, Errors};
+use crate::names::{Sym, sym};
+use crate::tree::{Node, StrRef};
+use crate::vocab::{self, DefaultSlot, ElementSpec};
+
+/// Attributes that together give one orientation: a new one replaces all of them.
+const ORIENTATION: [&str; 5] = ["quat", "axisangle", "xyaxes", "zaxis", "euler"];
+/// Light: `directional` and `type` both set the light type; the nearer one wins.
+const LIGHT_TYPE: [&str; 2] = ["directional", "type"];
+
+/// Raw control-model attributes of `<general>`: a shortcut resets all of them.
+const GENERAL_CONTROL: [&str; 9] = [
+    "dyntype",
+    "gaintype",
+    "biastype",
+    "dynprm",
+    "gainprm",
+    "biasprm",
+    "actdim",
+    "input",
+    "inheritrange",
+];
+
+/// Default slots other than the actuator one, in a fixed order (index into class slots).
+const SLOTS: [DefaultSlot; 11] = [
+    DefaultSlot::Mesh,
+    DefaultSlot::Texture,
+    DefaultSlot::Material,
+    DefaultSlot::Joint,
+    DefaultSlot::Geom,
+    DefaultSlot::Site,
+    DefaultSlot::Camera,
+    DefaultSlot::Light,
+    DefaultSlot::Pair,
+    DefaultSlot::Equality,
+    DefaultSlot::Tendon,
+];
+
+fn slot_index(slot: DefaultSlot) -> Option<usize> {
+    SLOTS.iter().position(|s| *s == slot)
+}
+
+/// The slot a child of `<default>` writes, by its tag.
+fn default_child_slot(tag: &str) -> Option<DefaultSlot> {
+    let default = vocab::element("default")?;
+    vocab::child(default, tag)?.default_slot
+}
+
+/// An ordered attribute set: one class's dummy element.
+#[derive(Clone, Debug, Default)]
+struct AttrSet(Vec<(Sym, StrRef)>);
+
+impl AttrSet {
+    fn get(&self, name: Sym) -> Option<StrRef> {
+        self.0.iter().find(|(n, _)| *n == name).map(|(_, v)| *v)
+    }
+
+    fn remove(&mut self, name: Sym) {
+        self.0.retain(|(n, _)| *n != name);
+    }
+
+    fn set(&mut self, name: Sym, value: StrRef) {
+        match self.0.iter_mut().find(|(n, _)| *n == name) {
+            Some(slot) => slot.1 = value,
+            None => self.0.push((name, value)),
+        }
+    }
+}
+
+/// The shared actuator dummy of a class.
+#[derive(Clone, Debug)]
+struct ActuatorSlot {
+    /// The tag of the element that wrote the slot last (`general` for the built-in one).
+    writer: Sym,
+    /// Mechanical attributes (ctrlrange, gear, forcerange, group, ...).
+    mech: AttrSet,
+    /// For `general`: the raw control model as written (gainprm, biastype, ...), over the
+    /// built-in one. For a shortcut: its parameters as written (kp, kv, ...), over the
+    /// shortcut's documented defaults.
+    control: AttrSet,
+}
+
+#[derive(Clone, Debug)]
+struct Class {
+    parent: Option<usize>,
+    slots: [AttrSet; SLOTS.len()],
+    actuator: ActuatorSlot,
+}
+
+/// Frequently used names, interned once.
+struct Syms {
+    class: Sym,
+    childclass: Sym,
+    default: Sym,
+    general: Sym,
+    gaintype: Sym,
+    input: Sym,
+    kv: Sym,
+    dampratio: Sym,
+    user: Sym,
+    orientation: [Sym; 5],
+    light_type: [Sym; 2],
+    control: [Sym; 9],
+}
+
+impl Syms {
+    fn new() -> Syms {
+        Syms {
+            class: sym("class"),
+            childclass: sym("childclass"),
+            default: sym("default"),
+            general: sym("general"),
+            gaintype: sym("gaintype"),
+            input: sym("input"),
+            kv: sym("kv"),
+            dampratio: sym("dampratio"),
+            user: sym("user"),
+            orientation: ORIENTATION.map(sym),
+            light_type: LIGHT_TYPE.map(sym),
+            control: GENERAL_CONTROL.map(sym),
+        }
+    }
+}
+
+struct Resolver<'a> {
+    doc: &'a mut Document,
+    syms: Syms,
+    classes: Vec<Class>,
+    by_name: AHashMap<String, usize>,
+    errors: Vec<Error>,
+    /// Values an element inherits but MJCF gives its kind no attribute for (a `<fixed>`
+    /// tendon's rgba, width and material): kept in residual classes, one per distinct set.
+    residuals: Vec<(DefaultSlot, Vec<(Sym, StrRef)>)>,
+}
+
+/// Resolves every default class into explicit attributes and removes `<default>`, `class`
+/// and `childclass`. All problems are reported at once.
+pub(crate) fn inline_defaults(doc: &mut Document) -> Result<(), Errors> {
+    let syms = Syms::new();
+    let main = Class {
+        parent: None,
+        slots: Default::default(),
+        actuator: ActuatorSlot {
+            writer: syms.general,
+            mech: AttrSet::default(),
+            control: AttrSet::default(),
+        },
+    };
+    let mut r = Resolver {
+        doc,
+        syms,
+        classes: vec![main],
+        by_name: AHashMap::from_iter([("main".to_string(), 0)]),
+        errors: Vec::new(),
+        residuals: Vec::new(),
+    };
+    let root = r.doc.root;
+    let sections: Vec<Node> = r
+        .doc
+        .elements(root)
+        .filter(|&n| r.doc.tag_sym(n) == Some(r.syms.default))
+        .collect();
+    for &section in &sections {
+        if let Some(name) = r.doc.attr_sym(section, r.syms.class) {
+            if name != "main" {
+                let e = r.doc.error_at(section, ErrorKind::RenamedMainClass(name.to_string()));
+                r.errors.push(e);
+            }
+        }
+        r.read_class(section, 0);
+    }
+    for &section in &sections {
+        r.doc.remove(section);
+    }
+    let root_spec = vocab::root();
+    let children: Vec<Node> = r.doc.elements(root).collect();
+    for child in children {
+        let tag = r.doc.tag(child).to_string();
+        if let Some(spec) = vocab::child(root_spec, &tag) {
+            r.resolve(child, spec, None);
+        }
+    }
+    if !r.errors.is_empty() {
+        return Err(Errors(r.errors));
+    }
+    r.write_residuals();
+    Ok(())
+}
+
+/// The tag of a default slot's row inside `<default>`.
+fn slot_tag(slot: DefaultSlot) -> &'static str {
+    let default = vocab::element("default").expect("default kind");
+    default
+        .children
+        .iter()
+        .filter_map(|n| vocab::element(n))
+        .find(|e| e.default_slot == Some(slot))
+        .map(|e| e.tag)
+        .expect("every slot has a default row")
+}
+
+/// The name of the `i`-th residual class.
+fn residual_class(i: usize) -> String {
+    format!("mjcf-forge-residual-{i}")
+}
+
+impl Resolver<'_> {
+    /// Writes the residual classes as the only `<default>` left (see [`Resolver::residuals`]).
+    fn write_residuals(&mut self) {
+        if self.residuals.is_empty() {
+            return;
+        }
+        let root = self.doc.root;
+        let top = self.doc.new_element(self.syms.default, None);
+        let residuals = std::mem::take(&mut self.residuals);
+        for (i, (slot, attrs)) in residuals.iter().enumerate() {
+            let class = self.doc.new_element(self.syms.default, None);
+            let name = self.doc.push_str(&residual_class(i));
+            self.doc.set_attr_ref(class, self.syms.class, name);
+            let tag = self.doc.intern(slot_tag(*slot));
+            let row = self.doc.new_element(tag, None);
+            let attrs: Vec<crate::tree::Attr> =
+                attrs.iter().map(|&(name, value)| crate::tree::Attr { name, value }).collect();
+            self.doc.replace_attrs(row, &attrs);
+            self.doc.tree.append(class, row);
+            self.doc.tree.append(top, class);
+        }
+        // Defaults are read before the kinematic tree whatever their place: first is tidy.
+        let first = self.doc.tree.first_child(root);
+        match first {
+            Some(first) => self.doc.tree.insert_before(first, top),
+            None => self.doc.tree.append(root, top),
+        }
+    }
+
+    /// Reads one `<default>` element into class `class`: its own elements first, in order,
+    /// then its nested classes (each a copy of this class as it is then), as MuJoCo does.
+    fn read_class(&mut self, section: Node, class: usize) {
+        let kids: Vec<Node> = self.doc.elements(section).collect();
+        for &el in &kids {
+            if self.doc.tag_sym(el) == Some(self.syms.default) {
+                continue;
+            }
+            let tag = self.doc.tag(el).to_string();
+            match default_child_slot(&tag) {
+                Some(DefaultSlot::Actuator) => {
+                    let slot = self.classes[class].actuator.clone();
+                    let own = self.own_attrs(el);
+                    match self.apply_actuator(&slot, class, el, &own) {
+                        Ok((next, _, _)) => self.classes[class].actuator = next,
+                        Err(e) => self.errors.push(e),
+                    }
+                }
+                Some(slot) => {
+                    let i = slot_index(slot).expect("non-actuator slot");
+                    let own = self.own_attrs(el);
+                    let mut set = std::mem::take(&mut self.classes[class].slots[i]);
+                    self.apply(&mut set, &own, None);
+                    self.classes[class].slots[i] = set;
+                }
+                None => {
+                    let e = self.doc.error_at(
+                        el,
+                        ErrorKind::Invalid(format!("<{tag}> cannot appear in <default>")),
+                    );
+                    self.errors.push(e);
+                }
+            }
+        }
+        for &el in &kids {
+            if self.doc.tag_sym(el) != Some(self.syms.default) {
+                continue;
+            }
+            let Some(name) = self.doc.attr_sym(el, self.syms.class).map(str::to_string) else {
+                let e = self.doc.error_at(el, ErrorKind::Invalid("nested <default> needs a 'class'".into()));
+                self.errors.push(e);
+                continue;
+            };
+            if self.by_name.contains_key(&name) {
+                let e = self.doc.error_at(el, ErrorKind::RepeatedClass(name));
+                self.errors.push(e);
+                continue;
+            }
+            let mut child = self.classes[class].clone();
+            child.parent = Some(class);
+            let index = self.classes.len();
+            self.classes.push(child);
+            self.by_name.insert(name, index);
+            self.read_class(el, index);
+        }
+    }
+
+    /// The attributes an element writes itself (its `class` left out).
+    fn own_attrs(&self, node: Node) -> Vec<(Sym, StrRef)> {
+        self.doc
+            .attr_slice(node)
+            .iter()
+            .filter(|a| a.name != self.syms.class && a.name != self.syms.childclass)
+            .map(|a| (a.name, a.value))
+            .collect()
+    }
+
+    /// Applies attributes onto a dummy, with MuJoCo's array overlay and orientation rules.
+    /// With `accepts`, attributes the element kind cannot carry are reported by name.
+    fn apply(&mut self, set: &mut AttrSet, own: &[(Sym, StrRef)], _accepts: Option<&ElementSpec>) {
+        for group in [&self.syms.orientation[..], &self.syms.light_type[..]] {
+            if own.iter().any(|(n, _)| group.contains(n)) {
+                for g in group {
+                    set.remove(*g);
+                }
+            }
+        }
+        for &(name, value) in own {
+            let value = match set.get(name) {
+                Some(base) if name != self.syms.user => self.overlay(value, base),
+                _ => value,
+            };
+            set.set(name, value);
+        }
+    }
+
+    /// `own` over `base` for numeric arrays: MuJoCo reads a fixed-capacity array by
+    /// overwriting as many leading entries as are given. Anything else: `own`.
+    fn overlay(&mut self, own: StrRef, base: StrRef) -> StrRef {
+        let own_s = self.doc.str(own);
+        let base_s = self.doc.str(base);
+        let own_n: Vec<&str> = own_s.split_ascii_whitespace().collect();
+        let base_n: Vec<&str> = base_s.split_ascii_whitespace().collect();
+        let numeric = |v: &[&str]| !v.is_empty() && v.iter().all(|t| t.parse::<f64>().is_ok());
+        if own_n.len() >= base_n.len() || !numeric(&own_n) || !numeric(&base_n) {
+            return own;
+        }
+        let mut joined = own_n.join(" ");
+        for t in &base_n[own_n.len()..] {
+            joined.push(' ');
+            joined.push_str(t);
+        }
+        self.doc.push_str(&joined)
+    }
+
+    /// Walks the model below `node` (whose kind is `spec`), resolving each element.
+    fn resolve(&mut self, node: Node, spec: &'static ElementSpec, childclass: Option<usize>) {
+        let mut active = childclass;
+        if let Some(cc) = self.doc.attr_sym(node, self.syms.childclass).map(str::to_string) {
+            match self.by_name.get(&cc) {
+                Some(&c) => active = Some(c),
+                None => {
+                    let e = self.doc.error_at(node, ErrorKind::UnknownClass(cc));
+                    self.errors.push(e);
+                }
+            }
+            self.doc.remove_attr_sym(node, self.syms.childclass);
+        }
+        if let Some(slot) = spec.default_slot {
+            self.resolve_element(node, spec, slot, active);
+        }
+        let kids: Vec<Node> = self.doc.elements(node).collect();
+        for kid in kids {
+            let tag = self.doc.tag(kid).to_string();
+            if let Some(kspec) = vocab::child(spec, &tag) {
+                self.resolve(kid, kspec, active);
+            }
+        }
+    }
+
+    fn class_of(&mut self, node: Node, childclass: Option<usize>) -> Option<usize> {
+        match self.doc.attr_sym(node, self.syms.class).map(str::to_string) {
+            Some(name) => match self.by_name.get(&name) {
+                Some(&c) => Some(c),
+                None => {
+                    let e = self.doc.error_at(node, ErrorKind::UnknownClass(name));
+                    self.errors.push(e);
+                    None
+                }
+            },
+            None => Some(childclass.unwrap_or(0)),
+        }
+    }
+
+    fn resolve_element(
+        &mut self,
+        node: Node,
+        spec: &'static ElementSpec,
+        slot: DefaultSlot,
+        childclass: Option<usize>,
+    ) {
+        let Some(class) = self.class_of(node, childclass) else {
+            return;
+        };
+        let own = self.own_attrs(node);
+        let merged = if slot == DefaultSlot::Actuator {
+            let dummy = self.classes[class].actuator.clone();
+            match self.apply_actuator(&dummy, class, node, &own) {
+                Ok((_, out_tag, attrs)) => {
+                    if self.doc.tag_sym(node) != Some(out_tag) {
+                        self.doc.set_tag(node, out_tag);
+                    }
+                    attrs
+                }
+                Err(e) => {
+                    self.errors.push(e);
+                    return;
+                }
+            }
+        } else {
+            let i = slot_index(slot).expect("non-actuator slot");
+            let mut set = self.classes[class].slots[i].clone();
+            self.apply(&mut set, &own, Some(spec));
+            set.0
+        };
+        // Own attributes keep their place; inherited ones follow in class order.
+        let mut out: Vec<crate::tree::Attr> = Vec::with_capacity(merged.len());
+        let mut residual: Vec<(Sym, StrRef)> = Vec::new();
+        for &(name, _) in &own {
+            if let Some(v) = merged.iter().find(|(n, _)| *n == name).map(|(_, v)| *v) {
+                out.push(crate::tree::Attr { name, value: v });
+            }
+        }
+        for &(name, value) in &merged {
+            if own.iter().any(|(n, _)| *n == name) {
+                continue;
+            }
+            let attr_name = self.doc.sym_name(name).to_string();
+            if spec.attr(&attr_name).is_none() {
+                residual.push((name, value));
+                continue;
+            }
+            out.push(crate::tree::Attr { name, value });
+        }
+        if !residual.is_empty() {
+            let key: Vec<(Sym, String)> =
+                residual.iter().map(|&(n, v)| (n, self.doc.str(v).to_string())).collect();
+            let found = self.residuals.iter().position(|(s, attrs)| {
+                *s == slot
+                    && attrs.len() == key.len()
+                    && attrs.iter().zip(&key).all(|(a, k)| a.0 == k.0 && self.doc.str(a.1) == k.1)
+            });
+            let i = found.unwrap_or_else(|| {
+                self.residuals.push((slot, residual));
+                self.residuals.len() - 1
+            });
+            let value = self.doc.push_str(&residual_class(i));
+            out.push(crate::tree::Attr { name: self.syms.class, value });
+        }
+        self.doc.replace_attrs(node, &out);
+    }
+
+    /// Applies an actuator element (in a class, or a real one) onto the class dummy `slot`;
+    /// returns the new dummy and the attributes that reproduce the element without classes.
+    fn apply_actuator(
+        &mut self,
+        slot: &ActuatorSlot,
+        class: usize,
+        node: Node,
+        own: &[(Sym, StrRef)],
+    ) -> Result<(ActuatorSlot, Sym, Vec<(Sym, StrRef)>), Error> {
+        let tag = self.doc.tag_sym(node).expect("element");
+        let tag_name = self.doc.sym_name(tag).to_string();
+        let is_general = tag == self.syms.general || tag_name == "plugin";
+        let params: Vec<Sym> = vocab::shortcut_params(&tag_name)
+            .iter()
+            .filter_map(|p| crate::names::known(p))
+            .collect();
+        let is_control = |n: Sym| {
+            if is_general {
+                self.syms.control.contains(&n)
+            } else {
+                params.contains(&n)
+            }
+        };
+        let spec = vocab::element(&tag_name)
+            .or_else(|| vocab::child(vocab::element("actuator").expect("actuator"), &tag_name));
+        // Transmission and other per-element attributes never enter a class dummy.
+        let defaultable = |doc: &Document, n: Sym| {
+            let name = doc.sym_name(n);
+            spec.and_then(|s| s.attr(name)).is_some_and(|a| !a.nodefault) && name != "name"
+        };
+        let mut mech_own: Vec<(Sym, StrRef)> = Vec::new();
+        let mut control_own: Vec<(Sym, StrRef)> = Vec::new();
+        let mut other_own: Vec<(Sym, StrRef)> = Vec::new();
+        for &(n, v) in own {
+            if is_control(n) {
+                control_own.push((n, v));
+            } else if defaultable(self.doc, n) {
+                mech_own.push((n, v));
+            } else {
+                other_own.push((n, v));
+            }
+        }
+        let mut mech = slot.mech.clone();
+        self.apply(&mut mech, &mech_own, None);
+
+        let control = if is_general {
+            let mut control = if slot.writer == self.syms.general {
+                slot.control.clone()
+            } else {
+                let writer = self.doc.sym_name(slot.writer).to_string();
+                self.shortcut_table(&writer, &slot.control, node)?
+            };
+            let inherited_gain = self.gaintype(&control);
+            if let Some(&(_, g)) = control_own.iter().find(|(n, _)| *n == self.syms.gaintype) {
+                if self.doc.str(g) != inherited_gain {
+                    control.remove(self.syms.input);
+                }
+            }
+            self.apply(&mut control, &control_own, None);
+            control
+        } else {
+            let mut s = match self.shortcut_source(slot, class, &tag_name) {
+                None => AttrSet::default(),
+                // The built-in slot reads as the shortcut's documented defaults.
+                Some(src) if src.control.0.is_empty() => AttrSet::default(),
+                Some(src) if src.writer == tag => src.control.clone(),
+                Some(src) => self.from_general(&src.control, &tag_name, node)?,
+            };
+            let damping_given = control_own
+                .iter()
+                .any(|(n, _)| *n == self.syms.kv || *n == self.syms.dampratio);
+            if damping_given {
+                s.remove(self.syms.kv);
+                s.remove(self.syms.dampratio);
+            }
+            self.apply(&mut s, &control_own, None);
+            s
+        };
+
+        let next = ActuatorSlot {
+            writer: if is_general { self.syms.general } else { tag },
+            mech,
+            control,
+        };
+        let out_tag = if is_general { tag } else { self.output_tag(&next, spec) };
+        let control_out = if out_tag == tag {
+            next.control.clone()
+        } else {
+            self.shortcut_table(&tag_name, &next.control, node)?
+        };
+        let out_spec = vocab::child(
+            vocab::element("actuator").expect("actuator kind"),
+            self.doc.sym_name(out_tag),
+        );
+        let forced = forced_by_shortcut(&tag_name);
+        let mut attrs: Vec<(Sym, StrRef)> = Vec::new();
+        for &(n, v) in &other_own {
+            attrs.push((n, v));
+        }
+        for &(n, v) in next.mech.0.iter().chain(control_out.0.iter()) {
+            let name = self.doc.sym_name(n);
+            if out_tag == tag && forced.contains(&name) {
+                continue;
+            }
+            if out_spec.is_some_and(|s| s.attr(name).is_none()) && out_tag == tag && !is_general {
+                continue;
+            }
+            attrs.push((n, v));
+        }
+        // Keep the element's own attribute order first, inherited ones after.
+        let position = |n: Sym| own.iter().position(|(m, _)| *m == n).unwrap_or(usize::MAX);
+        attrs.sort_by_key(|(n, _)| position(*n));
+        Ok((next, out_tag, attrs))
+    }
+
+    /// The tag an actuator is written with: its own shortcut when that shortcut can carry
+    /// every attribute it inherits (or sets those itself), else `general` with the
+    /// shortcut's table spelled out.
+    fn output_tag(&self, slot: &ActuatorSlot, spec: Option<&'static ElementSpec>) -> Sym {
+        let Some(spec) = spec else { return slot.writer };
+        let forced = forced_by_shortcut(spec.tag);
+        let carries = slot.mech.0.iter().all(|(n, _)| {
+            let name = self.doc.sym_name(*n);
+            spec.attr(name).is_some() || forced.contains(&name)
+        });
+        if carries { slot.writer } else { self.syms.general }
+    }
+
+    /// A shortcut's documented table of `general` attributes (XMLreference, actuator
+    /// shortcuts), for parameters `s` over the shortcut's documented defaults.
+    fn shortcut_table(&mut self, tag: &str, s: &AttrSet, node: Node) -> Result<AttrSet, Error> {
+        let get = |doc: &Document, k: &str| -> Option<Vec<f64>> {
+            let sym = crate::names::known(k)?;
+            let r = s.get(sym)?;
+            Some(doc.str(r).split_ascii_whitespace().map(|t| t.parse().unwrap_or(0.0)).collect())
+        };
+        let one = |doc: &Document, k: &str, d: f64| get(doc, k).and_then(|v| v.first().copied()).unwrap_or(d);
+        let list = |v: &[f64]| v.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(" ");
+        let damping = |doc: &Document| -> f64 {
+            if let Some(dr) = get(doc, "dampratio").and_then(|v| v.first().copied()) {
+                dr
+            } else {
+                -one(doc, "kv", 0.0)
+            }
+        };
+        let mut out: Vec<(&str, String)> = Vec::new();
+        match tag {
+            "motor" => {
+                out.extend([("dyntype", "none".into()), ("dynprm", "1 0 0".into())]);
+                out.extend([("gaintype", "fixed".into()), ("gainprm", "1 0 0".into())]);
+                out.extend([("biastype", "none".into()), ("biasprm", "0 0 0".into())]);
+            }
+            "position" | "intvelocity" => {
+                let kp = one(self.doc, "kp", 1.0);
+                if tag == "intvelocity" {
+                    out.extend([("dyntype", "integrator".into()), ("dynprm", "1 0 0".into())]);
+                } else if let Some(tc) = get(self.doc, "timeconst").and_then(|v| v.first().copied()) {
+                    out.extend([("dyntype", "filterexact".into()), ("dynprm", list(&[tc, 0.0, 0.0]))]);
+                } else {
+                    out.extend([("dyntype", "none".into()), ("dynprm", "1 0 0".into())]);
+                }
+                out.extend([("gaintype", "fixed".into()), ("gainprm", list(&[kp, 0.0, 0.0]))]);
+                out.extend([("biastype", "affine".into()), ("biasprm", list(&[0.0, -kp, damping(self.doc)]))]);
+                out.push(("input", if tag == "position" { "pos" } else { "vel" }.into()));
+                if let Some(ir) = get(self.doc, "inheritrange") {
+                    out.push(("inheritrange", list(&ir)));
+                }
+            }
+            "velocity" => {
+                let kv = one(self.doc, "kv", 1.0);
+                out.extend([("dyntype", "none".into()), ("dynprm", "1 0 0".into())]);
+                out.extend([("gaintype", "fixed".into()), ("gainprm", list(&[kv, 0.0, 0.0]))]);
+                out.extend([("biastype", "affine".into()), ("biasprm", list(&[0.0, 0.0, -kv]))]);
+                out.push(("input", "vel".into()));
+            }
+            "damper" => {
+                let kv = one(self.doc, "kv", 0.0);
+                out.extend([("dyntype", "none".into()), ("dynprm", "1 0 0".into())]);
+                out.extend([("gaintype", "affine".into()), ("gainprm", list(&[0.0, 0.0, -kv]))]);
+                out.extend([("biastype", "none".into()), ("biasprm", "0 0 0".into())]);
+                out.push(("ctrllimited", "true".into()));
+            }
+            "cylinder" => {
+                let tc = one(self.doc, "timeconst", 1.0);
+                let mut area = one(self.doc, "area", 1.0);
+                let diameter = one(self.doc, "diameter", -1.0);
+                if diameter >= 0.0 {
+                    area = std::f64::consts::PI / 4.0 * diameter * diameter;
+                }
+                let mut bias = get(self.doc, "bias").unwrap_or_default();
+                bias.resize(3, 0.0);
+                out.extend([("dyntype", "filter".into()), ("dynprm", list(&[tc, 0.0, 0.0]))]);
+                out.extend([("gaintype", "fixed".into()), ("gainprm", list(&[area, 0.0, 0.0]))]);
+                out.extend([("biastype", "affine".into()), ("biasprm", list(&bias))]);
+                out.push(("input", "pressure".into()));
+            }
+            "muscle" => {
+                let mut tc = get(self.doc, "timeconst").unwrap_or_else(|| vec![0.01, 0.04]);
+                tc.resize(2, 0.0);
+                let mut range = get(self.doc, "range").unwrap_or_else(|| vec![0.75, 1.05]);
+                range.resize(2, 0.0);
+                let prm = [
+                    range[0],
+                    range[1],
+                    one(self.doc, "force", -1.0),
+                    one(self.doc, "scale", 200.0),
+                    one(self.doc, "lmin", 0.5),
+                    one(self.doc, "lmax", 1.6),
+                    one(self.doc, "vmax", 1.5),
+                    one(self.doc, "fpmax", 1.3),
+                    one(self.doc, "fvmax", 1.2),
+                ];
+                let tausmooth = one(self.doc, "tausmooth", 0.0);
+                out.extend([("dyntype", "muscle".into()), ("dynprm", list(&[tc[0], tc[1], tausmooth]))]);
+                out.extend([("gaintype", "muscle".into()), ("gainprm", list(&prm))]);
+                out.extend([("biastype", "muscle".into()), ("biasprm", list(&prm))]);
+            }
+            "adhesion" => {
+                let gain = one(self.doc, "gain", 1.0);
+                out.extend([("dyntype", "none".into()), ("dynprm", "1 0 0".into())]);
+                out.extend([("gaintype", "fixed".into()), ("gainprm", list(&[gain, 0.0, 0.0]))]);
+                out.extend([("biastype", "none".into()), ("biasprm", "0 0 0".into())]);
+                out.push(("ctrllimited", "true".into()));
+            }
+            other => {
+                return Err(self.doc.error_at(
+                    node,
+                    ErrorKind::Inexpressible(format!(
+                        "the <{other}> shortcut cannot be rewritten as <general> yet"
+                    )),
+                ));
+            }
+        }
+        let mut set = AttrSet::default();
+        for (k, v) in out {
+            let name = self.doc.intern(k);
+            let value = self.doc.push_str(&v);
+            set.set(name, value);
+        }
+        Ok(set)
+    }
+
+    fn gaintype(&self, control: &AttrSet) -> String {
+        control
+            .get(self.syms.gaintype)
+            .map(|v| self.doc.str(v).trim().to_string())
+            .unwrap_or_else(|| "fixed".to_string())
+    }
+
+    /// The slot a shortcut pre-reads: this class's dummy if written with the same shortcut
+    /// or with `general` of the shortcut's gain type, else the nearest such ancestor.
+    fn shortcut_source(&self, slot: &ActuatorSlot, class: usize, tag: &str) -> Option<ActuatorSlot> {
+        let inherits = |s: &ActuatorSlot| {
+            let writer = self.doc.sym_name(s.writer);
+            if writer == tag {
+                return true;
+            }
+            if s.writer != self.syms.general {
+                return false;
+            }
+            let want = match tag {
+                "damper" => "affine",
+                "muscle" => "muscle",
+                "dcmotor" => "dcmotor",
+                "pid" => "pid",
+                "orientation" => "so3",
+                _ => "fixed",
+            };
+            self.gaintype(&s.control) == want
+        };
+        if inherits(slot) {
+            return Some(slot.clone());
+        }
+        let mut c = self.classes[class].parent;
+        while let Some(i) = c {
+            if inherits(&self.classes[i].actuator) {
+                return Some(self.classes[i].actuator.clone());
+            }
+            c = self.classes[i].parent;
+        }
+        None
+    }
+
+    /// A shortcut's parameters read off a `general` dummy's raw control model, the way
+    /// MuJoCo pre-reads them (gain, bias and dynamics parameters in the shortcut's layout).
+    fn from_general(&mut self, control: &AttrSet, tag: &str, node: Node) -> Result<AttrSet, Error> {
+        let nums = |doc: &Document, name: &str, builtin: &[f64]| -> Vec<f64> {
+            let mut v = builtin.to_vec();
+            v.resize(10, 0.0);
+            if let Some(r) = crate::names::known(name).and_then(|s| control.get(s)) {
+                for (i, t) in doc.str(r).split_ascii_whitespace().enumerate().take(10) {
+                    v[i] = t.parse().unwrap_or(0.0);
+                }
+            }
+            v
+        };
+        let g = nums(self.doc, "gainprm", &[1.0]);
+        let b = nums(self.doc, "biasprm", &[0.0]);
+        let d = nums(self.doc, "dynprm", &[1.0]);
+        let dyntype = crate::names::known("dyntype")
+            .and_then(|s| control.get(s))
+            .map(|r| self.doc.str(r).trim().to_string())
+            .unwrap_or_else(|| "none".into());
+        let inheritrange = crate::names::known("inheritrange")
+            .and_then(|s| control.get(s))
+            .map(|r| self.doc.str(r).to_string());
+        let mut out: Vec<(&str, String)> = Vec::new();
+        let num = |x: f64| format!("{x}");
+        let damping = |out: &mut Vec<(&str, String)>| {
+            if b[2] < 0.0 {
+                out.push(("kv", num(-b[2])));
+            } else if b[2] > 0.0 {
+                out.push(("dampratio", num(b[2])));
+            }
+        };
+        match tag {
+            "motor" => {}
+            "position" | "intvelocity" => {
+                out.push(("kp", num(g[0])));
+                damping(&mut out);
+                if dyntype == "filterexact" {
+                    out.push(("timeconst", num(d[0])));
+                }
+                if let Some(r) = inheritrange {
+                    out.push(("inheritrange", r));
+                }
+            }
+            "velocity" => out.push(("kv", num(g[0]))),
+            "damper" => out.push(("kv", num(-g[2]))),
+            "adhesion" => out.push(("gain", num(g[0]))),
+            "cylinder" => {
+                out.push(("timeconst", num(d[0])));
+                out.push(("area", num(g[0])));
+                out.push(("bias", format!("{} {} {}", num(b[0]), num(b[1]), num(b[2]))));
+            }
+            "muscle" => {
+                out.push(("timeconst", format!("{} {}", num(d[0]), num(d[1]))));
+                out.push(("tausmooth", num(d[2])));
+                out.push(("range", format!("{} {}", num(g[0]), num(g[1]))));
+                for (i, k) in ["force", "scale", "lmin", "lmax", "vmax", "fpmax", "fvmax"].iter().enumerate() {
+                    out.push((k, num(g[2 + i])));
+                }
+            }
+            other => {
+                return Err(self.doc.error_at(
+                    node,
+                    ErrorKind::Inexpressible(format!(
+                        "<{other}> pre-reads its parameters from a <general> default; not supported for <{other}>"
+                    )),
+                ));
+            }
+        }
+        let mut set = AttrSet::default();
+        for (k, v) in out {
+            let name = self.doc.intern(k);
+            let value = self.doc.push_str(&v);
+            set.set(name, value);
+        }
+        Ok(set)
+    }
+}
+
+/// Attributes a shortcut sets itself (its documented table), so what a class says of
+/// them does not reach the compiled model.
+fn forced_by_shortcut(tag: &str) -> &'static [&'static str] {
+    match tag {
+        "damper" | "adhesion" => &["ctrllimited"],
+        _ => &[],
+    }
+}

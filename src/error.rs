@@ -1,0 +1,185 @@
+//! Errors: one type, positioned at `file:line:col`, with the include chain that led there.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Where something is in the sources: a file, a 1-based line and column, and the chain of
+/// `<include>` elements through which that file was reached (outermost first).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Location {
+    /// The file, as it was named to us (absolute for included files).
+    pub file: Arc<Path>,
+    /// 1-based line.
+    pub line: u32,
+    /// 1-based column, counted in bytes.
+    pub col: u32,
+    /// The `<include>` elements that led to `file`, outermost first.
+    pub included_from: Vec<(Arc<Path>, u32, u32)>,
+}
+
+impl Location {
+    /// A location with no include chain.
+    pub fn new(file: Arc<Path>, line: u32, col: u32) -> Location {
+        Location { file, line, col, included_from: Vec::new() }
+    }
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}:{}:{}", self.file.display(), self.line, self.col)
+    }
+}
+
+/// What went wrong.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ErrorKind {
+    /// A file could not be read.
+    Io {
+        /// The path we tried.
+        path: PathBuf,
+        /// The operating system's words.
+        reason: String,
+    },
+    /// The XML itself is malformed.
+    Syntax(String),
+    /// The document is not MJCF (wrong root element and the like).
+    NotMjcf(String),
+    /// `<include>` without a `file` attribute.
+    IncludeWithoutFile,
+    /// An included file is part of its own include chain.
+    IncludeCycle {
+        /// The chain of files, outermost first, ending with the repeated one.
+        chain: Vec<PathBuf>,
+    },
+    /// The same file is included twice (MuJoCo refuses that too).
+    IncludedTwice(PathBuf),
+    /// An included file inserts no element.
+    EmptyInclude(PathBuf),
+    /// `class` or `childclass` names no default class.
+    UnknownClass(String),
+    /// Two default classes share a name.
+    RepeatedClass(String),
+    /// A top-level `<default>` with a class other than `main`.
+    RenamedMainClass(String),
+    /// A default class would change the compiled model in a way MJCF cannot write
+    /// without classes.
+    Inexpressible(String),
+    /// Any other problem with the model, in words.
+    Invalid(String),
+    /// Writing an output file failed.
+    Write {
+        /// The output path.
+        path: PathBuf,
+        /// The operating system's words.
+        reason: String,
+    },
+}
+
+impl fmt::Display for ErrorKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ErrorKind::Io { path, reason } => {
+                write!(f, "cannot read '{}': {reason}", path.display())
+            }
+            ErrorKind::Syntax(msg) => write!(f, "malformed XML: {msg}"),
+            ErrorKind::NotMjcf(msg) => write!(f, "not an MJCF model: {msg}"),
+            ErrorKind::IncludeWithoutFile => write!(f, "<include> needs a 'file' attribute"),
+            ErrorKind::IncludeCycle { chain } => {
+                let names: Vec<String> = chain.iter().map(|p| p.display().to_string()).collect();
+                write!(f, "include cycle: {}", names.join(" -> "))
+            }
+            ErrorKind::IncludedTwice(p) => {
+                write!(f, "file '{}' is already included (MuJoCo allows each file once)", p.display())
+            }
+            ErrorKind::EmptyInclude(p) => {
+                write!(f, "included file '{}' inserts no element", p.display())
+            }
+            ErrorKind::UnknownClass(c) => write!(f, "unknown default class '{c}'"),
+            ErrorKind::RepeatedClass(c) => write!(f, "repeated default class name '{c}'"),
+            ErrorKind::RenamedMainClass(c) => {
+                write!(f, "top-level default class 'main' cannot be renamed (found '{c}')")
+            }
+            ErrorKind::Inexpressible(msg) => write!(f, "cannot inline defaults exactly: {msg}"),
+            ErrorKind::Invalid(msg) => f.write_str(msg),
+            ErrorKind::Write { path, reason } => {
+                write!(f, "cannot write '{}': {reason}", path.display())
+            }
+        }
+    }
+}
+
+/// An error with its position: `Display` gives `file:line:col: message`, followed by the
+/// include chain when the position is inside an included file.
+///
+/// ```
+/// use mjcf_forge::Document;
+/// let err = Document::from_str("<mujoco><worldbody><geom class='x'/></worldbody></mujoco>", ".")
+///     .unwrap_err();
+/// assert_eq!(err.to_string(), "<string>:1:20: unknown default class 'x'");
+/// ```
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Error {
+    /// Where; `None` for problems that are not in any file (such as an unreadable top file).
+    pub location: Option<Location>,
+    /// What.
+    pub kind: ErrorKind,
+}
+
+impl Error {
+    pub(crate) fn at(location: Location, kind: ErrorKind) -> Error {
+        Error { location: Some(location), kind }
+    }
+
+    pub(crate) fn bare(kind: ErrorKind) -> Error {
+        Error { location: None, kind }
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.location {
+            Some(loc) => {
+                write!(f, "{loc}: {}", self.kind)?;
+                for (file, line, col) in loc.included_from.iter().rev() {
+                    write!(f, " (included from {}:{line}:{col})", file.display())?;
+                }
+                Ok(())
+            }
+            None => write!(f, "{}", self.kind),
+        }
+    }
+}
+
+impl std::error::Error for Error {}
+
+/// All problems found by one pass, in document order. `Display` writes one per line.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Errors(pub Vec<Error>);
+
+impl Errors {
+    /// The first problem.
+    pub fn first(&self) -> &Error {
+        &self.0[0]
+    }
+}
+
+impl fmt::Display for Errors {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, e) in self.0.iter().enumerate() {
+            if i > 0 {
+                writeln!(f)?;
+            }
+            write!(f, "{e}")?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for Errors {}
+
+impl From<Error> for Errors {
+    fn from(e: Error) -> Errors {
+        Errors(vec![e])
+    }
+}

@@ -1,0 +1,730 @@
+//! Compile MJCF with MuJoCo's own C library (cargo feature `mujoco`).
+//!
+//! [`compile_file`] and [`compile_str`] run MuJoCo's XML loader (`mj_loadXML`: parse,
+//! then compile) and return a [`CompiledModel`], a safe owning handle to the resulting
+//! `mjModel`, or a [`CompileError`] carrying MuJoCo's own message and, when MuJoCo names
+//! one, the line of the offending element.
+//!
+//! The library is MuJoCo 3.17.0 from the PyPI wheel that `scripts/setup.sh` installs
+//! (see `build.rs`); the FFI declarations come from the `mujoco-rs` crate
+//! (`mujoco_rs::mujoco_c`), which was generated from the 3.17.0 headers. This module calls
+//! `mj_loadXML` itself instead of `mujoco_rs::prelude::MjModel::from_xml*`, because those
+//! read MuJoCo's error into a 100-byte buffer, which cuts longer messages short, often
+//! before the `line N` part.
+//!
+//! # Thread safety
+//!
+//! The loader is called without any lock of ours: `mj_loadXML` is safe to call from several
+//! threads at once in MuJoCo 3.x. Its only process-wide state is the "last loaded spec"
+//! kept for `mj_saveLastXML`, which MuJoCo guards with its own mutex; the compiler reports
+//! engine errors through thread-local handlers (`_mjPRIVATE__set_tls_error_fn`) and a
+//! thread-local jump buffer; the XML reader switches the number locale per thread
+//! (`uselocale`); each call here gets its own VFS. (Source: MuJoCo's `xml_api.cc`,
+//! `xml_global.cc`, `xml.cc` and `user_model.cc`; the wheel's own `thread_safety_test.py`
+//! creates models from several threads.) `tests/mujoco_compile.rs` checks it with 8
+//! threads compiling different models, with and without mesh files, 50 times each. What
+//! stays global in MuJoCo is what this module never touches: the user error/warning
+//! callbacks (`mju_user_error`, `mju_user_warning`) and `mj_saveLastXML`.
+//!
+//! # Example
+//!
+//! ```no_run
+//! use std::path::Path;
+//! use mjcf_forge::mujoco::{compile_str, ObjType};
+//!
+//! let xml = r#"<mujoco><worldbody>
+//!   <body name="ball"><freejoint/><geom name="g" size="0.1"/></body>
+//! </worldbody></mujoco>"#;
+//! let model = compile_str(xml, Path::new(".")).expect("valid model");
+//! assert_eq!(model.sizes().nbody, 2);
+//! assert_eq!(model.names(ObjType::Body), ["world", "ball"]);
+//! ```
+
+use std::ffi::{CStr, CString, c_char, c_int};
+use std::fmt;
+use std::path::Path;
+use std::ptr::NonNull;
+use std::sync::OnceLock;
+
+use mujoco_rs::mujoco_c as ffi;
+use mujoco_rs::wrappers::MjVfs;
+
+/// Bytes for MuJoCo's error (or warning) text; longer text is cut at this length.
+const ERROR_BUF_LEN: usize = 4096;
+
+/// Name under which [`compile_str`] puts its string into the VFS, inside the caller's `dir`
+/// (MuJoCo resolves relative file references against the directory of this name).
+const STRING_MODEL_NAME: &str = "__mjcf_forge_string_model__.xml";
+
+/// Why MuJoCo could not compile a model.
+///
+/// `message` is MuJoCo's own error text (as `mj_loadXML` writes it, trailing newlines
+/// removed); `element_line` is the 1-based line of the offending element when MuJoCo names
+/// one (`"Element 'geom', line 12"`, `"Element name 'a', id 0, line 9"`, or tinyxml2's
+/// `"Line number=3"` for malformed XML). `Display` prints the message alone.
+///
+/// ```no_run
+/// use std::path::Path;
+/// use mjcf_forge::mujoco::compile_str;
+///
+/// let xml = "<mujoco>\n<worldbody>\n<geom size=\"x\"/>\n</worldbody>\n</mujoco>";
+/// let err = compile_str(xml, Path::new(".")).unwrap_err();
+/// assert_eq!(err.element_line, Some(3));
+/// assert!(err.to_string().contains("bad format in attribute 'size'"));
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CompileError {
+    /// MuJoCo's error text.
+    pub message: String,
+    /// The line MuJoCo's message names, if any.
+    pub element_line: Option<u32>,
+}
+
+impl CompileError {
+    /// An error from MuJoCo's text: parses the line number out of it.
+    ///
+    /// ```
+    /// use mjcf_forge::mujoco::CompileError;
+    ///
+    /// let err = CompileError::from_message("XML Error: bad format\nElement 'geom', line 12\n");
+    /// assert_eq!(err.element_line, Some(12));
+    /// assert_eq!(err.message, "XML Error: bad format\nElement 'geom', line 12");
+    /// ```
+    pub fn from_message(message: impl Into<String>) -> Self {
+        let mut message = message.into();
+        message.truncate(message.trim_end().len());
+        let element_line = parse_line(&message);
+        Self { message, element_line }
+    }
+
+    /// An error that did not come from MuJoCo (bad path, version mismatch): no line.
+    fn local(message: String) -> Self {
+        Self { message, element_line: None }
+    }
+}
+
+impl fmt::Display for CompileError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for CompileError {}
+
+/// The line number in a MuJoCo error message: MuJoCo's `", line N"` (it ends the
+/// `Element ...` line of its messages), else tinyxml2's `"Line number=N"`.
+fn parse_line(message: &str) -> Option<u32> {
+    let element_line = message
+        .lines()
+        .rev()
+        .filter(|line| line.trim_start().starts_with("Element"))
+        .find_map(|line| number_after(line, ", line "));
+    element_line
+        .or_else(|| number_after(message, ", line "))
+        .or_else(|| number_after(message, "Line number="))
+}
+
+/// The decimal number right after the last `marker` in `text` that has one.
+fn number_after(text: &str, marker: &str) -> Option<u32> {
+    text.rmatch_indices(marker).find_map(|(at, _)| {
+        let rest = &text[at + marker.len()..];
+        let end = rest.find(|c: char| !c.is_ascii_digit()).unwrap_or(rest.len());
+        rest[..end].parse().ok()
+    })
+}
+
+/// Compiles the MJCF (or URDF) file at `path`; its relative file references (includes,
+/// meshes, textures) resolve against the file's directory, as in MuJoCo.
+///
+/// Never panics on bad input: unreadable files, malformed XML, schema violations, missing
+/// assets and compiler errors all come back as [`CompileError`].
+///
+/// ```no_run
+/// use std::path::Path;
+/// use mjcf_forge::mujoco::compile_file;
+///
+/// match compile_file(Path::new("robot.xml")) {
+///     Ok(model) => println!("{}", model.sizes().to_json()),
+///     Err(err) => eprintln!("line {:?}: {err}", err.element_line),
+/// }
+/// ```
+pub fn compile_file(path: &Path) -> Result<CompiledModel, CompileError> {
+    check_version()?;
+    let c_path = path_to_cstring(path)?;
+    load_xml(&c_path, None)
+}
+
+/// Compiles the MJCF document `xml`, resolving its relative file references (includes,
+/// meshes, textures, `meshdir`, ...) against `dir`, as if it were a file in `dir`.
+///
+/// The string goes into a MuJoCo virtual file system (VFS) private to this call, under a
+/// name in `dir`: nothing is written to disk, `dir` may be read-only, and concurrent calls
+/// do not interfere. Assets are read from the real file system.
+///
+/// ```no_run
+/// use std::path::Path;
+/// use mjcf_forge::mujoco::{compile_str, ObjType};
+///
+/// let xml = r#"<mujoco>
+///   <asset><mesh name="part" file="meshes/part.obj"/></asset>
+///   <worldbody><geom type="mesh" mesh="part"/></worldbody>
+/// </mujoco>"#;
+/// // reads ./models/meshes/part.obj
+/// let model = compile_str(xml, Path::new("models")).unwrap();
+/// assert_eq!(model.names(ObjType::Mesh), ["part"]);
+/// ```
+pub fn compile_str(xml: &str, dir: &Path) -> Result<CompiledModel, CompileError> {
+    check_version()?;
+    let name = path_to_cstring(&dir.join(STRING_MODEL_NAME))?;
+    let len = c_int::try_from(xml.len()).map_err(|_| {
+        CompileError::local(format!("MJCF string too long for MuJoCo ({} bytes)", xml.len()))
+    })?;
+    let mut vfs = MjVfs::new();
+    // SAFETY: `vfs` is a live VFS made by `mj_defaultVFS` (in `MjVfs::new`); adding a file
+    // through MuJoCo's own API keeps its invariants. `name` is NUL-terminated, and MuJoCo
+    // copies `len` bytes from `xml` before returning.
+    let added = unsafe {
+        ffi::mj_addBufferVFS(vfs.ffi_mut(), name.as_ptr(), xml.as_ptr().cast(), len)
+    };
+    if added != 0 {
+        return Err(CompileError::local(format!(
+            "could not add the MJCF string to MuJoCo's VFS (code {added})"
+        )));
+    }
+    load_xml(&name, Some(&vfs))
+}
+
+/// Runs `mj_loadXML` and wraps the result.
+fn load_xml(path: &CStr, vfs: Option<&MjVfs>) -> Result<CompiledModel, CompileError> {
+    let mut buf = vec![0 as c_char; ERROR_BUF_LEN];
+    let vfs_ptr = vfs.map_or(std::ptr::null(), |v| std::ptr::from_ref(v.ffi()));
+    // SAFETY: `path` is NUL-terminated; `vfs_ptr` is null or a live VFS that outlives the
+    // call; `buf` holds `ERROR_BUF_LEN` bytes, which is what MuJoCo is told it may write.
+    let model = unsafe {
+        ffi::mj_loadXML(path.as_ptr(), vfs_ptr, buf.as_mut_ptr(), ERROR_BUF_LEN as c_int)
+    };
+    // MuJoCo NUL-terminates within `error_sz`; the last byte stays 0 in any case.
+    buf[ERROR_BUF_LEN - 1] = 0;
+    // SAFETY: `buf` is NUL-terminated (see above).
+    let text = unsafe { CStr::from_ptr(buf.as_ptr()) }.to_string_lossy().into_owned();
+    match NonNull::new(model) {
+        Some(ptr) => {
+            let text = text.trim_end();
+            let warnings = (!text.is_empty()).then(|| text.to_owned());
+            Ok(CompiledModel { ptr, warnings })
+        }
+        None if text.trim().is_empty() => Err(CompileError::local(
+            "MuJoCo could not compile the model and gave no reason".to_owned(),
+        )),
+        None => Err(CompileError::from_message(text)),
+    }
+}
+
+/// Refuses to call into a MuJoCo other than the one the FFI declarations were made for
+/// (mujoco-rs itself would panic there).
+fn check_version() -> Result<(), CompileError> {
+    static LINKED: OnceLock<c_int> = OnceLock::new();
+    // SAFETY: `mj_version` only returns a constant.
+    let linked = *LINKED.get_or_init(|| unsafe { ffi::mj_version() });
+    if u32::try_from(linked).ok() == Some(ffi::mjVERSION_HEADER) {
+        Ok(())
+    } else {
+        Err(CompileError::local(format!(
+            "linked MuJoCo library has version code {linked}, expected {} (MuJoCo 3.17.0): \
+             run scripts/setup.sh",
+            ffi::mjVERSION_HEADER
+        )))
+    }
+}
+
+fn path_to_cstring(path: &Path) -> Result<CString, CompileError> {
+    #[cfg(unix)]
+    let bytes = {
+        use std::os::unix::ffi::OsStrExt;
+        path.as_os_str().as_bytes().to_vec()
+    };
+    #[cfg(not(unix))]
+    let bytes = match path.to_str() {
+        Some(s) => s.as_bytes().to_vec(),
+        None => {
+            return Err(CompileError::local(format!(
+                "path is not valid Unicode: {}",
+                path.display()
+            )));
+        }
+    };
+    CString::new(bytes).map_err(|_| {
+        CompileError::local(format!("path contains a NUL byte: {}", path.display()))
+    })
+}
+
+/// A model compiled by MuJoCo: owns the `mjModel`, which is freed (`mj_deleteModel`) on
+/// drop. All access is read-only.
+///
+/// `CompiledModel` is `Send`: the `mjModel` is one heap allocation owned by this handle
+/// alone (no other pointer to it escapes, and MuJoCo keeps none), and MuJoCo ties no thread
+/// to a model, so using and freeing it on another thread is fine. It is also `Sync`: every
+/// method takes `&self` and only reads the model (`mj_id2name` included), there is no
+/// interior mutability, and concurrent reads of memory nobody writes are not a data race.
+///
+/// ```no_run
+/// use std::path::Path;
+/// use mjcf_forge::mujoco::{compile_file, ObjType};
+///
+/// let model = compile_file(Path::new("arm.xml")).unwrap();
+/// let sizes = model.sizes();
+/// for (name, pos) in model.names(ObjType::Body).iter().zip(model.body_pos().chunks(3)) {
+///     println!("{name}: {pos:?}");
+/// }
+/// let handle = std::thread::spawn(move || model.sizes()); // Send
+/// assert_eq!(handle.join().unwrap(), sizes);
+/// ```
+pub struct CompiledModel {
+    ptr: NonNull<ffi::mjModel>,
+    warnings: Option<String>,
+}
+
+// SAFETY: see the type's documentation: exclusive ownership of a heap allocation without
+// thread affinity.
+unsafe impl Send for CompiledModel {}
+// SAFETY: see the type's documentation: only reads through `&self`.
+unsafe impl Sync for CompiledModel {}
+
+impl Drop for CompiledModel {
+    fn drop(&mut self) {
+        // SAFETY: `ptr` came from `mj_loadXML`, is owned by `self` alone and freed only here.
+        unsafe { ffi::mj_deleteModel(self.ptr.as_ptr()) }
+    }
+}
+
+impl fmt::Debug for CompiledModel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("CompiledModel")
+            .field("sizes", &self.sizes())
+            .field("warnings", &self.warnings)
+            .finish()
+    }
+}
+
+/// The kinds of named object [`CompiledModel::names`] lists (MuJoCo's `mjtObj`).
+///
+/// ```
+/// use mjcf_forge::mujoco::ObjType;
+///
+/// assert_eq!(ObjType::Geom.as_str(), "geom");
+/// assert_eq!(ObjType::ALL.len(), 14);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ObjType {
+    /// `mjOBJ_BODY` (index 0 is `world`).
+    Body,
+    /// `mjOBJ_JOINT`.
+    Joint,
+    /// `mjOBJ_GEOM`.
+    Geom,
+    /// `mjOBJ_SITE`.
+    Site,
+    /// `mjOBJ_CAMERA`.
+    Camera,
+    /// `mjOBJ_LIGHT`.
+    Light,
+    /// `mjOBJ_MESH`.
+    Mesh,
+    /// `mjOBJ_MATERIAL`.
+    Material,
+    /// `mjOBJ_TEXTURE`.
+    Texture,
+    /// `mjOBJ_TENDON`.
+    Tendon,
+    /// `mjOBJ_ACTUATOR`.
+    Actuator,
+    /// `mjOBJ_SENSOR`.
+    Sensor,
+    /// `mjOBJ_EQUALITY`.
+    Equality,
+    /// `mjOBJ_KEY` (keyframes).
+    Key,
+}
+
+impl ObjType {
+    /// Every variant, in declaration order.
+    pub const ALL: [ObjType; 14] = [
+        ObjType::Body,
+        ObjType::Joint,
+        ObjType::Geom,
+        ObjType::Site,
+        ObjType::Camera,
+        ObjType::Light,
+        ObjType::Mesh,
+        ObjType::Material,
+        ObjType::Texture,
+        ObjType::Tendon,
+        ObjType::Actuator,
+        ObjType::Sensor,
+        ObjType::Equality,
+        ObjType::Key,
+    ];
+
+    /// The MJCF element name of this kind (`"body"`, `"joint"`, ..., `"key"`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ObjType::Body => "body",
+            ObjType::Joint => "joint",
+            ObjType::Geom => "geom",
+            ObjType::Site => "site",
+            ObjType::Camera => "camera",
+            ObjType::Light => "light",
+            ObjType::Mesh => "mesh",
+            ObjType::Material => "material",
+            ObjType::Texture => "texture",
+            ObjType::Tendon => "tendon",
+            ObjType::Actuator => "actuator",
+            ObjType::Sensor => "sensor",
+            ObjType::Equality => "equality",
+            ObjType::Key => "key",
+        }
+    }
+
+    fn to_mjt(self) -> ffi::mjtObj {
+        use ffi::mjtObj::*;
+        match self {
+            ObjType::Body => mjOBJ_BODY,
+            ObjType::Joint => mjOBJ_JOINT,
+            ObjType::Geom => mjOBJ_GEOM,
+            ObjType::Site => mjOBJ_SITE,
+            ObjType::Camera => mjOBJ_CAMERA,
+            ObjType::Light => mjOBJ_LIGHT,
+            ObjType::Mesh => mjOBJ_MESH,
+            ObjType::Material => mjOBJ_MATERIAL,
+            ObjType::Texture => mjOBJ_TEXTURE,
+            ObjType::Tendon => mjOBJ_TENDON,
+            ObjType::Actuator => mjOBJ_ACTUATOR,
+            ObjType::Sensor => mjOBJ_SENSOR,
+            ObjType::Equality => mjOBJ_EQUALITY,
+            ObjType::Key => mjOBJ_KEY,
+        }
+    }
+}
+
+impl fmt::Display for ObjType {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// Defines [`Sizes`] from one list, so the struct, [`Sizes::entries`] and
+/// [`Sizes::to_json`] cannot disagree on fields or order.
+macro_rules! sizes_struct {
+    ($($field:ident: $doc:literal,)*) => {
+        /// Sizes of a compiled model (copied from `mjModel`), e.g. `nbody` counts the world
+        /// body too. [`Sizes::to_json`] writes them as one JSON object with a fixed key order:
+        /// `nbody njnt ngeom nsite nu nsensor nq nv nmesh`, then the rest as declared.
+        ///
+        /// ```no_run
+        /// use std::path::Path;
+        /// use mjcf_forge::mujoco::compile_file;
+        ///
+        /// let sizes = compile_file(Path::new("arm.xml")).unwrap().sizes();
+        /// println!("{} bodies, {} dofs", sizes.nbody, sizes.nv);
+        /// assert!(sizes.to_json().starts_with("{\"nbody\":"));
+        /// ```
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+        pub struct Sizes {
+            $(#[doc = $doc] pub $field: usize,)*
+        }
+
+        impl Sizes {
+            /// Number of fields, i.e. of [`Sizes::entries`].
+            pub const LEN: usize = [$(stringify!($field)),*].len();
+
+            /// `(name, value)` of every field, in [`Sizes::to_json`]'s order.
+            pub fn entries(&self) -> [(&'static str, usize); Self::LEN] {
+                [$((stringify!($field), self.$field)),*]
+            }
+
+            fn from_model(m: &ffi::mjModel) -> Self {
+                Self { $($field: n(m.$field),)* }
+            }
+        }
+    };
+}
+
+sizes_struct! {
+    nbody: "Bodies, including the world body.",
+    njnt: "Joints.",
+    ngeom: "Geoms.",
+    nsite: "Sites.",
+    nu: "Scalar controls (`dim(ctrl)`).",
+    nsensor: "Sensors.",
+    nq: "Generalized coordinates (`dim(qpos)`).",
+    nv: "Degrees of freedom (`dim(qvel)`).",
+    nmesh: "Meshes.",
+    na: "Activation states (`dim(act)`).",
+    nactuator: "Actuators.",
+    ncam: "Cameras.",
+    nlight: "Lights.",
+    ntex: "Textures.",
+    nmat: "Materials.",
+    ntendon: "Tendons.",
+    nwrap: "Tendon wrap objects.",
+    neq: "Equality constraints.",
+    nkey: "Keyframes.",
+    nmocap: "Mocap bodies.",
+    nhfield: "Height fields.",
+    nskin: "Skins.",
+    nflex: "Flexes.",
+    npair: "Predefined geom pairs.",
+    nexclude: "Excluded body pairs.",
+    nnumeric: "Numeric custom fields.",
+    ntext: "Text custom fields.",
+    ntuple: "Tuple custom fields.",
+    nplugin: "Plugin instances.",
+    nsensordata: "Sensor data values (`dim(sensordata)`).",
+    nuser_body: "User numbers per body.",
+    nuser_jnt: "User numbers per joint.",
+    nuser_geom: "User numbers per geom.",
+    nuser_site: "User numbers per site.",
+    nuser_cam: "User numbers per camera.",
+    nuser_tendon: "User numbers per tendon.",
+    nuser_actuator: "User numbers per actuator.",
+    nuser_sensor: "User numbers per sensor.",
+    nnames: "Bytes of the names buffer.",
+}
+
+impl Sizes {
+    /// One JSON object, keys in [`Sizes::entries`] order, no whitespace:
+    /// `{"nbody":2,"njnt":1,...}`.
+    ///
+    /// ```
+    /// use mjcf_forge::mujoco::Sizes;
+    ///
+    /// let sizes = Sizes { nbody: 2, nq: 7, ..Sizes::default() };
+    /// let json = sizes.to_json();
+    /// assert!(json.starts_with(r#"{"nbody":2,"njnt":0,"ngeom":0,"nsite":0,"nu":0,"#));
+    /// assert!(json.contains(r#""nq":7,"nv":0,"nmesh":0,"na":0"#));
+    /// ```
+    pub fn to_json(&self) -> String {
+        let mut out = String::from("{");
+        for (i, (key, value)) in self.entries().iter().enumerate() {
+            if i > 0 {
+                out.push(',');
+            }
+            out.push_str(&format!("\"{key}\":{value}"));
+        }
+        out.push('}');
+        out
+    }
+}
+
+/// Defines read-only slice accessors for `mjModel` arrays: `name: type, |m| length`.
+macro_rules! model_arrays {
+    ($($(#[$doc:meta])* $field:ident: $ty:ty, |$m:ident| $len:expr;)*) => {
+        impl CompiledModel {
+            $(
+                $(#[$doc])*
+                pub fn $field(&self) -> &[$ty] {
+                    let $m = self.raw();
+                    // SAFETY: MuJoCo allocates `$field` with exactly this many elements
+                    // (see mjmodel.h) inside the model, which lives as long as `self` and
+                    // is never written after compilation.
+                    unsafe { slice_or_empty($m.$field, $len) }
+                }
+            )*
+        }
+    };
+}
+
+/// A size field of `mjModel` as `usize` (they are never negative).
+fn n(size: ffi::mjtSize) -> usize {
+    usize::try_from(size).unwrap_or(0)
+}
+
+model_arrays! {
+    /// Body positions relative to the parent body, 3 per body (`nbody x 3`).
+    body_pos: f64, |m| n(m.nbody) * 3;
+    /// Body orientations relative to the parent body, quaternions `w x y z` (`nbody x 4`).
+    body_quat: f64, |m| n(m.nbody) * 4;
+    /// Body masses (`nbody`).
+    body_mass: f64, |m| n(m.nbody);
+    /// Parent body ids (`nbody`; the world body is its own parent).
+    body_parentid: i32, |m| n(m.nbody);
+    /// Joint types (`mjtJoint`: 0 free, 1 ball, 2 slide, 3 hinge) (`njnt`).
+    jnt_type: i32, |m| n(m.njnt);
+    /// Joint axes in the body frame (`njnt x 3`).
+    jnt_axis: f64, |m| n(m.njnt) * 3;
+    /// Joint limits (`njnt x 2`).
+    jnt_range: f64, |m| n(m.njnt) * 2;
+    /// Geom types (`mjtGeom`) (`ngeom`).
+    geom_type: i32, |m| n(m.ngeom);
+    /// Ids of the geoms' bodies (`ngeom`).
+    geom_bodyid: i32, |m| n(m.ngeom);
+    /// Geom size parameters (`ngeom x 3`).
+    geom_size: f64, |m| n(m.ngeom) * 3;
+    /// Geom positions relative to their body (`ngeom x 3`).
+    geom_pos: f64, |m| n(m.ngeom) * 3;
+    /// Geom friction: slide, spin, roll (`ngeom x 3`).
+    geom_friction: f64, |m| n(m.ngeom) * 3;
+    /// Geom colors when no material is set (`ngeom x 4`).
+    geom_rgba: f32, |m| n(m.ngeom) * 4;
+    /// Site positions relative to their body (`nsite x 3`).
+    site_pos: f64, |m| n(m.nsite) * 3;
+    /// Actuator gain parameters, `mjNGAIN` (10) per actuator (`nactuator x 10`).
+    actuator_gainprm: f64, |m| n(m.nactuator) * ffi::mjNGAIN as usize;
+    /// Actuator bias parameters, `mjNBIAS` (10) per actuator (`nactuator x 10`).
+    actuator_biasprm: f64, |m| n(m.nactuator) * ffi::mjNBIAS as usize;
+    /// Default pose (`nq`).
+    qpos0: f64, |m| n(m.nq);
+    /// Keyframe times (`nkey`).
+    key_time: f64, |m| n(m.nkey);
+    /// Keyframe positions (`nkey x nq`).
+    key_qpos: f64, |m| n(m.nkey) * n(m.nq);
+}
+
+/// `len` elements at `ptr`, or an empty slice when `len` is 0 (MuJoCo may leave such
+/// arrays null).
+///
+/// # Safety
+/// When `len > 0`, `ptr` must point to `len` initialized elements that stay valid and
+/// unwritten for `'a`.
+unsafe fn slice_or_empty<'a, T>(ptr: *const T, len: usize) -> &'a [T] {
+    if len == 0 || ptr.is_null() {
+        &[]
+    } else {
+        // SAFETY: guaranteed by the caller.
+        unsafe { std::slice::from_raw_parts(ptr, len) }
+    }
+}
+
+impl CompiledModel {
+    fn raw(&self) -> &ffi::mjModel {
+        // SAFETY: `ptr` is a live model owned by `self` (see `Drop`).
+        unsafe { self.ptr.as_ref() }
+    }
+
+    /// The model's sizes (see [`Sizes`]).
+    ///
+    /// ```no_run
+    /// use std::path::Path;
+    /// use mjcf_forge::mujoco::compile_str;
+    ///
+    /// let m = compile_str("<mujoco><worldbody><body><freejoint/><geom size='1'/></body>\
+    ///                      </worldbody></mujoco>", Path::new(".")).unwrap();
+    /// let s = m.sizes();
+    /// assert_eq!((s.nbody, s.njnt, s.nq, s.nv), (2, 1, 7, 6));
+    /// ```
+    pub fn sizes(&self) -> Sizes {
+        Sizes::from_model(self.raw())
+    }
+
+    /// The names of all objects of kind `obj`, indexed by MuJoCo id (so `names(Body)[0]`
+    /// is `"world"`); unnamed objects give `""`.
+    ///
+    /// ```no_run
+    /// use std::path::Path;
+    /// use mjcf_forge::mujoco::{compile_str, ObjType};
+    ///
+    /// let m = compile_str("<mujoco><worldbody><geom name='floor' type='plane' size='1 1 1'/>\
+    ///                      <geom size='1'/></worldbody></mujoco>", Path::new(".")).unwrap();
+    /// assert_eq!(m.names(ObjType::Geom), ["floor", ""]);
+    /// ```
+    pub fn names(&self, obj: ObjType) -> Vec<String> {
+        let m = self.raw();
+        let count = match obj {
+            ObjType::Body => m.nbody,
+            ObjType::Joint => m.njnt,
+            ObjType::Geom => m.ngeom,
+            ObjType::Site => m.nsite,
+            ObjType::Camera => m.ncam,
+            ObjType::Light => m.nlight,
+            ObjType::Mesh => m.nmesh,
+            ObjType::Material => m.nmat,
+            ObjType::Texture => m.ntex,
+            ObjType::Tendon => m.ntendon,
+            ObjType::Actuator => m.nactuator,
+            ObjType::Sensor => m.nsensor,
+            ObjType::Equality => m.neq,
+            ObjType::Key => m.nkey,
+        };
+        let count = c_int::try_from(count).unwrap_or(0);
+        let kind = obj.to_mjt() as c_int;
+        (0..count)
+            .map(|id| {
+                // SAFETY: the model is live; `id` is in range for `kind`; MuJoCo returns
+                // null or a NUL-terminated string inside the model's names buffer.
+                let name = unsafe { ffi::mj_id2name(self.ptr.as_ptr(), kind, id) };
+                if name.is_null() {
+                    String::new()
+                } else {
+                    // SAFETY: non-null, NUL-terminated, lives as long as the model.
+                    unsafe { CStr::from_ptr(name) }.to_string_lossy().into_owned()
+                }
+            })
+            .collect()
+    }
+
+    /// The compiler's warnings, if any (MuJoCo reports them in the error buffer of a
+    /// successful `mj_loadXML`), one per line.
+    ///
+    /// ```no_run
+    /// use std::path::Path;
+    /// use mjcf_forge::mujoco::compile_file;
+    ///
+    /// let model = compile_file(Path::new("arm.xml")).unwrap();
+    /// if let Some(w) = model.warnings() {
+    ///     eprintln!("MuJoCo warned: {w}");
+    /// }
+    /// ```
+    pub fn warnings(&self) -> Option<&str> {
+        self.warnings.as_deref()
+    }
+
+    /// The raw `mjModel`, read-only, for fields without an accessor here.
+    ///
+    /// ```no_run
+    /// use std::path::Path;
+    /// use mjcf_forge::mujoco::compile_file;
+    ///
+    /// let model = compile_file(Path::new("arm.xml")).unwrap();
+    /// println!("timestep {}", model.ffi().opt.timestep);
+    /// ```
+    pub fn ffi(&self) -> &ffi::mjModel {
+        self.raw()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn line_from_element_messages() {
+        let cases = [
+            ("XML Error: Schema violation: unrecognized attribute: 'sizee'\nElement 'geom', line 5\n", Some(5)),
+            ("Error: unknown transmission target 'nope' for actuator id = 0\nElement name '', id 0, line 9", Some(9)),
+            ("XML parse error 14:\nError=XML_ERROR_MISMATCHED_ELEMENT ErrorID=14 (0xe) Line number=3: XMLElement name=geom\n", Some(3)),
+            ("Error: Error opening file 'does_not_exist.obj'", None),
+            ("XML Error: Unrecognized XML model type: 'foo'", None),
+            ("Error: file 'baseline.xml' missing\nElement 'geom', line x", None),
+        ];
+        for (message, line) in cases {
+            let err = CompileError::from_message(message);
+            assert_eq!(err.element_line, line, "{message:?}");
+            assert_eq!(err.to_string(), message.trim_end());
+        }
+    }
+
+    #[test]
+    fn json_key_order() {
+        let json = Sizes::default().to_json();
+        let keys: Vec<&str> = json
+            .trim_matches(|c| c == '{' || c == '}')
+            .split(',')
+            .map(|kv| kv.split(':').next().unwrap().trim_matches('"'))
+            .collect();
+        assert_eq!(
+            &keys[..9],
+            ["nbody", "njnt", "ngeom", "nsite", "nu", "nsensor", "nq", "nv", "nmesh"]
+        );
+        assert_eq!(keys.len(), Sizes::LEN);
+    }
+}

@@ -1,0 +1,106 @@
+//! The arena: the only module that names `indextree`.
+//!
+//! A document is one `indextree::Arena` of small node payloads plus flat side tables
+//! (attributes, string bytes, source spans) owned by [`crate::Document`]. Cloning a document
+//! is therefore a handful of `Vec` copies, which is what makes template -> variant cheap.
+
+use indextree::{Arena, NodeId};
+
+use crate::names::Sym;
+
+/// A range of bytes in the document's string buffer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct StrRef {
+    pub(crate) start: u32,
+    pub(crate) len: u32,
+}
+
+/// One attribute: an interned name and a value in the string buffer (12 bytes).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Attr {
+    pub(crate) name: Sym,
+    pub(crate) value: StrRef,
+}
+
+/// A run of attributes in the document's flat attribute table.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct AttrRange {
+    pub(crate) start: u32,
+    pub(crate) len: u32,
+}
+
+/// Node payload: kept tiny because it is multiplied by nodes and then by variants.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum NodeData {
+    Element { tag: Sym, attrs: AttrRange },
+    /// Character data that is not just white space; `cdata` keeps `<![CDATA[..]]>` form.
+    Text { text: StrRef, cdata: bool },
+}
+
+/// A handle to one node of a [`crate::Document`]. Cheap to copy; only meaningful for the
+/// document it came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Node(pub(crate) NodeId);
+
+/// The tree of a document.
+#[derive(Clone, Debug)]
+pub(crate) struct Tree {
+    arena: Arena<NodeData>,
+}
+
+impl Tree {
+    pub(crate) fn with_capacity(n: usize) -> Tree {
+        Tree { arena: Arena::with_capacity(n) }
+    }
+
+    pub(crate) fn new_node(&mut self, data: NodeData) -> Node {
+        Node(self.arena.new_node(data))
+    }
+
+    /// Dense index of a node, for side tables (0-based).
+    pub(crate) fn index(node: Node) -> usize {
+        usize::from(node.0) - 1
+    }
+
+    pub(crate) fn data(&self, node: Node) -> &NodeData {
+        self.arena[node.0].get()
+    }
+
+    pub(crate) fn data_mut(&mut self, node: Node) -> &mut NodeData {
+        self.arena[node.0].get_mut()
+    }
+
+    pub(crate) fn append(&mut self, parent: Node, child: Node) {
+        parent.0.append(child.0, &mut self.arena);
+    }
+
+    pub(crate) fn insert_before(&mut self, sibling: Node, new: Node) {
+        sibling.0.insert_before(new.0, &mut self.arena);
+    }
+
+    pub(crate) fn detach(&mut self, node: Node) {
+        node.0.detach(&mut self.arena);
+    }
+
+    pub(crate) fn parent(&self, node: Node) -> Option<Node> {
+        self.arena[node.0].parent().map(Node)
+    }
+
+    pub(crate) fn first_child(&self, node: Node) -> Option<Node> {
+        self.arena[node.0].first_child().map(Node)
+    }
+
+
+    pub(crate) fn children(&self, node: Node) -> impl Iterator<Item = Node> + '_ {
+        node.0.children(&self.arena).map(Node)
+    }
+
+    /// The node and all its descendants in document order.
+    pub(crate) fn descendants(&self, node: Node) -> impl Iterator<Item = Node> + '_ {
+        node.0.descendants(&self.arena).map(Node)
+    }
+
+    pub(crate) fn count(&self) -> usize {
+        self.arena.len()
+    }
+}
