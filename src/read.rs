@@ -33,8 +33,12 @@ struct Builder {
     files: Vec<SourceFile>,
     /// Canonical paths of the files being read, outermost first (for cycles).
     chain: Vec<PathBuf>,
+    /// The same files as the user would name them.
+    chain_display: Vec<PathBuf>,
     /// Canonical paths of every file read so far (MuJoCo includes a file at most once).
     seen: Vec<PathBuf>,
+    /// The main file's folder as the user named it: included files are shown under it.
+    display_dir: PathBuf,
 }
 
 pub(crate) fn read_file(path: &Path) -> Result<Document, Errors> {
@@ -44,18 +48,20 @@ pub(crate) fn read_file(path: &Path) -> Result<Document, Errors> {
     let abs = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
     let dir = abs.parent().map(Path::to_path_buf).unwrap_or_default();
     let canonical = std::fs::canonicalize(path).unwrap_or(abs);
-    read_bytes(&bytes, Arc::from(path), &dir, Some(canonical))
+    let display_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    read_bytes(&bytes, Arc::from(path), &dir, &display_dir, Some(canonical))
 }
 
 pub(crate) fn read_str(xml: &str, base_dir: &Path) -> Result<Document, Errors> {
     let dir = std::path::absolute(base_dir).unwrap_or_else(|_| base_dir.to_path_buf());
-    read_bytes(xml.as_bytes(), Arc::from(Path::new("<string>")), &dir, None)
+    read_bytes(xml.as_bytes(), Arc::from(Path::new("<string>")), &dir, base_dir, None)
 }
 
 fn read_bytes(
     bytes: &[u8],
     name: Arc<Path>,
     dir: &Path,
+    display_dir: &Path,
     canonical: Option<PathBuf>,
 ) -> Result<Document, Errors> {
     let mut tree = Tree::with_capacity(bytes.len() / 40 + 16);
@@ -74,9 +80,11 @@ fn read_bytes(
             names: Names::default(),
             model_dir: Arc::from(dir),
         },
-        files: vec![SourceFile { path: name, included_at: None }],
+        files: vec![SourceFile { path: name.clone(), included_at: None }],
         chain: canonical.iter().cloned().collect(),
+        chain_display: vec![name.to_path_buf()],
         seen: canonical.into_iter().collect(),
+        display_dir: display_dir.to_path_buf(),
     };
     b.doc.spans.push(Span::default());
     b.parse(bytes, 0, None)?;
@@ -117,6 +125,9 @@ impl Builder {
         let mut stack: Vec<Option<Node>> = Vec::new();
         let mut inserted = 0usize;
         let mut seen_root = false;
+        // Character data is gathered across text and entity events, then kept only if it
+        // is more than white space.
+        let mut pending: Option<(Node, String, Span)> = None;
         loop {
             let offset = reader.buffer_position() as usize;
             let event = reader.read_event().map_err(|e| {
@@ -125,6 +136,13 @@ impl Builder {
             })?;
             let (line, col) = lines.line_col(offset);
             let span = Span { file, line, col };
+            if !matches!(event, Event::Text(_) | Event::GeneralRef(_)) {
+                if let Some((host, text, at)) = pending.take() {
+                    if !text.trim().is_empty() {
+                        self.text(host, &text, false, at);
+                    }
+                }
+            }
             let is_empty = matches!(event, Event::Empty(_));
             match event {
                 Event::Start(e) | Event::Empty(e) => {
@@ -198,12 +216,10 @@ impl Builder {
                         let raw = t.decode().map_err(|e| {
                             Error::at(self.loc(file, line, col), ErrorKind::Syntax(e.to_string()))
                         })?;
-                        if !raw.trim().is_empty() {
-                            let text = quick_xml::escape::unescape(&raw).map_err(|e| {
-                                Error::at(self.loc(file, line, col), ErrorKind::Syntax(e.to_string()))
-                            })?;
-                            self.text(*host, &text, false, span);
-                        }
+                        let text = quick_xml::escape::unescape(&raw).map_err(|e| {
+                            Error::at(self.loc(file, line, col), ErrorKind::Syntax(e.to_string()))
+                        })?;
+                        pending.get_or_insert_with(|| (*host, String::new(), span)).1.push_str(&text);
                     }
                 }
                 Event::GeneralRef(r) => {
@@ -213,8 +229,7 @@ impl Builder {
                         let text = quick_xml::escape::unescape(&entity).map_err(|e| {
                             Error::at(self.loc(file, line, col), ErrorKind::Syntax(e.to_string()))
                         })?;
-                        let text = text.into_owned();
-                        self.text(*host, &text, false, span);
+                        pending.get_or_insert_with(|| (*host, String::new(), span)).1.push_str(&text);
                     }
                 }
                 Event::CData(t) => {
@@ -290,8 +305,17 @@ impl Builder {
         let start = self.doc.attrs.len() as u32;
         for attr in e.attributes() {
             let attr = attr.map_err(|err| {
-                let (line, col) = lines.line_col(offset);
-                Error::at(self.loc(span.file, line, col), ErrorKind::Syntax(err.to_string()))
+                use quick_xml::events::attributes::AttrError;
+                // quick-xml counts attribute offsets from the byte after '<'.
+                let (at, msg) = match err {
+                    AttrError::Duplicated(at, _) => (at, "attribute is already defined".to_string()),
+                    AttrError::ExpectedEq(at) => (at, "expected '=' after attribute name".to_string()),
+                    AttrError::ExpectedValue(at) => (at, "expected attribute value".to_string()),
+                    AttrError::UnquotedValue(at) => (at, "attribute value must be quoted".to_string()),
+                    AttrError::ExpectedQuote(at, _) => (at, "unterminated attribute value".to_string()),
+                };
+                let (line, col) = lines.line_col(offset + 1 + at);
+                Error::at(self.loc(span.file, line, col), ErrorKind::Syntax(msg))
             })?;
             let key = std::str::from_utf8(attr.key.as_ref()).map_err(|err| {
                 Error::at(self.loc(span.file, span.line, span.col), ErrorKind::Syntax(err.to_string()))
@@ -326,27 +350,30 @@ impl Builder {
             return Err(Error::at(here, ErrorKind::IncludeWithoutFile).into());
         };
         // MuJoCo resolves every include against the main file's folder, not the including one.
-        let path = self.doc.model_dir.join(&file);
-        let canonical = std::fs::canonicalize(&path).map_err(|err| {
+        let full = self.doc.model_dir.join(&file);
+        let path = self.display_dir.join(&file);
+        let canonical = std::fs::canonicalize(&full).map_err(|err| {
             Error::at(here.clone(), ErrorKind::Io { path: path.clone(), reason: err.to_string() })
         })?;
         if let Some(i) = self.chain.iter().position(|p| *p == canonical) {
-            let mut chain = self.chain[i..].to_vec();
-            chain.push(canonical);
+            let mut chain = self.chain_display[i..].to_vec();
+            chain.push(path);
             return Err(Error::at(here, ErrorKind::IncludeCycle { chain }).into());
         }
         if self.seen.contains(&canonical) {
             return Err(Error::at(here, ErrorKind::IncludedTwice(path)).into());
         }
-        let bytes = std::fs::read(&path).map_err(|err| {
+        let bytes = std::fs::read(&full).map_err(|err| {
             Error::at(here.clone(), ErrorKind::Io { path: path.clone(), reason: err.to_string() })
         })?;
         let index = self.files.len() as u32;
         self.files.push(SourceFile { path: Arc::from(path.as_path()), included_at: Some(span) });
         self.chain.push(canonical.clone());
+        self.chain_display.push(path.clone());
         self.seen.push(canonical);
         let inserted = self.parse(&bytes, index, Some(host))?;
         self.chain.pop();
+        self.chain_display.pop();
         if inserted == 0 {
             return Err(Error::at(here, ErrorKind::EmptyInclude(path)).into());
         }

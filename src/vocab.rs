@@ -20,7 +20,8 @@
 //! under a parent kind. The children of `<default>` are their own kinds
 //! (`default_geom`, ...): the settable rows of each default slot.
 //!
-//! 166 element kinds, 1899 attribute rows: File 12, Id 95, ObjName 21, ObjType 21, Plain 1525, Ref 223, RefList 2.
+//! 166 element kinds, 1899 attribute rows (by kind: File 12, Id 95, ObjName 21, ObjType 21,
+//! Plain 1525, Ref 223, RefList 2).
 
 /// A name namespace of MJCF (the `ns` of `id<ns>` / `ref<ns>` in MuJoCo's schema).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -297,7 +298,8 @@ const fn nd(name: &'static str, kind: AttrKind) -> AttrSpec {
     }
 }
 
-/// Attributes of `accelerometer`, `force`, `gyro`, `magnetometer`, `torque`, `touch`, `velocimeter`.
+/// Attributes of `accelerometer`, `force`, `gyro`, `magnetometer`, `torque`, `touch`,
+/// `velocimeter`.
 const ACCELEROMETER_ATTRS: &[AttrSpec] = &[
     a("name", Id(Ns::Sensor)),
     a("nsample", Plain),
@@ -381,7 +383,8 @@ const ATTACH_ATTRS: &[AttrSpec] = &[
     a("prefix", Plain),
 ];
 
-/// Attributes of `ballangvel`, `ballquat`, `jointactuatorfrc`, `jointlimitfrc`, `jointlimitpos`, `jointlimitvel`, `jointpos`, `jointvel`.
+/// Attributes of `ballangvel`, `ballquat`, `jointactuatorfrc`, `jointlimitfrc`, `jointlimitpos`,
+/// `jointlimitvel`, `jointpos`, `jointvel`.
 const BALLANGVEL_ATTRS: &[AttrSpec] = &[
     a("name", Id(Ns::Sensor)),
     a("nsample", Plain),
@@ -1086,7 +1089,7 @@ const DEFAULT_SITE_ATTRS: &[AttrSpec] = &[
     a("fromto", Plain),
     a("rgba", Plain),
     a("user", Plain),
-    a("mesh", Ref(Ns::Mesh)), // 3.17.0-only (absent from mjcf.schema): mesh asset name ("mesh 'x' not found")
+    a("mesh", Ref(Ns::Mesh)), // 3.17.0-only (absent from mjcf.schema): mesh asset name
 ];
 
 /// Attributes of `default_tendon`.
@@ -1338,7 +1341,7 @@ const FLEXCOMP_ATTRS: &[AttrSpec] = &[
     a("zaxis", Plain),
     a("euler", Plain),
     a("origin", Plain),
-    a("mesh", Ref(Ns::Mesh)), // 3.17.0-only (absent from mjcf.schema): mesh asset name ("mesh 'x' not found")
+    a("mesh", Ref(Ns::Mesh)), // 3.17.0-only (absent from mjcf.schema): mesh asset name
 ];
 
 /// Attributes of `flexcomp_contact`.
@@ -1409,7 +1412,8 @@ const FRAMEANGACC_ATTRS: &[AttrSpec] = &[
     a("objname", ObjName),
 ];
 
-/// Attributes of `frameangvel`, `framelinvel`, `framepos`, `framequat`, `framexaxis`, `frameyaxis`, `framezaxis`.
+/// Attributes of `frameangvel`, `framelinvel`, `framepos`, `framequat`, `framexaxis`,
+/// `frameyaxis`, `framezaxis`.
 const FRAMEANGVEL_ATTRS: &[AttrSpec] = &[
     a("name", Id(Ns::Sensor)),
     a("nsample", Plain),
@@ -2143,7 +2147,7 @@ const SITE_ATTRS: &[AttrSpec] = &[
     a("fromto", Plain),
     a("rgba", Plain),
     a("user", Plain),
-    a("mesh", Ref(Ns::Mesh)), // 3.17.0-only (absent from mjcf.schema): mesh asset name ("mesh 'x' not found")
+    a("mesh", Ref(Ns::Mesh)), // 3.17.0-only (absent from mjcf.schema): mesh asset name
 ];
 
 /// Attributes of `size`.
@@ -2243,7 +2247,8 @@ const TACTILE_ATTRS: &[AttrSpec] = &[
     a("cutoff", Plain), // 3.17.0-only (absent from mjcf.schema)
 ];
 
-/// Attributes of `tendonactuatorfrc`, `tendonlimitfrc`, `tendonlimitpos`, `tendonlimitvel`, `tendonpos`, `tendonvel`.
+/// Attributes of `tendonactuatorfrc`, `tendonlimitfrc`, `tendonlimitpos`, `tendonlimitvel`,
+/// `tendonpos`, `tendonvel`.
 const TENDONACTUATORFRC_ATTRS: &[AttrSpec] = &[
     a("name", Id(Ns::Sensor)),
     a("nsample", Plain),
@@ -2262,6 +2267,7 @@ const TEXT_ATTRS: &[AttrSpec] = &[a("name", Id(Ns::Text)), a("data", Plain)];
 /// Attributes of `texture`.
 const TEXTURE_ATTRS: &[AttrSpec] = &[
     a("name", Id(Ns::Texture)),
+    a("class", Ref(Ns::Default)), // 3.17.0-only (absent from mjcf.schema): default class name
     a("type", Plain),
     a("colorspace", Plain),
     nd("content_type", Plain),
@@ -2285,8 +2291,7 @@ const TEXTURE_ATTRS: &[AttrSpec] = &[
     a("hflip", Plain),
     a("vflip", Plain),
     a("nchannel", Plain),
-    a("class", Ref(Ns::Default)), // 3.17.0-only (absent from mjcf.schema): default class name
-    a("embed", Plain),            // 3.17.0-only (absent from mjcf.schema)
+    a("embed", Plain), // 3.17.0-only (absent from mjcf.schema)
 ];
 
 /// Attributes of `tuple`.
@@ -2452,8 +2457,8 @@ static ELEMENTS: &[ElementSpec] = &[
         attrs: BODY_ATTRS,
         children: &[
             "body",
-            "replicate",
             "frame",
+            "replicate",
             "inertial",
             "joint",
             "freejoint",
@@ -2974,8 +2979,8 @@ static ELEMENTS: &[ElementSpec] = &[
         attrs: FRAME_ATTRS,
         children: &[
             "body",
-            "replicate",
             "frame",
+            "replicate",
             "inertial",
             "joint",
             "freejoint",
@@ -3385,8 +3390,8 @@ static ELEMENTS: &[ElementSpec] = &[
         attrs: REPLICATE_ATTRS,
         children: &[
             "body",
-            "replicate",
             "frame",
+            "replicate",
             "inertial",
             "joint",
             "freejoint",
@@ -3688,8 +3693,8 @@ static ELEMENTS: &[ElementSpec] = &[
         attrs: &[],
         children: &[
             "body",
-            "replicate",
             "frame",
+            "replicate",
             "inertial",
             "joint",
             "freejoint",
