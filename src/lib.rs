@@ -18,12 +18,16 @@
 //! );
 //! # Ok::<(), mjcf_forge::Errors>(())
 //! ```
-#![forbid(unsafe_code)]
+#![cfg_attr(not(feature = "mujoco"), forbid(unsafe_code))]
+// The one FFI module, `mujoco`, opts back in; everything else stays safe.
+#![cfg_attr(feature = "mujoco", deny(unsafe_code))]
 #![warn(missing_docs)]
 
 mod defaults;
 mod document;
 mod error;
+#[cfg(feature = "mujoco")]
+pub mod mujoco;
 mod names;
 mod paths;
 mod read;

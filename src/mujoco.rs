@@ -28,7 +28,7 @@
 //!
 //! # Example
 //!
-//! ```no_run
+//! ```
 //! use std::path::Path;
 //! use mjcf_forge::mujoco::{compile_str, ObjType};
 //!
@@ -39,6 +39,10 @@
 //! assert_eq!(model.sizes().nbody, 2);
 //! assert_eq!(model.names(ObjType::Body), ["world", "ball"]);
 //! ```
+
+// The FFI calls into MuJoCo are confined to this module; the crate root denies unsafe code
+// elsewhere (it must use `deny`, not `forbid`, in builds with this feature).
+#![allow(unsafe_code)]
 
 use std::ffi::{CStr, CString, c_char, c_int};
 use std::fmt;
@@ -63,7 +67,7 @@ const STRING_MODEL_NAME: &str = "__mjcf_forge_string_model__.xml";
 /// one (`"Element 'geom', line 12"`, `"Element name 'a', id 0, line 9"`, or tinyxml2's
 /// `"Line number=3"` for malformed XML). `Display` prints the message alone.
 ///
-/// ```no_run
+/// ```
 /// use std::path::Path;
 /// use mjcf_forge::mujoco::compile_str;
 ///
@@ -94,12 +98,18 @@ impl CompileError {
         let mut message = message.into();
         message.truncate(message.trim_end().len());
         let element_line = parse_line(&message);
-        Self { message, element_line }
+        Self {
+            message,
+            element_line,
+        }
     }
 
     /// An error that did not come from MuJoCo (bad path, version mismatch): no line.
     fn local(message: String) -> Self {
-        Self { message, element_line: None }
+        Self {
+            message,
+            element_line: None,
+        }
     }
 }
 
@@ -128,7 +138,9 @@ fn parse_line(message: &str) -> Option<u32> {
 fn number_after(text: &str, marker: &str) -> Option<u32> {
     text.rmatch_indices(marker).find_map(|(at, _)| {
         let rest = &text[at + marker.len()..];
-        let end = rest.find(|c: char| !c.is_ascii_digit()).unwrap_or(rest.len());
+        let end = rest
+            .find(|c: char| !c.is_ascii_digit())
+            .unwrap_or(rest.len());
         rest[..end].parse().ok()
     })
 }
@@ -177,15 +189,17 @@ pub fn compile_str(xml: &str, dir: &Path) -> Result<CompiledModel, CompileError>
     check_version()?;
     let name = path_to_cstring(&dir.join(STRING_MODEL_NAME))?;
     let len = c_int::try_from(xml.len()).map_err(|_| {
-        CompileError::local(format!("MJCF string too long for MuJoCo ({} bytes)", xml.len()))
+        CompileError::local(format!(
+            "MJCF string too long for MuJoCo ({} bytes)",
+            xml.len()
+        ))
     })?;
     let mut vfs = MjVfs::new();
     // SAFETY: `vfs` is a live VFS made by `mj_defaultVFS` (in `MjVfs::new`); adding a file
     // through MuJoCo's own API keeps its invariants. `name` is NUL-terminated, and MuJoCo
     // copies `len` bytes from `xml` before returning.
-    let added = unsafe {
-        ffi::mj_addBufferVFS(vfs.ffi_mut(), name.as_ptr(), xml.as_ptr().cast(), len)
-    };
+    let added =
+        unsafe { ffi::mj_addBufferVFS(vfs.ffi_mut(), name.as_ptr(), xml.as_ptr().cast(), len) };
     if added != 0 {
         return Err(CompileError::local(format!(
             "could not add the MJCF string to MuJoCo's VFS (code {added})"
@@ -201,12 +215,19 @@ fn load_xml(path: &CStr, vfs: Option<&MjVfs>) -> Result<CompiledModel, CompileEr
     // SAFETY: `path` is NUL-terminated; `vfs_ptr` is null or a live VFS that outlives the
     // call; `buf` holds `ERROR_BUF_LEN` bytes, which is what MuJoCo is told it may write.
     let model = unsafe {
-        ffi::mj_loadXML(path.as_ptr(), vfs_ptr, buf.as_mut_ptr(), ERROR_BUF_LEN as c_int)
+        ffi::mj_loadXML(
+            path.as_ptr(),
+            vfs_ptr,
+            buf.as_mut_ptr(),
+            ERROR_BUF_LEN as c_int,
+        )
     };
     // MuJoCo NUL-terminates within `error_sz`; the last byte stays 0 in any case.
     buf[ERROR_BUF_LEN - 1] = 0;
     // SAFETY: `buf` is NUL-terminated (see above).
-    let text = unsafe { CStr::from_ptr(buf.as_ptr()) }.to_string_lossy().into_owned();
+    let text = unsafe { CStr::from_ptr(buf.as_ptr()) }
+        .to_string_lossy()
+        .into_owned();
     match NonNull::new(model) {
         Some(ptr) => {
             let text = text.trim_end();
@@ -253,9 +274,8 @@ fn path_to_cstring(path: &Path) -> Result<CString, CompileError> {
             )));
         }
     };
-    CString::new(bytes).map_err(|_| {
-        CompileError::local(format!("path contains a NUL byte: {}", path.display()))
-    })
+    CString::new(bytes)
+        .map_err(|_| CompileError::local(format!("path contains a NUL byte: {}", path.display())))
 }
 
 /// A model compiled by MuJoCo: owns the `mjModel`, which is freed (`mj_deleteModel`) on
@@ -603,7 +623,7 @@ impl CompiledModel {
 
     /// The model's sizes (see [`Sizes`]).
     ///
-    /// ```no_run
+    /// ```
     /// use std::path::Path;
     /// use mjcf_forge::mujoco::compile_str;
     ///
@@ -619,7 +639,7 @@ impl CompiledModel {
     /// The names of all objects of kind `obj`, indexed by MuJoCo id (so `names(Body)[0]`
     /// is `"world"`); unnamed objects give `""`.
     ///
-    /// ```no_run
+    /// ```
     /// use std::path::Path;
     /// use mjcf_forge::mujoco::{compile_str, ObjType};
     ///
@@ -656,14 +676,16 @@ impl CompiledModel {
                     String::new()
                 } else {
                     // SAFETY: non-null, NUL-terminated, lives as long as the model.
-                    unsafe { CStr::from_ptr(name) }.to_string_lossy().into_owned()
+                    unsafe { CStr::from_ptr(name) }
+                        .to_string_lossy()
+                        .into_owned()
                 }
             })
             .collect()
     }
 
     /// The compiler's warnings, if any (MuJoCo reports them in the error buffer of a
-    /// successful `mj_loadXML`), one per line.
+    /// successful `mj_loadXML`), joined by newlines as MuJoCo joins them.
     ///
     /// ```no_run
     /// use std::path::Path;
@@ -699,12 +721,24 @@ mod tests {
     #[test]
     fn line_from_element_messages() {
         let cases = [
-            ("XML Error: Schema violation: unrecognized attribute: 'sizee'\nElement 'geom', line 5\n", Some(5)),
-            ("Error: unknown transmission target 'nope' for actuator id = 0\nElement name '', id 0, line 9", Some(9)),
-            ("XML parse error 14:\nError=XML_ERROR_MISMATCHED_ELEMENT ErrorID=14 (0xe) Line number=3: XMLElement name=geom\n", Some(3)),
+            (
+                "XML Error: Schema violation: unrecognized attribute: 'sizee'\nElement 'geom', line 5\n",
+                Some(5),
+            ),
+            (
+                "Error: unknown transmission target 'nope' for actuator id = 0\nElement name '', id 0, line 9",
+                Some(9),
+            ),
+            (
+                "XML parse error 14:\nError=XML_ERROR_MISMATCHED_ELEMENT ErrorID=14 (0xe) Line number=3: XMLElement name=geom\n",
+                Some(3),
+            ),
             ("Error: Error opening file 'does_not_exist.obj'", None),
             ("XML Error: Unrecognized XML model type: 'foo'", None),
-            ("Error: file 'baseline.xml' missing\nElement 'geom', line x", None),
+            (
+                "Error: file 'baseline.xml' missing\nElement 'geom', line x",
+                None,
+            ),
         ];
         for (message, line) in cases {
             let err = CompileError::from_message(message);
@@ -723,7 +757,9 @@ mod tests {
             .collect();
         assert_eq!(
             &keys[..9],
-            ["nbody", "njnt", "ngeom", "nsite", "nu", "nsensor", "nq", "nv", "nmesh"]
+            [
+                "nbody", "njnt", "ngeom", "nsite", "nu", "nsensor", "nq", "nv", "nmesh"
+            ]
         );
         assert_eq!(keys.len(), Sizes::LEN);
     }

@@ -1,0 +1,98 @@
+//! Build script: only does something with the cargo feature `mujoco`.
+//!
+//! With the feature, the crate links MuJoCo's C library through `mujoco-rs`, taking the
+//! library from the PyPI wheel `mujoco==3.17.0` that `scripts/setup.sh` installs into the
+//! repository's `.cache/venv`. The wheel ships the versioned file `libmujoco.so.3.17.0`
+//! only; `.cargo/config.toml` points mujoco-rs (`MUJOCO_DYNAMIC_LINK_DIR`) at a committed
+//! linker script named `libmujoco.so` that redirects `-lmujoco` to that versioned name.
+//! This script:
+//!
+//! 1. finds the wheel's directory (or `MJCF_FORGE_MUJOCO_LIB_DIR` when set),
+//! 2. stops the build with a message naming `scripts/setup.sh` when the library is missing,
+//! 3. puts the directory on the linker's search path, so the linker script resolves, and
+//! 4. embeds it as an rpath in every binary, test and example of this package, so they run
+//!    without `LD_LIBRARY_PATH`.
+//!
+//! Without the feature it prints nothing but its own rerun condition, so the default build
+//! neither needs nor looks for MuJoCo.
+
+use std::env;
+use std::path::{Path, PathBuf};
+
+/// The MuJoCo version that the `mujoco-rs` dependency binds and the wheel provides.
+const MUJOCO_VERSION: &str = "3.17.0";
+
+/// Overrides the directory that holds `libmujoco.so.<MUJOCO_VERSION>`.
+const LIB_DIR_VAR: &str = "MJCF_FORGE_MUJOCO_LIB_DIR";
+
+fn main() {
+    println!("cargo::rerun-if-changed=build.rs");
+    if env::var_os("CARGO_FEATURE_MUJOCO").is_none() {
+        return;
+    }
+    println!("cargo::rerun-if-env-changed={LIB_DIR_VAR}");
+
+    let manifest_dir = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").expect("set by cargo"));
+    let lib_name = format!("libmujoco.so.{MUJOCO_VERSION}");
+    let lib_dir = match env::var_os(LIB_DIR_VAR) {
+        Some(dir) => Some(PathBuf::from(dir)),
+        None => find_wheel_dir(&manifest_dir, &lib_name),
+    };
+    let lib_dir = match lib_dir {
+        Some(dir) if dir.join(&lib_name).is_file() => dir,
+        found => missing_library(&manifest_dir, &lib_name, found.as_deref()),
+    };
+    // An absolute path, so the rpath works from wherever a binary is started.
+    let lib_dir = lib_dir.canonicalize().unwrap_or(lib_dir);
+
+    println!(
+        "cargo::rerun-if-changed={}",
+        lib_dir.join(&lib_name).display()
+    );
+    println!(
+        "cargo::rerun-if-changed={}",
+        manifest_dir
+            .join(".cargo/mujoco-link/libmujoco.so")
+            .display()
+    );
+    println!("cargo::rustc-link-search=native={}", lib_dir.display());
+    let target_os = env::var("CARGO_CFG_TARGET_OS").unwrap_or_default();
+    if target_os != "windows" {
+        println!("cargo::rustc-link-arg=-Wl,-rpath,{}", lib_dir.display());
+    }
+}
+
+/// `<repo>/.cache/venv/lib/python3.*/site-packages/mujoco`, the first that holds the library.
+fn find_wheel_dir(manifest_dir: &Path, lib_name: &str) -> Option<PathBuf> {
+    let venv_lib = manifest_dir.join(".cache/venv/lib");
+    let mut candidates: Vec<PathBuf> = std::fs::read_dir(&venv_lib)
+        .ok()?
+        .filter_map(Result::ok)
+        .filter(|entry| entry.file_name().to_string_lossy().starts_with("python3"))
+        .map(|entry| entry.path().join("site-packages/mujoco"))
+        .collect();
+    candidates.sort();
+    candidates
+        .into_iter()
+        .find(|dir| dir.join(lib_name).is_file())
+}
+
+fn missing_library(manifest_dir: &Path, lib_name: &str, looked_in: Option<&Path>) -> ! {
+    let looked_in = looked_in.map_or_else(
+        || {
+            manifest_dir
+                .join(".cache/venv/lib/python3.*/site-packages/mujoco")
+                .display()
+                .to_string()
+        },
+        |dir| dir.display().to_string(),
+    );
+    eprintln!(
+        "\nerror: the cargo feature `mujoco` needs MuJoCo {MUJOCO_VERSION}'s C library, and {lib_name} \
+         was not found in {looked_in}.\n\
+         Run `scripts/setup.sh` in the repository root: it installs the PyPI wheel \
+         mujoco=={MUJOCO_VERSION} into .cache/venv, which ships the library.\n\
+         (Or set {LIB_DIR_VAR} to a directory that holds {lib_name}.)\n"
+    );
+    std::process::exit(1);
+}
