@@ -35,6 +35,7 @@ mod read;
 mod schema;
 mod skin;
 mod tree;
+mod validate;
 pub mod vocab;
 mod write;
 
