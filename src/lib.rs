@@ -26,8 +26,11 @@
 mod defaults;
 mod document;
 mod error;
+pub mod geometry;
 #[cfg(feature = "mujoco")]
 pub mod mujoco;
+mod merge;
+mod model;
 mod names;
 mod paths;
 mod prefix;
@@ -40,6 +43,8 @@ pub mod vocab;
 mod write;
 
 pub use document::{Document, Section};
+pub use merge::{MergeOptions, MergeReport};
+pub use model::{MujocoModel, XmlModel, XmlModelOptions};
 pub use error::{Error, ErrorKind, Errors, Location};
 pub use tree::Node;
 pub use write::write_atomic;

@@ -32,7 +32,7 @@ impl Document {
     /// let errors = doc.validate().unwrap_err();
     /// assert_eq!(errors.0.len(), 2);
     /// assert_eq!(errors.0[0].to_string(), "<string>:1:36: duplicate body name 'a' (first at <string>:1:20)");
-    /// assert_eq!(errors.0[1].to_string(), "<string>:2:25: 'joint' names no joint 'nope'");
+    /// assert_eq!(errors.0[1].to_string(), "<string>:2:18: 'joint' names no joint 'nope'");
     /// # Ok::<(), mjcf_forge::Errors>(())
     /// ```
     pub fn validate(&self) -> Result<(), Errors> {

@@ -1,0 +1,913 @@
+//! Merging models into one scene without changing any part's physics.
+//!
+//! A part's `<worldbody>` children go to the base's worldbody or into a named body of the
+//! base (their poses then relative to it); every other section is carried over. Assets with
+//! the same tag, name and content become one; the same name with other content is an error
+//! naming both. Parts written with other `compiler` settings are converted to the base's
+//! (angle units, Euler sequence, automatic limits) or refused where no exact conversion
+//! exists. `option`, `size`, `visual` and `statistic` come from the base (conflicts are
+//! warnings). Keyframes are remapped onto the merged model's joints, actuators and mocap
+//! bodies, each part's values landing on its own objects and everything else taking its
+//! default; keys of the same name can be fused into one.
+
+use ahash::AHashMap;
+
+use crate::document::{Document, Section, SourceFile};
+use crate::error::{Error, ErrorKind, Errors};
+use crate::geometry::{self, Angles};
+use crate::tree::{Attr, Node, NodeData, Tree};
+
+/// How to merge.
+#[derive(Clone, Debug, Default)]
+pub struct MergeOptions {
+    /// Fuse each part key named `part_prefix + N` into the base key named `N` (say, every
+    /// part's "home" pose into the scene's "home" key), instead of keeping it separate.
+    pub fuse_keys: bool,
+    /// The prefix the part's names carry (used to match keys when fusing).
+    pub part_prefix: String,
+}
+
+/// What a merge did besides merging: the settings of the part that the base overrode.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct MergeReport {
+    /// One line per ignored or adjusted setting, with its position in the part.
+    pub warnings: Vec<String>,
+    /// How many of the part's assets were already in the base (same tag, name, content).
+    pub shared_assets: usize,
+}
+
+/// Compiler attributes that change the compiled model and have no exact conversion: a
+/// part must agree with the base on them (value if absent, as MuJoCo's defaults).
+const MUST_AGREE: [(&str, &str); 12] = [
+    ("boundmass", "0"),
+    ("boundinertia", "0"),
+    ("settotalmass", "-1"),
+    ("balanceinertia", "false"),
+    ("fitaabb", "false"),
+    ("fusestatic", "false"),
+    ("discardvisual", "false"),
+    ("inertiafromgeom", "auto"),
+    ("inertiagrouprange", "0 5"),
+    ("alignfree", "false"),
+    ("saveinertial", "false"),
+    ("coordinate", "local"),
+];
+
+/// The effective value of each `compiler` attribute (later elements win).
+fn compiler_settings(doc: &Document) -> AHashMap<String, (String, Node)> {
+    let mut out = AHashMap::new();
+    for c in doc.elements(doc.root).filter(|&n| doc.tag(n) == "compiler") {
+        for (k, v) in doc.attrs(c) {
+            out.insert(k.to_string(), (v.trim().to_string(), c));
+        }
+    }
+    out
+}
+
+fn same_value(a: &str, b: &str) -> bool {
+    let ta: Vec<&str> = a.split_ascii_whitespace().collect();
+    let tb: Vec<&str> = b.split_ascii_whitespace().collect();
+    ta.len() == tb.len()
+        && ta.iter().zip(&tb).all(|(x, y)| match (x.parse::<f64>(), y.parse::<f64>()) {
+            (Ok(p), Ok(q)) => p == q,
+            _ => x == y,
+        })
+}
+
+fn fmt_num(x: f64) -> String {
+    format!("{x}")
+}
+
+/// How a joint sits in `qpos`/`qvel`.
+fn joint_widths(doc: &Document, joint: Node) -> (usize, usize) {
+    if doc.tag(joint) == "freejoint" {
+        return (7, 6);
+    }
+    match doc.attr(joint, "type").map(str::trim).unwrap_or("hinge") {
+        "free" => (7, 6),
+        "ball" => (4, 3),
+        _ => (1, 1),
+    }
+}
+
+/// How many activation states an actuator has.
+fn actuator_states(doc: &Document, act: Node) -> Result<usize, String> {
+    if let Some(d) = doc.attr(act, "actdim") {
+        let n: i64 = d.trim().parse().map_err(|_| format!("bad actdim '{d}'"))?;
+        if n >= 0 {
+            return Ok(n as usize);
+        }
+    }
+    Ok(match doc.tag(act) {
+        "general" => match doc.attr(act, "dyntype").map(str::trim).unwrap_or("none") {
+            "none" => 0,
+            _ => 1,
+        },
+        "position" => {
+            let tc = doc.attr(act, "timeconst").and_then(|t| t.trim().parse::<f64>().ok()).unwrap_or(0.0);
+            usize::from(tc > 0.0)
+        }
+        "intvelocity" | "cylinder" | "muscle" => 1,
+        "motor" | "velocity" | "damper" | "adhesion" => 0,
+        other => return Err(format!("activation size of <{other}> actuators is not known")),
+    })
+}
+
+/// The layout of a model's state vectors: joints (qpos/qvel), actuators (ctrl/act) and
+/// mocap bodies (mpos/mquat), in MuJoCo's order.
+#[derive(Default)]
+struct Layout {
+    joints: Vec<Node>,
+    actuators: Vec<Node>,
+    mocap: Vec<Node>,
+    /// Why the layout cannot be known (elements that expand into objects at compile time).
+    opaque: Option<(Node, String)>,
+}
+
+impl Layout {
+    fn of(doc: &Document) -> Layout {
+        let mut l = Layout::default();
+        if let Some(world) = doc.find_section(Section::Worldbody) {
+            l.visit_body(doc, world);
+        }
+        if let Some(acts) = doc.find_section(Section::Actuator) {
+            l.actuators = doc.elements(acts).collect();
+        }
+        l
+    }
+
+    /// MuJoCo numbers bodies depth first in document order; a body's joints (its own and
+    /// those in its frames) come before the joints of its child bodies.
+    fn visit_body(&mut self, doc: &Document, body: Node) {
+        if doc.attr(body, "mocap").map(str::trim) == Some("true") {
+            self.mocap.push(body);
+        }
+        let mut children = Vec::new();
+        self.collect(doc, body, &mut children);
+        for c in children {
+            self.visit_body(doc, c);
+        }
+    }
+
+    fn collect(&mut self, doc: &Document, node: Node, bodies: &mut Vec<Node>) {
+        for k in doc.elements(node) {
+            match doc.tag(k) {
+                "joint" | "freejoint" => self.joints.push(k),
+                "body" => bodies.push(k),
+                "frame" => self.collect(doc, k, bodies),
+                t @ ("replicate" | "composite" | "flexcomp" | "attach") => {
+                    if self.opaque.is_none() {
+                        self.opaque = Some((k, format!("<{t}> creates objects at compile time")));
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+}
+
+/// One keyframe: its element and its vectors as written (number tokens kept as text).
+struct Key {
+    node: Node,
+    name: Option<String>,
+    vectors: [Option<Vec<String>>; 6],
+}
+
+const KEY_VECTORS: [&str; 6] = ["qpos", "qvel", "act", "ctrl", "mpos", "mquat"];
+
+fn keys_of(doc: &Document) -> Vec<Key> {
+    let Some(section) = doc.find_section(Section::Keyframe) else {
+        return Vec::new();
+    };
+    doc.elements(section)
+        .filter(|&k| doc.tag(k) == "key")
+        .map(|k| Key {
+            node: k,
+            name: doc.attr(k, "name").map(str::to_string),
+            vectors: KEY_VECTORS.map(|v| {
+                doc.attr(k, v).map(|s| s.split_ascii_whitespace().map(str::to_string).collect())
+            }),
+        })
+        .collect()
+}
+
+impl Document {
+    /// Merges `part` into this document (see the module documentation): into the world
+    /// body, or into the body named `into`. On error nothing changes and every problem found
+    /// is reported.
+    ///
+    /// ```
+    /// use mjcf_forge::{Document, MergeOptions};
+    /// let mut arm = Document::from_str(
+    ///     r#"<mujoco><worldbody><body name="hand"><joint name="wrist"/><geom size="0.1"/></body></worldbody></mujoco>"#,
+    ///     ".",
+    /// )?;
+    /// let mut gripper = Document::from_str(
+    ///     r#"<mujoco><worldbody><body name="finger"><joint name="slide" type="slide"/><geom size="0.01"/></body></worldbody></mujoco>"#,
+    ///     ".",
+    /// )?;
+    /// gripper.apply_prefix("g0_")?;
+    /// arm.merge(&gripper, Some("hand"), &MergeOptions::default())?;
+    /// assert!(arm.to_xml_string().contains(r#"<body name="hand"><joint name="wrist"/><geom size="0.1"/><body name="g0_finger">"#));
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn merge(
+        &mut self,
+        part: &Document,
+        into: Option<&str>,
+        options: &MergeOptions,
+    ) -> Result<MergeReport, Errors> {
+        let mut merged = self.clone();
+        let report = merged.merge_in_place(part, into, options)?;
+        merged.validate()?;
+        *self = merged;
+        Ok(report)
+    }
+
+    fn merge_in_place(
+        &mut self,
+        part: &Document,
+        into: Option<&str>,
+        options: &MergeOptions,
+    ) -> Result<MergeReport, Errors> {
+        let mut report = MergeReport::default();
+        let mut errors: Vec<Error> = Vec::new();
+        let mut part = part.clone();
+        self.convert_compiler(&mut part, &mut errors);
+        if !errors.is_empty() {
+            return Err(Errors(errors));
+        }
+
+        // Keyframes are remapped from the layouts before the merge.
+        let base_layout = Layout::of(self);
+        let part_layout = Layout::of(&part);
+        let base_keys = keys_of(self);
+        let part_keys = keys_of(&part);
+
+        let target = match into {
+            None => self.section(Section::Worldbody),
+            Some(name) => match self.find_body(name) {
+                Some(b) => b,
+                None => {
+                    return Err(Error::at(
+                        self.location(self.root),
+                        ErrorKind::Invalid(format!("merge target body '{name}' is not in the base model")),
+                    )
+                    .into());
+                }
+            },
+        };
+
+        let file_offset = self.adopt_files(&part);
+        let mut map: AHashMap<Node, Node> = AHashMap::new();
+        let top: Vec<Node> = part.elements(part.root).collect();
+        for section in top {
+            let tag = part.tag(section).to_string();
+            match tag.as_str() {
+                "compiler" => {}
+                "option" | "size" | "visual" | "statistic" => {
+                    self.settings_from_part(&part, section, &mut report);
+                }
+                "default" => self.merge_residual_defaults(&part, section, file_offset, &mut errors),
+                "asset" => {
+                    let dest = self.section(Section::Asset);
+                    for a in part.elements(section).collect::<Vec<_>>() {
+                        match self.find_same_asset(&part, a) {
+                            Some(Ok(_)) => report.shared_assets += 1,
+                            Some(Err(e)) => errors.push(e),
+                            None => {
+                                let n = self.import(&part, a, file_offset, &mut map);
+                                self.tree.append(dest, n);
+                            }
+                        }
+                    }
+                }
+                "worldbody" => {
+                    for child in part.elements(section).collect::<Vec<_>>() {
+                        if into.is_some() && part.has_free_joint(child) {
+                            errors.push(part.error_at(
+                                child,
+                                ErrorKind::Invalid(format!(
+                                    "<{}> has a free joint: it can only be merged into the world body, not into '{}'",
+                                    part.tag(child),
+                                    into.unwrap_or_default()
+                                )),
+                            ));
+                            continue;
+                        }
+                        let n = self.import(&part, child, file_offset, &mut map);
+                        self.tree.append(target, n);
+                    }
+                }
+                "keyframe" => {}
+                other => {
+                    let dest = match Section::from_tag(other) {
+                        Some(s) => self.section(s),
+                        None => {
+                            let n = self.import(&part, section, file_offset, &mut map);
+                            self.tree.append(self.root, n);
+                            continue;
+                        }
+                    };
+                    for child in part.elements(section).collect::<Vec<_>>() {
+                        let n = self.import(&part, child, file_offset, &mut map);
+                        self.tree.append(dest, n);
+                    }
+                }
+            }
+        }
+        if !errors.is_empty() {
+            return Err(Errors(errors));
+        }
+        if !base_keys.is_empty() || !part_keys.is_empty() {
+            self.remap_keys(&base_layout, &base_keys, &part, &part_layout, &part_keys, &map, options)?;
+        }
+        Ok(report)
+    }
+
+    /// The body named `name` anywhere in the kinematic tree.
+    pub fn find_body(&self, name: &str) -> Option<Node> {
+        let world = self.find_section(Section::Worldbody)?;
+        self.descendants(world).find(|&n| self.tag(n) == "body" && self.attr(n, "name") == Some(name))
+    }
+
+    fn has_free_joint(&self, node: Node) -> bool {
+        self.descendants(node).any(|n| {
+            self.tag(n) == "freejoint"
+                || (self.tag(n) == "joint" && self.attr(n, "type").map(str::trim) == Some("free"))
+        })
+    }
+
+    /// Appends the part's file table to ours; returns the offset of its first file.
+    fn adopt_files(&mut self, part: &Document) -> u32 {
+        let offset = self.files.len() as u32;
+        let files = std::sync::Arc::make_mut(&mut self.files);
+        for f in part.files.iter() {
+            let mut f: SourceFile = f.clone();
+            if let Some(s) = &mut f.included_at {
+                s.file += offset;
+            }
+            files.push(f);
+        }
+        offset
+    }
+
+    /// Copies a subtree of another document into this arena (detached); records the node map.
+    fn import(&mut self, other: &Document, node: Node, file_offset: u32, map: &mut AHashMap<Node, Node>) -> Node {
+        let new = match *other.tree.data(node) {
+            NodeData::Element { tag, .. } => {
+                let tag = self.intern(other.sym_name(tag));
+                let n = self.tree.new_node(NodeData::Element { tag, attrs: Default::default() });
+                let attrs: Vec<Attr> = other
+                    .attr_slice(node)
+                    .iter()
+                    .map(|a| Attr { name: self.names.intern(other.sym_name(a.name)), value: self.push_str(other.str(a.value)) })
+                    .collect();
+                self.replace_attrs(n, &attrs);
+                n
+            }
+            NodeData::Text { text, cdata } => {
+                let text = self.push_str(other.str(text));
+                self.tree.new_node(NodeData::Text { text, cdata })
+            }
+        };
+        let mut span = other.spans[Tree::index(node)];
+        span.file += file_offset;
+        self.set_span(new, span);
+        map.insert(node, new);
+        let kids: Vec<Node> = other.tree.children(node).collect();
+        for k in kids {
+            let c = self.import(other, k, file_offset, map);
+            self.tree.append(new, c);
+        }
+        new
+    }
+}
+
+impl Document {
+    /// Brings `part` to this document's compiler settings, or reports why it cannot be.
+    fn convert_compiler(&self, part: &mut Document, errors: &mut Vec<Error>) {
+        let base = compiler_settings(self);
+        let theirs = compiler_settings(part);
+        let value = |m: &AHashMap<String, (String, Node)>, k: &str, d: &str| {
+            m.get(k).map(|(v, _)| v.clone()).unwrap_or_else(|| d.to_string())
+        };
+        for (attr, default) in MUST_AGREE {
+            let (b, p) = (value(&base, attr, default), value(&theirs, attr, default));
+            if !same_value(&b, &p) {
+                let at = theirs.get(attr).map(|(_, n)| *n).unwrap_or(part.root);
+                errors.push(part.error_at(
+                    at,
+                    ErrorKind::Invalid(format!(
+                        "cannot merge: compiler {attr}=\"{p}\" differs from the base's \"{b}\" and has no exact conversion"
+                    )),
+                ));
+            }
+        }
+        if !errors.is_empty() {
+            return;
+        }
+        let (base_angles, part_angles) = match (Angles::of(self), Angles::of(part)) {
+            (Ok(b), Ok(p)) => (b, p),
+            (Err(e), _) => return errors.push(self.error_at(self.root, ErrorKind::Invalid(e))),
+            (_, Err(e)) => return errors.push(part.error_at(part.root, ErrorKind::Invalid(e))),
+        };
+        if base_angles.seq != part_angles.seq {
+            part.rewrite_euler_as_quat(&part_angles);
+        }
+        if base_angles.degrees != part_angles.degrees {
+            part.convert_angles(part_angles.degrees, base_angles.degrees);
+        }
+        let (ba, pa) = (value(&base, "autolimits", "true"), value(&theirs, "autolimits", "true"));
+        if ba != pa {
+            part.make_limits_explicit(pa == "true");
+        }
+    }
+
+    /// Every `euler` becomes the `quat` it means under `angles` (for a base with another
+    /// Euler sequence).
+    fn rewrite_euler_as_quat(&mut self, angles: &Angles) {
+        let nodes: Vec<Node> = self.descendants(self.root).filter(|&n| self.attr(n, "euler").is_some()).collect();
+        for n in nodes {
+            let e: Vec<f64> = self.attr(n, "euler").unwrap_or_default().split_ascii_whitespace().filter_map(|t| t.parse().ok()).collect();
+            if e.len() != 3 || self.tag(n) == "replicate" {
+                continue;
+            }
+            let q = geometry::euler_to_quat([e[0], e[1], e[2]], angles);
+            self.remove_attr(n, "euler");
+            self.set_attr(n, "quat", &q.map(fmt_num).join(" "));
+        }
+    }
+
+    /// Converts every angle-valued attribute between degrees and radians: Euler angles, the
+    /// angle of `axisangle`, and hinge/ball joint `range`, `ref`, `springref` (the ones
+    /// MuJoCo's `compiler angle` applies to).
+    fn convert_angles(&mut self, from_degrees: bool, to_degrees: bool) {
+        if from_degrees == to_degrees {
+            return;
+        }
+        let factor = if from_degrees { std::f64::consts::PI / 180.0 } else { 180.0 / std::f64::consts::PI };
+        let convert = |v: &str, which: &dyn Fn(usize) -> bool| -> String {
+            v.split_ascii_whitespace()
+                .enumerate()
+                .map(|(i, t)| match t.parse::<f64>() {
+                    Ok(x) if which(i) => fmt_num(x * factor),
+                    _ => t.to_string(),
+                })
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
+        let nodes: Vec<Node> = self.descendants(self.root).collect();
+        for n in nodes {
+            let tag = self.tag(n).to_string();
+            let mut edits: Vec<(&str, String)> = Vec::new();
+            if let Some(v) = self.attr(n, "euler") {
+                edits.push(("euler", convert(v, &|_| true)));
+            }
+            if let Some(v) = self.attr(n, "axisangle") {
+                edits.push(("axisangle", convert(v, &|i| i == 3)));
+            }
+            let in_body = self.parent(n).is_some_and(|p| matches!(self.tag(p), "body" | "frame" | "replicate" | "worldbody"));
+            if tag == "joint" && in_body {
+                let ty = self.attr(n, "type").map(str::trim).unwrap_or("hinge");
+                if ty == "hinge" || ty == "ball" {
+                    for a in ["range", "ref", "springref"] {
+                        if ty == "ball" && a != "range" {
+                            continue;
+                        }
+                        if let Some(v) = self.attr(n, a) {
+                            edits.push((a, convert(v, &|_| true)));
+                        }
+                    }
+                }
+            }
+            for (a, v) in edits {
+                self.set_attr(n, a, &v);
+            }
+        }
+    }
+
+    /// Writes `limited`-style flags explicitly where a range is given without one, with the
+    /// meaning they had under `autolimits` (for a base with the other setting).
+    fn make_limits_explicit(&mut self, autolimits: bool) {
+        const PAIRS: [(&str, &str); 5] = [
+            ("range", "limited"),
+            ("ctrlrange", "ctrllimited"),
+            ("forcerange", "forcelimited"),
+            ("actrange", "actlimited"),
+            ("actuatorfrcrange", "actuatorfrclimited"),
+        ];
+        let value = if autolimits { "true" } else { "false" };
+        let nodes: Vec<Node> = self.descendants(self.root).collect();
+        for n in nodes {
+            if !matches!(self.tag(n), "joint" | "spatial" | "fixed") && self.parent(n).is_none_or(|p| self.tag(p) != "actuator") {
+                continue;
+            }
+            for (range, flag) in PAIRS {
+                if self.attr(n, range).is_some() && self.attr(n, flag).is_none() {
+                    self.set_attr(n, flag, value);
+                }
+            }
+        }
+    }
+
+    /// `option`/`size`/`visual`/`statistic` of a part: the base's values win; every part
+    /// setting the base does not share is reported. `size` user-data widths take the larger.
+    fn settings_from_part(&mut self, part: &Document, section: Node, report: &mut MergeReport) {
+        let tag = part.tag(section).to_string();
+        let base = self.elements(self.root).find(|&n| self.tag(n) == tag);
+        let mut items: Vec<(Node, Option<Node>)> = vec![(section, base)];
+        while let Some((p, b)) = items.pop() {
+            for (k, v) in part.attrs(p) {
+                let bv = b.and_then(|b| self.attr(b, k)).map(str::to_string);
+                if tag == "size" && k.starts_with("nuser_") {
+                    let pv: i64 = v.trim().parse().unwrap_or(-1);
+                    let cur: i64 = bv.as_deref().and_then(|x| x.trim().parse().ok()).unwrap_or(-1);
+                    if pv > cur {
+                        let b = match b {
+                            Some(b) => b,
+                            None => {
+                                let n = self.append_element(self.root, "size", &[]);
+                                items.retain(|_| true);
+                                n
+                            }
+                        };
+                        self.set_attr(b, k, v);
+                        report.warnings.push(format!(
+                            "{}: <size {k}=\"{v}\"> of the part is used (the larger user-data width)",
+                            part.location(p)
+                        ));
+                    }
+                    continue;
+                }
+                if bv.as_deref().is_some_and(|bv| same_value(bv, v)) {
+                    continue;
+                }
+                report.warnings.push(format!(
+                    "{}: the part's <{} {k}=\"{v}\"> is ignored: the base's {} wins",
+                    part.location(p),
+                    part.tag(p),
+                    bv.map(|x| format!("\"{x}\"")).unwrap_or_else(|| "value (MuJoCo's default)".into())
+                ));
+            }
+            for pk in part.elements(p) {
+                let t = part.tag(pk);
+                let bk = b.and_then(|b| self.elements(b).find(|&x| self.tag(x) == t));
+                items.push((pk, bk));
+            }
+        }
+    }
+
+    /// Residual default classes of a part (see `defaults`): the same name must mean the same.
+    fn merge_residual_defaults(&mut self, part: &Document, section: Node, file_offset: u32, errors: &mut Vec<Error>) {
+        let existing = self.elements(self.root).find(|&n| self.tag(n) == "default");
+        let dest = match existing {
+            Some(d) => d,
+            None => {
+                let sym = self.intern("default");
+                let d = self.new_element(sym, None);
+                match self.tree.first_child(self.root) {
+                    Some(f) => self.tree.insert_before(f, d),
+                    None => self.tree.append(self.root, d),
+                }
+                d
+            }
+        };
+        let mut map = AHashMap::new();
+        for class in part.elements(section).collect::<Vec<_>>() {
+            let name = part.attr(class, "class").unwrap_or_default().to_string();
+            let existing = self.elements(dest).find(|&c| self.attr(c, "class") == Some(name.as_str()));
+            match existing {
+                Some(c) if self.same_subtree(c, part, class) => {}
+                Some(c) => errors.push(part.error_at(
+                    class,
+                    ErrorKind::Invalid(format!("default class '{name}' differs from the base's at {}", self.location(c))),
+                )),
+                None => {
+                    let n = self.import(part, class, file_offset, &mut map);
+                    self.tree.append(dest, n);
+                }
+            }
+        }
+    }
+
+    /// Whether two elements (here and in `other`) have the same tag, attributes (in any
+    /// order) and children.
+    fn same_subtree(&self, a: Node, other: &Document, b: Node) -> bool {
+        if self.tag(a) != other.tag(b) || self.text(a) != other.text(b) {
+            return false;
+        }
+        let mut x: Vec<(&str, &str)> = self.attrs(a).collect();
+        let mut y: Vec<(&str, &str)> = other.attrs(b).collect();
+        x.sort_unstable();
+        y.sort_unstable();
+        if x != y {
+            return false;
+        }
+        let ka: Vec<Node> = self.children(a).collect();
+        let kb: Vec<Node> = other.children(b).collect();
+        ka.len() == kb.len() && ka.iter().zip(&kb).all(|(&p, &q)| self.same_subtree(p, other, q))
+    }
+
+    /// The base asset with the part asset's tag and name: `Ok` when the content is the same,
+    /// an error naming both when it is not, `None` when there is none.
+    fn find_same_asset(&self, part: &Document, asset: Node) -> Option<Result<Node, Error>> {
+        let tag = part.tag(asset);
+        let name_of = |d: &Document, n: Node| -> Option<String> {
+            d.attr(n, "name").map(str::to_string).or_else(|| {
+                d.attr(n, "file").and_then(|f| crate::prefix::name_from_file(d.tag(n), f))
+            })
+        };
+        let name = name_of(part, asset)?;
+        let assets = self.find_section(Section::Asset)?;
+        let same = self.elements(assets).find(|&n| self.tag(n) == tag && name_of(self, n).as_deref() == Some(&name))?;
+        if self.same_subtree(same, part, asset) {
+            Some(Ok(same))
+        } else {
+            Some(Err(part.error_at(
+                asset,
+                ErrorKind::Invalid(format!(
+                    "asset <{tag}> '{name}' differs from the base's <{tag}> '{name}' at {}",
+                    self.location(same)
+                )),
+            )))
+        }
+    }
+}
+
+/// Which document a state-vector item came from, and its index in that document's layout.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Origin {
+    Base(usize),
+    Part(usize),
+}
+
+/// Offsets of each item in a document's state vectors.
+struct Offsets {
+    qpos: Vec<(usize, usize)>,
+    qvel: Vec<(usize, usize)>,
+    act: Vec<(usize, usize)>,
+    ctrl: Vec<(usize, usize)>,
+    mpos: Vec<(usize, usize)>,
+    mquat: Vec<(usize, usize)>,
+}
+
+impl Offsets {
+    fn of(doc: &Document, layout: &Layout, need_act: bool) -> Result<Offsets, String> {
+        let run = |widths: Vec<usize>| -> Vec<(usize, usize)> {
+            let mut at = 0;
+            widths
+                .into_iter()
+                .map(|w| {
+                    let r = (at, w);
+                    at += w;
+                    r
+                })
+                .collect()
+        };
+        let jw: Vec<(usize, usize)> = layout.joints.iter().map(|&j| joint_widths(doc, j)).collect();
+        let act = if need_act {
+            layout.actuators.iter().map(|&a| actuator_states(doc, a)).collect::<Result<Vec<_>, _>>()?
+        } else {
+            vec![0; layout.actuators.len()]
+        };
+        Ok(Offsets {
+            qpos: run(jw.iter().map(|w| w.0).collect()),
+            qvel: run(jw.iter().map(|w| w.1).collect()),
+            act: run(act),
+            ctrl: run(vec![1; layout.actuators.len()]),
+            mpos: run(vec![3; layout.mocap.len()]),
+            mquat: run(vec![4; layout.mocap.len()]),
+        })
+    }
+
+    fn vector(&self, v: usize) -> &[(usize, usize)] {
+        match v {
+            0 => &self.qpos,
+            1 => &self.qvel,
+            2 => &self.act,
+            3 => &self.ctrl,
+            4 => &self.mpos,
+            _ => &self.mquat,
+        }
+    }
+
+    fn len(&self, v: usize) -> usize {
+        self.vector(v).last().map(|(a, w)| a + w).unwrap_or(0)
+    }
+}
+
+impl Document {
+    /// The world pose of a body as written (through enclosing frames), quaternion normalized.
+    fn written_world_pose(&self, body: Node, angles: &Angles) -> Result<([f64; 3], [f64; 4]), String> {
+        let mut chain = vec![body];
+        let mut p = self.parent(body);
+        while let Some(n) = p {
+            match self.tag(n) {
+                "frame" => chain.push(n),
+                "worldbody" => break,
+                other => return Err(format!("a free or mocap body inside <{other}>")),
+            }
+            p = self.parent(n);
+        }
+        let mut world = geometry::Pose::default();
+        for &n in chain.iter().rev() {
+            world = world.compose(&geometry::element_pose(self, n, angles)?);
+        }
+        let q = world.quat;
+        let norm = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+        Ok((world.pos, q.map(|x| x / norm)))
+    }
+
+    /// What a state-vector item holds when no key gives it: `qpos0` for joints (the joint's
+    /// `ref`, the unit quaternion, or a free body's written pose), zero velocities, controls
+    /// and activations, and a mocap body's written pose.
+    fn default_tokens(&self, v: usize, item: Node, width: usize, angles: &Angles) -> Result<Vec<String>, String> {
+        let zeros = || vec!["0".to_string(); width];
+        match v {
+            0 => {
+                let (w, _) = joint_widths(self, item);
+                match w {
+                    7 => {
+                        let body = self.parent(item).ok_or("joint without a body")?;
+                        let (p, q) = self.written_world_pose(body, angles)?;
+                        Ok(p.iter().chain(q.iter()).map(|&x| fmt_num(x)).collect())
+                    }
+                    4 => Ok(["1", "0", "0", "0"].map(String::from).to_vec()),
+                    _ => {
+                        let r: f64 = self.attr(item, "ref").and_then(|r| r.trim().parse().ok()).unwrap_or(0.0);
+                        let hinge = self.attr(item, "type").map(str::trim).unwrap_or("hinge") == "hinge";
+                        let r = if hinge && angles.degrees { r * std::f64::consts::PI / 180.0 } else { r };
+                        Ok(vec![fmt_num(r)])
+                    }
+                }
+            }
+            4 | 5 => {
+                let (p, q) = self.written_world_pose(item, angles)?;
+                Ok(if v == 4 { p.iter().map(|&x| fmt_num(x)).collect() } else { q.iter().map(|&x| fmt_num(x)).collect() })
+            }
+            _ => Ok(zeros()),
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn remap_keys(
+        &mut self,
+        base_layout: &Layout,
+        base_keys: &[Key],
+        part: &Document,
+        part_layout: &Layout,
+        part_keys: &[Key],
+        map: &AHashMap<Node, Node>,
+        options: &MergeOptions,
+    ) -> Result<(), Errors> {
+        for (doc, layout) in [(&*self, base_layout), (part, part_layout)] {
+            if let Some((n, why)) = &layout.opaque {
+                return Err(doc
+                    .error_at(*n, ErrorKind::Invalid(format!("cannot remap keyframes: {why}")))
+                    .into());
+            }
+        }
+        let need_act = base_keys.iter().chain(part_keys).any(|k| k.vectors[2].is_some());
+        let located = |doc: &Document, n: Node, e: String| -> Errors { doc.error_at(n, ErrorKind::Invalid(e)).into() };
+        let base_off = Offsets::of(self, base_layout, need_act).map_err(|e| located(self, self.root, e))?;
+        let part_off = Offsets::of(part, part_layout, need_act).map_err(|e| located(part, part.root, e))?;
+        // Keys must fit their own model, as MuJoCo requires.
+        let mut errors = Vec::new();
+        for (doc, keys, off) in [(&*self, base_keys, &base_off), (part, part_keys, &part_off)] {
+            for k in keys {
+                for (v, vec) in k.vectors.iter().enumerate() {
+                    if let Some(vec) = vec {
+                        if vec.len() != off.len(v) {
+                            errors.push(doc.error_at(
+                                k.node,
+                                ErrorKind::Invalid(format!(
+                                    "key {} has {} values, the model needs {}",
+                                    KEY_VECTORS[v],
+                                    vec.len(),
+                                    off.len(v)
+                                )),
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+        if !errors.is_empty() {
+            return Err(Errors(errors));
+        }
+
+        // Where each item of the merged model comes from.
+        let merged = Layout::of(self);
+        let angles = Angles::of(self).map_err(|e| located(self, self.root, e))?;
+        let mut from_part: AHashMap<Node, usize> = AHashMap::new();
+        let mut from_base: AHashMap<Node, usize> = AHashMap::new();
+        for items in [&part_layout.joints, &part_layout.actuators, &part_layout.mocap] {
+            for (j, n) in items.iter().enumerate() {
+                if let Some(&m) = map.get(n) {
+                    from_part.insert(m, j);
+                }
+            }
+        }
+        for items in [&base_layout.joints, &base_layout.actuators, &base_layout.mocap] {
+            for (j, n) in items.iter().enumerate() {
+                from_base.insert(*n, j);
+            }
+        }
+        let origin = |n: Node| -> Option<Origin> {
+            from_base.get(&n).map(|&i| Origin::Base(i)).or_else(|| from_part.get(&n).map(|&i| Origin::Part(i)))
+        };
+
+        // Which keys become one: each base key, with the part key fused into it if asked.
+        let mut groups: Vec<(Option<&Key>, Option<&Key>)> = base_keys.iter().map(|k| (Some(k), None)).collect();
+        for pk in part_keys {
+            let fused = options.fuse_keys
+                && pk.name.as_deref().is_some_and(|n| {
+                    let stripped = n.strip_prefix(options.part_prefix.as_str()).unwrap_or(n);
+                    groups.iter().any(|(b, p)| p.is_none() && b.and_then(|b| b.name.as_deref()) == Some(stripped))
+                });
+            if fused {
+                let n = pk.name.as_deref().unwrap_or_default();
+                let stripped = n.strip_prefix(options.part_prefix.as_str()).unwrap_or(n);
+                if let Some(g) = groups
+                    .iter_mut()
+                    .find(|(b, p)| p.is_none() && b.and_then(|b| b.name.as_deref()) == Some(stripped))
+                {
+                    g.1 = Some(pk);
+                }
+            } else {
+                groups.push((None, Some(pk)));
+            }
+        }
+
+        let mut new_keys: Vec<Vec<(String, String)>> = Vec::new();
+        for (bk, pk) in &groups {
+            let mut attrs: Vec<(String, String)> = Vec::new();
+            let first = bk.or(*pk).expect("a group has a key");
+            let first_doc: &Document = if bk.is_some() { self } else { part };
+            for (k, v) in first_doc.attrs(first.node) {
+                if !KEY_VECTORS.contains(&k) {
+                    attrs.push((k.to_string(), v.to_string()));
+                }
+            }
+            for v in 0..6 {
+                if bk.and_then(|k| k.vectors[v].as_ref()).is_none() && pk.and_then(|k| k.vectors[v].as_ref()).is_none() {
+                    continue;
+                }
+                let items: &[Node] = match v {
+                    0 | 1 => &merged.joints,
+                    2 | 3 => &merged.actuators,
+                    _ => &merged.mocap,
+                };
+                let mut tokens: Vec<String> = Vec::new();
+                for &item in items {
+                    let given = match origin(item) {
+                        Some(Origin::Base(i)) => bk.and_then(|k| k.vectors[v].as_ref()).map(|vec| {
+                            let (at, w) = base_off.vector(v)[i];
+                            vec[at..at + w].to_vec()
+                        }),
+                        Some(Origin::Part(i)) => pk.and_then(|k| k.vectors[v].as_ref()).map(|vec| {
+                            let (at, w) = part_off.vector(v)[i];
+                            vec[at..at + w].to_vec()
+                        }),
+                        None => None,
+                    };
+                    match given {
+                        Some(t) => tokens.extend(t),
+                        None => {
+                            let width = match v {
+                                0 => joint_widths(self, item).0,
+                                1 => joint_widths(self, item).1,
+                                2 => actuator_states(self, item).map_err(|e| located(self, item, e))?,
+                                3 => 1,
+                                4 => 3,
+                                _ => 4,
+                            };
+                            let d = self.default_tokens(v, item, width, &angles).map_err(|e| located(self, item, e))?;
+                            tokens.extend(d);
+                        }
+                    }
+                }
+                attrs.push((KEY_VECTORS[v].to_string(), tokens.join(" ")));
+            }
+            new_keys.push(attrs);
+        }
+
+        // Replace the keys: the base's in place of the old ones, the part's after them.
+        let section = self.section(Section::Keyframe);
+        let origins: Vec<Option<Node>> = groups.iter().map(|(b, _)| b.map(|k| k.node)).collect();
+        let old: Vec<Node> = self.elements(section).filter(|&k| self.tag(k) == "key").collect();
+        for (attrs, base_node) in new_keys.iter().zip(origins) {
+            let refs: Vec<(&str, &str)> = attrs.iter().map(|(k, v)| (k.as_str(), v.as_str())).collect();
+            let key = self.append_element(section, "key", &refs);
+            if let Some(b) = base_node {
+                let span = self.spans[Tree::index(b)];
+                self.set_span(key, span);
+            }
+        }
+        for k in old {
+            self.remove(k);
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,520 @@
+//! The model tier: one instance of a model in a scene, with its own name prefix and the
+//! semantic lists robot-learning code asks for (robosuite's `MujocoModel` vocabulary).
+
+use std::collections::BTreeMap;
+use std::sync::OnceLock;
+
+use crate::document::{Document, Section};
+use crate::error::{Error, ErrorKind, Errors};
+use crate::geometry;
+use crate::merge::{MergeOptions, MergeReport};
+use crate::tree::Node;
+use crate::vocab::Ns;
+
+/// What a model in a scene offers: its names, its parts sorted by role, and where it sits.
+/// Names returned by the list methods carry the model's prefix.
+pub trait MujocoModel {
+    /// The model's name.
+    fn name(&self) -> &str;
+    /// The prefix every name of this instance carries.
+    fn naming_prefix(&self) -> &str;
+    /// Whether `name` (of namespace `ns`) stays without prefix.
+    fn exclude_from_prefixing(&self, ns: Ns, name: &str) -> bool {
+        let _ = (ns, name);
+        false
+    }
+    /// A raw name as it appears in this instance: prefixed unless excluded or empty.
+    fn correct_naming(&self, name: &str) -> String {
+        if name.is_empty() || self.exclude_from_prefixing(Ns::Body, name) {
+            name.to_string()
+        } else {
+            format!("{}{name}", self.naming_prefix())
+        }
+    }
+    /// [`MujocoModel::correct_naming`] of each name of a list.
+    fn correct_naming_list(&self, names: &[&str]) -> Vec<String> {
+        names.iter().map(|n| self.correct_naming(n)).collect()
+    }
+    /// [`MujocoModel::correct_naming`] of each value of a map.
+    fn correct_naming_map(&self, names: &BTreeMap<String, String>) -> BTreeMap<String, String> {
+        names.iter().map(|(k, v)| (k.clone(), self.correct_naming(v))).collect()
+    }
+    /// The one top-level body.
+    fn root_body(&self) -> &str;
+    /// Every named body, the root first.
+    fn bodies(&self) -> &[String];
+    /// Every named joint (free joints included).
+    fn joints(&self) -> &[String];
+    /// Every named actuator.
+    fn actuators(&self) -> &[String];
+    /// Every named site of the kinematic tree.
+    fn sites(&self) -> &[String];
+    /// Every named sensor.
+    fn sensors(&self) -> &[String];
+    /// Collision geoms: group 0 (MuJoCo's default group).
+    fn contact_geoms(&self) -> &[String];
+    /// Visual geoms: group 1.
+    fn visual_geoms(&self) -> &[String];
+    /// Geoms that matter to a task, by role.
+    fn important_geoms(&self) -> &BTreeMap<String, Vec<String>>;
+    /// Sites that matter to a task, by role.
+    fn important_sites(&self) -> &BTreeMap<String, String>;
+    /// Sensors that matter to a task, by role.
+    fn important_sensors(&self) -> &BTreeMap<String, String>;
+    /// The root body's position in its parent.
+    fn base_offset(&self) -> [f64; 3];
+    /// From the root body's origin down to the model's lowest point, in the root's frame.
+    fn bottom_offset(&self) -> [f64; 3];
+    /// From the root body's origin up to the model's highest point, in the root's frame.
+    fn top_offset(&self) -> [f64; 3];
+    /// The largest horizontal distance of the model's geometry from the root's z axis.
+    fn horizontal_radius(&self) -> f64;
+}
+
+/// How to make an [`XmlModel`].
+#[derive(Clone, Debug)]
+pub struct XmlModelOptions {
+    /// The model's name; by default the `model` attribute, else the root body's name.
+    pub name: Option<String>,
+    /// Colour for collision geoms (group 0); their material is dropped. `None` leaves them.
+    pub contact_geom_rgba: Option<[f64; 4]>,
+    /// Give unnamed geoms of group 0 and 1 the names `g{n}_col` and `g{n}_vis`.
+    pub name_unnamed_geoms: bool,
+    /// Names that stay without prefix, in any namespace.
+    pub exclude_from_prefixing: Vec<String>,
+}
+
+impl Default for XmlModelOptions {
+    /// robosuite's choices: collision geoms drawn in its robot collision colour, unnamed
+    /// geoms named.
+    fn default() -> XmlModelOptions {
+        XmlModelOptions {
+            name: None,
+            contact_geom_rgba: Some([0.0, 0.5, 0.0, 1.0]),
+            name_unnamed_geoms: true,
+            exclude_from_prefixing: Vec::new(),
+        }
+    }
+}
+
+/// Offsets of a model, computed from its geometry or set by hand.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Offsets {
+    base: [f64; 3],
+    bottom: [f64; 3],
+    top: [f64; 3],
+    horizontal_radius: f64,
+}
+
+/// One instance of an MJCF model (robosuite's `MujocoXMLModel`): the document with every
+/// name prefixed `{idn}_`, and its parts sorted into the [`MujocoModel`] lists.
+///
+/// ```
+/// use mjcf_forge::{Document, MujocoModel, XmlModel, XmlModelOptions};
+/// let doc = Document::from_str(
+///     r#"<mujoco model="cube"><worldbody><body name="cube" pos="0 0 0.5">
+///          <freejoint name="free"/><geom type="box" size="0.1 0.1 0.1"/>
+///          <geom type="box" size="0.1 0.1 0.1" group="1" contype="0" conaffinity="0"/>
+///        </body></worldbody></mujoco>"#,
+///     ".",
+/// )?;
+/// let cube = XmlModel::new(doc, 3)?;
+/// assert_eq!(cube.naming_prefix(), "3_");
+/// assert_eq!(cube.root_body(), "3_cube");
+/// assert_eq!(cube.joints(), ["3_free"]);
+/// assert_eq!(cube.contact_geoms(), ["3_g0_col"]);
+/// assert_eq!(cube.visual_geoms(), ["3_g0_vis"]);
+/// assert!((cube.bottom_offset()[2] + 0.1).abs() < 1e-12);
+/// assert!((cube.horizontal_radius() - 0.02f64.sqrt()).abs() < 1e-12);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct XmlModel {
+    doc: Document,
+    name: String,
+    prefix: String,
+    exclude: Vec<String>,
+    root_body: String,
+    bodies: Vec<String>,
+    joints: Vec<String>,
+    actuators: Vec<String>,
+    sites: Vec<String>,
+    sensors: Vec<String>,
+    contact_geoms: Vec<String>,
+    visual_geoms: Vec<String>,
+    important_geoms: BTreeMap<String, Vec<String>>,
+    important_sites: BTreeMap<String, String>,
+    important_sensors: BTreeMap<String, String>,
+    /// Computed on first use (meshes are read from disk), unless set by hand.
+    offsets: OnceLock<Result<Offsets, String>>,
+}
+
+fn group_of(doc: &Document, geom: Node) -> i64 {
+    doc.attr(geom, "group").and_then(|g| g.trim().parse().ok()).unwrap_or(0)
+}
+
+impl XmlModel {
+    /// An instance with robosuite's default options (see [`XmlModelOptions`]).
+    pub fn new(doc: Document, idn: impl std::fmt::Display) -> Result<XmlModel, Errors> {
+        XmlModel::with_options(doc, idn, XmlModelOptions::default())
+    }
+
+    /// An instance named with prefix `{idn}_`. Errors: not exactly one top-level body.
+    pub fn with_options(
+        mut doc: Document,
+        idn: impl std::fmt::Display,
+        options: XmlModelOptions,
+    ) -> Result<XmlModel, Errors> {
+        let prefix = format!("{idn}_");
+        let world = doc.section(Section::Worldbody);
+        let roots: Vec<Node> = doc.elements(world).filter(|&n| doc.tag(n) == "body").collect();
+        if roots.len() != 1 {
+            return Err(Error::at(
+                doc.location(world),
+                ErrorKind::Invalid(format!("expected exactly one top-level body in <worldbody>, found {}", roots.len())),
+            )
+            .into());
+        }
+        // Body geoms (the ones MuJoCo lets carry a name), in document order.
+        let geoms: Vec<Node> = doc.descendants(world).filter(|&n| doc.tag(n) == "geom" && doc.is_body_child(n)).collect();
+        if options.name_unnamed_geoms {
+            let (mut col, mut vis) = (0, 0);
+            for &g in &geoms {
+                if doc.attr(g, "name").is_some() {
+                    continue;
+                }
+                match group_of(&doc, g) {
+                    0 => {
+                        doc.set_attr(g, "name", &format!("g{col}_col"));
+                        col += 1;
+                    }
+                    1 => {
+                        doc.set_attr(g, "name", &format!("g{vis}_vis"));
+                        vis += 1;
+                    }
+                    _ => {}
+                }
+            }
+        }
+        if let Some(rgba) = options.contact_geom_rgba {
+            let rgba = rgba.map(|x| format!("{x}")).join(" ");
+            for &g in &geoms {
+                if group_of(&doc, g) == 0 {
+                    doc.set_attr(g, "rgba", &rgba);
+                    doc.remove_attr(g, "material");
+                }
+            }
+        }
+        let exclude = options.exclude_from_prefixing.clone();
+        doc.apply_prefix_except(&prefix, |_, name| exclude.iter().any(|e| e == name))?;
+
+        let named = |doc: &Document, nodes: &mut dyn Iterator<Item = Node>| -> Vec<String> {
+            nodes.filter_map(|n| doc.attr(n, "name").map(str::to_string)).collect()
+        };
+        let world = doc.section(Section::Worldbody);
+        let root = doc.elements(world).find(|&n| doc.tag(n) == "body").expect("root body");
+        let bodies = named(&doc, &mut doc.descendants(root).filter(|&n| doc.tag(n) == "body"));
+        let joints = named(
+            &doc,
+            &mut doc.descendants(world).filter(|&n| matches!(doc.tag(n), "joint" | "freejoint") && doc.is_body_child(n)),
+        );
+        let sites = named(&doc, &mut doc.descendants(world).filter(|&n| doc.tag(n) == "site" && doc.is_body_child(n)));
+        let actuators = match doc.find_section(Section::Actuator) {
+            Some(s) => named(&doc, &mut doc.elements(s)),
+            None => Vec::new(),
+        };
+        let sensors = match doc.find_section(Section::Sensor) {
+            Some(s) => named(&doc, &mut doc.elements(s)),
+            None => Vec::new(),
+        };
+        let contact_geoms = named(&doc, &mut geoms.iter().copied().filter(|&g| group_of(&doc, g) == 0));
+        let visual_geoms = named(&doc, &mut geoms.iter().copied().filter(|&g| group_of(&doc, g) == 1));
+        let root_body = doc.attr(root, "name").unwrap_or_default().to_string();
+        let name = options
+            .name
+            .clone()
+            .or_else(|| doc.model_name().map(str::to_string))
+            .unwrap_or_else(|| root_body.clone());
+        Ok(XmlModel {
+            doc,
+            name,
+            prefix,
+            exclude: options.exclude_from_prefixing,
+            root_body,
+            bodies,
+            joints,
+            actuators,
+            sites,
+            sensors,
+            contact_geoms,
+            visual_geoms,
+            important_geoms: BTreeMap::new(),
+            important_sites: BTreeMap::new(),
+            important_sensors: BTreeMap::new(),
+            offsets: OnceLock::new(),
+        })
+    }
+
+    /// The instance's document (names prefixed).
+    pub fn document(&self) -> &Document {
+        &self.doc
+    }
+
+    /// The instance's document, for changes.
+    pub fn document_mut(&mut self) -> &mut Document {
+        &mut self.doc
+    }
+
+    /// The instance's document, taken out.
+    pub fn into_document(self) -> Document {
+        self.doc
+    }
+
+    /// Sets the important geoms by role, with raw (unprefixed) names.
+    pub fn set_important_geoms(&mut self, geoms: BTreeMap<String, Vec<String>>) {
+        self.important_geoms = geoms
+            .into_iter()
+            .map(|(k, v)| (k, v.iter().map(|n| self.correct_naming(n)).collect()))
+            .collect();
+    }
+
+    /// Sets the important sites by role, with raw (unprefixed) names.
+    pub fn set_important_sites(&mut self, sites: BTreeMap<String, String>) {
+        self.important_sites = self.correct_naming_map(&sites);
+    }
+
+    /// Sets the important sensors by role, with raw (unprefixed) names.
+    pub fn set_important_sensors(&mut self, sensors: BTreeMap<String, String>) {
+        self.important_sensors = self.correct_naming_map(&sensors);
+    }
+
+    /// The offsets from the model's geometry (computed once, on first use): the root body's
+    /// position, and the bounds of every geom below it in the root's frame with the tree as
+    /// written (primitives exactly, meshes from their vertices; planes and height fields
+    /// left out). An unreadable mesh file is the error.
+    pub fn try_offsets(&self) -> Result<([f64; 3], [f64; 3], [f64; 3], f64), String> {
+        let o = self.offsets.get_or_init(|| self.compute_offsets()).clone()?;
+        Ok((o.base, o.bottom, o.top, o.horizontal_radius))
+    }
+
+    fn compute_offsets(&self) -> Result<Offsets, String> {
+        let doc = &self.doc;
+        let world = doc.find_section(Section::Worldbody).ok_or("no worldbody")?;
+        let root = doc.elements(world).find(|&n| doc.tag(n) == "body").ok_or("no root body")?;
+        let angles = geometry::Angles::of(doc)?;
+        let base = geometry::element_pose(doc, root, &angles)?.pos;
+        let bounds = geometry::subtree_bounds(doc, root, |_, _| true)?;
+        let finite = bounds.min.iter().chain(&bounds.max).all(|x| x.is_finite());
+        Ok(Offsets {
+            base,
+            bottom: [0.0, 0.0, if finite { bounds.min[2] } else { 0.0 }],
+            top: [0.0, 0.0, if finite { bounds.max[2] } else { 0.0 }],
+            horizontal_radius: if finite { bounds.horizontal_radius } else { 0.0 },
+        })
+    }
+
+    fn offsets_mut(&mut self) -> &mut Offsets {
+        if self.offsets.get().is_none_or(|o| o.is_err()) {
+            let computed = self.compute_offsets().unwrap_or_default();
+            self.offsets = OnceLock::from(Ok(computed));
+        }
+        self.offsets.get_mut().and_then(|o| o.as_mut().ok()).expect("offsets set above")
+    }
+
+    /// Overrides the computed bottom offset.
+    pub fn set_bottom_offset(&mut self, offset: [f64; 3]) {
+        self.offsets_mut().bottom = offset;
+    }
+
+    /// Overrides the computed top offset.
+    pub fn set_top_offset(&mut self, offset: [f64; 3]) {
+        self.offsets_mut().top = offset;
+    }
+
+    /// Overrides the computed horizontal radius.
+    pub fn set_horizontal_radius(&mut self, radius: f64) {
+        self.offsets_mut().horizontal_radius = radius;
+    }
+
+    /// Overrides the base offset.
+    pub fn set_base_offset(&mut self, offset: [f64; 3]) {
+        self.offsets_mut().base = offset;
+    }
+
+    /// Merges another instance into this one: into the world body, or into this model's
+    /// body named `into` (a full, prefixed name). Lists grow by the other's.
+    pub fn merge(&mut self, other: &XmlModel, into: Option<&str>, fuse_keys: bool) -> Result<MergeReport, Errors> {
+        let options = MergeOptions { fuse_keys, part_prefix: other.prefix.clone() };
+        let report = self.doc.merge(&other.doc, into, &options)?;
+        // The model's extent changed with the merge.
+        self.offsets = OnceLock::new();
+        self.bodies.extend(other.bodies.iter().cloned());
+        self.joints.extend(other.joints.iter().cloned());
+        self.actuators.extend(other.actuators.iter().cloned());
+        self.sites.extend(other.sites.iter().cloned());
+        self.sensors.extend(other.sensors.iter().cloned());
+        self.contact_geoms.extend(other.contact_geoms.iter().cloned());
+        self.visual_geoms.extend(other.visual_geoms.iter().cloned());
+        Ok(report)
+    }
+}
+
+impl Document {
+    /// Whether an element sits in the kinematic tree as a body's own child (through frames),
+    /// not inside a tendon, composite or default.
+    pub(crate) fn is_body_child(&self, node: Node) -> bool {
+        let mut p = self.parent(node);
+        while let Some(n) = p {
+            match self.tag(n) {
+                "body" | "worldbody" => return true,
+                "frame" => p = self.parent(n),
+                _ => return false,
+            }
+        }
+        false
+    }
+}
+
+impl MujocoModel for XmlModel {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn naming_prefix(&self) -> &str {
+        &self.prefix
+    }
+    fn exclude_from_prefixing(&self, _ns: Ns, name: &str) -> bool {
+        self.exclude.iter().any(|e| e == name)
+    }
+    fn root_body(&self) -> &str {
+        &self.root_body
+    }
+    fn bodies(&self) -> &[String] {
+        &self.bodies
+    }
+    fn joints(&self) -> &[String] {
+        &self.joints
+    }
+    fn actuators(&self) -> &[String] {
+        &self.actuators
+    }
+    fn sites(&self) -> &[String] {
+        &self.sites
+    }
+    fn sensors(&self) -> &[String] {
+        &self.sensors
+    }
+    fn contact_geoms(&self) -> &[String] {
+        &self.contact_geoms
+    }
+    fn visual_geoms(&self) -> &[String] {
+        &self.visual_geoms
+    }
+    fn important_geoms(&self) -> &BTreeMap<String, Vec<String>> {
+        &self.important_geoms
+    }
+    fn important_sites(&self) -> &BTreeMap<String, String> {
+        &self.important_sites
+    }
+    fn important_sensors(&self) -> &BTreeMap<String, String> {
+        &self.important_sensors
+    }
+    /// NaN when the geometry cannot be read (see [`XmlModel::try_offsets`]).
+    fn base_offset(&self) -> [f64; 3] {
+        self.try_offsets().map(|o| o.0).unwrap_or([f64::NAN; 3])
+    }
+    /// NaN when the geometry cannot be read (see [`XmlModel::try_offsets`]).
+    fn bottom_offset(&self) -> [f64; 3] {
+        self.try_offsets().map(|o| o.1).unwrap_or([f64::NAN; 3])
+    }
+    /// NaN when the geometry cannot be read (see [`XmlModel::try_offsets`]).
+    fn top_offset(&self) -> [f64; 3] {
+        self.try_offsets().map(|o| o.2).unwrap_or([f64::NAN; 3])
+    }
+    /// NaN when the geometry cannot be read (see [`XmlModel::try_offsets`]).
+    fn horizontal_radius(&self) -> f64 {
+        self.try_offsets().map(|o| o.3).unwrap_or(f64::NAN)
+    }
+}
+
+/// A JSON string literal.
+fn json_str(s: &str) -> String {
+    let mut out = String::with_capacity(s.len() + 2);
+    out.push('"');
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            '\n' => out.push_str("\\n"),
+            '\t' => out.push_str("\\t"),
+            '\r' => out.push_str("\\r"),
+            c if (c as u32) < 0x20 => out.push_str(&format!("\\u{:04x}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
+fn json_list(v: &[String]) -> String {
+    format!("[{}]", v.iter().map(|s| json_str(s)).collect::<Vec<_>>().join(", "))
+}
+
+fn json_num(x: f64) -> String {
+    if x.is_finite() { format!("{x}") } else { "null".to_string() }
+}
+
+fn json_vec3(v: [f64; 3]) -> String {
+    format!("[{}, {}, {}]", json_num(v[0]), json_num(v[1]), json_num(v[2]))
+}
+
+impl XmlModel {
+    /// Everything [`MujocoModel`] tells, as one JSON object (keys in a fixed order).
+    ///
+    /// ```
+    /// use mjcf_forge::{Document, XmlModel};
+    /// let doc = Document::from_str(r#"<mujoco><worldbody><body name="b"><geom size="1"/></body></worldbody></mujoco>"#, ".")?;
+    /// let json = XmlModel::new(doc, 0)?.info_json();
+    /// assert!(json.starts_with(r#"{"name": "0_b", "naming_prefix": "0_", "root_body": "0_b""#));
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn info_json(&self) -> String {
+        let maps = |m: &BTreeMap<String, String>| {
+            format!(
+                "{{{}}}",
+                m.iter().map(|(k, v)| format!("{}: {}", json_str(k), json_str(v))).collect::<Vec<_>>().join(", ")
+            )
+        };
+        let geoms = format!(
+            "{{{}}}",
+            self.important_geoms
+                .iter()
+                .map(|(k, v)| format!("{}: {}", json_str(k), json_list(v)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+        let offsets = self.try_offsets();
+        let error = match &offsets {
+            Ok(_) => String::new(),
+            Err(e) => format!(", \"geometry_error\": {}", json_str(e)),
+        };
+        format!(
+            "{{\"name\": {}, \"naming_prefix\": {}, \"root_body\": {}, \"bodies\": {}, \"joints\": {}, \"actuators\": {}, \"sites\": {}, \"sensors\": {}, \"contact_geoms\": {}, \"visual_geoms\": {}, \"important_geoms\": {geoms}, \"important_sites\": {}, \"important_sensors\": {}, \"base_offset\": {}, \"bottom_offset\": {}, \"top_offset\": {}, \"horizontal_radius\": {}{error}}}",
+            json_str(&self.name),
+            json_str(&self.prefix),
+            json_str(&self.root_body),
+            json_list(&self.bodies),
+            json_list(&self.joints),
+            json_list(&self.actuators),
+            json_list(&self.sites),
+            json_list(&self.sensors),
+            json_list(&self.contact_geoms),
+            json_list(&self.visual_geoms),
+            maps(&self.important_sites),
+            maps(&self.important_sensors),
+            json_vec3(self.base_offset()),
+            json_vec3(self.bottom_offset()),
+            json_vec3(self.top_offset()),
+            json_num(self.horizontal_radius()),
+        )
+    }
+}
