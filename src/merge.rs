@@ -74,8 +74,11 @@ fn same_value(a: &str, b: &str) -> bool {
         })
 }
 
-fn fmt_num(x: f64) -> String {
-    format!("{x}")
+/// The shortest text that reads back as `x` (plain or with an exponent).
+pub(crate) fn fmt_num(x: f64) -> String {
+    let plain = format!("{x}");
+    let exp = format!("{x:e}");
+    if exp.len() < plain.len() { exp } else { plain }
 }
 
 /// How a joint sits in `qpos`/`qvel`.
@@ -392,7 +395,14 @@ impl Document {
         let value = |m: &AHashMap<String, (String, Node)>, k: &str, d: &str| {
             m.get(k).map(|(v, _)| v.clone()).unwrap_or_else(|| d.to_string())
         };
+        // inertiafromgeom "true" ignores <inertial>; under the base's "auto" the same model is
+        // the part without its <inertial> elements.
+        let (bi, pi) = (value(&base, "inertiafromgeom", "auto"), value(&theirs, "inertiafromgeom", "auto"));
+        let drop_inertials = pi == "true" && bi == "auto";
         for (attr, default) in MUST_AGREE {
+            if attr == "inertiafromgeom" && drop_inertials {
+                continue;
+            }
             let (b, p) = (value(&base, attr, default), value(&theirs, attr, default));
             if !same_value(&b, &p) {
                 let at = theirs.get(attr).map(|(_, n)| *n).unwrap_or(part.root);
@@ -406,6 +416,12 @@ impl Document {
         }
         if !errors.is_empty() {
             return;
+        }
+        if drop_inertials {
+            let inertials: Vec<Node> = part.descendants(part.root).filter(|&n| part.tag(n) == "inertial").collect();
+            for n in inertials {
+                part.remove(n);
+            }
         }
         let (base_angles, part_angles) = match (Angles::of(self), Angles::of(part)) {
             (Ok(b), Ok(p)) => (b, p),
