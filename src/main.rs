@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use mjcf_forge::Document;
+use mjcf_forge::{Document, MergeOptions, XmlModel, XmlModelOptions};
 use rayon::prelude::*;
 
 #[derive(Parser)]
@@ -46,6 +46,56 @@ enum Command {
         /// (needs the `mujoco` feature).
         #[arg(long)]
         validate: bool,
+    },
+    /// Load a model and give every name in it a prefix (identifiers and every reference).
+    Prefix {
+        /// Input MJCF file.
+        input: PathBuf,
+        /// The prefix.
+        #[arg(long)]
+        prefix: String,
+        /// Output file; standard output without it.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Write compact XML instead of indented XML.
+        #[arg(long)]
+        compact: bool,
+        /// Compile the output with MuJoCo first (needs the `mujoco` feature).
+        #[arg(long)]
+        validate: bool,
+    },
+    /// Merge parts into a base model: `--part FILE[:PREFIX[:BODY]]` gives the part the name
+    /// prefix PREFIX and puts it into the base's body BODY (the world body without it).
+    Merge {
+        /// The base model.
+        base: PathBuf,
+        /// A part: FILE, FILE:PREFIX or FILE:PREFIX:BODY (in order of merging).
+        #[arg(long = "part", required = true)]
+        parts: Vec<String>,
+        /// Fuse each part key PREFIX+NAME into the base key NAME (one "home" pose for the scene).
+        #[arg(long)]
+        fuse_keys: bool,
+        /// Output file; standard output without it.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Write compact XML instead of indented XML.
+        #[arg(long)]
+        compact: bool,
+        /// Compile the output with MuJoCo first (needs the `mujoco` feature).
+        #[arg(long)]
+        validate: bool,
+    },
+    /// The model tier's view of a model: its lists (bodies, joints, actuators, sites,
+    /// sensors, contact and visual geoms) and offsets.
+    Info {
+        /// Input MJCF file (exactly one top-level body).
+        input: PathBuf,
+        /// Naming prefix of the instance (none by default).
+        #[arg(long, default_value = "")]
+        prefix: String,
+        /// Print one JSON object (the only output form for now).
+        #[arg(long)]
+        json: bool,
     },
     /// Load a model as `inline` does, compile it with MuJoCo and print its sizes
     /// (needs the `mujoco` feature).
@@ -85,7 +135,108 @@ fn main() -> ExitCode {
                 None => inline_one_input(&inputs, output.as_deref(), options),
             }
         }
+        Command::Prefix { input, prefix, output, compact, validate } => {
+            if validate && let Err(e) = require_mujoco() {
+                eprintln!("mjcf-forge: --validate: {e}");
+                return ExitCode::from(USAGE);
+            }
+            let result = Document::load(&input).map_err(|e| e.to_string()).and_then(|mut doc| {
+                doc.apply_prefix(&prefix).map_err(|e| e.to_string())?;
+                emit(&doc, output.as_deref(), InlineOptions { compact, validate })
+            });
+            finish(&[result])
+        }
+        Command::Merge { base, parts, fuse_keys, output, compact, validate } => {
+            if validate && let Err(e) = require_mujoco() {
+                eprintln!("mjcf-forge: --validate: {e}");
+                return ExitCode::from(USAGE);
+            }
+            let specs: Vec<PartSpec> = match parts.iter().map(|p| PartSpec::parse(p)).collect() {
+                Ok(s) => s,
+                Err(e) => {
+                    eprintln!("mjcf-forge: {e}");
+                    return ExitCode::from(USAGE);
+                }
+            };
+            finish(&[merge(&base, &specs, fuse_keys, output.as_deref(), InlineOptions { compact, validate })])
+        }
+        Command::Info { input, prefix, json } => {
+            if !json {
+                eprintln!("mjcf-forge: info prints JSON only: add --json");
+                return ExitCode::from(USAGE);
+            }
+            let result = Document::load(&input).map_err(|e| e.to_string()).and_then(|doc| {
+                let options = XmlModelOptions { contact_geom_rgba: None, ..XmlModelOptions::default() };
+                let model = XmlModel::with_prefix(doc, &prefix, options).map_err(|e| e.to_string())?;
+                println!("{}", model.info_json());
+                Ok(())
+            });
+            finish(&[result])
+        }
         Command::Compile { input, json } => compile(&input, json),
+    }
+}
+
+/// One `--part FILE[:PREFIX[:BODY]]` of `merge`.
+struct PartSpec {
+    file: PathBuf,
+    prefix: String,
+    body: Option<String>,
+}
+
+impl PartSpec {
+    fn parse(spec: &str) -> Result<PartSpec, String> {
+        let mut it = spec.splitn(3, ':');
+        let file = it.next().filter(|f| !f.is_empty()).ok_or_else(|| format!("--part '{spec}': no file"))?;
+        let prefix = it.next().unwrap_or_default().to_string();
+        let body = it.next().filter(|b| !b.is_empty()).map(str::to_string);
+        Ok(PartSpec { file: PathBuf::from(file), prefix, body })
+    }
+}
+
+/// `merge`: loads the base and every part, prefixes and merges each in order, then writes.
+fn merge(
+    base: &Path,
+    parts: &[PartSpec],
+    fuse_keys: bool,
+    output: Option<&Path>,
+    options: InlineOptions,
+) -> Result<(), String> {
+    let mut scene = Document::load(base).map_err(|e| e.to_string())?;
+    // Parts load in parallel; they merge in the order given.
+    let loaded: Vec<Result<Document, String>> = parts
+        .par_iter()
+        .map(|p| {
+            let mut doc = Document::load(&p.file).map_err(|e| e.to_string())?;
+            doc.apply_prefix(&p.prefix).map_err(|e| e.to_string())?;
+            Ok(doc)
+        })
+        .collect();
+    for (spec, doc) in parts.iter().zip(loaded) {
+        let doc = doc?;
+        let merge_options = MergeOptions { fuse_keys, part_prefix: spec.prefix.clone() };
+        let report = scene.merge(&doc, spec.body.as_deref(), &merge_options).map_err(|e| e.to_string())?;
+        for w in report.warnings {
+            eprintln!("warning: {w}");
+        }
+    }
+    emit(&scene, output, options)
+}
+
+/// Writes a finished document (validated first when asked) to a file or standard output.
+fn emit(doc: &Document, output: Option<&Path>, options: InlineOptions) -> Result<(), String> {
+    if options.validate {
+        validate(doc)?;
+    }
+    let text = if options.compact { doc.to_xml_string() } else { doc.to_pretty_string() };
+    match output {
+        Some(path) => mjcf_forge::write_atomic(path, text.as_bytes()).map_err(|e| e.to_string()),
+        None => {
+            let mut out = std::io::stdout().lock();
+            out.write_all(text.as_bytes())
+                .and_then(|()| out.flush())
+                .map_err(|e| format!("cannot write to standard output: {e}"))
+        }
     }
 }
 

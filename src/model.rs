@@ -161,13 +161,18 @@ impl XmlModel {
 
     /// An instance named with prefix `{idn}_`. Errors: not exactly one top-level body.
     pub fn with_options(
-        mut doc: Document,
+        doc: Document,
         idn: impl std::fmt::Display,
         options: XmlModelOptions,
     ) -> Result<XmlModel, Errors> {
-        let prefix = format!("{idn}_");
+        XmlModel::with_prefix(doc, &format!("{idn}_"), options)
+    }
+
+    /// An instance whose names all get exactly `prefix` (which may be empty).
+    pub fn with_prefix(mut doc: Document, prefix: &str, options: XmlModelOptions) -> Result<XmlModel, Errors> {
+        let prefix = prefix.to_string();
         let world = doc.section(Section::Worldbody);
-        let roots: Vec<Node> = doc.elements(world).filter(|&n| doc.tag(n) == "body").collect();
+        let roots = doc.top_level_bodies(world);
         if roots.len() != 1 {
             return Err(Error::at(
                 doc.location(world),
@@ -212,7 +217,7 @@ impl XmlModel {
             nodes.filter_map(|n| doc.attr(n, "name").map(str::to_string)).collect()
         };
         let world = doc.section(Section::Worldbody);
-        let root = doc.elements(world).find(|&n| doc.tag(n) == "body").expect("root body");
+        let root = doc.top_level_bodies(world)[0];
         let bodies = named(&doc, &mut doc.descendants(root).filter(|&n| doc.tag(n) == "body"));
         let joints = named(
             &doc,
@@ -300,7 +305,7 @@ impl XmlModel {
     fn compute_offsets(&self) -> Result<Offsets, String> {
         let doc = &self.doc;
         let world = doc.find_section(Section::Worldbody).ok_or("no worldbody")?;
-        let root = doc.elements(world).find(|&n| doc.tag(n) == "body").ok_or("no root body")?;
+        let root = *doc.top_level_bodies(world).first().ok_or("no root body")?;
         let angles = geometry::Angles::of(doc)?;
         let base = geometry::element_pose(doc, root, &angles)?.pos;
         let bounds = geometry::subtree_bounds(doc, root, |_, _| true)?;
@@ -360,6 +365,19 @@ impl XmlModel {
 }
 
 impl Document {
+    /// The bodies whose parent is the world body (directly or through frames).
+    pub(crate) fn top_level_bodies(&self, world: Node) -> Vec<Node> {
+        let mut out = Vec::new();
+        for k in self.elements(world) {
+            match self.tag(k) {
+                "body" => out.push(k),
+                "frame" => out.extend(self.top_level_bodies(k)),
+                _ => {}
+            }
+        }
+        out
+    }
+
     /// Whether an element sits in the kinematic tree as a body's own child (through frames),
     /// not inside a tendon, composite or default.
     pub(crate) fn is_body_child(&self, node: Node) -> bool {
