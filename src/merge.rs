@@ -220,9 +220,12 @@ impl Document {
         into: Option<&str>,
         options: &MergeOptions,
     ) -> Result<MergeReport, Errors> {
+        let clashes = self.name_clashes(part);
+        if !clashes.is_empty() {
+            return Err(Errors(clashes));
+        }
         let mut merged = self.clone();
         let report = merged.merge_in_place(part, into, options)?;
-        merged.validate()?;
         *self = merged;
         Ok(report)
     }
@@ -242,10 +245,11 @@ impl Document {
         }
 
         // Keyframes are remapped from the layouts before the merge.
-        let base_layout = Layout::of(self);
-        let part_layout = Layout::of(&part);
         let base_keys = keys_of(self);
         let part_keys = keys_of(&part);
+        let has_keys = !base_keys.is_empty() || !part_keys.is_empty();
+        let (base_layout, part_layout) =
+            if has_keys { (Layout::of(self), Layout::of(&part)) } else { (Layout::default(), Layout::default()) };
 
         let target = match into {
             None => self.section(Section::Worldbody),
@@ -274,8 +278,9 @@ impl Document {
                 "default" => self.merge_residual_defaults(&part, section, file_offset, &mut errors),
                 "asset" => {
                     let dest = self.section(Section::Asset);
+                    let index = self.asset_index();
                     for a in part.elements(section).collect::<Vec<_>>() {
-                        match self.find_same_asset(&part, a) {
+                        match self.find_same_asset(&index, &part, a) {
                             Some(Ok(_)) => report.shared_assets += 1,
                             Some(Err(e)) => errors.push(e),
                             None => {
@@ -322,7 +327,7 @@ impl Document {
         if !errors.is_empty() {
             return Err(Errors(errors));
         }
-        if !base_keys.is_empty() || !part_keys.is_empty() {
+        if has_keys {
             self.remap_keys(&base_layout, &base_keys, &part, &part_layout, &part_keys, &map, options)?;
         }
         Ok(report)
@@ -625,18 +630,37 @@ impl Document {
         ka.len() == kb.len() && ka.iter().zip(&kb).all(|(&p, &q)| self.same_subtree(p, other, q))
     }
 
+    /// The name of an asset: its `name`, else the one MuJoCo derives from its file.
+    fn asset_name(&self, n: Node) -> Option<String> {
+        self.attr(n, "name")
+            .map(str::to_string)
+            .or_else(|| self.attr(n, "file").and_then(|f| crate::prefix::name_from_file(self.tag(n), f)))
+    }
+
+    /// The base's assets by (tag, name).
+    fn asset_index(&self) -> AHashMap<(String, String), Node> {
+        let mut index = AHashMap::new();
+        if let Some(assets) = self.find_section(Section::Asset) {
+            for n in self.elements(assets) {
+                if let Some(name) = self.asset_name(n) {
+                    index.entry((self.tag(n).to_string(), name)).or_insert(n);
+                }
+            }
+        }
+        index
+    }
+
     /// The base asset with the part asset's tag and name: `Ok` when the content is the same,
     /// an error naming both when it is not, `None` when there is none.
-    fn find_same_asset(&self, part: &Document, asset: Node) -> Option<Result<Node, Error>> {
+    fn find_same_asset(
+        &self,
+        index: &AHashMap<(String, String), Node>,
+        part: &Document,
+        asset: Node,
+    ) -> Option<Result<Node, Error>> {
         let tag = part.tag(asset);
-        let name_of = |d: &Document, n: Node| -> Option<String> {
-            d.attr(n, "name").map(str::to_string).or_else(|| {
-                d.attr(n, "file").and_then(|f| crate::prefix::name_from_file(d.tag(n), f))
-            })
-        };
-        let name = name_of(part, asset)?;
-        let assets = self.find_section(Section::Asset)?;
-        let same = self.elements(assets).find(|&n| self.tag(n) == tag && name_of(self, n).as_deref() == Some(&name))?;
+        let name = part.asset_name(asset)?;
+        let same = *index.get(&(tag.to_string(), name.clone()))?;
         if self.same_subtree(same, part, asset) {
             Some(Ok(same))
         } else {

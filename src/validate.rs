@@ -142,3 +142,74 @@ impl Document {
         }
     }
 }
+
+impl Document {
+    /// The names `part` declares that this document declares too, each reported at the
+    /// part's element with the position of ours (what a merge of the two would break).
+    pub(crate) fn name_clashes(&self, part: &Document) -> Vec<Error> {
+        let theirs = part.declared_names();
+        if theirs.is_empty() {
+            return Vec::new();
+        }
+        let wanted: ahash::AHashSet<(Ns, &str)> = theirs.iter().map(|(ns, name, _)| (*ns, *name)).collect();
+        let mut ours: AHashMap<(Ns, &str), Node> = AHashMap::new();
+        for (ns, name, node) in self.declared_names() {
+            if wanted.contains(&(ns, name)) {
+                ours.entry((ns, name)).or_insert(node);
+            }
+        }
+        theirs
+            .iter()
+            .filter_map(|&(ns, name, node)| {
+                ours.get(&(ns, name)).map(|&first| {
+                    let msg = format!("duplicate {} name '{name}' (first at {})", ns.as_str(), self.location(first));
+                    part.error_at(node, ErrorKind::Invalid(msg))
+                })
+            })
+            .collect()
+    }
+
+    /// Every name the document declares (its `id` attributes, and assets named after their
+    /// file), with the declaring element, in document order.
+    pub(crate) fn declared_names(&self) -> Vec<(Ns, &str, Node)> {
+        let mut out = Vec::new();
+        let mut stack: Vec<(Node, Kind)> = vec![(self.root, Kind::root())];
+        while let Some((node, kind)) = stack.pop() {
+            let mut declared = false;
+            for a in self.attr_slice(node) {
+                if let Some(spec) = kind.attr(a.name) {
+                    if let AttrKind::Id(ns) = spec.kind {
+                        declared = true;
+                        let v = self.str(a.value).trim();
+                        if !v.is_empty() {
+                            out.push((ns, v, node));
+                        }
+                    }
+                }
+            }
+            if !declared && matches!(self.tag(node), "mesh" | "texture" | "hfield" | "skin") {
+                if let Some(file) = self.attr(node, "file") {
+                    if name_from_file(self.tag(node), file).is_some() {
+                        let base = file.rsplit(['/', '\\']).next().unwrap_or(file);
+                        let stem = base.rfind('.').map_or(base, |i| &base[..i]);
+                        let ns = match self.tag(node) {
+                            "mesh" => Ns::Mesh,
+                            "texture" => Ns::Texture,
+                            "hfield" => Ns::Hfield,
+                            _ => Ns::Skin,
+                        };
+                        out.push((ns, stem, node));
+                    }
+                }
+            }
+            let n = stack.len();
+            for k in self.elements(node) {
+                if let Some(c) = self.tag_sym(k).and_then(|t| kind.child(t)) {
+                    stack.push((k, c));
+                }
+            }
+            stack[n..].reverse();
+        }
+        out
+    }
+}

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Sets up everything (Python venv with the pinned MuJoCo, the robosuite and dm-control
+# wheel corpora, a release build with MuJoCo compiled in) and runs the main jobs on built-in
+# examples, writing to out/:
+#   1. inline: a feature model with includes, default classes and compiler dirs;
+#   2. merge: robosuite's Lift scene (table arena, Panda + gripper, a can), validated by
+#      compiling it with MuJoCo;
+#   3. compile --json and info --json on the results.
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+
+bash scripts/setup.sh
+cargo build --release --features mujoco
+forge=target/release/mjcf-forge
+rs=.cache/corpus/robosuite-1.5.2/robosuite/models/assets
+mkdir -p out
+
+echo "== inline corpora/features/include_nested.xml -> out/include_nested.xml"
+"$forge" inline corpora/features/include_nested.xml -o out/include_nested.xml --validate
+
+echo "== merge a Lift scene -> out/lift.xml"
+"$forge" merge "$rs/arenas/table_arena.xml" \
+  --part "$rs/robots/panda/robot.xml:robot0_" \
+  --part "$rs/grippers/panda_gripper.xml:gripper0_:robot0_right_hand" \
+  --part "$rs/objects/can.xml:cube_" \
+  -o out/lift.xml --validate
+
+echo "== compile --json out/lift.xml"
+"$forge" compile out/lift.xml --json
+echo "== info --json (the can as one instance)"
+"$forge" info "$rs/objects/can.xml" --prefix can0_ --json

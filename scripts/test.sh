@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Runs every test of mjcf-forge (the README's test command; .ci/run calls it):
+# formatting, clippy, the Rust tests with and without the `mujoco` feature (real MuJoCo
+# judges every output), and the judge's own tests. Sets up first (idempotent).
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+
+bash scripts/setup.sh
+
+echo "== cargo fmt --check"
+cargo fmt --all -- --check
+echo "== cargo clippy"
+cargo clippy --all-targets -- -D warnings
+cargo clippy --all-targets --features mujoco -- -D warnings
+echo "== cargo test (default features)"
+cargo test --all-targets
+echo "== cargo test --features mujoco (with doctests)"
+cargo test --features mujoco
+echo "== judge self-tests"
+.cache/venv/bin/python -m pytest tests/judge -q -p no:cacheprovider
