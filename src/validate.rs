@@ -146,8 +146,15 @@ impl Document {
 impl Document {
     /// The names `part` declares that this document declares too, each reported at the
     /// part's element with the position of ours (what a merge of the two would break).
+    ///
+    /// Assets and default classes are left out: a merge shares identical ones and reports
+    /// the others with both contents' positions.
     pub(crate) fn name_clashes(&self, part: &Document) -> Vec<Error> {
-        let theirs = part.declared_names();
+        let shared = |ns: Ns| {
+            matches!(ns, Ns::Mesh | Ns::Texture | Ns::Material | Ns::Hfield | Ns::Skin | Ns::Default)
+        };
+        let mut theirs = part.declared_names();
+        theirs.retain(|(ns, _, _)| !shared(*ns));
         if theirs.is_empty() {
             return Vec::new();
         }

@@ -1,0 +1,77 @@
+//! Merge rules one by one: refusals with their exact messages, shared assets, and the
+//! settings the base overrides reported as warnings (the merged result judged by MuJoCo).
+
+mod common;
+
+use common::root;
+use mjcf_forge::{Document, MergeOptions};
+
+fn load(rel: &str) -> Document {
+    std::env::set_current_dir(root()).unwrap();
+    Document::load(rel).unwrap()
+}
+
+fn merge_error(part: &str, prefix: &str, into: Option<&str>) -> String {
+    let mut base = load("corpora/errors/merge/base.xml");
+    let before = base.to_xml_string();
+    let mut part = load(part);
+    part.apply_prefix(prefix).unwrap();
+    let err = base.merge(&part, into, &MergeOptions::default()).unwrap_err().to_string();
+    assert_eq!(before, base.to_xml_string(), "a failed merge changes nothing");
+    err
+}
+
+#[test]
+fn same_asset_name_with_other_content_names_both_origins() {
+    assert_eq!(
+        merge_error("corpora/errors/merge/part_asset_conflict.xml", "", None),
+        "corpora/errors/merge/part_asset_conflict.xml:3:5: asset <material> 'red' differs from the base's <material> 'red' at corpora/errors/merge/base.xml:3:5"
+    );
+}
+
+#[test]
+fn compiler_settings_without_exact_conversion_are_refused() {
+    assert_eq!(
+        merge_error("corpora/errors/merge/part_settotalmass.xml", "p_", None),
+        "corpora/errors/merge/part_settotalmass.xml:2:3: cannot merge: compiler settotalmass=\"2\" differs from the base's \"-1\" and has no exact conversion"
+    );
+}
+
+#[test]
+fn a_free_body_only_goes_into_the_world() {
+    assert_eq!(
+        merge_error("corpora/errors/merge/part_free_body.xml", "p_", Some("hand")),
+        "corpora/errors/merge/part_free_body.xml:3:5: <body> has a free joint: it can only be merged into the world body, not into 'hand'"
+    );
+}
+
+#[test]
+fn name_clashes_are_all_reported() {
+    // The material is identical in both, so it is shared rather than a clash.
+    assert_eq!(
+        merge_error("corpora/errors/merge/base.xml", "", None),
+        [
+            "corpora/errors/merge/base.xml:6:5: duplicate body name 'hand' (first at corpora/errors/merge/base.xml:6:5)",
+            "corpora/errors/merge/base.xml:7:7: duplicate joint name 'wrist' (first at corpora/errors/merge/base.xml:7:7)",
+        ]
+        .join("\n")
+    );
+}
+
+#[test]
+fn identical_assets_are_shared_and_base_settings_win_with_warnings() {
+    let mut base = load("corpora/errors/merge/base.xml");
+    let part = load("corpora/errors/merge/part_shared_asset.xml");
+    let report = base.merge(&part, None, &MergeOptions::default()).unwrap();
+    assert_eq!(report.shared_assets, 1);
+    assert_eq!(
+        report.warnings,
+        [
+            "corpora/errors/merge/part_shared_asset.xml:2:3: the part's <option timestep=\"0.001\"> is ignored: the base's value (MuJoCo's default) wins",
+            "corpora/errors/merge/part_shared_asset.xml:3:3: <size nuser_geom=\"2\"> of the part is used (the larger user-data width)",
+        ]
+    );
+    let xml = base.to_xml_string();
+    assert_eq!(xml.matches("<material name=\"red\"").count(), 1);
+    assert!(xml.contains("<size nuser_geom=\"2\"/>"));
+}
