@@ -45,38 +45,71 @@ use crate::tree::Node;
 /// An error about `node`, ending with its source position (house style).
 fn err_at(doc: &Document, node: Node, msg: impl std::fmt::Display) -> String {
     match doc.attr(node, "name") {
-        Some(name) => format!("<{} name=\"{name}\">: {msg} at {}", doc.tag(node), doc.location(node)),
+        Some(name) => format!(
+            "<{} name=\"{name}\">: {msg} at {}",
+            doc.tag(node),
+            doc.location(node)
+        ),
         None => format!("<{}>: {msg} at {}", doc.tag(node), doc.location(node)),
     }
 }
 
 /// The numbers of attribute `name`, `None` when it is absent.
 fn numbers(doc: &Document, node: Node, name: &str) -> Result<Option<Vec<f64>>, String> {
-    let Some(text) = doc.attr(node, name) else { return Ok(None) };
+    let Some(text) = doc.attr(node, name) else {
+        return Ok(None);
+    };
     text.split_ascii_whitespace()
         .map(|t| {
-            t.parse::<f64>()
-                .map_err(|_| err_at(doc, node, format_args!("attribute '{name}': '{t}' is not a number")))
+            t.parse::<f64>().map_err(|_| {
+                err_at(
+                    doc,
+                    node,
+                    format_args!("attribute '{name}': '{t}' is not a number"),
+                )
+            })
         })
         .collect::<Result<Vec<f64>, String>>()
         .map(Some)
 }
 
 /// Attribute `name` as exactly `N` numbers (MuJoCo rejects too few and too many).
-fn exact<const N: usize>(doc: &Document, node: Node, name: &str) -> Result<Option<[f64; N]>, String> {
-    let Some(v) = numbers(doc, node, name)? else { return Ok(None) };
+fn exact<const N: usize>(
+    doc: &Document,
+    node: Node,
+    name: &str,
+) -> Result<Option<[f64; N]>, String> {
+    let Some(v) = numbers(doc, node, name)? else {
+        return Ok(None);
+    };
     <[f64; N]>::try_from(v.as_slice()).map(Some).map_err(|_| {
-        err_at(doc, node, format_args!("attribute '{name}' needs {N} numbers, found {}", v.len()))
+        err_at(
+            doc,
+            node,
+            format_args!("attribute '{name}' needs {N} numbers, found {}", v.len()),
+        )
     })
 }
 
 /// Attribute `name` as at most `N` numbers, the missing ones `fill` (MuJoCo's non-exact
 /// reads, e.g. geom `size`).
-fn up_to<const N: usize>(doc: &Document, node: Node, name: &str, fill: [f64; N]) -> Result<[f64; N], String> {
+fn up_to<const N: usize>(
+    doc: &Document,
+    node: Node,
+    name: &str,
+    fill: [f64; N],
+) -> Result<[f64; N], String> {
     let mut out = fill;
     if let Some(v) = numbers(doc, node, name)? {
         if v.len() > N {
-            return Err(err_at(doc, node, format_args!("attribute '{name}' takes at most {N} numbers, found {}", v.len())));
+            return Err(err_at(
+                doc,
+                node,
+                format_args!(
+                    "attribute '{name}' takes at most {N} numbers, found {}",
+                    v.len()
+                ),
+            ));
         }
         out[..v.len()].copy_from_slice(&v);
     }

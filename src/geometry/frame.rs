@@ -36,7 +36,10 @@ pub struct Angles {
 impl Default for Angles {
     /// MuJoCo's defaults for MJCF: degrees, `xyz`.
     fn default() -> Angles {
-        Angles { degrees: true, seq: *b"xyz" }
+        Angles {
+            degrees: true,
+            seq: *b"xyz",
+        }
     }
 }
 
@@ -55,13 +58,20 @@ impl Angles {
             .try_into()
             .map_err(|_| format!("eulerseq '{seq}' must have exactly 3 letters"))?;
         if !bytes.iter().all(|c| b"xyzXYZ".contains(c)) {
-            return Err(format!("eulerseq '{seq}' can only contain x, y, z, X, Y, Z"));
+            return Err(format!(
+                "eulerseq '{seq}' can only contain x, y, z, X, Y, Z"
+            ));
         }
-        Ok(Angles { degrees, seq: bytes })
+        Ok(Angles {
+            degrees,
+            seq: bytes,
+        })
     }
 
     /// The settings of a document: its `<compiler>` elements read in order, each overriding
-    /// what the earlier ones set.
+    /// what the earlier ones set. An `eulerseq` that is not 3 bytes long is an error; one
+    /// with other letters than `xyzXYZ` is kept, and [`element_pose`] refuses `euler`
+    /// attributes under it, as MuJoCo does.
     ///
     /// ```
     /// let doc = mjcf_forge::Document::from_str("<mujoco/>", ".")?;
@@ -70,16 +80,33 @@ impl Angles {
     /// ```
     pub fn of(doc: &Document) -> Result<Angles, String> {
         let mut angles = Angles::default();
-        for c in doc.elements(doc.root()).filter(|&n| doc.tag(n) == "compiler") {
+        for c in doc
+            .elements(doc.root())
+            .filter(|&n| doc.tag(n) == "compiler")
+        {
             if let Some(a) = doc.attr(c, "angle") {
                 angles.degrees = match a.trim() {
                     "degree" => true,
                     "radian" => false,
-                    other => return Err(err_at(doc, c, format_args!("angle must be 'degree' or 'radian', not '{other}'"))),
+                    other => {
+                        return Err(err_at(
+                            doc,
+                            c,
+                            format_args!("angle must be 'degree' or 'radian', not '{other}'"),
+                        ));
+                    }
                 };
             }
             if let Some(s) = doc.attr(c, "eulerseq") {
-                angles.seq = Angles::new(angles.degrees, s.trim()).map_err(|e| err_at(doc, c, e))?.seq;
+                // Like MuJoCo: the length is checked here, the letters when an `euler` is
+                // read (a model with no `euler` compiles whatever they are).
+                angles.seq = s.as_bytes().try_into().map_err(|_| {
+                    err_at(
+                        doc,
+                        c,
+                        format_args!("eulerseq '{s}' must have exactly 3 letters"),
+                    )
+                })?;
             }
         }
         Ok(angles)
@@ -93,7 +120,11 @@ impl Angles {
     /// ```
     pub fn radians(&self, angle: f64) -> f64 {
         // MuJoCo's own expression (angle / 180 * pi), so results agree to the last bit.
-        if self.degrees { angle / 180.0 * std::f64::consts::PI } else { angle }
+        if self.degrees {
+            angle / 180.0 * std::f64::consts::PI
+        } else {
+            angle
+        }
     }
 }
 
@@ -125,7 +156,10 @@ impl Default for Pose {
 
 impl Pose {
     /// No translation, no rotation.
-    pub const IDENTITY: Pose = Pose { pos: [0.0; 3], quat: [1.0, 0.0, 0.0, 0.0] };
+    pub const IDENTITY: Pose = Pose {
+        pos: [0.0; 3],
+        quat: [1.0, 0.0, 0.0, 0.0],
+    };
 
     /// `self` followed by `child`: the pose of a grandchild frame in `self`'s parent
     /// (MuJoCo's `mjuu_frameaccum`).
@@ -152,9 +186,15 @@ impl Pose {
     /// ```
     pub fn inverse(&self) -> Pose {
         let conj = [self.quat[0], -self.quat[1], -self.quat[2], -self.quat[3]];
-        let inv = Pose { pos: [0.0; 3], quat: conj };
+        let inv = Pose {
+            pos: [0.0; 3],
+            quat: conj,
+        };
         let p = inv.rotate(self.pos);
-        Pose { pos: [-p[0], -p[1], -p[2]], quat: conj }
+        Pose {
+            pos: [-p[0], -p[1], -p[2]],
+            quat: conj,
+        }
     }
 
     /// A point of the child frame in the parent frame.
@@ -211,9 +251,21 @@ pub(crate) fn quat_to_mat(q: [f64; 4]) -> [[f64; 3]; 3] {
     let [w, x, y, z] = q;
     let (ww, xx, yy, zz) = (w * w, x * x, y * y, z * z);
     [
-        [ww + xx - yy - zz, 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)],
-        [2.0 * (x * y + w * z), ww - xx + yy - zz, 2.0 * (y * z - w * x)],
-        [2.0 * (x * z - w * y), 2.0 * (y * z + w * x), ww - xx - yy + zz],
+        [
+            ww + xx - yy - zz,
+            2.0 * (x * y - w * z),
+            2.0 * (x * z + w * y),
+        ],
+        [
+            2.0 * (x * y + w * z),
+            ww - xx + yy - zz,
+            2.0 * (y * z - w * x),
+        ],
+        [
+            2.0 * (x * z - w * y),
+            2.0 * (y * z + w * x),
+            ww - xx - yy + zz,
+        ],
     ]
 }
 
@@ -237,7 +289,11 @@ fn normalized<const N: usize>(mut v: [f64; N]) -> [f64; N] {
 }
 
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 
 /// The minimal rotation taking `+z` to the unit vector `v` (MuJoCo's `mjuu_z2quat`; a
@@ -259,16 +315,36 @@ fn frame_to_quat(x: [f64; 3], y: [f64; 3], z: [f64; 3]) -> [f64; 4] {
     let m = [x, y, z]; // m[col][row]
     let q = if m[0][0] + m[1][1] + m[2][2] > 0.0 {
         let w = 0.5 * (1.0 + m[0][0] + m[1][1] + m[2][2]).sqrt();
-        [w, 0.25 * (m[1][2] - m[2][1]) / w, 0.25 * (m[2][0] - m[0][2]) / w, 0.25 * (m[0][1] - m[1][0]) / w]
+        [
+            w,
+            0.25 * (m[1][2] - m[2][1]) / w,
+            0.25 * (m[2][0] - m[0][2]) / w,
+            0.25 * (m[0][1] - m[1][0]) / w,
+        ]
     } else if m[0][0] > m[1][1] && m[0][0] > m[2][2] {
         let a = 0.5 * (1.0 + m[0][0] - m[1][1] - m[2][2]).sqrt();
-        [0.25 * (m[1][2] - m[2][1]) / a, a, 0.25 * (m[1][0] + m[0][1]) / a, 0.25 * (m[2][0] + m[0][2]) / a]
+        [
+            0.25 * (m[1][2] - m[2][1]) / a,
+            a,
+            0.25 * (m[1][0] + m[0][1]) / a,
+            0.25 * (m[2][0] + m[0][2]) / a,
+        ]
     } else if m[1][1] > m[2][2] {
         let b = 0.5 * (1.0 - m[0][0] + m[1][1] - m[2][2]).sqrt();
-        [0.25 * (m[2][0] - m[0][2]) / b, 0.25 * (m[1][0] + m[0][1]) / b, b, 0.25 * (m[2][1] + m[1][2]) / b]
+        [
+            0.25 * (m[2][0] - m[0][2]) / b,
+            0.25 * (m[1][0] + m[0][1]) / b,
+            b,
+            0.25 * (m[2][1] + m[1][2]) / b,
+        ]
     } else {
         let c = 0.5 * (1.0 - m[0][0] - m[1][1] + m[2][2]).sqrt();
-        [0.25 * (m[0][1] - m[1][0]) / c, 0.25 * (m[2][0] + m[0][2]) / c, 0.25 * (m[2][1] + m[1][2]) / c, c]
+        [
+            0.25 * (m[0][1] - m[1][0]) / c,
+            0.25 * (m[2][0] + m[0][2]) / c,
+            0.25 * (m[2][1] + m[1][2]) / c,
+            c,
+        ]
     };
     normalized(q)
 }
@@ -302,7 +378,11 @@ pub fn euler_to_quat(euler: [f64; 3], angles: &Angles) -> [f64; 4] {
             b'z' => [cos, 0.0, 0.0, sin],
             _ => continue,
         };
-        q = if axis.is_ascii_lowercase() { quat_mul(q, rot) } else { quat_mul(rot, q) };
+        q = if axis.is_ascii_lowercase() {
+            quat_mul(q, rot)
+        } else {
+            quat_mul(rot, q)
+        };
     }
     normalized(q)
 }
@@ -312,11 +392,23 @@ const ORIENTATIONS: [&str; 5] = ["quat", "axisangle", "xyaxes", "zaxis", "euler"
 
 /// The orientation of an element from its one orientation attribute (identity if none).
 fn orientation(doc: &Document, node: Node, angles: &Angles) -> Result<[f64; 4], String> {
-    let given: Vec<&str> = ORIENTATIONS.into_iter().filter(|a| doc.attr(node, a).is_some()).collect();
+    let given: Vec<&str> = ORIENTATIONS
+        .into_iter()
+        .filter(|a| doc.attr(node, a).is_some())
+        .collect();
     if given.len() > 1 {
-        return Err(err_at(doc, node, format_args!("multiple orientation specifiers ({}) are not allowed", given.join(", "))));
+        return Err(err_at(
+            doc,
+            node,
+            format_args!(
+                "multiple orientation specifiers ({}) are not allowed",
+                given.join(", ")
+            ),
+        ));
     }
-    let Some(&which) = given.first() else { return Ok([1.0, 0.0, 0.0, 0.0]) };
+    let Some(&which) = given.first() else {
+        return Ok([1.0, 0.0, 0.0, 0.0]);
+    };
     let too_small = |what: &str| err_at(doc, node, format_args!("{which}: {what} too small"));
     match which {
         "quat" => {
@@ -360,7 +452,19 @@ fn orientation(doc: &Document, node: Node, angles: &Angles) -> Result<[f64; 4], 
             }
             Ok(z_to_quat(z))
         }
-        _ => Ok(euler_to_quat(exact::<3>(doc, node, "euler")?.unwrap_or_default(), angles)),
+        _ => {
+            if !angles.seq.iter().all(|c| b"xyzXYZ".contains(c)) {
+                return Err(err_at(
+                    doc,
+                    node,
+                    "euler sequence can only contain x, y, z, X, Y, Z",
+                ));
+            }
+            Ok(euler_to_quat(
+                exact::<3>(doc, node, "euler")?.unwrap_or_default(),
+                angles,
+            ))
+        }
     }
 }
 
@@ -375,10 +479,16 @@ pub(super) fn fromto(doc: &Document, node: Node) -> Result<Option<(Pose, f64)>, 
     if tag != "geom" && tag != "site" {
         return Ok(None);
     }
-    let Some(f) = exact::<6>(doc, node, "fromto")? else { return Ok(None) };
+    let Some(f) = exact::<6>(doc, node, "fromto")? else {
+        return Ok(None);
+    };
     let ty = doc.attr(node, "type").unwrap_or("sphere").trim();
     if !FROMTO_TYPES.contains(&ty) {
-        return Err(err_at(doc, node, format_args!("fromto requires capsule, cylinder, box or ellipsoid, not {ty}")));
+        return Err(err_at(
+            doc,
+            node,
+            format_args!("fromto requires capsule, cylinder, box or ellipsoid, not {ty}"),
+        ));
     }
     if exact::<3>(doc, node, "pos")?.is_some_and(|p| p != [0.0; 3]) {
         return Err(err_at(doc, node, "both pos and fromto defined"));
@@ -388,8 +498,18 @@ pub(super) fn fromto(doc: &Document, node: Node) -> Result<Option<(Pose, f64)>, 
     if half < EPS {
         return Err(err_at(doc, node, "fromto points too close"));
     }
-    let pos = [(f[0] + f[3]) / 2.0, (f[1] + f[4]) / 2.0, (f[2] + f[5]) / 2.0];
-    Ok(Some((Pose { pos, quat: z_to_quat(v) }, half)))
+    let pos = [
+        (f[0] + f[3]) / 2.0,
+        (f[1] + f[4]) / 2.0,
+        (f[2] + f[5]) / 2.0,
+    ];
+    Ok(Some((
+        Pose {
+            pos,
+            quat: z_to_quat(v),
+        },
+        half,
+    )))
 }
 
 /// The local pose of an element (body, frame, geom, site, camera, ...) in its parent's
@@ -415,7 +535,10 @@ pub fn element_pose(doc: &Document, node: Node, angles: &Angles) -> Result<Pose,
         return Ok(pose);
     }
     let pos = exact::<3>(doc, node, "pos")?.unwrap_or_default();
-    Ok(Pose { pos, quat: orientation(doc, node, angles)? })
+    Ok(Pose {
+        pos,
+        quat: orientation(doc, node, angles)?,
+    })
 }
 
 /// The pose of an element in the frame of the body that holds it: the `<frame>` elements
@@ -467,10 +590,18 @@ mod tests {
         let intrinsic = quat_mul(quat_mul(qx, qy), qz);
         assert!(close(&euler_to_quat([a, b, c], &rad), &intrinsic, 1e-15));
         let extrinsic = Angles::new(false, "XYZ").unwrap();
-        assert!(close(&euler_to_quat([a, b, c], &extrinsic), &quat_mul(quat_mul(qz, qy), qx), 1e-15));
+        assert!(close(
+            &euler_to_quat([a, b, c], &extrinsic),
+            &quat_mul(quat_mul(qz, qy), qx),
+            1e-15
+        ));
         // Mixed: x intrinsic, Y extrinsic, z intrinsic.
         let mixed = Angles::new(false, "xYz").unwrap();
-        assert!(close(&euler_to_quat([a, b, c], &mixed), &quat_mul(quat_mul(qy, qx), qz), 1e-15));
+        assert!(close(
+            &euler_to_quat([a, b, c], &mixed),
+            &quat_mul(quat_mul(qy, qx), qz),
+            1e-15
+        ));
     }
 
     #[test]
@@ -493,47 +624,109 @@ mod tests {
 
     #[test]
     fn z_to_quat_maps_z_onto_the_vector() {
-        for v in [[1.0, 2.0, 3.0], [0.0, 0.0, -1.0], [0.0, 0.0, 1.0], [-1.0, 0.5, -0.2]] {
+        for v in [
+            [1.0, 2.0, 3.0],
+            [0.0, 0.0, -1.0],
+            [0.0, 0.0, 1.0],
+            [-1.0, 0.5, -0.2],
+        ] {
             let u = normalized(v);
-            let p = Pose { pos: [0.0; 3], quat: z_to_quat(u) };
+            let p = Pose {
+                pos: [0.0; 3],
+                quat: z_to_quat(u),
+            };
             assert!(close(&p.rotate([0.0, 0.0, 1.0]), &u, 1e-15), "{v:?}");
         }
-        assert_eq!(z_to_quat([0.0, 0.0, -1.0]), [(std::f64::consts::FRAC_PI_2).cos(), 1.0, 0.0, 0.0]);
+        assert_eq!(
+            z_to_quat([0.0, 0.0, -1.0]),
+            [(std::f64::consts::FRAC_PI_2).cos(), 1.0, 0.0, 0.0]
+        );
     }
 
     #[test]
     fn inverse_and_compose_round_trip() {
-        let p = Pose { pos: [0.3, -1.0, 2.0], quat: normalized([0.4, -0.2, 0.7, 0.1]) };
-        let q = Pose { pos: [1.0, 2.0, 3.0], quat: normalized([0.1, 0.9, 0.3, -0.2]) };
+        let p = Pose {
+            pos: [0.3, -1.0, 2.0],
+            quat: normalized([0.4, -0.2, 0.7, 0.1]),
+        };
+        let q = Pose {
+            pos: [1.0, 2.0, 3.0],
+            quat: normalized([0.1, 0.9, 0.3, -0.2]),
+        };
         let pq = p.compose(&q);
         let x = [0.5, 0.25, -2.0];
-        assert!(close(&pq.transform_point(x), &p.transform_point(q.transform_point(x)), 1e-14));
+        assert!(close(
+            &pq.transform_point(x),
+            &p.transform_point(q.transform_point(x)),
+            1e-14
+        ));
         let id = p.inverse().compose(&p);
         assert!(close(&id.pos, &[0.0; 3], 1e-15) && close(&id.quat, &[1.0, 0.0, 0.0, 0.0], 1e-15));
     }
 
     fn first_geom(xml: &str) -> (Document, Node) {
         let doc = Document::from_str(xml, ".").unwrap();
-        let g = doc.descendants(doc.root()).find(|&n| doc.tag(n) == "geom").unwrap();
+        let g = doc
+            .descendants(doc.root())
+            .find(|&n| doc.tag(n) == "geom")
+            .unwrap();
         (doc, g)
     }
 
     #[test]
     fn orientation_errors_name_the_problem_and_the_place() {
-        let (doc, g) = first_geom(r#"<mujoco><worldbody><geom euler="1 2 3" quat="1 0 0 0"/></worldbody></mujoco>"#);
+        let (doc, g) = first_geom(
+            r#"<mujoco><worldbody><geom euler="1 2 3" quat="1 0 0 0"/></worldbody></mujoco>"#,
+        );
         let e = element_pose(&doc, g, &Angles::default()).unwrap_err();
-        assert!(e.contains("multiple orientation specifiers (quat, euler)") && e.ends_with("<string>:1:20"), "{e}");
-        let (doc, g) = first_geom(r#"<mujoco><worldbody><geom type="sphere" size="1" fromto="0 0 0 1 0 0"/></worldbody></mujoco>"#);
+        assert!(
+            e.contains("multiple orientation specifiers (quat, euler)")
+                && e.ends_with("<string>:1:20"),
+            "{e}"
+        );
+        let (doc, g) = first_geom(
+            r#"<mujoco><worldbody><geom type="sphere" size="1" fromto="0 0 0 1 0 0"/></worldbody></mujoco>"#,
+        );
         let e = element_pose(&doc, g, &Angles::default()).unwrap_err();
-        assert!(e.contains("fromto requires capsule, cylinder, box or ellipsoid, not sphere"), "{e}");
+        assert!(
+            e.contains("fromto requires capsule, cylinder, box or ellipsoid, not sphere"),
+            "{e}"
+        );
         let (doc, g) = first_geom(r#"<mujoco><worldbody><geom pos="1 2"/></worldbody></mujoco>"#);
         let e = element_pose(&doc, g, &Angles::default()).unwrap_err();
-        assert!(e.contains("attribute 'pos' needs 3 numbers, found 2"), "{e}");
+        assert!(
+            e.contains("attribute 'pos' needs 3 numbers, found 2"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn eulerseq_letters_are_checked_where_an_euler_is_read() {
+        let xml = r#"<mujoco><compiler eulerseq="xyw"/><worldbody><geom size="1"/><geom euler="1 2 3"/></worldbody></mujoco>"#;
+        let doc = Document::from_str(xml, ".").unwrap();
+        let angles = Angles::of(&doc).unwrap();
+        let geoms: Vec<Node> = doc
+            .descendants(doc.root())
+            .filter(|&n| doc.tag(n) == "geom")
+            .collect();
+        assert!(element_pose(&doc, geoms[0], &angles).is_ok());
+        let e = element_pose(&doc, geoms[1], &angles).unwrap_err();
+        assert!(
+            e.contains("euler sequence can only contain x, y, z, X, Y, Z"),
+            "{e}"
+        );
+        let doc = Document::from_str(r#"<mujoco><compiler eulerseq="xy"/></mujoco>"#, ".").unwrap();
+        assert!(
+            Angles::of(&doc)
+                .unwrap_err()
+                .contains("eulerseq 'xy' must have exactly 3 letters")
+        );
     }
 
     #[test]
     fn xyaxes_orthogonalizes_y_like_mujoco() {
-        let (doc, g) = first_geom(r#"<mujoco><worldbody><geom xyaxes="0 2 0 -1 1 0"/></worldbody></mujoco>"#);
+        let (doc, g) =
+            first_geom(r#"<mujoco><worldbody><geom xyaxes="0 2 0 -1 1 0"/></worldbody></mujoco>"#);
         let q = element_pose(&doc, g, &Angles::default()).unwrap().quat;
         let h = std::f64::consts::FRAC_1_SQRT_2;
         assert!(close(&q, &[h, 0.0, 0.0, h], 1e-15), "{q:?}");

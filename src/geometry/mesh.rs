@@ -32,7 +32,9 @@ use crate::tree::Node;
 /// ```
 pub fn find_mesh(doc: &Document, name: &str) -> Option<Node> {
     let asset = doc.find_section(Section::Asset)?;
-    doc.elements(asset).filter(|&n| doc.tag(n) == "mesh").find(|&n| mesh_name(doc, n).as_deref() == Some(name))
+    doc.elements(asset)
+        .filter(|&n| doc.tag(n) == "mesh")
+        .find(|&n| mesh_name(doc, n).as_deref() == Some(name))
 }
 
 /// The name a mesh asset goes by.
@@ -65,26 +67,44 @@ pub fn mesh_vertices(doc: &Document, mesh: Node) -> Result<Vec<[f64; 3]>, String
             Some("model/stl") => "stl".to_string(),
             Some("model/obj") => "obj".to_string(),
             Some("model/vnd.mujoco.msh") => "msh".to_string(),
-            Some(other) => return Err(err_at(doc, mesh, format_args!("unsupported content_type '{other}'"))),
-            None => Path::new(file).extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default(),
+            Some(other) => {
+                return Err(err_at(
+                    doc,
+                    mesh,
+                    format_args!("unsupported content_type '{other}'"),
+                ));
+            }
+            None => Path::new(file)
+                .extension()
+                .map(|e| e.to_string_lossy().to_ascii_lowercase())
+                .unwrap_or_default(),
         };
-        let bytes = std::fs::read(file).map_err(|e| err_at(doc, mesh, format_args!("cannot read '{file}': {e}")))?;
+        let bytes = std::fs::read(file)
+            .map_err(|e| err_at(doc, mesh, format_args!("cannot read '{file}': {e}")))?;
         let parsed = match kind.as_str() {
             "stl" => read_stl(&bytes),
             "obj" => read_obj(&bytes),
             "msh" => read_msh(&bytes),
-            other => Err(format!("unknown mesh file type '{other}' (MuJoCo reads stl, obj, msh)")),
+            other => Err(format!(
+                "unknown mesh file type '{other}' (MuJoCo reads stl, obj, msh)"
+            )),
         };
         parsed.map_err(|e| err_at(doc, mesh, format_args!("'{file}': {e}")))?
     } else if let Some(v) = numbers(doc, mesh, "vertex")? {
         if v.len() % 3 != 0 {
             return Err(err_at(doc, mesh, "vertex data must be a multiple of 3"));
         }
-        v.chunks_exact(3).map(|c| [c[0] as f32, c[1] as f32, c[2] as f32]).collect()
+        v.chunks_exact(3)
+            .map(|c| [c[0] as f32, c[1] as f32, c[2] as f32])
+            .collect()
     } else if doc.attr(mesh, "builtin").is_some() {
         return Err(err_at(doc, mesh, "built-in meshes are not supported"));
     } else {
-        return Err(err_at(doc, mesh, "mesh has neither 'file' nor 'vertex' (plugin meshes are not supported)"));
+        return Err(err_at(
+            doc,
+            mesh,
+            "mesh has neither 'file' nor 'vertex' (plugin meshes are not supported)",
+        ));
     };
     if raw.is_empty() {
         return Err(err_at(doc, mesh, "mesh has no vertices"));
@@ -100,7 +120,11 @@ pub fn mesh_vertices(doc: &Document, mesh: Node) -> Result<Vec<[f64; 3]>, String
     Ok(raw
         .into_iter()
         .map(|v| {
-            let p = [f64::from(v[0]) - refpos[0], f64::from(v[1]) - refpos[1], f64::from(v[2]) - refpos[2]];
+            let p = [
+                f64::from(v[0]) - refpos[0],
+                f64::from(v[1]) - refpos[1],
+                f64::from(v[2]) - refpos[2],
+            ];
             // R^T p: the conjugate of refquat.
             let p = match rot {
                 Some(m) => [
@@ -129,13 +153,18 @@ fn read_stl(bytes: &[u8]) -> Result<Vec<[f32; 3]>, String> {
     if bytes.len() >= 84 {
         let n = u32_at(bytes, 80) as usize;
         if n.checked_mul(50).and_then(|b| b.checked_add(84)) == Some(bytes.len()) {
-            return Ok((0..n)
-                .flat_map(|t| (0..3).map(move |k| 84 + 50 * t + 12 + 12 * k))
-                .map(|at| [f32_at(bytes, at), f32_at(bytes, at + 4), f32_at(bytes, at + 8)])
-                .collect());
+            let mut out = Vec::with_capacity(3 * n);
+            for tri in bytes[84..].chunks_exact(50) {
+                for at in [12, 24, 36] {
+                    out.push([f32_at(tri, at), f32_at(tri, at + 4), f32_at(tri, at + 8)]);
+                }
+            }
+            return Ok(out);
         }
     }
-    let text = std::str::from_utf8(bytes).map_err(|_| "neither a binary STL (size does not match its triangle count) nor ASCII".to_string())?;
+    let text = std::str::from_utf8(bytes).map_err(|_| {
+        "neither a binary STL (size does not match its triangle count) nor ASCII".to_string()
+    })?;
     if !text.trim_start().starts_with("solid") {
         return Err("binary STL size does not match its triangle count".into());
     }
@@ -153,8 +182,12 @@ fn read_stl(bytes: &[u8]) -> Result<Vec<[f32; 3]>, String> {
 fn three<'a>(mut words: impl Iterator<Item = &'a str>, line: usize) -> Result<[f32; 3], String> {
     let mut v = [0f32; 3];
     for slot in &mut v {
-        let w = words.next().ok_or_else(|| format!("line {}: a vertex needs 3 coordinates", line + 1))?;
-        *slot = w.parse::<f32>().map_err(|_| format!("line {}: '{w}' is not a number", line + 1))?;
+        let w = words
+            .next()
+            .ok_or_else(|| format!("line {}: a vertex needs 3 coordinates", line + 1))?;
+        *slot = w
+            .parse::<f32>()
+            .map_err(|_| format!("line {}: '{w}' is not a number", line + 1))?;
     }
     Ok(v)
 }
@@ -164,9 +197,9 @@ fn read_obj(bytes: &[u8]) -> Result<Vec<[f32; 3]>, String> {
     let text = String::from_utf8_lossy(bytes);
     let mut out = Vec::new();
     for (i, line) in text.lines().enumerate() {
-        let mut words = line.split_ascii_whitespace();
-        if words.next() == Some("v") {
-            out.push(three(words, i)?);
+        // Most lines are faces and normals: look at the first bytes before splitting.
+        if line.starts_with("v ") || line.starts_with("v\t") {
+            out.push(three(line[2..].split_ascii_whitespace(), i)?);
         }
     }
     Ok(out)
@@ -178,7 +211,14 @@ fn read_msh(bytes: &[u8]) -> Result<Vec<[f32; 3]>, String> {
     if bytes.len() < 16 {
         return Err("MSH file shorter than its 16-byte header".into());
     }
-    let count = |k: usize| i32::from_le_bytes([bytes[4 * k], bytes[4 * k + 1], bytes[4 * k + 2], bytes[4 * k + 3]]);
+    let count = |k: usize| {
+        i32::from_le_bytes([
+            bytes[4 * k],
+            bytes[4 * k + 1],
+            bytes[4 * k + 2],
+            bytes[4 * k + 3],
+        ])
+    };
     let [nv, nn, nt, nf] = [count(0), count(1), count(2), count(3)];
     if [nv, nn, nt, nf].iter().any(|&c| c < 0) {
         return Err("MSH header has a negative count".into());
@@ -186,9 +226,21 @@ fn read_msh(bytes: &[u8]) -> Result<Vec<[f32; 3]>, String> {
     let [nv, nn, nt, nf] = [nv, nn, nt, nf].map(|c| c as usize);
     let expected = 16 + 12 * (nv + nn + nf) + 8 * nt;
     if bytes.len() != expected {
-        return Err(format!("MSH file has {} bytes, its header says {expected}", bytes.len()));
+        return Err(format!(
+            "MSH file has {} bytes, its header says {expected}",
+            bytes.len()
+        ));
     }
-    Ok((0..nv).map(|i| 16 + 12 * i).map(|at| [f32_at(bytes, at), f32_at(bytes, at + 4), f32_at(bytes, at + 8)]).collect())
+    Ok((0..nv)
+        .map(|i| 16 + 12 * i)
+        .map(|at| {
+            [
+                f32_at(bytes, at),
+                f32_at(bytes, at + 4),
+                f32_at(bytes, at + 8),
+            ]
+        })
+        .collect())
 }
 
 #[cfg(test)]
@@ -220,23 +272,37 @@ mod tests {
     #[test]
     fn ascii_stl() {
         let text = "solid t\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n   vertex 0 1e-1 0\n  endloop\n endfacet\nendsolid t\n";
-        assert_eq!(read_stl(text.as_bytes()).unwrap(), vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.1, 0.0]]);
+        assert_eq!(
+            read_stl(text.as_bytes()).unwrap(),
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.1, 0.0]]
+        );
         assert!(read_stl(b"junk that is not an stl").is_err());
     }
 
     #[test]
     fn obj_reads_v_lines_only() {
-        let text = "# c\nv 1 2 3\nvn 0 0 1\nvt 0.5 0.5\nv -1 -2 -3 1.0\nv 0 0 0 0.1 0.2 0.3\nf 1 2 3\n";
-        assert_eq!(read_obj(text.as_bytes()).unwrap(), vec![[1.0, 2.0, 3.0], [-1.0, -2.0, -3.0], [0.0; 3]]);
+        let text =
+            "# c\nv 1 2 3\nvn 0 0 1\nvt 0.5 0.5\nv -1 -2 -3 1.0\nv 0 0 0 0.1 0.2 0.3\nf 1 2 3\n";
+        assert_eq!(
+            read_obj(text.as_bytes()).unwrap(),
+            vec![[1.0, 2.0, 3.0], [-1.0, -2.0, -3.0], [0.0; 3]]
+        );
         assert!(read_obj(b"v 1 2\n").unwrap_err().contains("line 1"));
     }
 
     #[test]
     fn msh_checks_its_size() {
         let mut b = Vec::new();
-        [2i32, 0, 0, 0].iter().for_each(|c| b.extend(c.to_le_bytes()));
-        [1f32, 2.0, 3.0, 4.0, 5.0, 6.0].iter().for_each(|c| b.extend(c.to_le_bytes()));
-        assert_eq!(read_msh(&b).unwrap(), vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]);
+        [2i32, 0, 0, 0]
+            .iter()
+            .for_each(|c| b.extend(c.to_le_bytes()));
+        [1f32, 2.0, 3.0, 4.0, 5.0, 6.0]
+            .iter()
+            .for_each(|c| b.extend(c.to_le_bytes()));
+        assert_eq!(
+            read_msh(&b).unwrap(),
+            vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]
+        );
         b.push(0);
         assert!(read_msh(&b).unwrap_err().contains("header says 40"));
     }
@@ -251,12 +317,19 @@ mod tests {
         .unwrap();
         let v = mesh_vertices(&doc, find_mesh(&doc, "m").unwrap()).unwrap();
         // (1,0,0) turned by -90 degrees about z is (0,-1,0); then y scaled by 3.
-        assert!((v[0][1] + 3.0).abs() < 1e-12 && v[0][0].abs() < 1e-12, "{v:?}");
+        assert!(
+            (v[0][1] + 3.0).abs() < 1e-12 && v[0][0].abs() < 1e-12,
+            "{v:?}"
+        );
     }
 
     #[test]
     fn unnamed_meshes_go_by_file_stem() {
-        let doc = Document::from_str(r#"<mujoco><asset><mesh file="/x/y/Part.v2.STL"/></asset></mujoco>"#, ".").unwrap();
+        let doc = Document::from_str(
+            r#"<mujoco><asset><mesh file="/x/y/Part.v2.STL"/></asset></mujoco>"#,
+            ".",
+        )
+        .unwrap();
         assert!(find_mesh(&doc, "Part.v2").is_some());
     }
 }
