@@ -7,7 +7,7 @@
 use std::path::PathBuf;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use mjcf_forge::{Document, MergeOptions, XmlModel};
+use mjcf_forge::{Document, MergeOptions, MergePart, MujocoModel, XmlModel};
 
 fn rs(rel: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -44,14 +44,13 @@ fn assemble(p: &Parts) -> Document {
     let mut robot = XmlModel::new(p.robot.clone(), "robot0").unwrap();
     let gripper = XmlModel::new(p.gripper.clone(), "gripper0").unwrap();
     let mount = XmlModel::new(p.mount.clone(), "mount0").unwrap();
-    robot.merge(&gripper, Some("robot0_right_hand"), false).unwrap();
-    robot.merge(&mount, Some("robot0_base"), false).unwrap();
+    robot.merge_all(&[(&gripper, Some("robot0_right_hand")), (&mount, Some("robot0_base"))], false).unwrap();
+    let objects: Vec<XmlModel> =
+        p.objects.iter().enumerate().map(|(i, o)| XmlModel::new(o.clone(), format!("object{i}")).unwrap()).collect();
     let mut scene = p.arena.clone();
-    scene.merge(robot.document(), None, &MergeOptions::default()).unwrap();
-    for (i, o) in p.objects.iter().enumerate() {
-        let object = XmlModel::new(o.clone(), format!("object{i}")).unwrap();
-        scene.merge(object.document(), None, &MergeOptions::default()).unwrap();
-    }
+    let mut parts = vec![MergePart { doc: robot.document(), into: None, prefix: "robot0_" }];
+    parts.extend(objects.iter().map(|o| MergePart { doc: o.document(), into: None, prefix: o.naming_prefix() }));
+    scene.merge_all(&parts, false).unwrap();
     scene
 }
 

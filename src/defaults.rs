@@ -22,6 +22,7 @@ use ahash::AHashMap;
 use crate::document::Document;
 use crate::error::{Error, ErrorKind, Errors};
 use crate::names::{Sym, sym};
+use crate::schema::Kind;
 use crate::tree::{Node, StrRef};
 use crate::vocab::{self, DefaultSlot, ElementSpec};
 
@@ -63,9 +64,8 @@ fn slot_index(slot: DefaultSlot) -> Option<usize> {
 }
 
 /// The slot a child of `<default>` writes, by its tag.
-fn default_child_slot(tag: &str) -> Option<DefaultSlot> {
-    let default = vocab::element("default")?;
-    vocab::child(default, tag)?.default_slot
+fn default_child_slot(default: Kind, tag: Sym) -> Option<DefaultSlot> {
+    default.child(tag)?.spec().default_slot
 }
 
 /// An ordered attribute set: one class's dummy element.
@@ -88,6 +88,10 @@ impl AttrSet {
         }
     }
 }
+
+/// What [`Resolver::apply_actuator`] makes: the class's new actuator dummy, the tag the
+/// element is written with, and its attributes.
+type AppliedActuator = (ActuatorSlot, Sym, Vec<(Sym, StrRef)>);
 
 /// The shared actuator dummy of a class.
 #[derive(Clone, Debug)]
@@ -120,6 +124,8 @@ struct Syms {
     kv: Sym,
     dampratio: Sym,
     user: Sym,
+    name: Sym,
+    actuator: Sym,
     orientation: [Sym; 5],
     light_type: [Sym; 2],
     control: [Sym; 9],
@@ -137,6 +143,8 @@ impl Syms {
             kv: sym("kv"),
             dampratio: sym("dampratio"),
             user: sym("user"),
+            name: sym("name"),
+            actuator: sym("actuator"),
             orientation: ORIENTATION.map(sym),
             light_type: LIGHT_TYPE.map(sym),
             control: GENERAL_CONTROL.map(sym),
@@ -146,19 +154,37 @@ impl Syms {
 
 struct Resolver<'a> {
     doc: &'a mut Document,
-    syms: Syms,
+    syms: &'static Syms,
     classes: Vec<Class>,
     by_name: AHashMap<String, usize>,
     errors: Vec<Error>,
     /// Values an element inherits but MJCF gives its kind no attribute for (a `<fixed>`
     /// tendon's rgba, width and material): kept in residual classes, one per distinct set.
     residuals: Vec<(DefaultSlot, Vec<(Sym, StrRef)>)>,
+    /// The kind of `<default>` (its children are the rows of each slot).
+    default_kind: Kind,
+    /// Per actuator tag met: the kind its class rows are read as, and its kind as a child
+    /// of `<actuator>` (found by name in the vocabulary once, not per element).
+    actuator_kinds: Vec<(Sym, Option<Kind>, Option<Kind>)>,
+    /// Buffers reused across elements, so resolving allocates nothing per element.
+    scratch: Scratch,
+}
+
+#[derive(Default)]
+struct Scratch {
+    own: Vec<(Sym, StrRef)>,
+    set: AttrSet,
+    out: Vec<crate::tree::Attr>,
+    text: String,
 }
 
 /// Resolves every default class into explicit attributes and removes `<default>`, `class`
 /// and `childclass`. All problems are reported at once.
 pub(crate) fn inline_defaults(doc: &mut Document) -> Result<(), Errors> {
-    let syms = Syms::new();
+    // Vocabulary ids are the same in every document: interned once per process.
+    static SYMS: std::sync::OnceLock<Syms> = std::sync::OnceLock::new();
+    let syms = SYMS.get_or_init(Syms::new);
+    let syms_default = syms.default;
     let main = Class {
         parent: None,
         slots: Default::default(),
@@ -175,6 +201,9 @@ pub(crate) fn inline_defaults(doc: &mut Document) -> Result<(), Errors> {
         by_name: AHashMap::from_iter([("main".to_string(), 0)]),
         errors: Vec::new(),
         residuals: Vec::new(),
+        default_kind: Kind::root().child(syms_default).expect("<default> kind"),
+        actuator_kinds: Vec::new(),
+        scratch: Scratch::default(),
     };
     let root = r.doc.root;
     let sections: Vec<Node> = r
@@ -183,25 +212,20 @@ pub(crate) fn inline_defaults(doc: &mut Document) -> Result<(), Errors> {
         .filter(|&n| r.doc.tag_sym(n) == Some(r.syms.default))
         .collect();
     for &section in &sections {
-        if let Some(name) = r.doc.attr_sym(section, r.syms.class) {
-            if name != "main" {
-                let e = r.doc.error_at(section, ErrorKind::RenamedMainClass(name.to_string()));
-                r.errors.push(e);
-            }
+        if let Some(name) = r.doc.attr_sym(section, r.syms.class)
+            && name != "main"
+        {
+            let e = r
+                .doc
+                .error_at(section, ErrorKind::RenamedMainClass(name.to_string()));
+            r.errors.push(e);
         }
         r.read_class(section, 0);
     }
     for &section in &sections {
         r.doc.remove(section);
     }
-    let root_spec = vocab::root();
-    let children: Vec<Node> = r.doc.elements(root).collect();
-    for child in children {
-        let tag = r.doc.tag(child).to_string();
-        if let Some(spec) = vocab::child(root_spec, &tag) {
-            r.resolve(child, spec, None);
-        }
-    }
+    r.resolve_children(root, Kind::root(), None);
     if !r.errors.is_empty() {
         return Err(Errors(r.errors));
     }
@@ -241,8 +265,10 @@ impl Resolver<'_> {
             self.doc.set_attr_ref(class, self.syms.class, name);
             let tag = self.doc.intern(slot_tag(*slot));
             let row = self.doc.new_element(tag, None);
-            let attrs: Vec<crate::tree::Attr> =
-                attrs.iter().map(|&(name, value)| crate::tree::Attr { name, value }).collect();
+            let attrs: Vec<crate::tree::Attr> = attrs
+                .iter()
+                .map(|&(name, value)| crate::tree::Attr { name, value })
+                .collect();
             self.doc.replace_attrs(row, &attrs);
             self.doc.tree.append(class, row);
             self.doc.tree.append(top, class);
@@ -263,8 +289,8 @@ impl Resolver<'_> {
             if self.doc.tag_sym(el) == Some(self.syms.default) {
                 continue;
             }
-            let tag = self.doc.tag(el).to_string();
-            match default_child_slot(&tag) {
+            let tag = self.doc.tag_sym(el).expect("element");
+            match default_child_slot(self.default_kind, tag) {
                 Some(DefaultSlot::Actuator) => {
                     let slot = self.classes[class].actuator.clone();
                     let own = self.own_attrs(el);
@@ -281,6 +307,7 @@ impl Resolver<'_> {
                     self.classes[class].slots[i] = set;
                 }
                 None => {
+                    let tag = self.doc.sym_name(tag);
                     let e = self.doc.error_at(
                         el,
                         ErrorKind::Invalid(format!("<{tag}> cannot appear in <default>")),
@@ -294,7 +321,10 @@ impl Resolver<'_> {
                 continue;
             }
             let Some(name) = self.doc.attr_sym(el, self.syms.class).map(str::to_string) else {
-                let e = self.doc.error_at(el, ErrorKind::Invalid("nested <default> needs a 'class'".into()));
+                let e = self.doc.error_at(
+                    el,
+                    ErrorKind::Invalid("nested <default> needs a 'class'".into()),
+                );
                 self.errors.push(e);
                 continue;
             };
@@ -314,12 +344,20 @@ impl Resolver<'_> {
 
     /// The attributes an element writes itself (its `class` left out).
     fn own_attrs(&self, node: Node) -> Vec<(Sym, StrRef)> {
-        self.doc
-            .attr_slice(node)
-            .iter()
-            .filter(|a| a.name != self.syms.class && a.name != self.syms.childclass)
-            .map(|a| (a.name, a.value))
-            .collect()
+        let mut own = Vec::new();
+        self.own_attrs_into(node, &mut own);
+        own
+    }
+
+    fn own_attrs_into(&self, node: Node, own: &mut Vec<(Sym, StrRef)>) {
+        own.clear();
+        own.extend(
+            self.doc
+                .attr_slice(node)
+                .iter()
+                .filter(|a| a.name != self.syms.class && a.name != self.syms.childclass)
+                .map(|a| (a.name, a.value)),
+        );
     }
 
     /// Applies attributes onto a dummy, with MuJoCo's array overlay and orientation rules.
@@ -346,51 +384,73 @@ impl Resolver<'_> {
     fn overlay(&mut self, own: StrRef, base: StrRef) -> StrRef {
         let own_s = self.doc.str(own);
         let base_s = self.doc.str(base);
-        let own_n: Vec<&str> = own_s.split_ascii_whitespace().collect();
-        let base_n: Vec<&str> = base_s.split_ascii_whitespace().collect();
-        let numeric = |v: &[&str]| !v.is_empty() && v.iter().all(|t| t.parse::<f64>().is_ok());
-        if own_n.len() >= base_n.len() || !numeric(&own_n) || !numeric(&base_n) {
+        // Counted first: most values give at least as many numbers as their base.
+        let own_len = count_tokens(own_s, usize::MAX);
+        if own_len >= count_tokens(base_s, own_len + 1) {
             return own;
         }
-        let mut joined = own_n.join(" ");
-        for t in &base_n[own_n.len()..] {
+        let numeric = |v: &str| v.split_ascii_whitespace().all(|t| t.parse::<f64>().is_ok());
+        if own_len == 0 || !numeric(own_s) || !numeric(base_s) {
+            return own;
+        }
+        let mut joined = std::mem::take(&mut self.scratch.text);
+        joined.clear();
+        for (i, t) in own_s.split_ascii_whitespace().enumerate() {
+            if i > 0 {
+                joined.push(' ');
+            }
+            joined.push_str(t);
+        }
+        for t in base_s.split_ascii_whitespace().skip(own_len) {
             joined.push(' ');
             joined.push_str(t);
         }
-        self.doc.push_str(&joined)
+        let r = self.doc.push_str(&joined);
+        self.scratch.text = joined;
+        r
     }
 
-    /// Walks the model below `node` (whose kind is `spec`), resolving each element.
-    fn resolve(&mut self, node: Node, spec: &'static ElementSpec, childclass: Option<usize>) {
+    /// Walks the model below `node` (of kind `kind`), resolving each element.
+    fn resolve(&mut self, node: Node, kind: Kind, childclass: Option<usize>) {
         let mut active = childclass;
-        if let Some(cc) = self.doc.attr_sym(node, self.syms.childclass).map(str::to_string) {
-            match self.by_name.get(&cc) {
+        if let Some(cc) = self.doc.attr_sym(node, self.syms.childclass) {
+            match self.by_name.get(cc) {
                 Some(&c) => active = Some(c),
                 None => {
-                    let e = self.doc.error_at(node, ErrorKind::UnknownClass(cc));
+                    let e = self
+                        .doc
+                        .error_at(node, ErrorKind::UnknownClass(cc.to_string()));
                     self.errors.push(e);
                 }
             }
             self.doc.remove_attr_sym(node, self.syms.childclass);
         }
-        if let Some(slot) = spec.default_slot {
-            self.resolve_element(node, spec, slot, active);
+        if let Some(slot) = kind.spec().default_slot {
+            self.resolve_element(node, kind, slot, active);
         }
-        let kids: Vec<Node> = self.doc.elements(node).collect();
-        for kid in kids {
-            let tag = self.doc.tag(kid).to_string();
-            if let Some(kspec) = vocab::child(spec, &tag) {
-                self.resolve(kid, kspec, active);
+        self.resolve_children(node, kind, active);
+    }
+
+    /// Resolves the child elements MJCF knows under `node` (of kind `kind`). Resolving
+    /// changes attributes and tags only, never the tree, so siblings can be walked in place.
+    fn resolve_children(&mut self, node: Node, kind: Kind, childclass: Option<usize>) {
+        let mut next = self.doc.tree.first_child(node);
+        while let Some(kid) = next {
+            next = self.doc.tree.next_sibling(kid);
+            if let Some(kkind) = self.doc.tag_sym(kid).and_then(|t| kind.child(t)) {
+                self.resolve(kid, kkind, childclass);
             }
         }
     }
 
     fn class_of(&mut self, node: Node, childclass: Option<usize>) -> Option<usize> {
-        match self.doc.attr_sym(node, self.syms.class).map(str::to_string) {
-            Some(name) => match self.by_name.get(&name) {
+        match self.doc.attr_sym(node, self.syms.class) {
+            Some(name) => match self.by_name.get(name) {
                 Some(&c) => Some(c),
                 None => {
-                    let e = self.doc.error_at(node, ErrorKind::UnknownClass(name));
+                    let e = self
+                        .doc
+                        .error_at(node, ErrorKind::UnknownClass(name.to_string()));
                     self.errors.push(e);
                     None
                 }
@@ -402,69 +462,97 @@ impl Resolver<'_> {
     fn resolve_element(
         &mut self,
         node: Node,
-        spec: &'static ElementSpec,
+        kind: Kind,
         slot: DefaultSlot,
         childclass: Option<usize>,
     ) {
         let Some(class) = self.class_of(node, childclass) else {
             return;
         };
-        let own = self.own_attrs(node);
-        let merged = if slot == DefaultSlot::Actuator {
+        if slot != DefaultSlot::Actuator
+            && self.classes[class].slots[slot_index(slot).expect("non-actuator slot")]
+                .0
+                .is_empty()
+        {
+            // Nothing to inherit (the common case for classes that set few rows): what the
+            // general path below makes is the element's own attributes in their order.
+            self.doc.remove_attr_sym(node, self.syms.class);
+            return;
+        }
+        let mut own = std::mem::take(&mut self.scratch.own);
+        self.own_attrs_into(node, &mut own);
+        let mut merged = std::mem::take(&mut self.scratch.set);
+        if slot == DefaultSlot::Actuator {
             let dummy = self.classes[class].actuator.clone();
             match self.apply_actuator(&dummy, class, node, &own) {
                 Ok((_, out_tag, attrs)) => {
                     if self.doc.tag_sym(node) != Some(out_tag) {
                         self.doc.set_tag(node, out_tag);
                     }
-                    attrs
+                    merged.0 = attrs;
                 }
                 Err(e) => {
                     self.errors.push(e);
+                    self.scratch.own = own;
+                    self.scratch.set = merged;
                     return;
                 }
             }
         } else {
             let i = slot_index(slot).expect("non-actuator slot");
-            let mut set = self.classes[class].slots[i].clone();
-            self.apply(&mut set, &own, Some(spec));
-            set.0
-        };
+            merged.0.clear();
+            merged.0.extend_from_slice(&self.classes[class].slots[i].0);
+            self.apply(&mut merged, &own, Some(kind.spec()));
+        }
         // Own attributes keep their place; inherited ones follow in class order.
-        let mut out: Vec<crate::tree::Attr> = Vec::with_capacity(merged.len());
+        let mut out = std::mem::take(&mut self.scratch.out);
+        out.clear();
         let mut residual: Vec<(Sym, StrRef)> = Vec::new();
         for &(name, _) in &own {
-            if let Some(v) = merged.iter().find(|(n, _)| *n == name).map(|(_, v)| *v) {
+            if let Some(v) = merged.get(name) {
                 out.push(crate::tree::Attr { name, value: v });
             }
         }
-        for &(name, value) in &merged {
+        for &(name, value) in &merged.0 {
             if own.iter().any(|(n, _)| *n == name) {
                 continue;
             }
-            let attr_name = self.doc.sym_name(name).to_string();
-            if spec.attr(&attr_name).is_none() {
+            if kind.attr(name).is_none() {
                 residual.push((name, value));
                 continue;
             }
             out.push(crate::tree::Attr { name, value });
         }
         if !residual.is_empty() {
-            let key: Vec<(Sym, String)> =
-                residual.iter().map(|&(n, v)| (n, self.doc.str(v).to_string())).collect();
+            let key: Vec<(Sym, String)> = residual
+                .iter()
+                .map(|&(n, v)| (n, self.doc.str(v).to_string()))
+                .collect();
             let found = self.residuals.iter().position(|(s, attrs)| {
                 *s == slot
                     && attrs.len() == key.len()
-                    && attrs.iter().zip(&key).all(|(a, k)| a.0 == k.0 && self.doc.str(a.1) == k.1)
+                    && attrs
+                        .iter()
+                        .zip(&key)
+                        .all(|(a, k)| a.0 == k.0 && self.doc.str(a.1) == k.1)
             });
             let i = found.unwrap_or_else(|| {
                 self.residuals.push((slot, residual));
                 self.residuals.len() - 1
             });
             let value = self.doc.push_str(&residual_class(i));
-            out.push(crate::tree::Attr { name: self.syms.class, value });
+            out.push(crate::tree::Attr {
+                name: self.syms.class,
+                value,
+            });
         }
         self.doc.replace_attrs(node, &out);
+        self.scratch = Scratch {
+            own,
+            set: merged,
+            out,
+            text: std::mem::take(&mut self.scratch.text),
+        };
     }
 
     /// Applies an actuator element (in a class, or a real one) onto the class dummy `slot`;
@@ -475,7 +563,7 @@ impl Resolver<'_> {
         class: usize,
         node: Node,
         own: &[(Sym, StrRef)],
-    ) -> Result<(ActuatorSlot, Sym, Vec<(Sym, StrRef)>), Error> {
+    ) -> Result<AppliedActuator, Error> {
         let tag = self.doc.tag_sym(node).expect("element");
         let tag_name = self.doc.sym_name(tag).to_string();
         let is_general = tag == self.syms.general || tag_name == "plugin";
@@ -483,6 +571,7 @@ impl Resolver<'_> {
             .iter()
             .filter_map(|p| crate::names::known(p))
             .collect();
+        let (spec, _) = self.actuator_kinds(tag);
         let is_control = |n: Sym| {
             if is_general {
                 self.syms.control.contains(&n)
@@ -490,12 +579,10 @@ impl Resolver<'_> {
                 params.contains(&n)
             }
         };
-        let spec = vocab::element(&tag_name)
-            .or_else(|| vocab::child(vocab::element("actuator").expect("actuator"), &tag_name));
         // Transmission and other per-element attributes never enter a class dummy.
-        let defaultable = |doc: &Document, n: Sym| {
-            let name = doc.sym_name(n);
-            spec.and_then(|s| s.attr(name)).is_some_and(|a| !a.nodefault) && name != "name"
+        let name_attr = self.syms.name;
+        let defaultable = |_: &Document, n: Sym| {
+            spec.and_then(|s| s.attr(n)).is_some_and(|a| !a.nodefault) && n != name_attr
         };
         let mut mech_own: Vec<(Sym, StrRef)> = Vec::new();
         let mut control_own: Vec<(Sym, StrRef)> = Vec::new();
@@ -520,10 +607,10 @@ impl Resolver<'_> {
                 self.shortcut_table(&writer, &slot.control, node)?
             };
             let inherited_gain = self.gaintype(&control);
-            if let Some(&(_, g)) = control_own.iter().find(|(n, _)| *n == self.syms.gaintype) {
-                if self.doc.str(g) != inherited_gain {
-                    control.remove(self.syms.input);
-                }
+            if let Some(&(_, g)) = control_own.iter().find(|(n, _)| *n == self.syms.gaintype)
+                && self.doc.str(g) != inherited_gain
+            {
+                control.remove(self.syms.input);
             }
             self.apply(&mut control, &control_own, None);
             control
@@ -533,7 +620,7 @@ impl Resolver<'_> {
                 // The built-in slot reads as the shortcut's documented defaults.
                 Some(src) if src.control.0.is_empty() => AttrSet::default(),
                 Some(src) if src.writer == tag => src.control.clone(),
-                Some(src) => self.from_general(&src.control, &tag_name, node)?,
+                Some(src) => self.params_from_general(&src.control, &tag_name, node)?,
             };
             let damping_given = control_own
                 .iter()
@@ -551,16 +638,17 @@ impl Resolver<'_> {
             mech,
             control,
         };
-        let out_tag = if is_general { tag } else { self.output_tag(&next, spec) };
+        let out_tag = if is_general {
+            tag
+        } else {
+            self.output_tag(&next, spec)
+        };
         let control_out = if out_tag == tag {
             next.control.clone()
         } else {
             self.shortcut_table(&tag_name, &next.control, node)?
         };
-        let out_spec = vocab::child(
-            vocab::element("actuator").expect("actuator kind"),
-            self.doc.sym_name(out_tag),
-        );
+        let (_, out_spec) = self.actuator_kinds(out_tag);
         let forced = forced_by_shortcut(&tag_name);
         let mut attrs: Vec<(Sym, StrRef)> = Vec::new();
         for &(n, v) in &other_own {
@@ -571,7 +659,7 @@ impl Resolver<'_> {
             if out_tag == tag && forced.contains(&name) {
                 continue;
             }
-            if out_spec.is_some_and(|s| s.attr(name).is_none()) && out_tag == tag && !is_general {
+            if out_spec.is_some_and(|s| s.attr(n).is_none()) && out_tag == tag && !is_general {
                 continue;
             }
             attrs.push((n, v));
@@ -582,17 +670,44 @@ impl Resolver<'_> {
         Ok((next, out_tag, attrs))
     }
 
+    /// For an actuator tag: the kind its attributes are read as (the vocabulary's element of
+    /// that name, else the `<actuator>` child of that tag) and its kind as an `<actuator>`
+    /// child.
+    fn actuator_kinds(&mut self, tag: Sym) -> (Option<Kind>, Option<Kind>) {
+        if let Some(&(_, spec, child)) = self.actuator_kinds.iter().find(|(t, _, _)| *t == tag) {
+            return (spec, child);
+        }
+        let kinds = if crate::names::is_vocabulary(tag) {
+            let actuator = Kind::named(self.syms.actuator).expect("actuator kind");
+            let child = actuator.child(tag);
+            (Kind::named(tag).or(child), child)
+        } else {
+            // A name outside the vocabulary can still be a schema name (`default_geom`).
+            let name = self.doc.sym_name(tag);
+            let child = vocab::child(vocab::element("actuator").expect("actuator kind"), name);
+            let spec = vocab::element(name).or(child);
+            (spec.map(Kind::of), child.map(Kind::of))
+        };
+        self.actuator_kinds.push((tag, kinds.0, kinds.1));
+        kinds
+    }
+
     /// The tag an actuator is written with: its own shortcut when that shortcut can carry
     /// every attribute it inherits (or sets those itself), else `general` with the
     /// shortcut's table spelled out.
-    fn output_tag(&self, slot: &ActuatorSlot, spec: Option<&'static ElementSpec>) -> Sym {
+    fn output_tag(&self, slot: &ActuatorSlot, spec: Option<Kind>) -> Sym {
         let Some(spec) = spec else { return slot.writer };
-        let forced = forced_by_shortcut(spec.tag);
-        let carries = slot.mech.0.iter().all(|(n, _)| {
-            let name = self.doc.sym_name(*n);
-            spec.attr(name).is_some() || forced.contains(&name)
-        });
-        if carries { slot.writer } else { self.syms.general }
+        let forced = forced_by_shortcut(spec.spec().tag);
+        let carries = slot
+            .mech
+            .0
+            .iter()
+            .all(|(n, _)| spec.attr(*n).is_some() || forced.contains(&self.doc.sym_name(*n)));
+        if carries {
+            slot.writer
+        } else {
+            self.syms.general
+        }
     }
 
     /// A shortcut's documented table of `general` attributes (XMLreference, actuator
@@ -601,10 +716,22 @@ impl Resolver<'_> {
         let get = |doc: &Document, k: &str| -> Option<Vec<f64>> {
             let sym = crate::names::known(k)?;
             let r = s.get(sym)?;
-            Some(doc.str(r).split_ascii_whitespace().map(|t| t.parse().unwrap_or(0.0)).collect())
+            Some(
+                doc.str(r)
+                    .split_ascii_whitespace()
+                    .map(|t| t.parse().unwrap_or(0.0))
+                    .collect(),
+            )
         };
-        let one = |doc: &Document, k: &str, d: f64| get(doc, k).and_then(|v| v.first().copied()).unwrap_or(d);
-        let list = |v: &[f64]| v.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(" ");
+        let one = |doc: &Document, k: &str, d: f64| {
+            get(doc, k).and_then(|v| v.first().copied()).unwrap_or(d)
+        };
+        let list = |v: &[f64]| {
+            v.iter()
+                .map(|x| format!("{x}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
         let damping = |doc: &Document| -> f64 {
             if let Some(dr) = get(doc, "dampratio").and_then(|v| v.first().copied()) {
                 dr
@@ -623,14 +750,27 @@ impl Resolver<'_> {
                 let kp = one(self.doc, "kp", 1.0);
                 if tag == "intvelocity" {
                     out.extend([("dyntype", "integrator".into()), ("dynprm", "1 0 0".into())]);
-                } else if let Some(tc) = get(self.doc, "timeconst").and_then(|v| v.first().copied()) {
-                    out.extend([("dyntype", "filterexact".into()), ("dynprm", list(&[tc, 0.0, 0.0]))]);
+                } else if let Some(tc) = get(self.doc, "timeconst").and_then(|v| v.first().copied())
+                {
+                    out.extend([
+                        ("dyntype", "filterexact".into()),
+                        ("dynprm", list(&[tc, 0.0, 0.0])),
+                    ]);
                 } else {
                     out.extend([("dyntype", "none".into()), ("dynprm", "1 0 0".into())]);
                 }
-                out.extend([("gaintype", "fixed".into()), ("gainprm", list(&[kp, 0.0, 0.0]))]);
-                out.extend([("biastype", "affine".into()), ("biasprm", list(&[0.0, -kp, damping(self.doc)]))]);
-                out.push(("input", if tag == "position" { "pos" } else { "vel" }.into()));
+                out.extend([
+                    ("gaintype", "fixed".into()),
+                    ("gainprm", list(&[kp, 0.0, 0.0])),
+                ]);
+                out.extend([
+                    ("biastype", "affine".into()),
+                    ("biasprm", list(&[0.0, -kp, damping(self.doc)])),
+                ]);
+                out.push((
+                    "input",
+                    if tag == "position" { "pos" } else { "vel" }.into(),
+                ));
                 if let Some(ir) = get(self.doc, "inheritrange") {
                     out.push(("inheritrange", list(&ir)));
                 }
@@ -638,14 +778,23 @@ impl Resolver<'_> {
             "velocity" => {
                 let kv = one(self.doc, "kv", 1.0);
                 out.extend([("dyntype", "none".into()), ("dynprm", "1 0 0".into())]);
-                out.extend([("gaintype", "fixed".into()), ("gainprm", list(&[kv, 0.0, 0.0]))]);
-                out.extend([("biastype", "affine".into()), ("biasprm", list(&[0.0, 0.0, -kv]))]);
+                out.extend([
+                    ("gaintype", "fixed".into()),
+                    ("gainprm", list(&[kv, 0.0, 0.0])),
+                ]);
+                out.extend([
+                    ("biastype", "affine".into()),
+                    ("biasprm", list(&[0.0, 0.0, -kv])),
+                ]);
                 out.push(("input", "vel".into()));
             }
             "damper" => {
                 let kv = one(self.doc, "kv", 0.0);
                 out.extend([("dyntype", "none".into()), ("dynprm", "1 0 0".into())]);
-                out.extend([("gaintype", "affine".into()), ("gainprm", list(&[0.0, 0.0, -kv]))]);
+                out.extend([
+                    ("gaintype", "affine".into()),
+                    ("gainprm", list(&[0.0, 0.0, -kv])),
+                ]);
                 out.extend([("biastype", "none".into()), ("biasprm", "0 0 0".into())]);
                 out.push(("ctrllimited", "true".into()));
             }
@@ -658,8 +807,14 @@ impl Resolver<'_> {
                 }
                 let mut bias = get(self.doc, "bias").unwrap_or_default();
                 bias.resize(3, 0.0);
-                out.extend([("dyntype", "filter".into()), ("dynprm", list(&[tc, 0.0, 0.0]))]);
-                out.extend([("gaintype", "fixed".into()), ("gainprm", list(&[area, 0.0, 0.0]))]);
+                out.extend([
+                    ("dyntype", "filter".into()),
+                    ("dynprm", list(&[tc, 0.0, 0.0])),
+                ]);
+                out.extend([
+                    ("gaintype", "fixed".into()),
+                    ("gainprm", list(&[area, 0.0, 0.0])),
+                ]);
                 out.extend([("biastype", "affine".into()), ("biasprm", list(&bias))]);
                 out.push(("input", "pressure".into()));
             }
@@ -680,14 +835,20 @@ impl Resolver<'_> {
                     one(self.doc, "fvmax", 1.2),
                 ];
                 let tausmooth = one(self.doc, "tausmooth", 0.0);
-                out.extend([("dyntype", "muscle".into()), ("dynprm", list(&[tc[0], tc[1], tausmooth]))]);
+                out.extend([
+                    ("dyntype", "muscle".into()),
+                    ("dynprm", list(&[tc[0], tc[1], tausmooth])),
+                ]);
                 out.extend([("gaintype", "muscle".into()), ("gainprm", list(&prm))]);
                 out.extend([("biastype", "muscle".into()), ("biasprm", list(&prm))]);
             }
             "adhesion" => {
                 let gain = one(self.doc, "gain", 1.0);
                 out.extend([("dyntype", "none".into()), ("dynprm", "1 0 0".into())]);
-                out.extend([("gaintype", "fixed".into()), ("gainprm", list(&[gain, 0.0, 0.0]))]);
+                out.extend([
+                    ("gaintype", "fixed".into()),
+                    ("gainprm", list(&[gain, 0.0, 0.0])),
+                ]);
                 out.extend([("biastype", "none".into()), ("biasprm", "0 0 0".into())]);
                 out.push(("ctrllimited", "true".into()));
             }
@@ -718,7 +879,12 @@ impl Resolver<'_> {
 
     /// The slot a shortcut pre-reads: this class's dummy if written with the same shortcut
     /// or with `general` of the shortcut's gain type, else the nearest such ancestor.
-    fn shortcut_source(&self, slot: &ActuatorSlot, class: usize, tag: &str) -> Option<ActuatorSlot> {
+    fn shortcut_source(
+        &self,
+        slot: &ActuatorSlot,
+        class: usize,
+        tag: &str,
+    ) -> Option<ActuatorSlot> {
         let inherits = |s: &ActuatorSlot| {
             let writer = self.doc.sym_name(s.writer);
             if writer == tag {
@@ -752,7 +918,12 @@ impl Resolver<'_> {
 
     /// A shortcut's parameters read off a `general` dummy's raw control model, the way
     /// MuJoCo pre-reads them (gain, bias and dynamics parameters in the shortcut's layout).
-    fn from_general(&mut self, control: &AttrSet, tag: &str, node: Node) -> Result<AttrSet, Error> {
+    fn params_from_general(
+        &mut self,
+        control: &AttrSet,
+        tag: &str,
+        node: Node,
+    ) -> Result<AttrSet, Error> {
         let nums = |doc: &Document, name: &str, builtin: &[f64]| -> Vec<f64> {
             let mut v = builtin.to_vec();
             v.resize(10, 0.0);
@@ -806,7 +977,10 @@ impl Resolver<'_> {
                 out.push(("timeconst", format!("{} {}", num(d[0]), num(d[1]))));
                 out.push(("tausmooth", num(d[2])));
                 out.push(("range", format!("{} {}", num(g[0]), num(g[1]))));
-                for (i, k) in ["force", "scale", "lmin", "lmax", "vmax", "fpmax", "fvmax"].iter().enumerate() {
+                for (i, k) in ["force", "scale", "lmin", "lmax", "vmax", "fpmax", "fvmax"]
+                    .iter()
+                    .enumerate()
+                {
                     out.push((k, num(g[2 + i])));
                 }
             }
@@ -829,11 +1003,55 @@ impl Resolver<'_> {
     }
 }
 
+/// The number of words of `text` as `split_ascii_whitespace` splits it, counting no
+/// further than `limit` (a byte loop: the iterator is slow on these short values).
+fn count_tokens(text: &str, limit: usize) -> usize {
+    let mut n = 0;
+    let mut in_space = true;
+    for b in text.bytes() {
+        let space = b.is_ascii_whitespace();
+        if in_space && !space {
+            n += 1;
+            if n == limit {
+                break;
+            }
+        }
+        in_space = space;
+    }
+    n
+}
+
 /// Attributes a shortcut sets itself (its documented table), so what a class says of
 /// them does not reach the compiled model.
 fn forced_by_shortcut(tag: &str) -> &'static [&'static str] {
     match tag {
         "damper" | "adhesion" => &["ctrllimited"],
         _ => &[],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_tokens_like_split_ascii_whitespace() {
+        for t in [
+            "",
+            " ",
+            "1",
+            " 1",
+            "1 ",
+            "1 2",
+            "  1\t2\n3 \u{c}4\r",
+            "a\u{a0}b",
+            "\u{b}x y",
+        ] {
+            let n = t.split_ascii_whitespace().count();
+            assert_eq!(count_tokens(t, usize::MAX), n, "{t:?}");
+            for limit in 1..4 {
+                assert_eq!(count_tokens(t, limit), n.min(limit), "{t:?} {limit}");
+            }
+        }
     }
 }

@@ -1,6 +1,6 @@
 //! The document tier: an MJCF model held in an arena, with flat side tables.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 
 use crate::error::{Error, ErrorKind, Errors, Location};
@@ -153,7 +153,7 @@ impl Document {
         Ok(doc)
     }
 
-    fn finish_load(&mut self) -> Result<(), Errors> {
+    pub(crate) fn finish_load(&mut self) -> Result<(), Errors> {
         crate::defaults::inline_defaults(self)?;
         crate::paths::absolutize_paths(self)?;
         self.merge_repeated_sections();
@@ -188,22 +188,35 @@ impl Document {
 
     /// The section element with this tag, if the model has one.
     pub fn find_section(&self, section: Section) -> Option<Node> {
-        self.elements(self.root).find(|&n| self.tag(n) == section.tag())
+        self.elements(self.root)
+            .find(|&n| self.tag(n) == section.tag())
     }
 
     /// Merges repeated container sections (`<asset>`, `<worldbody>`, ...) into the first one
     /// of each kind, keeping order: MuJoCo reads all of them in order, so this changes nothing.
     fn merge_repeated_sections(&mut self) {
-        for section in Section::ALL {
-            let all: Vec<Node> = self.elements(self.root).filter(|&n| self.tag(n) == section.tag()).collect();
-            if let Some((&first, rest)) = all.split_first() {
-                for &other in rest {
-                    let kids: Vec<Node> = self.tree.children(other).collect();
-                    for k in kids {
+        // One pass in document order: sections of different kinds do not interact, so this
+        // is the same as merging each kind in turn.
+        static TAGS: std::sync::OnceLock<[Sym; Section::ALL.len()]> = std::sync::OnceLock::new();
+        let tags = TAGS.get_or_init(|| Section::ALL.map(|s| crate::names::sym(s.tag())));
+        let mut first: [Option<Node>; Section::ALL.len()] = [None; Section::ALL.len()];
+        let mut next = self.tree.first_child(self.root);
+        while let Some(node) = next {
+            next = self.tree.next_sibling(node);
+            let Some(tag) = self.tag_sym(node) else {
+                continue;
+            };
+            let Some(i) = tags.iter().position(|&t| t == tag) else {
+                continue;
+            };
+            match first[i] {
+                None => first[i] = Some(node),
+                Some(first) => {
+                    while let Some(k) = self.tree.first_child(node) {
                         self.tree.detach(k);
                         self.tree.append(first, k);
                     }
-                    self.tree.detach(other);
+                    self.tree.detach(node);
                 }
             }
         }
@@ -219,6 +232,7 @@ impl Document {
         }
     }
 
+    #[inline]
     pub(crate) fn tag_sym(&self, node: Node) -> Option<Sym> {
         match self.tree.data(node) {
             NodeData::Element { tag, .. } => Some(*tag),
@@ -227,6 +241,7 @@ impl Document {
     }
 
     /// Whether the node is an element (not character data).
+    #[inline]
     pub fn is_element(&self, node: Node) -> bool {
         matches!(self.tree.data(node), NodeData::Element { .. })
     }
@@ -239,16 +254,22 @@ impl Document {
         }
     }
 
+    #[inline]
     pub(crate) fn str(&self, r: StrRef) -> &str {
         &self.strings[r.start as usize..(r.start + r.len) as usize]
     }
 
+    #[inline]
     pub(crate) fn push_str(&mut self, s: &str) -> StrRef {
         let start = self.strings.len() as u32;
         self.strings.push_str(s);
-        StrRef { start, len: s.len() as u32 }
+        StrRef {
+            start,
+            len: s.len() as u32,
+        }
     }
 
+    #[inline]
     pub(crate) fn attr_range(&self, node: Node) -> AttrRange {
         match self.tree.data(node) {
             NodeData::Element { attrs, .. } => *attrs,
@@ -256,6 +277,7 @@ impl Document {
         }
     }
 
+    #[inline]
     pub(crate) fn attr_slice(&self, node: Node) -> &[Attr] {
         let r = self.attr_range(node);
         &self.attrs[r.start as usize..(r.start + r.len) as usize]
@@ -274,6 +296,7 @@ impl Document {
         self.attr_sym(node, sym)
     }
 
+    #[inline]
     pub(crate) fn attr_sym(&self, node: Node, sym: Sym) -> Option<&str> {
         self.attr_slice(node)
             .iter()
@@ -321,7 +344,12 @@ impl Document {
             at = f.included_at;
         }
         included_from.reverse();
-        Location { file: file.path.clone(), line: span.line, col: span.col, included_from }
+        Location {
+            file: file.path.clone(),
+            line: span.line,
+            col: span.col,
+            included_from,
+        }
     }
 
     pub(crate) fn error_at(&self, node: Node, kind: ErrorKind) -> Error {
@@ -332,12 +360,18 @@ impl Document {
 
     /// Creates a detached element; `origin` gives its source position (else the root's).
     pub(crate) fn new_element(&mut self, tag: Sym, origin: Option<Node>) -> Node {
-        let span = origin.map(|o| self.spans[Tree::index(o)]).unwrap_or_default();
-        let node = self.tree.new_node(NodeData::Element { tag, attrs: AttrRange::default() });
+        let span = origin
+            .map(|o| self.spans[Tree::index(o)])
+            .unwrap_or_default();
+        let node = self.tree.new_node(NodeData::Element {
+            tag,
+            attrs: AttrRange::default(),
+        });
         self.set_span(node, span);
         node
     }
 
+    #[inline]
     pub(crate) fn set_span(&mut self, node: Node, span: Span) {
         let i = Tree::index(node);
         if self.spans.len() <= i {
@@ -383,12 +417,18 @@ impl Document {
         let end = (range.start + range.len) as usize;
         let new_range = if end == self.attrs.len() {
             // The element's run is last in the table: grow it in place.
-            AttrRange { start: range.start, len: range.len + 1 }
+            AttrRange {
+                start: range.start,
+                len: range.len + 1,
+            }
         } else {
             // Copy the run to the end; the old run becomes garbage until the next compaction.
             let start = self.attrs.len() as u32;
             self.attrs.extend_from_within(range.start as usize..end);
-            AttrRange { start, len: range.len + 1 }
+            AttrRange {
+                start,
+                len: range.len + 1,
+            }
         };
         self.attrs.push(Attr { name, value });
         if let NodeData::Element { attrs, .. } = self.tree.data_mut(node) {
@@ -408,7 +448,10 @@ impl Document {
         let start = self.attrs.len() as u32;
         self.attrs.extend_from_slice(new);
         if let NodeData::Element { attrs, .. } = self.tree.data_mut(node) {
-            *attrs = AttrRange { start, len: new.len() as u32 };
+            *attrs = AttrRange {
+                start,
+                len: new.len() as u32,
+            };
         }
     }
 
@@ -451,10 +494,5 @@ impl Document {
 
     pub(crate) fn sym_name(&self, sym: Sym) -> &str {
         self.names.resolve(sym)
-    }
-
-    /// The folder that relative paths in this document are resolved against.
-    pub(crate) fn base_dir(&self) -> PathBuf {
-        self.model_dir.to_path_buf()
     }
 }

@@ -43,7 +43,7 @@ pub mod vocab;
 mod write;
 
 pub use document::{Document, Section};
-pub use merge::{MergeOptions, MergeReport};
+pub use merge::{MergeOptions, MergePart, MergeReport};
 pub use model::{MujocoModel, XmlModel, XmlModelOptions};
 pub use error::{Error, ErrorKind, Errors, Location};
 pub use tree::Node;

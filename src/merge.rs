@@ -15,7 +15,8 @@ use ahash::AHashMap;
 use crate::document::{Document, Section, SourceFile};
 use crate::error::{Error, ErrorKind, Errors};
 use crate::geometry::{self, Angles};
-use crate::tree::{Attr, Node, NodeData, Tree};
+use crate::names::Sym;
+use crate::tree::{Attr, Node, NodeData, StrRef, Tree};
 
 /// How to merge.
 #[derive(Clone, Debug, Default)]
@@ -25,6 +26,18 @@ pub struct MergeOptions {
     pub fuse_keys: bool,
     /// The prefix the part's names carry (used to match keys when fusing).
     pub part_prefix: String,
+}
+
+/// One part of [`Document::merge_all`]: the document (names already prefixed), the body
+/// of the scene it goes into (`None`: the world body), and its prefix (to fuse keys).
+#[derive(Clone, Copy, Debug)]
+pub struct MergePart<'a> {
+    /// The part.
+    pub doc: &'a Document,
+    /// The body of the scene it goes into; `None` for the world body.
+    pub into: Option<&'a str>,
+    /// The prefix its names carry.
+    pub prefix: &'a str,
 }
 
 /// What a merge did besides merging: the settings of the part that the base overrode.
@@ -54,14 +67,26 @@ const MUST_AGREE: [(&str, &str); 12] = [
 ];
 
 /// The effective value of each `compiler` attribute (later elements win).
-fn compiler_settings(doc: &Document) -> AHashMap<String, (String, Node)> {
-    let mut out = AHashMap::new();
-    for c in doc.elements(doc.root).filter(|&n| doc.tag(n) == "compiler") {
+fn compiler_settings(doc: &Document) -> Compiler<'_> {
+    let compiler = crate::names::sym("compiler");
+    let mut out = Compiler(Vec::new());
+    for c in doc.elements(doc.root).filter(|&n| doc.tag_sym(n) == Some(compiler)) {
         for (k, v) in doc.attrs(c) {
-            out.insert(k.to_string(), (v.trim().to_string(), c));
+            out.0.retain(|(name, _, _)| *name != k);
+            out.0.push((k, v.trim(), c));
         }
     }
     out
+}
+
+/// The effective `compiler` settings of a document: (attribute, value, element), the last
+/// element that sets an attribute winning. A handful of entries: a list beats a map.
+struct Compiler<'a>(Vec<(&'a str, &'a str, Node)>);
+
+impl<'a> Compiler<'a> {
+    fn get(&self, attr: &str) -> Option<(&'a str, Node)> {
+        self.0.iter().find(|(k, _, _)| *k == attr).map(|&(_, v, n)| (v, n))
+    }
 }
 
 fn same_value(a: &str, b: &str) -> bool {
@@ -79,6 +104,45 @@ pub(crate) fn fmt_num(x: f64) -> String {
     let plain = format!("{x}");
     let exp = format!("{x:e}");
     if exp.len() < plain.len() { exp } else { plain }
+}
+
+/// Names this module looks up often, interned once.
+struct Syms {
+    name: Sym,
+    file: Sym,
+    mesh: Sym,
+    texture: Sym,
+    hfield: Sym,
+    skin: Sym,
+    euler: Sym,
+    axisangle: Sym,
+    joint: Sym,
+    ty: Sym,
+    range: Sym,
+    reference: Sym,
+    springref: Sym,
+}
+
+fn syms() -> &'static Syms {
+    static SYMS: std::sync::OnceLock<Syms> = std::sync::OnceLock::new();
+    SYMS.get_or_init(|| {
+        let s = crate::names::sym;
+        Syms {
+            name: s("name"),
+            file: s("file"),
+            mesh: s("mesh"),
+            texture: s("texture"),
+            hfield: s("hfield"),
+            skin: s("skin"),
+            euler: s("euler"),
+            axisangle: s("axisangle"),
+            joint: s("joint"),
+            ty: s("type"),
+            range: s("range"),
+            reference: s("ref"),
+            springref: s("springref"),
+        }
+    })
 }
 
 /// How a joint sits in `qpos`/`qvel`.
@@ -169,6 +233,45 @@ impl Layout {
     }
 }
 
+/// State for copying nodes of one document into another.
+struct Import {
+    file_offset: u32,
+    /// Where the other document's string buffer starts in ours, once copied.
+    strings_at: Option<u32>,
+    /// The other document's name ids mapped to ours (the vocabulary's are the same);
+    /// `u32::MAX` where not looked up yet.
+    syms: Vec<u32>,
+    /// Old node to new node, when the caller needs it (keyframe remapping).
+    map: Option<AHashMap<Node, Node>>,
+}
+
+impl Import {
+    fn new(file_offset: u32, keep_map: bool) -> Import {
+        Import { file_offset, strings_at: None, syms: Vec::new(), map: keep_map.then(AHashMap::new) }
+    }
+
+    fn sym(&mut self, doc: &mut Document, other: &Document, sym: Sym) -> Sym {
+        let i = sym.0 as usize;
+        if i >= self.syms.len() {
+            self.syms.resize(i + 1, u32::MAX);
+        }
+        if self.syms[i] == u32::MAX {
+            self.syms[i] = doc.intern(other.sym_name(sym)).0;
+        }
+        Sym(self.syms[i])
+    }
+
+    /// The other document's string, as a range of ours: the whole buffer is copied once.
+    fn string(&mut self, doc: &mut Document, other: &Document, r: StrRef) -> StrRef {
+        let at = *self.strings_at.get_or_insert_with(|| {
+            let at = doc.strings.len() as u32;
+            doc.strings.push_str(&other.strings);
+            at
+        });
+        StrRef { start: r.start + at, len: r.len }
+    }
+}
+
 /// One keyframe: its element and its vectors as written (number tokens kept as text).
 struct Key {
     node: Node,
@@ -220,13 +323,51 @@ impl Document {
         into: Option<&str>,
         options: &MergeOptions,
     ) -> Result<MergeReport, Errors> {
-        let clashes = self.name_clashes(part);
+        let part = MergePart { doc: part, into, prefix: &options.part_prefix };
+        self.merge_all(&[part], options.fuse_keys)
+    }
+
+    /// Merges several parts in order, as [`Document::merge`] does one by one, but checks
+    /// every name of every part against the base and each other once, up front (the base is
+    /// walked once, not once per part). On error nothing changes.
+    ///
+    /// ```
+    /// use mjcf_forge::{Document, MergePart};
+    /// let mut scene = Document::from_str(r#"<mujoco><worldbody><geom type="plane" size="1 1 1"/></worldbody></mujoco>"#, ".")?;
+    /// let mut cube = Document::from_str(r#"<mujoco><worldbody><body name="cube"><freejoint/><geom type="box" size="0.1 0.1 0.1"/></body></worldbody></mujoco>"#, ".")?;
+    /// let mut a = cube.clone();
+    /// a.apply_prefix("a_")?;
+    /// cube.apply_prefix("b_")?;
+    /// let parts = [MergePart { doc: &a, into: None, prefix: "a_" }, MergePart { doc: &cube, into: None, prefix: "b_" }];
+    /// scene.merge_all(&parts, false)?;
+    /// assert!(scene.find_body("a_cube").is_some() && scene.find_body("b_cube").is_some());
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn merge_all(&mut self, parts: &[MergePart<'_>], fuse_keys: bool) -> Result<MergeReport, Errors> {
+        let clashes = self.name_clashes(&parts.iter().map(|p| p.doc).collect::<Vec<_>>());
         if !clashes.is_empty() {
             return Err(Errors(clashes));
         }
-        let mut merged = self.clone();
-        let report = merged.merge_in_place(part, into, options)?;
-        *self = merged;
+        // Every check runs before the document changes, except keyframe remapping: with
+        // keys, or with several parts, work on a copy so that a failure changes nothing.
+        let keys = !keys_of(self).is_empty() || parts.iter().any(|p| !keys_of(p.doc).is_empty());
+        let mut report = MergeReport::default();
+        let mut run = |doc: &mut Document| -> Result<(), Errors> {
+            for p in parts {
+                let options = MergeOptions { fuse_keys, part_prefix: p.prefix.to_string() };
+                let r = doc.merge_in_place(p.doc, p.into, &options)?;
+                report.warnings.extend(r.warnings);
+                report.shared_assets += r.shared_assets;
+            }
+            Ok(())
+        };
+        if !keys && parts.len() == 1 {
+            run(self)?;
+        } else {
+            let mut merged = self.clone();
+            run(&mut merged)?;
+            *self = merged;
+        }
         Ok(report)
     }
 
@@ -238,23 +379,24 @@ impl Document {
     ) -> Result<MergeReport, Errors> {
         let mut report = MergeReport::default();
         let mut errors: Vec<Error> = Vec::new();
-        let mut part = part.clone();
-        self.convert_compiler(&mut part, &mut errors);
+        self.adopt_angle_unit_if_smaller(part);
+        let converted = self.converted_part(part, &mut errors);
         if !errors.is_empty() {
             return Err(Errors(errors));
         }
+        let part: &Document = converted.as_ref().unwrap_or(part);
 
         // Keyframes are remapped from the layouts before the merge.
         let base_keys = keys_of(self);
-        let part_keys = keys_of(&part);
+        let part_keys = keys_of(part);
         let has_keys = !base_keys.is_empty() || !part_keys.is_empty();
         let (base_layout, part_layout) =
-            if has_keys { (Layout::of(self), Layout::of(&part)) } else { (Layout::default(), Layout::default()) };
+            if has_keys { (Layout::of(self), Layout::of(part)) } else { (Layout::default(), Layout::default()) };
 
         let target = match into {
-            None => self.section(Section::Worldbody),
+            None => None,
             Some(name) => match self.find_body(name) {
-                Some(b) => b,
+                Some(b) => Some(b),
                 None => {
                     return Err(Error::at(
                         self.location(self.root),
@@ -265,46 +407,61 @@ impl Document {
             },
         };
 
-        let file_offset = self.adopt_files(&part);
-        let mut map: AHashMap<Node, Node> = AHashMap::new();
+        // Checks before changes: free bodies, assets, residual classes.
+        let assets = self.asset_decisions(part, &mut errors);
+        if let (Some(into), Some(world)) = (into, part.find_section(Section::Worldbody)) {
+            for child in part.elements(world) {
+                if part.has_free_joint(child) {
+                    errors.push(part.error_at(
+                        child,
+                        ErrorKind::Invalid(format!(
+                            "<{}> has a free joint: it can only be merged into the world body, not into '{into}'",
+                            part.tag(child)
+                        )),
+                    ));
+                }
+            }
+        }
+        self.check_residual_defaults(part, &mut errors);
+        if !errors.is_empty() {
+            return Err(Errors(errors));
+        }
+        let target = match target {
+            Some(t) => t,
+            None => self.section(Section::Worldbody),
+        };
+
+        // Room for the part up front: growing these one push at a time reallocates (and
+        // copies) the whole scene again and again.
+        self.tree.reserve(part.node_count());
+        self.attrs.reserve(part.attrs.len());
+        self.strings.reserve(part.strings.len());
+        self.spans.reserve(part.node_count());
+        let file_offset = self.adopt_files(part);
+        let mut imp = Import::new(file_offset, has_keys);
         let top: Vec<Node> = part.elements(part.root).collect();
         for section in top {
             let tag = part.tag(section).to_string();
+            let imp = &mut imp;
             match tag.as_str() {
                 "compiler" => {}
                 "option" | "size" | "visual" | "statistic" => {
-                    self.settings_from_part(&part, section, &mut report);
+                    self.settings_from_part(part, section, &mut report);
                 }
-                "default" => self.merge_residual_defaults(&part, section, file_offset, &mut errors),
+                "default" => self.merge_residual_defaults(part, section, file_offset),
                 "asset" => {
                     let dest = self.section(Section::Asset);
-                    let index = self.asset_index();
-                    for a in part.elements(section).collect::<Vec<_>>() {
-                        match self.find_same_asset(&index, &part, a) {
-                            Some(Ok(_)) => report.shared_assets += 1,
-                            Some(Err(e)) => errors.push(e),
-                            None => {
-                                let n = self.import(&part, a, file_offset, &mut map);
-                                self.tree.append(dest, n);
-                            }
+                    for (a, shared) in part.elements(section).zip(assets.iter()) {
+                        if *shared {
+                            report.shared_assets += 1;
+                        } else {
+                            self.import(part, a, dest, imp);
                         }
                     }
                 }
                 "worldbody" => {
                     for child in part.elements(section).collect::<Vec<_>>() {
-                        if into.is_some() && part.has_free_joint(child) {
-                            errors.push(part.error_at(
-                                child,
-                                ErrorKind::Invalid(format!(
-                                    "<{}> has a free joint: it can only be merged into the world body, not into '{}'",
-                                    part.tag(child),
-                                    into.unwrap_or_default()
-                                )),
-                            ));
-                            continue;
-                        }
-                        let n = self.import(&part, child, file_offset, &mut map);
-                        self.tree.append(target, n);
+                        self.import(part, child, target, imp);
                     }
                 }
                 "keyframe" => {}
@@ -312,31 +469,30 @@ impl Document {
                     let dest = match Section::from_tag(other) {
                         Some(s) => self.section(s),
                         None => {
-                            let n = self.import(&part, section, file_offset, &mut map);
-                            self.tree.append(self.root, n);
+                            let root = self.root;
+                            self.import(part, section, root, imp);
                             continue;
                         }
                     };
                     for child in part.elements(section).collect::<Vec<_>>() {
-                        let n = self.import(&part, child, file_offset, &mut map);
-                        self.tree.append(dest, n);
+                        self.import(part, child, dest, imp);
                     }
                 }
             }
         }
-        if !errors.is_empty() {
-            return Err(Errors(errors));
-        }
         if has_keys {
-            self.remap_keys(&base_layout, &base_keys, &part, &part_layout, &part_keys, &map, options)?;
+            let map = imp.map.take().unwrap_or_default();
+            self.remap_keys(&base_layout, &base_keys, part, &part_layout, &part_keys, &map, options)?;
         }
         Ok(report)
     }
 
     /// The body named `name` anywhere in the kinematic tree.
     pub fn find_body(&self, name: &str) -> Option<Node> {
+        static SYMS: std::sync::OnceLock<(Sym, Sym)> = std::sync::OnceLock::new();
         let world = self.find_section(Section::Worldbody)?;
-        self.descendants(world).find(|&n| self.tag(n) == "body" && self.attr(n, "name") == Some(name))
+        let &(body, name_sym) = SYMS.get_or_init(|| (crate::names::sym("body"), crate::names::sym("name")));
+        self.descendants(world).find(|&n| self.tag_sym(n) == Some(body) && self.attr_sym(n, name_sym) == Some(name))
     }
 
     fn has_free_joint(&self, node: Node) -> bool {
@@ -360,46 +516,99 @@ impl Document {
         offset
     }
 
-    /// Copies a subtree of another document into this arena (detached); records the node map.
-    fn import(&mut self, other: &Document, node: Node, file_offset: u32, map: &mut AHashMap<Node, Node>) -> Node {
-        let new = match *other.tree.data(node) {
-            NodeData::Element { tag, .. } => {
-                let tag = self.intern(other.sym_name(tag));
-                let n = self.tree.new_node(NodeData::Element { tag, attrs: Default::default() });
-                let attrs: Vec<Attr> = other
-                    .attr_slice(node)
-                    .iter()
-                    .map(|a| Attr { name: self.names.intern(other.sym_name(a.name)), value: self.push_str(other.str(a.value)) })
-                    .collect();
-                self.replace_attrs(n, &attrs);
-                n
+    /// Copies a subtree of another document into this arena as the last child of
+    /// `parent`, through `imp`. Nodes are created in place (no detached copy to re-link).
+    fn import(&mut self, other: &Document, node: Node, parent: Node, imp: &mut Import) -> Node {
+        let data = match *other.tree.data(node) {
+            NodeData::Element { tag, attrs } => {
+                let tag = imp.sym(self, other, tag);
+                let start = self.attrs.len() as u32;
+                for i in attrs.start..attrs.start + attrs.len {
+                    let a = other.attrs[i as usize];
+                    let name = imp.sym(self, other, a.name);
+                    let value = imp.string(self, other, a.value);
+                    self.attrs.push(Attr { name, value });
+                }
+                NodeData::Element { tag, attrs: crate::tree::AttrRange { start, len: attrs.len } }
             }
-            NodeData::Text { text, cdata } => {
-                let text = self.push_str(other.str(text));
-                self.tree.new_node(NodeData::Text { text, cdata })
-            }
+            NodeData::Text { text, cdata } => NodeData::Text { text: imp.string(self, other, text), cdata },
         };
+        let new = self.tree.append_new(parent, data);
         let mut span = other.spans[Tree::index(node)];
-        span.file += file_offset;
+        span.file += imp.file_offset;
         self.set_span(new, span);
-        map.insert(node, new);
-        let kids: Vec<Node> = other.tree.children(node).collect();
-        for k in kids {
-            let c = self.import(other, k, file_offset, map);
-            self.tree.append(new, c);
+        if let Some(map) = imp.map.as_mut() {
+            map.insert(node, new);
+        }
+        let mut kid = other.tree.first_child(node);
+        while let Some(k) = kid {
+            self.import(other, k, new, imp);
+            kid = other.tree.next_sibling(k);
         }
         new
     }
 }
 
 impl Document {
+    /// When the part differs from this document only in the angle unit and this document is
+    /// the smaller, converts this document to the part's unit instead (the same compiled
+    /// model, less to rewrite: an arena receiving a robot, say).
+    fn adopt_angle_unit_if_smaller(&mut self, part: &Document) {
+        if self.node_count() >= part.node_count() {
+            return;
+        }
+        let ours = compiler_settings(self);
+        let theirs = compiler_settings(part);
+        let same = |k: &str| ours.get(k).map(|v| v.0) == theirs.get(k).map(|v| v.0);
+        let others = ["eulerseq", "autolimits", "inertiafromgeom"];
+        if same("angle") || !MUST_AGREE.iter().all(|(k, _)| same(k)) || !others.iter().all(|k| same(k)) {
+            return;
+        }
+        let (Ok(mine), Ok(target)) = (Angles::of(self), Angles::of(part)) else { return };
+        if mine.degrees == target.degrees {
+            return;
+        }
+        self.convert_angles(mine.degrees, target.degrees);
+        let compilers: Vec<Node> = self.elements(self.root).filter(|&n| self.tag(n) == "compiler").collect();
+        for &c in &compilers {
+            self.remove_attr(c, "angle");
+        }
+        let unit = if target.degrees { "degree" } else { "radian" };
+        match compilers.first() {
+            Some(&c) => self.set_attr(c, "angle", unit),
+            None => {
+                let sym = self.intern("compiler");
+                let c = self.new_element(sym, None);
+                match self.tree.first_child(self.root) {
+                    Some(f) => self.tree.insert_before(f, c),
+                    None => self.tree.append(self.root, c),
+                }
+                self.set_attr(c, "angle", unit);
+            }
+        }
+    }
+
+    /// The part brought to this document's compiler settings (`None`: it already is), or
+    /// the reasons it cannot be.
+    fn converted_part(&self, part: &Document, errors: &mut Vec<Error>) -> Option<Document> {
+        let ours = compiler_settings(self);
+        let theirs = compiler_settings(part);
+        let same = |k: &str| ours.get(k).map(|v| v.0) == theirs.get(k).map(|v| v.0);
+        let relevant = ["angle", "eulerseq", "autolimits", "inertiafromgeom"];
+        let agree = MUST_AGREE.iter().all(|(k, _)| same(k)) && relevant.iter().all(|k| same(k));
+        if agree {
+            return None;
+        }
+        let mut part = part.clone();
+        self.convert_compiler(&mut part, errors);
+        Some(part)
+    }
+
     /// Brings `part` to this document's compiler settings, or reports why it cannot be.
     fn convert_compiler(&self, part: &mut Document, errors: &mut Vec<Error>) {
         let base = compiler_settings(self);
         let theirs = compiler_settings(part);
-        let value = |m: &AHashMap<String, (String, Node)>, k: &str, d: &str| {
-            m.get(k).map(|(v, _)| v.clone()).unwrap_or_else(|| d.to_string())
-        };
+        let value = |m: &Compiler<'_>, k: &str, d: &str| m.get(k).map_or_else(|| d.to_string(), |(v, _)| v.to_string());
         // inertiafromgeom "true" ignores <inertial>; under the base's "auto" the same model is
         // the part without its <inertial> elements.
         let (bi, pi) = (value(&base, "inertiafromgeom", "auto"), value(&theirs, "inertiafromgeom", "auto"));
@@ -410,7 +619,7 @@ impl Document {
             }
             let (b, p) = (value(&base, attr, default), value(&theirs, attr, default));
             if !same_value(&b, &p) {
-                let at = theirs.get(attr).map(|(_, n)| *n).unwrap_or(part.root);
+                let at = theirs.get(attr).map(|(_, n)| n).unwrap_or(part.root);
                 errors.push(part.error_at(
                     at,
                     ErrorKind::Invalid(format!(
@@ -419,6 +628,8 @@ impl Document {
                 ));
             }
         }
+        let (ba, pa) = (value(&base, "autolimits", "true"), value(&theirs, "autolimits", "true"));
+        drop(theirs);
         if !errors.is_empty() {
             return;
         }
@@ -439,7 +650,6 @@ impl Document {
         if base_angles.degrees != part_angles.degrees {
             part.convert_angles(part_angles.degrees, base_angles.degrees);
         }
-        let (ba, pa) = (value(&base, "autolimits", "true"), value(&theirs, "autolimits", "true"));
         if ba != pa {
             part.make_limits_explicit(pa == "true");
         }
@@ -478,32 +688,32 @@ impl Document {
                 .collect::<Vec<_>>()
                 .join(" ")
         };
+        let s = syms();
         let nodes: Vec<Node> = self.descendants(self.root).collect();
         for n in nodes {
-            let tag = self.tag(n).to_string();
-            let mut edits: Vec<(&str, String)> = Vec::new();
-            if let Some(v) = self.attr(n, "euler") {
-                edits.push(("euler", convert(v, &|_| true)));
+            let mut edits: Vec<(Sym, String)> = Vec::new();
+            if let Some(v) = self.attr_sym(n, s.euler) {
+                edits.push((s.euler, convert(v, &|_| true)));
             }
-            if let Some(v) = self.attr(n, "axisangle") {
-                edits.push(("axisangle", convert(v, &|i| i == 3)));
+            if let Some(v) = self.attr_sym(n, s.axisangle) {
+                edits.push((s.axisangle, convert(v, &|i| i == 3)));
             }
-            let in_body = self.parent(n).is_some_and(|p| matches!(self.tag(p), "body" | "frame" | "replicate" | "worldbody"));
-            if tag == "joint" && in_body {
-                let ty = self.attr(n, "type").map(str::trim).unwrap_or("hinge");
+            if self.tag_sym(n) == Some(s.joint) && self.is_body_child(n) {
+                let ty = self.attr_sym(n, s.ty).map(str::trim).unwrap_or("hinge");
                 if ty == "hinge" || ty == "ball" {
-                    for a in ["range", "ref", "springref"] {
-                        if ty == "ball" && a != "range" {
+                    for a in [s.range, s.reference, s.springref] {
+                        if ty == "ball" && a != s.range {
                             continue;
                         }
-                        if let Some(v) = self.attr(n, a) {
+                        if let Some(v) = self.attr_sym(n, a) {
                             edits.push((a, convert(v, &|_| true)));
                         }
                     }
                 }
             }
             for (a, v) in edits {
-                self.set_attr(n, a, &v);
+                let value = self.push_str(&v);
+                self.set_attr_ref(n, a, value);
             }
         }
     }
@@ -580,7 +790,25 @@ impl Document {
     }
 
     /// Residual default classes of a part (see `defaults`): the same name must mean the same.
-    fn merge_residual_defaults(&mut self, part: &Document, section: Node, file_offset: u32, errors: &mut Vec<Error>) {
+    fn check_residual_defaults(&self, part: &Document, errors: &mut Vec<Error>) {
+        let Some(ours) = self.elements(self.root).find(|&n| self.tag(n) == "default") else { return };
+        for section in part.elements(part.root).filter(|&n| part.tag(n) == "default") {
+            for class in part.elements(section) {
+                let name = part.attr(class, "class").unwrap_or_default();
+                if let Some(c) = self.elements(ours).find(|&c| self.attr(c, "class") == Some(name)) {
+                    if !self.same_subtree(c, part, class) {
+                        errors.push(part.error_at(
+                            class,
+                            ErrorKind::Invalid(format!("default class '{name}' differs from the base's at {}", self.location(c))),
+                        ));
+                    }
+                }
+            }
+        }
+    }
+
+    /// Adds the part's residual classes the base does not have (checked beforehand).
+    fn merge_residual_defaults(&mut self, part: &Document, section: Node, file_offset: u32) {
         let existing = self.elements(self.root).find(|&n| self.tag(n) == "default");
         let dest = match existing {
             Some(d) => d,
@@ -594,21 +822,13 @@ impl Document {
                 d
             }
         };
-        let mut map = AHashMap::new();
+        let mut imp = Import::new(file_offset, false);
         for class in part.elements(section).collect::<Vec<_>>() {
-            let name = part.attr(class, "class").unwrap_or_default().to_string();
-            let existing = self.elements(dest).find(|&c| self.attr(c, "class") == Some(name.as_str()));
-            match existing {
-                Some(c) if self.same_subtree(c, part, class) => {}
-                Some(c) => errors.push(part.error_at(
-                    class,
-                    ErrorKind::Invalid(format!("default class '{name}' differs from the base's at {}", self.location(c))),
-                )),
-                None => {
-                    let n = self.import(part, class, file_offset, &mut map);
-                    self.tree.append(dest, n);
-                }
+            let name = part.attr(class, "class").unwrap_or_default();
+            if self.elements(dest).any(|c| self.attr(c, "class") == Some(name)) {
+                continue;
             }
+            self.import(part, class, dest, &mut imp);
         }
     }
 
@@ -631,36 +851,51 @@ impl Document {
     }
 
     /// The name of an asset: its `name`, else the one MuJoCo derives from its file.
-    fn asset_name(&self, n: Node) -> Option<String> {
-        self.attr(n, "name")
-            .map(str::to_string)
-            .or_else(|| self.attr(n, "file").and_then(|f| crate::prefix::name_from_file(self.tag(n), f)))
+    fn asset_name(&self, n: Node) -> Option<&str> {
+        let s = syms();
+        self.attr_sym(n, s.name).or_else(|| {
+            let tag = self.tag_sym(n)?;
+            let named = [s.mesh, s.texture, s.hfield, s.skin].contains(&tag);
+            self.attr_sym(n, s.file).filter(|_| named).and_then(crate::validate::file_stem)
+        })
     }
 
-    /// The base's assets by (tag, name).
-    fn asset_index(&self) -> AHashMap<(String, String), Node> {
-        let mut index = AHashMap::new();
+    /// For each asset of the part, in order: whether the base already has it (same tag,
+    /// name and content); an asset with a base name but other content is an error naming both.
+    fn asset_decisions(&self, part: &Document, errors: &mut Vec<Error>) -> Vec<bool> {
+        let Some(theirs) = part.find_section(Section::Asset) else { return Vec::new() };
+        let mut index: AHashMap<(Sym, &str), Node> = AHashMap::with_capacity(64);
         if let Some(assets) = self.find_section(Section::Asset) {
             for n in self.elements(assets) {
-                if let Some(name) = self.asset_name(n) {
-                    index.entry((self.tag(n).to_string(), name)).or_insert(n);
+                if let (Some(tag), Some(name)) = (self.tag_sym(n), self.asset_name(n)) {
+                    index.entry((tag, name)).or_insert(n);
                 }
             }
         }
-        index
+        part.elements(theirs)
+            .map(|a| match self.find_same_asset(&index, part, a) {
+                Some(Ok(_)) => true,
+                Some(Err(e)) => {
+                    errors.push(e);
+                    false
+                }
+                None => false,
+            })
+            .collect()
     }
 
     /// The base asset with the part asset's tag and name: `Ok` when the content is the same,
     /// an error naming both when it is not, `None` when there is none.
     fn find_same_asset(
         &self,
-        index: &AHashMap<(String, String), Node>,
+        index: &AHashMap<(Sym, &str), Node>,
         part: &Document,
         asset: Node,
     ) -> Option<Result<Node, Error>> {
         let tag = part.tag(asset);
         let name = part.asset_name(asset)?;
-        let same = *index.get(&(tag.to_string(), name.clone()))?;
+        let sym = crate::names::known(tag)?;
+        let same = *index.get(&(sym, name))?;
         if self.same_subtree(same, part, asset) {
             Some(Ok(same))
         } else {

@@ -7,7 +7,8 @@ use std::sync::OnceLock;
 use crate::document::{Document, Section};
 use crate::error::{Error, ErrorKind, Errors};
 use crate::geometry;
-use crate::merge::{MergeOptions, MergeReport};
+use crate::merge::MergeReport;
+use crate::names::{Sym, sym};
 use crate::tree::Node;
 use crate::vocab::Ns;
 
@@ -135,13 +136,9 @@ pub struct XmlModel {
     prefix: String,
     exclude: Vec<String>,
     root_body: String,
-    bodies: Vec<String>,
-    joints: Vec<String>,
-    actuators: Vec<String>,
-    sites: Vec<String>,
-    sensors: Vec<String>,
-    contact_geoms: Vec<String>,
-    visual_geoms: Vec<String>,
+    root: Node,
+    /// The semantic lists, read off the document on first use (and again after a merge).
+    lists: OnceLock<Lists>,
     important_geoms: BTreeMap<String, Vec<String>>,
     important_sites: BTreeMap<String, String>,
     important_sensors: BTreeMap<String, String>,
@@ -149,8 +146,90 @@ pub struct XmlModel {
     offsets: OnceLock<Result<Offsets, String>>,
 }
 
+/// The semantic lists of a model (names with their prefix).
+#[derive(Clone, Debug, Default)]
+struct Lists {
+    bodies: Vec<String>,
+    joints: Vec<String>,
+    actuators: Vec<String>,
+    sites: Vec<String>,
+    sensors: Vec<String>,
+    contact_geoms: Vec<String>,
+    visual_geoms: Vec<String>,
+}
+
+impl Lists {
+    /// Reads the lists off a document whose top-level body is `root`.
+    fn of(doc: &Document, root: Node) -> Lists {
+        let syms = Syms::get();
+        let mut l = Lists::default();
+        let name = |n: Node| doc.attr_sym(n, syms.name).map(str::to_string);
+        l.bodies.extend(name(root));
+        if let Some(world) = doc.find_section(Section::Worldbody) {
+            for n in doc.descendants(world) {
+                let Some(tag) = doc.tag_sym(n) else { continue };
+                let list = if tag == syms.body {
+                    if n == root {
+                        continue;
+                    }
+                    &mut l.bodies
+                } else if (tag == syms.joint || tag == syms.freejoint) && doc.is_body_child(n) {
+                    &mut l.joints
+                } else if tag == syms.site && doc.is_body_child(n) {
+                    &mut l.sites
+                } else if tag == syms.geom && doc.is_body_child(n) {
+                    match group_of(doc, n) {
+                        0 => &mut l.contact_geoms,
+                        1 => &mut l.visual_geoms,
+                        _ => continue,
+                    }
+                } else {
+                    continue;
+                };
+                list.extend(name(n));
+            }
+        }
+        for (section, list) in [(Section::Actuator, &mut l.actuators), (Section::Sensor, &mut l.sensors)] {
+            if let Some(s) = doc.find_section(section) {
+                list.extend(doc.elements(s).filter_map(name));
+            }
+        }
+        l
+    }
+}
+
 fn group_of(doc: &Document, geom: Node) -> i64 {
-    doc.attr(geom, "group").and_then(|g| g.trim().parse().ok()).unwrap_or(0)
+    doc.attr_sym(geom, Syms::get().group).and_then(|v| v.trim().parse().ok()).unwrap_or(0)
+}
+
+/// Names this module looks up often, interned once.
+struct Syms {
+    body: Sym,
+    joint: Sym,
+    freejoint: Sym,
+    site: Sym,
+    geom: Sym,
+    name: Sym,
+    group: Sym,
+    rgba: Sym,
+    material: Sym,
+}
+
+impl Syms {
+    fn get() -> &'static Syms {
+        static SYMS: OnceLock<Syms> = OnceLock::new();
+        SYMS.get_or_init(|| Syms {
+            body: sym("body"),
+            joint: sym("joint"),
+            freejoint: sym("freejoint"),
+            site: sym("site"),
+            geom: sym("geom"),
+            name: sym("name"),
+            group: sym("group"),
+            rgba: sym("rgba"),
+            material: sym("material"),
+        })
+    }
 }
 
 impl XmlModel {
@@ -180,60 +259,43 @@ impl XmlModel {
             )
             .into());
         }
-        // Body geoms (the ones MuJoCo lets carry a name), in document order.
-        let geoms: Vec<Node> = doc.descendants(world).filter(|&n| doc.tag(n) == "geom" && doc.is_body_child(n)).collect();
+        // One pass over the kinematic tree: the elements of each list, in document order
+        // (only those that are a body's own, as MuJoCo lets those carry a name).
+        let syms = Syms::get();
+        let root = roots[0];
+        let geoms: Vec<Node> = doc
+            .descendants(world)
+            .filter(|&n| doc.tag_sym(n) == Some(syms.geom) && doc.is_body_child(n))
+            .collect();
+        let groups: Vec<i64> = geoms.iter().map(|&g| group_of(&doc, g)).collect();
         if options.name_unnamed_geoms {
             let (mut col, mut vis) = (0, 0);
-            for &g in &geoms {
-                if doc.attr(g, "name").is_some() {
+            for (&g, &grp) in geoms.iter().zip(&groups) {
+                if doc.attr_sym(g, syms.name).is_some() {
                     continue;
                 }
-                match group_of(&doc, g) {
-                    0 => {
-                        doc.set_attr(g, "name", &format!("g{col}_col"));
-                        col += 1;
-                    }
-                    1 => {
-                        doc.set_attr(g, "name", &format!("g{vis}_vis"));
-                        vis += 1;
-                    }
-                    _ => {}
-                }
+                let name = match grp {
+                    0 => format!("g{col}_col"),
+                    1 => format!("g{vis}_vis"),
+                    _ => continue,
+                };
+                if grp == 0 { col += 1 } else { vis += 1 }
+                let value = doc.push_str(&name);
+                doc.set_attr_ref(g, syms.name, value);
             }
         }
         if let Some(rgba) = options.contact_geom_rgba {
-            let rgba = rgba.map(|x| format!("{x}")).join(" ");
-            for &g in &geoms {
-                if group_of(&doc, g) == 0 {
-                    doc.set_attr(g, "rgba", &rgba);
-                    doc.remove_attr(g, "material");
+            let value = doc.push_str(&rgba.map(|x| format!("{x}")).join(" "));
+            for (&g, &grp) in geoms.iter().zip(&groups) {
+                if grp == 0 {
+                    doc.set_attr_ref(g, syms.rgba, value);
+                    doc.remove_attr_sym(g, syms.material);
                 }
             }
         }
         let exclude = options.exclude_from_prefixing.clone();
         doc.apply_prefix_except(&prefix, |_, name| exclude.iter().any(|e| e == name))?;
 
-        let named = |doc: &Document, nodes: &mut dyn Iterator<Item = Node>| -> Vec<String> {
-            nodes.filter_map(|n| doc.attr(n, "name").map(str::to_string)).collect()
-        };
-        let world = doc.section(Section::Worldbody);
-        let root = doc.top_level_bodies(world)[0];
-        let bodies = named(&doc, &mut doc.descendants(root).filter(|&n| doc.tag(n) == "body"));
-        let joints = named(
-            &doc,
-            &mut doc.descendants(world).filter(|&n| matches!(doc.tag(n), "joint" | "freejoint") && doc.is_body_child(n)),
-        );
-        let sites = named(&doc, &mut doc.descendants(world).filter(|&n| doc.tag(n) == "site" && doc.is_body_child(n)));
-        let actuators = match doc.find_section(Section::Actuator) {
-            Some(s) => named(&doc, &mut doc.elements(s)),
-            None => Vec::new(),
-        };
-        let sensors = match doc.find_section(Section::Sensor) {
-            Some(s) => named(&doc, &mut doc.elements(s)),
-            None => Vec::new(),
-        };
-        let contact_geoms = named(&doc, &mut geoms.iter().copied().filter(|&g| group_of(&doc, g) == 0));
-        let visual_geoms = named(&doc, &mut geoms.iter().copied().filter(|&g| group_of(&doc, g) == 1));
         let root_body = doc.attr(root, "name").unwrap_or_default().to_string();
         let name = options
             .name
@@ -246,18 +308,17 @@ impl XmlModel {
             prefix,
             exclude: options.exclude_from_prefixing,
             root_body,
-            bodies,
-            joints,
-            actuators,
-            sites,
-            sensors,
-            contact_geoms,
-            visual_geoms,
+            root,
+            lists: OnceLock::new(),
             important_geoms: BTreeMap::new(),
             important_sites: BTreeMap::new(),
             important_sensors: BTreeMap::new(),
             offsets: OnceLock::new(),
         })
+    }
+
+    fn lists(&self) -> &Lists {
+        self.lists.get_or_init(|| Lists::of(&self.doc, self.root))
     }
 
     /// The instance's document (names prefixed).
@@ -349,19 +410,23 @@ impl XmlModel {
     /// Merges another instance into this one: into the world body, or into this model's
     /// body named `into` (a full, prefixed name). Lists grow by the other's.
     pub fn merge(&mut self, other: &XmlModel, into: Option<&str>, fuse_keys: bool) -> Result<MergeReport, Errors> {
-        let options = MergeOptions { fuse_keys, part_prefix: other.prefix.clone() };
-        let report = self.doc.merge(&other.doc, into, &options)?;
-        // The model's extent changed with the merge.
+        self.merge_all(&[(other, into)], fuse_keys)
+    }
+
+    /// Merges several instances in order (each into the world body or into a body of this
+    /// model), checking every name once up front (see [`Document::merge_all`]).
+    pub fn merge_all(&mut self, others: &[(&XmlModel, Option<&str>)], fuse_keys: bool) -> Result<MergeReport, Errors> {
+        let parts: Vec<crate::merge::MergePart<'_>> = others
+            .iter()
+            .map(|(m, into)| crate::merge::MergePart { doc: &m.doc, into: *into, prefix: &m.prefix })
+            .collect();
+        let report = self.doc.merge_all(&parts, fuse_keys)?;
+        // The model's extent and lists changed with the merge.
         self.offsets = OnceLock::new();
-        self.bodies.extend(other.bodies.iter().cloned());
-        self.joints.extend(other.joints.iter().cloned());
-        self.actuators.extend(other.actuators.iter().cloned());
-        self.sites.extend(other.sites.iter().cloned());
-        self.sensors.extend(other.sensors.iter().cloned());
-        self.contact_geoms.extend(other.contact_geoms.iter().cloned());
-        self.visual_geoms.extend(other.visual_geoms.iter().cloned());
+        self.lists = OnceLock::new();
         Ok(report)
     }
+
 }
 
 impl Document {
@@ -407,25 +472,25 @@ impl MujocoModel for XmlModel {
         &self.root_body
     }
     fn bodies(&self) -> &[String] {
-        &self.bodies
+        &self.lists().bodies
     }
     fn joints(&self) -> &[String] {
-        &self.joints
+        &self.lists().joints
     }
     fn actuators(&self) -> &[String] {
-        &self.actuators
+        &self.lists().actuators
     }
     fn sites(&self) -> &[String] {
-        &self.sites
+        &self.lists().sites
     }
     fn sensors(&self) -> &[String] {
-        &self.sensors
+        &self.lists().sensors
     }
     fn contact_geoms(&self) -> &[String] {
-        &self.contact_geoms
+        &self.lists().contact_geoms
     }
     fn visual_geoms(&self) -> &[String] {
-        &self.visual_geoms
+        &self.lists().visual_geoms
     }
     fn important_geoms(&self) -> &BTreeMap<String, Vec<String>> {
         &self.important_geoms
@@ -520,13 +585,13 @@ impl XmlModel {
             json_str(&self.name),
             json_str(&self.prefix),
             json_str(&self.root_body),
-            json_list(&self.bodies),
-            json_list(&self.joints),
-            json_list(&self.actuators),
-            json_list(&self.sites),
-            json_list(&self.sensors),
-            json_list(&self.contact_geoms),
-            json_list(&self.visual_geoms),
+            json_list(self.bodies()),
+            json_list(self.joints()),
+            json_list(self.actuators()),
+            json_list(self.sites()),
+            json_list(self.sensors()),
+            json_list(self.contact_geoms()),
+            json_list(self.visual_geoms()),
             maps(&self.important_sites),
             maps(&self.important_sensors),
             json_vec3(self.base_offset()),

@@ -15,8 +15,10 @@ use std::path::{Path, PathBuf};
 
 use crate::document::Document;
 use crate::error::Errors;
+use crate::names::{Sym, sym};
+use crate::schema::Kind;
 use crate::tree::Node;
-use crate::vocab::{self, AttrKind, ElementSpec};
+use crate::vocab::AttrKind;
 
 #[derive(Default)]
 struct Dirs {
@@ -29,7 +31,11 @@ struct Dirs {
 pub(crate) fn absolutize_paths(doc: &mut Document) -> Result<(), Errors> {
     let root = doc.root;
     let mut dirs = Dirs::default();
-    let compilers: Vec<Node> = doc.elements(root).filter(|&n| doc.tag(n) == "compiler").collect();
+    let compiler = Some(sym("compiler"));
+    let compilers: Vec<Node> = doc
+        .elements(root)
+        .filter(|&n| doc.tag_sym(n) == compiler)
+        .collect();
     for &c in &compilers {
         if let Some(a) = doc.attr(c, "assetdir") {
             dirs.mesh = Some(a.to_string());
@@ -45,12 +51,12 @@ pub(crate) fn absolutize_paths(doc: &mut Document) -> Result<(), Errors> {
             dirs.strip = s.trim() == "true";
         }
     }
-    let model_dir = doc.base_dir();
-    let mut edits: Vec<(Node, String, String)> = Vec::new();
-    let spec = vocab::root();
-    collect(doc, root, spec, &dirs, &model_dir, &mut edits);
-    for (node, name, value) in edits {
-        doc.set_attr(node, &name, &value);
+    let model_dir = doc.model_dir.clone();
+    let mut found = Found::default();
+    collect(doc, root, Kind::root(), &dirs, &model_dir, &mut found);
+    for &(node, name, start, end) in &found.edits {
+        let value = doc.push_str(&found.text[start as usize..end as usize]);
+        doc.set_attr_ref(node, name, value);
     }
     if dirs.strip {
         // The names are absolute now; stripping them again would undo that.
@@ -61,52 +67,98 @@ pub(crate) fn absolutize_paths(doc: &mut Document) -> Result<(), Errors> {
     Ok(())
 }
 
+/// The new values `collect` finds, in one buffer (no allocation per file reference).
+#[derive(Default)]
+struct Found {
+    /// (element, attribute, value range in `text`).
+    edits: Vec<(Node, Sym, u32, u32)>,
+    text: String,
+    /// Reused for resolving each reference.
+    path: PathBuf,
+}
+
 fn collect(
     doc: &Document,
     node: Node,
-    spec: &'static ElementSpec,
+    kind: Kind,
     dirs: &Dirs,
     model_dir: &Path,
-    edits: &mut Vec<(Node, String, String)>,
+    found: &mut Found,
 ) {
-    for (name, value) in doc.attrs(node) {
-        let Some(a) = spec.attr(name) else { continue };
-        if a.kind != AttrKind::File {
-            continue;
-        }
-        let folder = match spec.tag {
-            "texture" => dirs.texture.as_deref(),
-            "mesh" | "hfield" | "skin" | "flexcomp" => dirs.mesh.as_deref(),
-            _ => None,
-        };
-        let resolved = resolve(value, folder, dirs.strip, model_dir);
-        if resolved.as_os_str() != value {
-            edits.push((node, name.to_string(), resolved.to_string_lossy().into_owned()));
+    if kind.has_file_attrs() {
+        for a in doc.attr_slice(node) {
+            if kind
+                .attr(a.name)
+                .is_none_or(|spec| spec.kind != AttrKind::File)
+            {
+                continue;
+            }
+            let value = doc.str(a.value);
+            let folder = match kind.spec().tag {
+                "texture" => dirs.texture.as_deref(),
+                "mesh" | "hfield" | "skin" | "flexcomp" => dirs.mesh.as_deref(),
+                _ => None,
+            };
+            resolve_into(&mut found.path, value, folder, dirs.strip, model_dir);
+            if found.path.as_os_str() != value {
+                let start = found.text.len() as u32;
+                match found.path.to_str() {
+                    Some(s) => found.text.push_str(s),
+                    None => found.text.push_str(&found.path.to_string_lossy()),
+                }
+                found
+                    .edits
+                    .push((node, a.name, start, found.text.len() as u32));
+            }
         }
     }
-    for kid in doc.elements(node) {
-        if let Some(kspec) = vocab::child(spec, doc.tag(kid)) {
-            collect(doc, kid, kspec, dirs, model_dir, edits);
+    let mut next = doc.tree.first_child(node);
+    while let Some(kid) = next {
+        next = doc.tree.next_sibling(kid);
+        if let Some(kkind) = doc.tag_sym(kid).and_then(|t| kind.child(t)) {
+            // Sections like <sensor> or <actuator> cannot hold a file reference.
+            if kkind.reaches_file_attrs() {
+                collect(doc, kid, kkind, dirs, model_dir, found);
+            }
         }
     }
 }
 
+#[cfg(test)]
 fn resolve(file: &str, folder: Option<&str>, strip: bool, model_dir: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    resolve_into(&mut out, file, folder, strip, model_dir);
+    out
+}
+
+/// The absolute path of `file` into `out` (cleared first; reused across references).
+fn resolve_into(
+    out: &mut PathBuf,
+    file: &str,
+    folder: Option<&str>,
+    strip: bool,
+    model_dir: &Path,
+) {
+    out.as_mut_os_string().clear();
     let file = if strip {
         // MuJoCo strips both separators, whatever the platform.
         file.rsplit(['/', '\\']).next().unwrap_or(file)
     } else {
         file
     };
-    let file_path = Path::new(file);
-    if file_path.is_absolute() {
-        return file_path.to_path_buf();
+    if Path::new(file).is_absolute() {
+        out.push(file);
+        return;
     }
     match folder {
-        Some(f) if Path::new(f).is_absolute() => Path::new(f).join(file),
-        Some(f) => model_dir.join(f).join(file),
-        None => model_dir.join(file),
+        Some(f) if Path::new(f).is_absolute() => out.push(f),
+        Some(f) => {
+            out.push(model_dir);
+            out.push(f);
+        }
+        None => out.push(model_dir),
     }
+    out.push(file);
 }
 
 #[cfg(test)]
@@ -116,10 +168,22 @@ mod tests {
     #[test]
     fn resolves_like_mujoco() {
         let m = Path::new("/models");
-        assert_eq!(resolve("a.stl", Some("meshes"), false, m), Path::new("/models/meshes/a.stl"));
-        assert_eq!(resolve("a.stl", Some("/abs"), false, m), Path::new("/abs/a.stl"));
-        assert_eq!(resolve("/x/a.stl", Some("meshes"), false, m), Path::new("/x/a.stl"));
-        assert_eq!(resolve("sub/a.stl", Some("m"), true, m), Path::new("/models/m/a.stl"));
+        assert_eq!(
+            resolve("a.stl", Some("meshes"), false, m),
+            Path::new("/models/meshes/a.stl")
+        );
+        assert_eq!(
+            resolve("a.stl", Some("/abs"), false, m),
+            Path::new("/abs/a.stl")
+        );
+        assert_eq!(
+            resolve("/x/a.stl", Some("meshes"), false, m),
+            Path::new("/x/a.stl")
+        );
+        assert_eq!(
+            resolve("sub/a.stl", Some("m"), true, m),
+            Path::new("/models/m/a.stl")
+        );
         assert_eq!(resolve("a.png", None, false, m), Path::new("/models/a.png"));
     }
 }

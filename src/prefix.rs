@@ -53,11 +53,24 @@ pub(crate) fn name_from_file(tag: &str, file: &str) -> Option<String> {
     (!stem.is_empty()).then(|| stem.to_string())
 }
 
-/// One rename to apply: which node, which attribute, the new value.
-struct Edit {
-    node: Node,
-    name: Sym,
-    value: String,
+/// One rename to apply.
+enum Rename {
+    /// One name (an identifier or a reference): `old` is its text, trimmed.
+    One { node: Node, name: Sym, old: StrRef },
+    /// A space-separated list of names of one namespace.
+    List { node: Node, name: Sym, old: StrRef, ns: Ns },
+    /// An asset named after its file gets `prefix + stem` as its name.
+    Named { node: Node, stem: String },
+}
+
+/// The part of `r` (whose text is `text`) without surrounding white space.
+fn trimmed(text: &str, r: StrRef) -> StrRef {
+    let b = text.as_bytes();
+    if b.first().is_none_or(|c| !c.is_ascii_whitespace()) && b.last().is_none_or(|c| !c.is_ascii_whitespace()) {
+        return r;
+    }
+    let lead = text.len() - text.trim_start().len();
+    StrRef { start: r.start + lead as u32, len: text.trim().len() as u32 }
 }
 
 impl Document {
@@ -96,69 +109,60 @@ impl Document {
             return Ok(());
         }
         self.inline_skin_files()?;
-        let mut edits: Vec<Edit> = Vec::new();
+        // First find what to rename (no allocation per name), then write every new value
+        // straight into the string buffer.
+        let mut edits: Vec<Rename> = Vec::new();
         let mut stack: Vec<(Node, Kind)> = vec![(self.root, Kind::root())];
-        let rename = |ns: Ns, v: &str| -> Option<String> {
-            let v = v.trim();
-            if v.is_empty() || (ns == Ns::Body && v == "world") || keep(ns, v) {
-                None
-            } else {
-                Some(format!("{prefix}{v}"))
-            }
+        let renamed = |ns: Ns, v: &str| -> bool {
+            !v.is_empty() && !(ns == Ns::Body && v == "world") && !keep(ns, v)
         };
         while let Some((node, kind)) = stack.pop() {
             let mut has_name = false;
+            let naming = name_attrs(kind);
+            if naming.is_empty() && !kind.is_named_after_file() {
+                for kid in self.elements(node) {
+                    if let Some(k) = self.tag_sym(kid).and_then(|t| kind.child(t)) {
+                        stack.push((kid, k));
+                    }
+                }
+                continue;
+            }
             for a in self.attr_slice(node) {
-                let Some(spec) = kind.attr(a.name) else { continue };
-                let value = self.str(a.value);
-                let new = match spec.kind {
-                    AttrKind::Id(ns) => {
-                        has_name = true;
-                        rename(ns, value)
+                let Some(&(_, attr_kind)) = naming.iter().find(|(s, _)| *s == a.name) else { continue };
+                match attr_kind {
+                    AttrKind::Id(ns) | AttrKind::Ref(ns) => {
+                        has_name |= matches!(attr_kind, AttrKind::Id(_));
+                        let old = trimmed(self.str(a.value), a.value);
+                        if renamed(ns, self.str(old)) {
+                            edits.push(Rename::One { node, name: a.name, old });
+                        }
                     }
-                    AttrKind::Ref(ns) => rename(ns, value),
-                    AttrKind::RefList(ns) => {
-                        let tokens: Vec<String> = value
-                            .split_ascii_whitespace()
-                            .map(|t| rename(ns, t).unwrap_or_else(|| t.to_string()))
-                            .collect();
-                        Some(tokens.join(" "))
-                    }
+                    AttrKind::RefList(ns) => edits.push(Rename::List { node, name: a.name, old: a.value, ns }),
                     AttrKind::ObjType { name_attr } => {
-                        let target = crate::names::known(name_attr);
-                        let ns = ns_of_objtype(value);
-                        match (target, ns) {
-                            (Some(t), Some(ns)) => {
-                                if let Some(v) = self.attr_sym(node, t) {
-                                    if let Some(nv) = rename(ns, v) {
-                                        edits.push(Edit { node, name: t, value: nv });
-                                    }
+                        if let (Some(t), Some(ns)) = (crate::names::known(name_attr), ns_of_objtype(self.str(a.value))) {
+                            if let Some(r) = self.attr_ref(node, t) {
+                                let old = trimmed(self.str(r), r);
+                                if renamed(ns, self.str(old)) {
+                                    edits.push(Rename::One { node, name: t, old });
                                 }
                             }
-                            _ => {}
                         }
-                        None
                     }
-                    AttrKind::Plain | AttrKind::File | AttrKind::ObjName => None,
-                };
-                if let Some(value) = new {
-                    edits.push(Edit { node, name: a.name, value });
+                    AttrKind::Plain | AttrKind::File | AttrKind::ObjName => {}
                 }
             }
-            if !has_name {
+            if !has_name && kind.is_named_after_file() {
                 // An asset named after its file gets that name explicitly, prefixed.
                 let tag = self.tag(node);
-                if let Some(file) = self.attr(node, "file") {
-                    if let Some(stem) = name_from_file(tag, file) {
-                        let ns = match tag {
-                            "mesh" => Ns::Mesh,
-                            "texture" => Ns::Texture,
-                            "hfield" => Ns::Hfield,
-                            _ => Ns::Skin,
-                        };
-                        if let (Some(value), Some(name)) = (rename(ns, &stem), crate::names::known("name")) {
-                            edits.push(Edit { node, name, value });
-                        }
+                if let Some(stem) = self.attr(node, "file").and_then(|f| name_from_file(tag, f)) {
+                    let ns = match tag {
+                        "mesh" => Ns::Mesh,
+                        "texture" => Ns::Texture,
+                        "hfield" => Ns::Hfield,
+                        _ => Ns::Skin,
+                    };
+                    if renamed(ns, &stem) {
+                        edits.push(Rename::Named { node, stem });
                     }
                 }
             }
@@ -168,10 +172,72 @@ impl Document {
                 }
             }
         }
+        let name_sym = crate::names::sym("name");
+        self.strings.reserve(edits.len() * (prefix.len() + 24));
         for e in edits {
-            let value: StrRef = self.push_str(&e.value);
-            self.set_attr_ref(e.node, e.name, value);
+            let start = self.strings.len();
+            let (node, name) = match e {
+                Rename::One { node, name, old } => {
+                    self.strings.push_str(prefix);
+                    self.strings.extend_from_within(old.start as usize..(old.start + old.len) as usize);
+                    (node, name)
+                }
+                Rename::List { node, name, old, ns } => {
+                    let text = self.str(old).to_string();
+                    for (i, t) in text.split_ascii_whitespace().enumerate() {
+                        if i > 0 {
+                            self.strings.push(' ');
+                        }
+                        if renamed(ns, t) {
+                            self.strings.push_str(prefix);
+                        }
+                        self.strings.push_str(t);
+                    }
+                    (node, name)
+                }
+                Rename::Named { node, stem } => {
+                    self.strings.push_str(prefix);
+                    self.strings.push_str(&stem);
+                    (node, name_sym)
+                }
+            };
+            let value = StrRef { start: start as u32, len: (self.strings.len() - start) as u32 };
+            self.set_attr_ref(node, name, value);
         }
         Ok(())
     }
+}
+
+impl Document {
+    /// The value of an attribute, as a range of the string buffer.
+    fn attr_ref(&self, node: Node, name: Sym) -> Option<StrRef> {
+        self.attr_slice(node).iter().find(|a| a.name == name).map(|a| a.value)
+    }
+}
+
+impl Kind {
+    /// Whether MuJoCo names an unnamed element of this kind after its file.
+    fn is_named_after_file(self) -> bool {
+        matches!(self.spec().name, "mesh" | "texture" | "hfield" | "skin")
+    }
+}
+
+/// The attributes of a kind that hold names (identifiers, references, name lists, object
+/// types), computed once per kind.
+fn name_attrs(kind: Kind) -> &'static [(Sym, AttrKind)] {
+    static TABLE: std::sync::OnceLock<Vec<Vec<(Sym, AttrKind)>>> = std::sync::OnceLock::new();
+    let table = TABLE.get_or_init(|| {
+        (0..crate::vocab::elements().len())
+            .map(|i| {
+                Kind(i as u16)
+                    .spec()
+                    .attrs
+                    .iter()
+                    .filter(|a| !matches!(a.kind, AttrKind::Plain | AttrKind::File | AttrKind::ObjName))
+                    .filter_map(|a| crate::names::known(a.name).map(|s| (s, a.kind)))
+                    .collect()
+            })
+            .collect()
+    });
+    table.get(kind.0 as usize).map_or(&[], Vec::as_slice)
 }

@@ -1,4 +1,12 @@
-//! Reading: quick-xml events go straight into the arena; `<include>` is expanded on the way.
+//! Reading: the markup goes straight into the arena; `<include>` is expanded on the way.
+//!
+//! Two readers build the same document. [`Builder::parse_fast`] reads the markup that
+//! well-formed MJCF uses (elements, attributes, comments, processing instructions,
+//! character data without references) in one pass over the bytes, finding exactly what
+//! quick-xml finds there. Anything else, and every error, sends the whole load through
+//! [`Builder::parse`] on quick-xml's events, which handles all of XML and words the errors
+//! with their positions. `tests` below and the document judge hold the two to the same
+//! output; the fast one is what makes loading several times quicker.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -11,20 +19,411 @@ use crate::error::{Error, ErrorKind, Errors, Location};
 use crate::names::Names;
 use crate::tree::{Node, NodeData, Tree};
 
-/// Line starts of a source text, to turn byte offsets into line:col.
-struct Lines(Vec<usize>);
+/// Turns byte offsets of one source text into 1-based line:col. The reader asks for
+/// offsets in increasing order, so a cursor counts only the bytes in between; error paths
+/// use [`Lines::line_col`], which counts from the start.
+struct Lines<'a> {
+    text: &'a [u8],
+    /// Lines counted before `scanned` (1-based line of `scanned`).
+    line: u32,
+    /// Offset of the first byte of that line.
+    line_start: usize,
+    scanned: usize,
+}
 
-impl Lines {
-    fn new(text: &[u8]) -> Lines {
-        let mut starts = vec![0];
-        starts.extend(text.iter().enumerate().filter(|(_, b)| **b == b'\n').map(|(i, _)| i + 1));
-        Lines(starts)
+impl<'a> Lines<'a> {
+    fn new(text: &'a [u8]) -> Lines<'a> {
+        Lines {
+            text,
+            line: 1,
+            line_start: 0,
+            scanned: 0,
+        }
     }
 
+    /// The line and column of `offset`, moving the cursor there.
+    fn advance(&mut self, offset: usize) -> (u32, u32) {
+        if offset < self.scanned {
+            (self.line, self.line_start, self.scanned) = (1, 0, 0);
+        }
+        let end = offset.min(self.text.len());
+        if end > self.scanned {
+            let chunk = &self.text[self.scanned..end];
+            let n = count_newlines(chunk);
+            if n > 0 {
+                self.line += n as u32;
+                let last = chunk.iter().rposition(|&b| b == b'\n').unwrap_or(0);
+                self.line_start = self.scanned + last + 1;
+            }
+            self.scanned = end;
+        }
+        (self.line, (offset - self.line_start + 1) as u32)
+    }
+
+    /// The line and column of any offset, without the cursor (for error positions).
     fn line_col(&self, offset: usize) -> (u32, u32) {
-        let line = self.0.partition_point(|&s| s <= offset);
-        let col = offset - self.0[line - 1] + 1;
-        (line as u32, col as u32)
+        let before = &self.text[..offset.min(self.text.len())];
+        let line = 1 + count_newlines(before);
+        let start = before
+            .iter()
+            .rposition(|&b| b == b'\n')
+            .map_or(0, |i| i + 1);
+        (line as u32, (offset - start + 1) as u32)
+    }
+}
+
+/// The number of `\n` bytes. Counted in blocks of at most 255 bytes into a byte-wide sum,
+/// which compiles to a few vector instructions per 16 bytes (a plain count does not
+/// vectorise). Called once per tag, on the bytes since the last one.
+fn count_newlines(text: &[u8]) -> usize {
+    text.chunks(255)
+        .map(|block| usize::from(block.iter().fold(0u8, |n, &b| n + u8::from(b == b'\n'))))
+        .sum()
+}
+
+/// Whether character data is only white space (and so not kept). Most of it is ASCII
+/// indentation, checked bytewise before Unicode's wider definition.
+fn is_blank(text: &str) -> bool {
+    const LO: u64 = 0x0101_0101_0101_0101;
+    const SPACES: [u8; 4] = [b' ', b'\t', b'\n', b'\r'];
+    // Eight bytes at a time: blank when every byte matches one of the four.
+    let blank_word = |w: &[u8]| {
+        let w = u64::from_le_bytes(w.try_into().expect("8 bytes"));
+        SPACES
+            .iter()
+            .fold(0, |m, &c| m | exact_zero_bytes(w ^ (LO * u64::from(c))))
+            == LO << 7
+    };
+    let mut words = text.as_bytes().chunks_exact(8);
+    (words.all(blank_word) && words.remainder().iter().all(|b| SPACES.contains(b)))
+        || text.trim().is_empty()
+}
+
+/// XML white space, as quick-xml defines it.
+#[inline]
+fn is_xml_space(b: u8) -> bool {
+    // One bit per white-space byte below 33: no jump table, no branch.
+    const SPACES: u64 = 1 << b' ' | 1 << b'\t' | 1 << b'\n' | 1 << b'\r';
+    (b <= b' ') & (SPACES.wrapping_shr(u32::from(b)) & 1 != 0)
+}
+
+/// `part` (a slice quick-xml borrowed from the source) as a slice of `src`, the same source
+/// already checked to be UTF-8; `None` if it does not lie in `src` on character boundaries.
+fn sub_str<'s>(src: &'s str, part: &[u8]) -> Option<&'s str> {
+    let start = (part.as_ptr() as usize).checked_sub(src.as_ptr() as usize)?;
+    let s = src.get(start..start.checked_add(part.len())?)?;
+    std::ptr::eq(s.as_ptr(), part.as_ptr()).then_some(s)
+}
+
+/// Marks exactly the zero bytes of `x` (no false marks, unlike [`zero_bytes`]).
+fn exact_zero_bytes(x: u64) -> u64 {
+    const LO: u64 = 0x0101_0101_0101_0101;
+    let hi = LO << 7;
+    // Bytes with the high bit clear: adding 0x7f sets it unless the byte is zero.
+    !(((x & !hi).wrapping_add(!hi & (LO * 0x7f))) | x) & hi
+}
+
+/// Marks the zero bytes of `x`: the lowest marked byte is the first zero byte exactly
+/// (higher marks can be false, from the borrow), and no mark means no zero byte.
+fn zero_bytes(x: u64) -> u64 {
+    const LO: u64 = 0x0101_0101_0101_0101;
+    x.wrapping_sub(LO) & !x & (LO << 7)
+}
+
+/// The offset of the first `quote` in `value`, and whether an `&` or a newline comes
+/// before it. Eight bytes at a time: attribute values are most of a model's bytes.
+fn find_quote(value: &[u8], quote: u8) -> Option<(usize, bool)> {
+    const LO: u64 = 0x0101_0101_0101_0101;
+    let (q, amp, nl) = (
+        LO * u64::from(quote),
+        LO * u64::from(b'&'),
+        LO * u64::from(b'\n'),
+    );
+    let mut unusual = false;
+    let mut words = value.chunks_exact(8);
+    let mut at = 0;
+    for w in &mut words {
+        let w = u64::from_le_bytes(w.try_into().expect("8 bytes"));
+        // Each mask's lowest mark is exact, so the lowest of the two is.
+        let (mq, mu) = (zero_bytes(w ^ q), zero_bytes(w ^ amp) | zero_bytes(w ^ nl));
+        if mq != 0 {
+            let end = mq.trailing_zeros();
+            unusual |= mu != 0 && mu.trailing_zeros() < end;
+            return Some((at + end as usize / 8, unusual));
+        }
+        unusual |= mu != 0;
+        at += 8;
+    }
+    for (i, &b) in words.remainder().iter().enumerate() {
+        if b == quote {
+            return Some((at + i, unusual));
+        }
+        unusual |= b == b'&' || b == b'\n';
+    }
+    None
+}
+
+/// The offset of the first byte of `bytes` that is one of `needles`, eight bytes at a time.
+fn find_any<const N: usize>(bytes: &[u8], needles: [u8; N]) -> Option<usize> {
+    const LO: u64 = 0x0101_0101_0101_0101;
+    let mut words = bytes.chunks_exact(8);
+    let mut at = 0;
+    for w in &mut words {
+        let w = u64::from_le_bytes(w.try_into().expect("8 bytes"));
+        // Each mask's lowest mark is its needle's first place, so the lowest of all is.
+        let marks = needles
+            .iter()
+            .fold(0, |m, &n| m | zero_bytes(w ^ (LO * u64::from(n))));
+        if marks != 0 {
+            return Some(at + marks.trailing_zeros() as usize / 8);
+        }
+        at += 8;
+    }
+    words
+        .remainder()
+        .iter()
+        .position(|b| needles.contains(b))
+        .map(|i| at + i)
+}
+
+/// The line of the reading position in [`Builder::parse_fast`], kept up to date as the
+/// reader passes over newlines.
+struct LineCursor {
+    line: u32,
+    /// Offset of the line's first byte.
+    start: usize,
+}
+
+impl LineCursor {
+    /// The span of `offset`, which must be on the cursor's line.
+    #[inline]
+    fn span(&self, file: u32, offset: usize) -> Span {
+        Span {
+            file,
+            line: self.line,
+            col: (offset - self.start + 1) as u32,
+        }
+    }
+
+    /// Moves over `bytes[from..to]`.
+    #[inline]
+    fn pass(&mut self, bytes: &[u8], from: usize, to: usize) {
+        let region = &bytes[from..to];
+        let n = count_newlines(region);
+        if n > 0 {
+            self.line += n as u32;
+            self.start = from + region.iter().rposition(|&b| b == b'\n').unwrap_or(0) + 1;
+        }
+    }
+
+    /// Moves over one white-space byte at `offset`.
+    #[inline]
+    fn pass_space(&mut self, b: u8, offset: usize) {
+        if b == b'\n' {
+            self.line += 1;
+            self.start = offset + 1;
+        }
+    }
+}
+
+/// A start tag found by [`scan_start_tag`]; offsets into the source.
+struct StartTag {
+    /// The `>` that ends the tag.
+    gt: usize,
+    /// The end of the tag's content (before `/>` for an empty element).
+    content_end: usize,
+    name_len: usize,
+    is_empty: bool,
+}
+
+/// Bytes that end a start tag's name or an attribute key in [`scan_start_tag`].
+const NAME_END: [bool; 256] = {
+    let mut t = [false; 256];
+    let ends = *b"= \t\n\r>/\"'";
+    let mut i = 0;
+    while i < ends.len() {
+        t[ends[i] as usize] = true;
+        i += 1;
+    }
+    t
+};
+
+/// The end of the name or key starting at `i`: the first [`NAME_END`] byte. Those are all
+/// below `@`, as are few name bytes (digits, `-`, `.`), so eight bytes at a time are
+/// passed over when none is below `@`.
+#[inline]
+fn name_end(bytes: &[u8], mut i: usize) -> usize {
+    const LO: u64 = 0x0101_0101_0101_0101;
+    while let Some(w) = bytes.get(i..i + 8) {
+        let w = u64::from_le_bytes(w.try_into().expect("8 bytes"));
+        // The lowest mark is exactly the first byte below `@` (higher ones may be false).
+        let below = w.wrapping_sub(LO * 0x40) & !w & (LO << 7);
+        if below == 0 {
+            i += 8;
+            continue;
+        }
+        i += below.trailing_zeros() as usize / 8;
+        if NAME_END[bytes[i] as usize] {
+            return i;
+        }
+        i += 1;
+    }
+    while i < bytes.len() && !NAME_END[bytes[i] as usize] {
+        i += 1;
+    }
+    i
+}
+
+/// Reads the start tag whose content begins at `from` (after `<`) in one pass, with its
+/// attributes into `spans` (offsets from `from`), for tags whose names and keys hold no
+/// quote, `=`, `>` or `/`. For those, quotes appear only around values, so the `>` found
+/// here is the one quick-xml's `ElementParser` finds (the first outside quotes), and the
+/// attributes are what [`scan_attrs`] finds in that content; anything else is `None`.
+fn scan_start_tag(
+    bytes: &[u8],
+    from: usize,
+    spans: &mut Vec<AttrSpan>,
+    at: &mut LineCursor,
+) -> Option<StartTag> {
+    spans.clear();
+    let n = bytes.len();
+    // Names and keys hold no newline (it ends them); white space and values may.
+    let mut i = name_end(bytes, from);
+    let name_len = i - from;
+    loop {
+        while i < n && is_xml_space(bytes[i]) {
+            at.pass_space(bytes[i], i);
+            i += 1;
+        }
+        match *bytes.get(i)? {
+            b'>' => {
+                return Some(StartTag {
+                    gt: i,
+                    content_end: i,
+                    name_len,
+                    is_empty: false,
+                });
+            }
+            b'/' if bytes.get(i + 1) == Some(&b'>') => {
+                return Some(StartTag {
+                    gt: i + 1,
+                    content_end: i,
+                    name_len,
+                    is_empty: true,
+                });
+            }
+            b'/' | b'"' | b'\'' | b'=' => return None,
+            _ => {}
+        }
+        if i == from + name_len {
+            return None; // a name ended by something other than white space
+        }
+        let key_start = i;
+        i = name_end(bytes, i);
+        let key_end = i;
+        while i < n && is_xml_space(bytes[i]) {
+            at.pass_space(bytes[i], i);
+            i += 1;
+        }
+        if bytes.get(i) != Some(&b'=') {
+            return None;
+        }
+        i += 1;
+        while i < n && is_xml_space(bytes[i]) {
+            at.pass_space(bytes[i], i);
+            i += 1;
+        }
+        let quote = *bytes.get(i)?;
+        if quote != b'"' && quote != b'\'' {
+            return None;
+        }
+        let value_start = i + 1;
+        let (len, unusual) = find_quote(&bytes[value_start..], quote)?;
+        i = value_start + len;
+        // Rare: a reference to expand, or a newline to count.
+        let has_ref = unusual && bytes[value_start..i].contains(&b'&');
+        if unusual {
+            at.pass(bytes, value_start, i);
+        }
+        spans.push(AttrSpan {
+            key: ((key_start - from) as u32, (key_end - from) as u32),
+            value: ((value_start - from) as u32, (i - from) as u32),
+            has_ref,
+        });
+        i += 1;
+    }
+}
+
+/// One attribute of a start tag, as byte ranges of the tag's content.
+#[derive(Clone, Copy)]
+struct AttrSpan {
+    key: (u32, u32),
+    value: (u32, u32),
+    /// The value holds `&` (an entity or character reference to expand).
+    has_ref: bool,
+}
+
+/// Bytes that end an attribute key: `=` and XML white space.
+const KEY_END: [bool; 256] = {
+    let mut t = [false; 256];
+    t[b'=' as usize] = true;
+    t[b' ' as usize] = true;
+    t[b'\t' as usize] = true;
+    t[b'\n' as usize] = true;
+    t[b'\r' as usize] = true;
+    t
+};
+
+/// The attributes of a start tag's content from `from` on, found the way quick-xml's
+/// attribute iterator finds them in XML mode (same white space, same key and quote rules).
+/// `false` for anything quick-xml would report as an error: the caller then takes
+/// quick-xml's path, which words the error.
+fn scan_attrs(content: &[u8], from: usize, out: &mut Vec<AttrSpan>) -> bool {
+    out.clear();
+    let mut i = from;
+    let n = content.len();
+    loop {
+        while i < n && is_xml_space(content[i]) {
+            i += 1;
+        }
+        if i == n {
+            return true;
+        }
+        let key_start = i;
+        // Like quick-xml, the key's first byte is taken whatever it is (even `=`).
+        i += 1;
+        while i < n && !KEY_END[content[i] as usize] {
+            i += 1;
+        }
+        let key_end = i;
+        while i < n && is_xml_space(content[i]) {
+            i += 1;
+        }
+        if i == n || content[i] != b'=' {
+            return false;
+        }
+        i += 1;
+        while i < n && is_xml_space(content[i]) {
+            i += 1;
+        }
+        if i == n {
+            return false;
+        }
+        let quote = content[i];
+        if quote != b'"' && quote != b'\'' {
+            return false;
+        }
+        let value_start = i + 1;
+        let Some((len, has_ref)) = find_quote(&content[value_start..], quote) else {
+            return false;
+        };
+        i = value_start + len;
+        out.push(AttrSpan {
+            key: (key_start as u32, key_end as u32),
+            value: (value_start as u32, i as u32),
+            has_ref,
+        });
+        i += 1;
     }
 }
 
@@ -39,22 +438,51 @@ struct Builder {
     seen: Vec<PathBuf>,
     /// The main file's folder as the user named it: included files are shown under it.
     display_dir: PathBuf,
+    /// The main file's absolute path until its canonical path is needed: that takes a
+    /// system call per path component, and only `<include>` needs it.
+    main_to_canonicalize: Option<PathBuf>,
+    /// Character data gathered across text and entity events (reused buffer).
+    pending_text: String,
+    /// Attribute spans of the tag being read (reused buffer).
+    attr_spans: Vec<AttrSpan>,
+    /// For `parse_fast`: the open elements' name ranges in their source (reused buffer).
+    open_names: Vec<(u32, u32)>,
 }
 
 pub(crate) fn read_file(path: &Path) -> Result<Document, Errors> {
     let bytes = std::fs::read(path).map_err(|e| {
-        Error::bare(ErrorKind::Io { path: path.to_path_buf(), reason: e.to_string() })
+        Error::bare(ErrorKind::Io {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        })
     })?;
     let abs = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
-    let dir = abs.parent().map(Path::to_path_buf).unwrap_or_default();
-    let canonical = std::fs::canonicalize(path).unwrap_or(abs);
-    let display_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    read_bytes(&bytes, Arc::from(path), &dir, &display_dir, Some(canonical))
+    let dir = abs.parent().unwrap_or(Path::new(""));
+    let display_dir = path.parent().unwrap_or(Path::new(""));
+    read_bytes(
+        &bytes,
+        Arc::from(path),
+        dir,
+        display_dir,
+        Main::File { abs: abs.clone() },
+    )
 }
 
 pub(crate) fn read_str(xml: &str, base_dir: &Path) -> Result<Document, Errors> {
     let dir = std::path::absolute(base_dir).unwrap_or_else(|_| base_dir.to_path_buf());
-    read_bytes(xml.as_bytes(), Arc::from(Path::new("<string>")), &dir, base_dir, None)
+    read_bytes(
+        xml.as_bytes(),
+        Arc::from(Path::new("<string>")),
+        &dir,
+        base_dir,
+        Main::Text,
+    )
+}
+
+/// Where the main text came from: a file (which takes part in include cycles) or a string.
+enum Main {
+    File { abs: PathBuf },
+    Text,
 }
 
 fn read_bytes(
@@ -62,45 +490,94 @@ fn read_bytes(
     name: Arc<Path>,
     dir: &Path,
     display_dir: &Path,
-    canonical: Option<PathBuf>,
+    main: Main,
 ) -> Result<Document, Errors> {
-    let mut tree = Tree::with_capacity(bytes.len() / 40 + 16);
-    let placeholder = tree.new_node(NodeData::Text {
-        text: crate::tree::StrRef { start: 0, len: 0 },
-        cdata: false,
-    });
-    let mut b = Builder {
-        doc: Document {
-            tree,
-            root: placeholder,
-            attrs: Vec::with_capacity(bytes.len() / 20),
-            strings: String::with_capacity(bytes.len() / 2),
-            spans: Vec::with_capacity(bytes.len() / 40 + 16),
-            files: Arc::new(Vec::new()),
-            names: Names::default(),
-            model_dir: Arc::from(dir),
-        },
-        files: vec![SourceFile { path: name.clone(), included_at: None }],
-        chain: canonical.iter().cloned().collect(),
-        chain_display: vec![name.to_path_buf()],
-        seen: canonical.into_iter().collect(),
-        display_dir: display_dir.to_path_buf(),
-    };
-    b.doc.spans.push(Span::default());
-    b.parse(bytes, 0, None)?;
-    let mut doc = b.doc;
-    doc.files = Arc::new(b.files);
-    if doc.root == placeholder {
-        return Err(Error::at(
-            Location::new(doc.files[0].path.clone(), 1, 1),
-            ErrorKind::NotMjcf("no root element".into()),
-        )
-        .into());
+    read_bytes_with(bytes, name, dir, display_dir, main, true)
+}
+
+fn read_bytes_with(
+    bytes: &[u8],
+    name: Arc<Path>,
+    dir: &Path,
+    display_dir: &Path,
+    main: Main,
+    try_fast: bool,
+) -> Result<Document, Errors> {
+    let model_dir: Arc<Path> = Arc::from(dir);
+    // Models are read by `Builder::parse_fast` when it can; anything outside what it handles
+    // (and every error) sends the whole load, includes and all, through quick-xml.
+    if let Some(src) = std::str::from_utf8(bytes).ok().filter(|_| try_fast) {
+        let mut b = Builder::new(bytes.len(), &name, &model_dir, display_dir, &main);
+        if b.parse_fast(src, 0, None).is_some() {
+            return b.finish();
+        }
     }
-    Ok(doc)
+    let mut b = Builder::new(bytes.len(), &name, &model_dir, display_dir, &main);
+    b.parse(bytes, 0, None)?;
+    b.finish()
 }
 
 impl Builder {
+    fn new(
+        size: usize,
+        name: &Arc<Path>,
+        model_dir: &Arc<Path>,
+        display_dir: &Path,
+        main: &Main,
+    ) -> Builder {
+        // Sized from the robosuite and dm_control models (about 100 bytes of XML per node,
+        // 15 per attribute once defaults are inlined, 0.55 bytes of values per byte), so
+        // that loading seldom grows a table.
+        let mut tree = Tree::with_capacity(size / 80 + 16);
+        let placeholder = tree.new_node(NodeData::Text {
+            text: crate::tree::StrRef { start: 0, len: 0 },
+            cdata: false,
+        });
+        let mut spans = Vec::with_capacity(size / 80 + 16);
+        spans.push(Span::default());
+        Builder {
+            doc: Document {
+                tree,
+                root: placeholder,
+                attrs: Vec::with_capacity(size / 12 + 16),
+                strings: String::with_capacity(size / 2 + size / 8),
+                spans,
+                files: Arc::new(Vec::new()),
+                names: Names::default(),
+                model_dir: model_dir.clone(),
+            },
+            files: vec![SourceFile {
+                path: name.clone(),
+                included_at: None,
+            }],
+            chain: Vec::new(),
+            chain_display: vec![name.to_path_buf()],
+            seen: Vec::new(),
+            display_dir: display_dir.to_path_buf(),
+            main_to_canonicalize: match main {
+                Main::File { abs } => Some(abs.clone()),
+                Main::Text => None,
+            },
+            pending_text: String::new(),
+            attr_spans: Vec::new(),
+            open_names: Vec::new(),
+        }
+    }
+
+    fn finish(self) -> Result<Document, Errors> {
+        let mut doc = self.doc;
+        doc.files = Arc::new(self.files);
+        // The placeholder (node 0) stays the root when the text had no root element.
+        if Tree::index(doc.root) == 0 {
+            return Err(Error::at(
+                Location::new(doc.files[0].path.clone(), 1, 1),
+                ErrorKind::NotMjcf("no root element".into()),
+            )
+            .into());
+        }
+        Ok(doc)
+    }
+
     fn loc(&self, file: u32, line: u32, col: u32) -> Location {
         let mut loc = Location::new(self.files[file as usize].path.clone(), line, col);
         let mut at = self.files[file as usize].included_at;
@@ -118,34 +595,42 @@ impl Builder {
     /// is dropped, its children inserted in the include's place). Returns how many elements
     /// were inserted under `parent`.
     fn parse(&mut self, bytes: &[u8], file: u32, parent: Option<Node>) -> Result<usize, Errors> {
-        let lines = Lines::new(bytes);
+        let mut lines = Lines::new(bytes);
+        // Checked once here, the text lets tags, attribute values and character data be
+        // taken as slices below without checking each piece again; text that is not UTF-8
+        // takes quick-xml's decoding path, which reports where.
+        let src = std::str::from_utf8(bytes).ok();
         let mut reader = Reader::from_reader(bytes);
         reader.config_mut().check_end_names = true;
         // Open elements; `None` marks the dropped root of an included file, or an include.
         let mut stack: Vec<Option<Node>> = Vec::new();
         let mut inserted = 0usize;
         let mut seen_root = false;
-        // Character data is gathered across text and entity events, then kept only if it
-        // is more than white space.
-        let mut pending: Option<(Node, String, Span)> = None;
+        // Character data is gathered across text and entity events (in `pending_text`),
+        // then kept only if it is more than white space.
+        let mut pending: Option<(Node, Span)> = None;
+        self.pending_text.clear();
         loop {
             let offset = reader.buffer_position() as usize;
             let event = reader.read_event().map_err(|e| {
                 let (line, col) = lines.line_col(reader.error_position() as usize);
                 Error::at(self.loc(file, line, col), ErrorKind::Syntax(e.to_string()))
             })?;
-            let (line, col) = lines.line_col(offset);
-            let span = Span { file, line, col };
-            if !matches!(event, Event::Text(_) | Event::GeneralRef(_)) {
-                if let Some((host, text, at)) = pending.take() {
-                    if !text.trim().is_empty() {
-                        self.text(host, &text, false, at);
-                    }
+            if !matches!(event, Event::Text(_) | Event::GeneralRef(_))
+                && let Some((host, at)) = pending.take()
+            {
+                let text = std::mem::take(&mut self.pending_text);
+                if !is_blank(&text) {
+                    self.text(host, &text, false, at);
                 }
+                self.pending_text = text;
+                self.pending_text.clear();
             }
             let is_empty = matches!(event, Event::Empty(_));
             match event {
                 Event::Start(e) | Event::Empty(e) => {
+                    let (line, col) = lines.advance(offset);
+                    let span = Span { file, line, col };
                     let current = stack.last().copied();
                     let node = if stack.is_empty() {
                         if seen_root {
@@ -158,7 +643,14 @@ impl Builder {
                         seen_root = true;
                         match parent {
                             None => {
-                                let n = self.element(&e, span, &reader, &lines, offset)?;
+                                let n = match src.and_then(|src| sub_str(src, &e)) {
+                                    Some(content) => self.element_fast(content, span, None),
+                                    None => None,
+                                };
+                                let n = match n {
+                                    Some(n) => n,
+                                    None => self.element(&e, span, &reader, &lines, offset)?,
+                                };
                                 if self.doc.tag(n) != "mujoco" {
                                     return Err(Error::at(
                                         self.loc(file, line, col),
@@ -190,8 +682,18 @@ impl Builder {
                                 None
                             }
                             Some(host) => {
-                                let n = self.element(&e, span, &reader, &lines, offset)?;
-                                self.doc.tree.append(host, n);
+                                let fast = match src.and_then(|src| sub_str(src, &e)) {
+                                    Some(content) => self.element_fast(content, span, Some(host)),
+                                    None => None,
+                                };
+                                let n = match fast {
+                                    Some(n) => n,
+                                    None => {
+                                        let n = self.element(&e, span, &reader, &lines, offset)?;
+                                        self.doc.tree.append(host, n);
+                                        n
+                                    }
+                                };
                                 if Some(host) == parent {
                                     inserted += 1;
                                 }
@@ -213,33 +715,53 @@ impl Builder {
                 }
                 Event::Text(t) => {
                     if let Some(Some(host)) = stack.last() {
-                        let raw = t.decode().map_err(|e| {
-                            Error::at(self.loc(file, line, col), ErrorKind::Syntax(e.to_string()))
-                        })?;
-                        let text = quick_xml::escape::unescape(&raw).map_err(|e| {
-                            Error::at(self.loc(file, line, col), ErrorKind::Syntax(e.to_string()))
-                        })?;
-                        pending.get_or_insert_with(|| (*host, String::new(), span)).1.push_str(&text);
+                        if pending.is_none() {
+                            let (line, col) = lines.advance(offset);
+                            pending = Some((*host, Span { file, line, col }));
+                        }
+                        match src.and_then(|src| sub_str(src, &t)) {
+                            Some(raw) if !raw.contains('&') => self.pending_text.push_str(raw),
+                            _ => {
+                                let (line, col) = lines.line_col(offset);
+                                let raw = t.decode().map_err(|e| {
+                                    Error::at(
+                                        self.loc(file, line, col),
+                                        ErrorKind::Syntax(e.to_string()),
+                                    )
+                                })?;
+                                let text = quick_xml::escape::unescape(&raw).map_err(|e| {
+                                    Error::at(
+                                        self.loc(file, line, col),
+                                        ErrorKind::Syntax(e.to_string()),
+                                    )
+                                })?;
+                                self.pending_text.push_str(&text);
+                            }
+                        }
                     }
                 }
                 Event::GeneralRef(r) => {
                     if let Some(Some(host)) = stack.last() {
+                        let (line, col) = lines.advance(offset);
                         let name = r.decode().unwrap_or_default();
                         let entity = format!("&{name};");
                         let text = quick_xml::escape::unescape(&entity).map_err(|e| {
                             Error::at(self.loc(file, line, col), ErrorKind::Syntax(e.to_string()))
                         })?;
-                        pending.get_or_insert_with(|| (*host, String::new(), span)).1.push_str(&text);
+                        pending.get_or_insert((*host, Span { file, line, col }));
+                        self.pending_text.push_str(&text);
                     }
                 }
                 Event::CData(t) => {
                     if let Some(Some(host)) = stack.last() {
+                        let (line, col) = lines.advance(offset);
                         let text = String::from_utf8_lossy(&t).into_owned();
-                        self.text(*host, &text, true, span);
+                        self.text(*host, &text, true, Span { file, line, col });
                     }
                 }
                 Event::Eof => {
                     if !stack.is_empty() {
+                        let (line, col) = lines.advance(offset);
                         return Err(Error::at(
                             self.loc(file, line, col),
                             ErrorKind::Syntax("unexpected end of file: unclosed element".into()),
@@ -262,26 +784,272 @@ impl Builder {
         Ok(inserted)
     }
 
-    fn text(&mut self, host: Node, text: &str, cdata: bool, span: Span) {
-        // Adjacent runs (text split by entity references) are joined into one node.
-        if !cdata {
-            let last = self.doc.tree.children(host).last();
-            if let Some(last) = last {
-                if let NodeData::Text { text: r, cdata: false } = *self.doc.tree.data(last) {
-                    if (r.start + r.len) as usize == self.doc.strings.len() {
-                        self.doc.strings.push_str(text);
-                        if let NodeData::Text { text: r, .. } = self.doc.tree.data_mut(last) {
-                            r.len += text.len() as u32;
-                        }
-                        return;
+    /// Reads one file like [`Builder::parse`] does, for the markup well-formed MJCF uses:
+    /// elements, attributes without errors, character data without references, comments,
+    /// processing instructions. It finds what quick-xml finds (tag ends outside quotes,
+    /// comment and instruction ends, attribute rules) and builds the same nodes, without
+    /// events in between. `None` as soon as anything else (a CDATA section, an entity, a
+    /// mismatched end tag, any error) comes up: the caller starts the load over through
+    /// [`Builder::parse`], which handles everything and words the errors.
+    fn parse_fast(&mut self, src: &str, file: u32, parent: Option<Node>) -> Option<usize> {
+        let bytes = src.as_bytes();
+        if bytes.starts_with(b"\xEF\xBB\xBF") {
+            return None; // a byte order mark: quick-xml skips it
+        }
+        // Lines are counted as the markup is read: each byte is looked at once.
+        let mut at = LineCursor { line: 1, start: 0 };
+        // As in `parse`, with each open element's name (for its end tag) alongside.
+        let mut stack: Vec<Option<Node>> = Vec::with_capacity(32);
+        let mut names = std::mem::take(&mut self.open_names);
+        names.clear();
+        let mut inserted = 0usize;
+        let mut pos = 0;
+        let done = loop {
+            let lt = pos + find_any(&bytes[pos..], [b'<', b'&'])?;
+            if bytes[lt] == b'&' {
+                break None; // a reference: quick-xml's events
+            }
+            // Without references, character data is one run per gap between markup: kept
+            // (where `parse` would keep it) unless it is only white space.
+            if lt > pos {
+                if let Some(Some(host)) = stack.last() {
+                    let text = src.get(pos..lt)?;
+                    if !is_blank(text) {
+                        self.text(*host, text, false, at.span(file, pos));
                     }
                 }
+                at.pass(bytes, pos, lt);
             }
+            match *bytes.get(lt + 1)? {
+                b'!' => {
+                    // Only comments. quick-xml ends one at the first `>` after `--` that is
+                    // at least five bytes past the `!` (`<!---->` is the shortest).
+                    if !bytes[lt + 1..].starts_with(b"!--") {
+                        break None;
+                    }
+                    let mut gt = lt + 6;
+                    loop {
+                        gt += find_any(bytes.get(gt..)?, [b'>'])?;
+                        if bytes[gt - 2..gt] == *b"--" {
+                            break;
+                        }
+                        gt += 1;
+                    }
+                    at.pass(bytes, lt, gt);
+                    pos = gt + 1;
+                }
+                b'?' => {
+                    // Ends at the first `?>` after `<`; `<?>` is quick-xml's error.
+                    let mut gt = lt + 2;
+                    loop {
+                        gt += find_any(&bytes[gt..], [b'>'])?;
+                        if bytes[gt - 1] == b'?' {
+                            break;
+                        }
+                        gt += 1;
+                    }
+                    if gt - (lt + 1) <= 1 {
+                        break None;
+                    }
+                    at.pass(bytes, lt, gt);
+                    pos = gt + 1;
+                }
+                b'/' => {
+                    let gt = lt + 2 + find_any(&bytes[lt + 2..], [b'>', b'"', b'\''])?;
+                    if bytes[gt] != b'>' {
+                        break None; // quick-xml reads quotes in end tags
+                    }
+                    let end = &bytes[lt + 2..gt];
+                    // quick-xml trims white space after the name (all of it stays if that is all).
+                    let end = &end[..end
+                        .iter()
+                        .rposition(|&b| !is_xml_space(b))
+                        .map_or(end.len(), |i| i + 1)];
+                    let (start, len) = names.pop()?;
+                    if end != &bytes[start as usize..(start + len) as usize] {
+                        break None;
+                    }
+                    stack.pop();
+                    if stack.is_empty() {
+                        break Some(inserted);
+                    }
+                    at.pass(bytes, lt, gt);
+                    pos = gt + 1;
+                }
+                _ => {
+                    let span = at.span(file, lt);
+                    let mut spans = std::mem::take(&mut self.attr_spans);
+                    let tag = scan_start_tag(bytes, lt + 1, &mut spans, &mut at);
+                    self.attr_spans = spans;
+                    let StartTag {
+                        gt,
+                        content_end,
+                        name_len,
+                        is_empty,
+                    } = tag?;
+                    let content = src.get(lt + 1..content_end)?;
+                    let current = stack.last().copied();
+                    let node = if stack.is_empty() {
+                        match parent {
+                            None => {
+                                let n = self.commit_scanned(content, name_len, span, None)?;
+                                if self.doc.tag(n) != "mujoco" {
+                                    break None;
+                                }
+                                self.doc.root = n;
+                                Some(n)
+                            }
+                            Some(_) => None,
+                        }
+                    } else {
+                        let host = match current {
+                            Some(Some(n)) => Some(n),
+                            Some(None) if stack.len() == 1 => parent,
+                            _ => None,
+                        };
+                        match host {
+                            None => None, // inside an <include>: ignored, as MuJoCo does
+                            Some(host) if &content[..name_len] == "include" => {
+                                if Some(host) == parent {
+                                    inserted += 1;
+                                }
+                                let node = self.commit_scanned(content, name_len, span, None)?;
+                                if !matches!(self.expand_include(node, span, host, true), Ok(true))
+                                {
+                                    break None;
+                                }
+                                None
+                            }
+                            Some(host) => {
+                                let n = self.commit_scanned(content, name_len, span, Some(host))?;
+                                if Some(host) == parent {
+                                    inserted += 1;
+                                }
+                                Some(n)
+                            }
+                        }
+                    };
+                    if !is_empty {
+                        stack.push(node);
+                        names.push(((lt + 1) as u32, name_len as u32));
+                    } else if stack.is_empty() {
+                        break Some(inserted);
+                    }
+                    pos = gt + 1;
+                }
+            }
+        };
+        self.open_names = names;
+        done
+    }
+
+    fn text(&mut self, host: Node, text: &str, cdata: bool, span: Span) {
+        // Adjacent runs (text split by entity references) are joined into one node.
+        if !cdata
+            && let Some(last) = self.doc.tree.last_child(host)
+            && let NodeData::Text {
+                text: r,
+                cdata: false,
+            } = *self.doc.tree.data(last)
+            && (r.start + r.len) as usize == self.doc.strings.len()
+        {
+            self.doc.strings.push_str(text);
+            if let NodeData::Text { text: r, .. } = self.doc.tree.data_mut(last) {
+                r.len += text.len() as u32;
+            }
+            return;
         }
         let r = self.doc.push_str(text);
-        let n = self.doc.tree.new_node(NodeData::Text { text: r, cdata });
+        let n = self
+            .doc
+            .tree
+            .append_new(host, NodeData::Text { text: r, cdata });
         self.doc.set_span(n, span);
-        self.doc.tree.append(host, n);
+    }
+
+    /// Reads a start tag from the source text: the same element [`Builder::element`] makes,
+    /// without quick-xml's per-attribute decoding and copying. `None` (with nothing added
+    /// but interned names) where quick-xml would see an error, so that path words it.
+    fn element_fast(&mut self, content: &str, span: Span, host: Option<Node>) -> Option<Node> {
+        let bytes = content.as_bytes();
+        let name_len = bytes
+            .iter()
+            .position(|&b| is_xml_space(b))
+            .unwrap_or(bytes.len());
+        let mut spans = std::mem::take(&mut self.attr_spans);
+        let ok = scan_attrs(bytes, name_len, &mut spans);
+        let node = if ok {
+            self.commit_element(content, name_len, &spans, span, host)
+        } else {
+            None
+        };
+        self.attr_spans = spans;
+        node
+    }
+
+    /// [`Builder::commit_element`] with the spans [`scan_start_tag`] left in `attr_spans`.
+    fn commit_scanned(
+        &mut self,
+        content: &str,
+        name_len: usize,
+        span: Span,
+        host: Option<Node>,
+    ) -> Option<Node> {
+        let spans = std::mem::take(&mut self.attr_spans);
+        let node = self.commit_element(content, name_len, &spans, span, host);
+        self.attr_spans = spans;
+        node
+    }
+
+    fn commit_element(
+        &mut self,
+        content: &str,
+        name_len: usize,
+        spans: &[AttrSpan],
+        span: Span,
+        host: Option<Node>,
+    ) -> Option<Node> {
+        let tag = self.doc.names.intern(content.get(..name_len)?);
+        let (attrs_at, strings_at) = (self.doc.attrs.len(), self.doc.strings.len());
+        let undo = |doc: &mut Document| {
+            doc.attrs.truncate(attrs_at);
+            doc.strings.truncate(strings_at);
+            None
+        };
+        for a in spans {
+            let (Some(key), Some(raw)) = (
+                content.get(a.key.0 as usize..a.key.1 as usize),
+                content.get(a.value.0 as usize..a.value.1 as usize),
+            ) else {
+                return undo(&mut self.doc);
+            };
+            let name = self.doc.names.intern(key);
+            let doc = &mut self.doc;
+            if doc.attrs[attrs_at..].iter().any(|a| a.name == name) {
+                return undo(doc);
+            }
+            let value = if a.has_ref {
+                match quick_xml::escape::unescape(raw) {
+                    Ok(v) => doc.push_str(&v),
+                    Err(_) => return undo(doc),
+                }
+            } else {
+                doc.push_str(raw)
+            };
+            doc.attrs.push(crate::tree::Attr { name, value });
+        }
+        let doc = &mut self.doc;
+        let attrs = crate::tree::AttrRange {
+            start: attrs_at as u32,
+            len: (doc.attrs.len() - attrs_at) as u32,
+        };
+        let data = NodeData::Element { tag, attrs };
+        let node = match host {
+            Some(host) => doc.tree.append_new(host, data),
+            None => doc.tree.new_node(data),
+        };
+        doc.set_span(node, span);
+        Some(node)
     }
 
     fn element(
@@ -294,7 +1062,10 @@ impl Builder {
     ) -> Result<Node, Errors> {
         let tag_bytes = e.name();
         let tag = std::str::from_utf8(tag_bytes.as_ref()).map_err(|err| {
-            Error::at(self.loc(span.file, span.line, span.col), ErrorKind::Syntax(err.to_string()))
+            Error::at(
+                self.loc(span.file, span.line, span.col),
+                ErrorKind::Syntax(err.to_string()),
+            )
         })?;
         let tag = self.doc.names.intern(tag);
         let node = self.doc.tree.new_node(NodeData::Element {
@@ -308,21 +1079,37 @@ impl Builder {
                 use quick_xml::events::attributes::AttrError;
                 // quick-xml counts attribute offsets from the byte after '<'.
                 let (at, msg) = match err {
-                    AttrError::Duplicated(at, _) => (at, "attribute is already defined".to_string()),
-                    AttrError::ExpectedEq(at) => (at, "expected '=' after attribute name".to_string()),
+                    AttrError::Duplicated(at, _) => {
+                        (at, "attribute is already defined".to_string())
+                    }
+                    AttrError::ExpectedEq(at) => {
+                        (at, "expected '=' after attribute name".to_string())
+                    }
                     AttrError::ExpectedValue(at) => (at, "expected attribute value".to_string()),
-                    AttrError::UnquotedValue(at) => (at, "attribute value must be quoted".to_string()),
-                    AttrError::ExpectedQuote(at, _) => (at, "unterminated attribute value".to_string()),
+                    AttrError::UnquotedValue(at) => {
+                        (at, "attribute value must be quoted".to_string())
+                    }
+                    AttrError::ExpectedQuote(at, _) => {
+                        (at, "unterminated attribute value".to_string())
+                    }
                 };
                 let (line, col) = lines.line_col(offset + 1 + at);
                 Error::at(self.loc(span.file, line, col), ErrorKind::Syntax(msg))
             })?;
             let key = std::str::from_utf8(attr.key.as_ref()).map_err(|err| {
-                Error::at(self.loc(span.file, span.line, span.col), ErrorKind::Syntax(err.to_string()))
+                Error::at(
+                    self.loc(span.file, span.line, span.col),
+                    ErrorKind::Syntax(err.to_string()),
+                )
             })?;
-            let value = attr.decode_and_unescape_value(reader.decoder()).map_err(|err| {
-                Error::at(self.loc(span.file, span.line, span.col), ErrorKind::Syntax(err.to_string()))
-            })?;
+            let value = attr
+                .decode_and_unescape_value(reader.decoder())
+                .map_err(|err| {
+                    Error::at(
+                        self.loc(span.file, span.line, span.col),
+                        ErrorKind::Syntax(err.to_string()),
+                    )
+                })?;
             let name = self.doc.names.intern(key);
             let value = self.doc.push_str(&value);
             self.doc.attrs.push(crate::tree::Attr { name, value });
@@ -343,9 +1130,22 @@ impl Builder {
         lines: &Lines,
         offset: usize,
     ) -> Result<(), Errors> {
-        let here = self.loc(span.file, span.line, span.col);
         // Read the include's attributes through the common path, then drop the element.
         let node = self.element(e, span, reader, lines, offset)?;
+        self.expand_include(node, span, host, false).map(|_| ())
+    }
+
+    /// Reads the file an `<include>` (read into the detached `node`) names, in its place
+    /// under `host`. With `fast`, the file is read by [`Builder::parse_fast`], and `Ok(false)`
+    /// means it was not in that reader's reach (the load then starts over with quick-xml).
+    fn expand_include(
+        &mut self,
+        node: Node,
+        span: Span,
+        host: Node,
+        fast: bool,
+    ) -> Result<bool, Errors> {
+        let here = self.loc(span.file, span.line, span.col);
         let Some(file) = self.doc.attr(node, "file").map(str::to_owned) else {
             return Err(Error::at(here, ErrorKind::IncludeWithoutFile).into());
         };
@@ -353,8 +1153,21 @@ impl Builder {
         let full = self.doc.model_dir.join(&file);
         let path = self.display_dir.join(&file);
         let canonical = std::fs::canonicalize(&full).map_err(|err| {
-            Error::at(here.clone(), ErrorKind::Io { path: path.clone(), reason: err.to_string() })
+            Error::at(
+                here.clone(),
+                ErrorKind::Io {
+                    path: path.clone(),
+                    reason: err.to_string(),
+                },
+            )
         })?;
+        if let Some(abs) = self.main_to_canonicalize.take() {
+            // The main file heads the chain (only the main file is read when the first
+            // include is met).
+            let main = std::fs::canonicalize(&*self.files[0].path).unwrap_or(abs);
+            self.chain.insert(0, main.clone());
+            self.seen.insert(0, main);
+        }
         if let Some(i) = self.chain.iter().position(|p| *p == canonical) {
             let mut chain = self.chain_display[i..].to_vec();
             chain.push(path);
@@ -364,19 +1177,217 @@ impl Builder {
             return Err(Error::at(here, ErrorKind::IncludedTwice(path)).into());
         }
         let bytes = std::fs::read(&full).map_err(|err| {
-            Error::at(here.clone(), ErrorKind::Io { path: path.clone(), reason: err.to_string() })
+            Error::at(
+                here.clone(),
+                ErrorKind::Io {
+                    path: path.clone(),
+                    reason: err.to_string(),
+                },
+            )
         })?;
         let index = self.files.len() as u32;
-        self.files.push(SourceFile { path: Arc::from(path.as_path()), included_at: Some(span) });
+        self.files.push(SourceFile {
+            path: Arc::from(path.as_path()),
+            included_at: Some(span),
+        });
         self.chain.push(canonical.clone());
         self.chain_display.push(path.clone());
         self.seen.push(canonical);
-        let inserted = self.parse(&bytes, index, Some(host))?;
+        let inserted = if fast {
+            match std::str::from_utf8(&bytes)
+                .ok()
+                .and_then(|src| self.parse_fast(src, index, Some(host)))
+            {
+                Some(n) => n,
+                None => return Ok(false),
+            }
+        } else {
+            self.parse(&bytes, index, Some(host))?
+        };
         self.chain.pop();
         self.chain_display.pop();
         if inserted == 0 {
             return Err(Error::at(here, ErrorKind::EmptyInclude(path)).into());
         }
-        Ok(())
+        Ok(true)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// What a load gives, as text: the document (compact, pretty, every node's position)
+    /// or the errors.
+    fn outcome(xml: &str, fast: bool) -> String {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("corpora/features");
+        let name = Arc::from(Path::new("<string>"));
+        match read_bytes_with(xml.as_bytes(), name, &dir, &dir, Main::Text, fast)
+            .and_then(|mut d| d.finish_load().map(|()| d))
+        {
+            Ok(d) => {
+                let mut out = format!("{}\n{}", d.to_xml_string(), d.to_pretty_string());
+                for n in d.descendants(d.root()) {
+                    let l = d.location(n);
+                    out.push_str(&format!(" {}:{}", l.line, l.col));
+                }
+                out
+            }
+            Err(e) => format!("error: {e}"),
+        }
+    }
+
+    #[test]
+    fn both_readers_build_the_same_document() {
+        let cases = [
+            "<mujoco/>",
+            "<?xml version=\"1.0\"?>\n<!-- c\n -->\n<mujoco model='m'>\n <worldbody>\n  <geom size=\"1\"\n    rgba=\"1 0 0 1\"/>\n </worldbody>\n</mujoco>",
+            "<mujoco><default><geom size=\"1 2\"/></default><worldbody><body name=\"b\" pos='0 0 0'><geom size=\"3\"/></body></worldbody></mujoco>",
+            "<mujoco><worldbody><body>some text<geom/>  <!-- c -->more\ntext<?pi x?><geom/></body></worldbody></mujoco>",
+            "<mujoco><custom><text name=\"t\" data=\"a&amp;b\nc\"/></custom></mujoco>",
+            "<mujoco><worldbody><body>a &amp; b<![CDATA[x]]></body></worldbody></mujoco>",
+            "<mujoco><worldbody><geom a=\"1\"b=\"2\" c = '3' /></worldbody ></mujoco>",
+            "<mujoco><worldbody><geom a=\"1\" a=\"2\"/></worldbody></mujoco>",
+            "<mujoco><worldbody><geom a=\"1/></worldbody></mujoco>",
+            "<mujoco><worldbody></body></mujoco>",
+            "<mujoco><worldbody><geom/ ></worldbody></mujoco>",
+            "<mujoco><worldbody><geom size=\"1\">></geom></worldbody></mujoco>",
+            "<mujoco><!--></mujoco>--></mujoco>",
+            "<mujoco><?></mujoco>",
+            "\u{feff}<mujoco/>",
+            "<robot/>",
+            "",
+            "<mujoco><include file=\"parts/defaults.xml\"/><worldbody><include file=\"parts/arm.xml\"/></worldbody></mujoco>",
+            "<mujoco><worldbody><include file=\"parts/arm.xml\"/><include file=\"parts/arm.xml\"/></worldbody></mujoco>",
+            "<mujoco><worldbody><include file=\"parts/missing.xml\"/></worldbody></mujoco>",
+        ];
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("corpora/features");
+        let mut files: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "xml"))
+            .map(|p| std::fs::read_to_string(p).unwrap())
+            .collect();
+        files.sort();
+        for xml in cases
+            .iter()
+            .copied()
+            .chain(files.iter().map(String::as_str))
+        {
+            assert_eq!(outcome(xml, true), outcome(xml, false), "{xml:?}");
+            // And every prefix of it, which cuts markup at every place.
+            for cut in (0..xml.len()).filter(|&i| xml.is_char_boundary(i)) {
+                let part = &xml[..cut];
+                assert_eq!(outcome(part, true), outcome(part, false), "{part:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn finds_the_closing_quote_like_a_byte_loop() {
+        let samples: &[&[u8]] = &[
+            b"",
+            b"\"",
+            b"abc\"",
+            b"0 0 1\" x=\"",
+            b"a&amp;b\"",
+            b"12345678\"&",
+            b"1234567&\"",
+            b"1234567\"&",
+            b"&",
+            b"no quote here at all, long enough",
+            b"'\"",
+            b"\xc3\xa9\"",
+            b"0.1 0.2 0.3 0.4 0.5&lt;0.6\"tail&",
+            b"\x80\x80\x80\x80\x80\x80\x80\x80\"",
+            b"0 0\n1\"",
+            b"0 0 0 0 1\"\n",
+            b"12345678\n\"",
+            b"\n",
+        ];
+        for s in samples {
+            for quote in [b'"', b'\''] {
+                let naive = s
+                    .iter()
+                    .position(|&b| b == quote)
+                    .map(|i| (i, s[..i].contains(&b'&') || s[..i].contains(&b'\n')));
+                assert_eq!(
+                    find_quote(s, quote),
+                    naive,
+                    "{:?}",
+                    String::from_utf8_lossy(s)
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn xml_space_is_quick_xmls() {
+        for b in 0..=255u8 {
+            assert_eq!(
+                is_xml_space(b),
+                matches!(b, b' ' | b'\r' | b'\n' | b'\t'),
+                "{b}"
+            );
+        }
+    }
+
+    #[test]
+    fn blank_is_unicode_white_space() {
+        for t in [
+            "",
+            " ",
+            "\n\t\r ",
+            "        \n",
+            "         x",
+            "x",
+            " \u{a0}",
+            "\u{2003}\n",
+            "\u{0}       ",
+            "\u{b}",
+        ] {
+            for pad in 0..10 {
+                let s = format!("{}{t}", " ".repeat(pad));
+                assert_eq!(is_blank(&s), s.trim().is_empty(), "{s:?}");
+            }
+        }
+        for b in 0..=255u8 {
+            let w = u64::from_le_bytes([b, 0, 7, b, 255, 0x80, 1, b]);
+            let naive = w
+                .to_le_bytes()
+                .iter()
+                .fold(0u64, |m, &x| m << 8 | u64::from(x == 0) << 7);
+            assert_eq!(
+                exact_zero_bytes(w),
+                u64::from_be_bytes(naive.to_le_bytes()),
+                "{b}"
+            );
+        }
+    }
+
+    #[test]
+    fn lines_and_columns() {
+        let text = b"ab\ncd\n\nefg";
+        let mut lines = Lines::new(text);
+        for offset in [0, 1, 2, 3, 5, 6, 7, 8, 10, 11, 20, 4, 0] {
+            let slow = {
+                let before = &text[..offset.min(text.len())];
+                let line = 1 + before.iter().filter(|&&b| b == b'\n').count();
+                let start = before
+                    .iter()
+                    .rposition(|&b| b == b'\n')
+                    .map_or(0, |i| i + 1);
+                (line as u32, (offset - start + 1) as u32)
+            };
+            assert_eq!(lines.advance(offset), slow, "{offset}");
+            assert_eq!(lines.line_col(offset), slow, "{offset}");
+        }
+        let long: Vec<u8> = (0..1000)
+            .map(|i| if i % 7 == 0 { b'\n' } else { b'x' })
+            .collect();
+        assert_eq!(
+            count_newlines(&long),
+            long.iter().filter(|&&b| b == b'\n').count()
+        );
     }
 }

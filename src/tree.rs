@@ -32,9 +32,15 @@ pub(crate) struct AttrRange {
 /// Node payload: kept tiny because it is multiplied by nodes and then by variants.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum NodeData {
-    Element { tag: Sym, attrs: AttrRange },
+    Element {
+        tag: Sym,
+        attrs: AttrRange,
+    },
     /// Character data that is not just white space; `cdata` keeps `<![CDATA[..]]>` form.
-    Text { text: StrRef, cdata: bool },
+    Text {
+        text: StrRef,
+        cdata: bool,
+    },
 }
 
 /// A handle to one node of a [`crate::Document`]. Cheap to copy; only meaningful for the
@@ -50,7 +56,15 @@ pub(crate) struct Tree {
 
 impl Tree {
     pub(crate) fn with_capacity(n: usize) -> Tree {
-        Tree { arena: Arena::with_capacity(n) }
+        Tree {
+            arena: Arena::with_capacity(n),
+        }
+    }
+
+    #[inline]
+    /// Makes room for `n` more nodes.
+    pub(crate) fn reserve(&mut self, n: usize) {
+        self.arena.reserve(n);
     }
 
     pub(crate) fn new_node(&mut self, data: NodeData) -> Node {
@@ -58,20 +72,30 @@ impl Tree {
     }
 
     /// Dense index of a node, for side tables (0-based).
+    #[inline]
     pub(crate) fn index(node: Node) -> usize {
         usize::from(node.0) - 1
     }
 
+    #[inline]
     pub(crate) fn data(&self, node: Node) -> &NodeData {
         self.arena[node.0].get()
     }
 
+    #[inline]
     pub(crate) fn data_mut(&mut self, node: Node) -> &mut NodeData {
         self.arena[node.0].get_mut()
     }
 
     pub(crate) fn append(&mut self, parent: Node, child: Node) {
         parent.0.append(child.0, &mut self.arena);
+    }
+
+    /// Creates a node as the last child of `parent`. Unlike [`Tree::append`] this skips
+    /// the ancestor walk that guards against cycles: a new node cannot be an ancestor.
+    #[inline]
+    pub(crate) fn append_new(&mut self, parent: Node, data: NodeData) -> Node {
+        Node(parent.0.append_value(data, &mut self.arena))
     }
 
     pub(crate) fn insert_before(&mut self, sibling: Node, new: Node) {
@@ -82,14 +106,25 @@ impl Tree {
         node.0.detach(&mut self.arena);
     }
 
+    #[inline]
     pub(crate) fn parent(&self, node: Node) -> Option<Node> {
         self.arena[node.0].parent().map(Node)
     }
 
+    #[inline]
     pub(crate) fn first_child(&self, node: Node) -> Option<Node> {
         self.arena[node.0].first_child().map(Node)
     }
 
+    #[inline]
+    pub(crate) fn last_child(&self, node: Node) -> Option<Node> {
+        self.arena[node.0].last_child().map(Node)
+    }
+
+    #[inline]
+    pub(crate) fn next_sibling(&self, node: Node) -> Option<Node> {
+        self.arena[node.0].next_sibling().map(Node)
+    }
 
     pub(crate) fn children(&self, node: Node) -> impl Iterator<Item = Node> + '_ {
         node.0.children(&self.arena).map(Node)

@@ -6,6 +6,7 @@ use crate::document::Document;
 use crate::error::{Error, ErrorKind, Errors};
 use crate::prefix::{name_from_file, ns_of_objtype};
 use crate::schema::Kind;
+use crate::names::Sym;
 use crate::tree::Node;
 use crate::vocab::{AttrKind, Ns};
 
@@ -144,36 +145,57 @@ impl Document {
 }
 
 impl Document {
-    /// The names `part` declares that this document declares too, each reported at the
-    /// part's element with the position of ours (what a merge of the two would break).
+    /// The names the parts declare that this document or an earlier part declares too,
+    /// each reported at the later element with the position of the first. This document is
+    /// walked once; nothing is allocated per name.
     ///
     /// Assets and default classes are left out: a merge shares identical ones and reports
     /// the others with both contents' positions.
-    pub(crate) fn name_clashes(&self, part: &Document) -> Vec<Error> {
+    pub(crate) fn name_clashes(&self, parts: &[&Document]) -> Vec<Error> {
         let shared = |ns: Ns| {
             matches!(ns, Ns::Mesh | Ns::Texture | Ns::Material | Ns::Hfield | Ns::Skin | Ns::Default)
         };
-        let mut theirs = part.declared_names();
-        theirs.retain(|(ns, _, _)| !shared(*ns));
-        if theirs.is_empty() {
+        let theirs: Vec<Vec<(Ns, &str, Node)>> = parts
+            .iter()
+            .map(|p| {
+                let mut names = p.declared_names();
+                names.retain(|(ns, _, _)| !shared(*ns));
+                names
+            })
+            .collect();
+        if theirs.iter().all(Vec::is_empty) {
             return Vec::new();
         }
-        let wanted: ahash::AHashSet<(Ns, &str)> = theirs.iter().map(|(ns, name, _)| (*ns, *name)).collect();
-        let mut ours: AHashMap<(Ns, &str), Node> = AHashMap::new();
-        for (ns, name, node) in self.declared_names() {
-            if wanted.contains(&(ns, name)) {
-                ours.entry((ns, name)).or_insert(node);
+        // Only the names some part declares matter: index those, then walk ourselves.
+        let total: usize = theirs.iter().map(Vec::len).sum();
+        let mut seen: std::collections::HashMap<(Ns, &str), (usize, Option<Node>), NameHash> =
+            std::collections::HashMap::with_capacity_and_hasher(total, NameHash);
+        for names in &theirs {
+            for &(ns, name, _) in names {
+                seen.entry((ns, name)).or_insert((usize::MAX, None));
             }
         }
-        theirs
-            .iter()
-            .filter_map(|&(ns, name, node)| {
-                ours.get(&(ns, name)).map(|&first| {
-                    let msg = format!("duplicate {} name '{name}' (first at {})", ns.as_str(), self.location(first));
-                    part.error_at(node, ErrorKind::Invalid(msg))
-                })
-            })
-            .collect()
+        for (ns, name, node) in self.declared_names() {
+            if let Some(e) = seen.get_mut(&(ns, name)) {
+                if e.0 == usize::MAX {
+                    *e = (0, Some(node));
+                }
+            }
+        }
+        let mut errors = Vec::new();
+        for (i, names) in theirs.iter().enumerate() {
+            for &(ns, name, node) in names {
+                let e = seen.get_mut(&(ns, name)).expect("indexed above");
+                let Some(at) = e.1.filter(|_| e.0 != usize::MAX) else {
+                    *e = (i + 1, Some(node));
+                    continue;
+                };
+                let first = if e.0 == 0 { self.location(at) } else { parts[e.0 - 1].location(at) };
+                let msg = format!("duplicate {} name '{name}' (first at {first})", ns.as_str());
+                errors.push(parts[i].error_at(node, ErrorKind::Invalid(msg)));
+            }
+        }
+        errors
     }
 
     /// Every name the document declares (its `id` attributes, and assets named after their
@@ -183,28 +205,20 @@ impl Document {
         let mut stack: Vec<(Node, Kind)> = vec![(self.root, Kind::root())];
         while let Some((node, kind)) = stack.pop() {
             let mut declared = false;
-            for a in self.attr_slice(node) {
-                if let Some(spec) = kind.attr(a.name) {
-                    if let AttrKind::Id(ns) = spec.kind {
-                        declared = true;
-                        let v = self.str(a.value).trim();
-                        if !v.is_empty() {
-                            out.push((ns, v, node));
-                        }
+            if let Some((id, ns)) = id_attr(kind) {
+                if let Some(a) = self.attr_slice(node).iter().find(|a| a.name == id) {
+                    declared = true;
+                    let v = trim(self.str(a.value));
+                    if !v.is_empty() {
+                        out.push((ns, v, node));
                     }
                 }
             }
-            if !declared && matches!(self.tag(node), "mesh" | "texture" | "hfield" | "skin") {
-                if let Some(file) = self.attr(node, "file") {
-                    if name_from_file(self.tag(node), file).is_some() {
-                        let base = file.rsplit(['/', '\\']).next().unwrap_or(file);
-                        let stem = base.rfind('.').map_or(base, |i| &base[..i]);
-                        let ns = match self.tag(node) {
-                            "mesh" => Ns::Mesh,
-                            "texture" => Ns::Texture,
-                            "hfield" => Ns::Hfield,
-                            _ => Ns::Skin,
-                        };
+            if !declared {
+                if let Some(ns) = named_after_file(kind) {
+                    static FILE: std::sync::OnceLock<Sym> = std::sync::OnceLock::new();
+                    let file = *FILE.get_or_init(|| crate::names::sym("file"));
+                    if let Some(stem) = self.attr_sym(node, file).and_then(file_stem) {
                         out.push((ns, stem, node));
                     }
                 }
@@ -218,5 +232,95 @@ impl Document {
             stack[n..].reverse();
         }
         out
+    }
+}
+
+/// The file name without folder and extension, as MuJoCo names an asset after its file.
+pub(crate) fn file_stem(file: &str) -> Option<&str> {
+    let base = file.rsplit(['/', '\\']).next().unwrap_or(file);
+    let stem = base.rfind('.').map_or(base, |i| &base[..i]);
+    (!stem.is_empty()).then_some(stem)
+}
+
+/// The namespace of an element kind that MuJoCo names after its file when unnamed.
+pub(crate) fn named_after_file(kind: Kind) -> Option<Ns> {
+    match kind.spec().name.as_bytes().first() {
+        Some(b'm' | b't' | b'h' | b's') => {}
+        _ => return None,
+    }
+    match kind.spec().name {
+        "mesh" => Some(Ns::Mesh),
+        "texture" => Some(Ns::Texture),
+        "hfield" => Some(Ns::Hfield),
+        "skin" => Some(Ns::Skin),
+        _ => None,
+    }
+}
+
+/// The attribute that declares a kind's name, and its namespace (computed once per kind).
+fn id_attr(kind: Kind) -> Option<(Sym, Ns)> {
+    static TABLE: std::sync::OnceLock<Vec<Option<(Sym, Ns)>>> = std::sync::OnceLock::new();
+    let table = TABLE.get_or_init(|| {
+        (0..crate::vocab::elements().len())
+            .map(|i| {
+                Kind(i as u16).spec().attrs.iter().find_map(|a| match a.kind {
+                    AttrKind::Id(ns) => crate::names::known(a.name).map(|s| (s, ns)),
+                    _ => None,
+                })
+            })
+            .collect()
+    });
+    table.get(kind.0 as usize).copied().flatten()
+}
+
+/// A hasher for short names: one multiply per 8 bytes. The keys are model names, not
+/// attacker-chosen input, and nothing that reaches output depends on map order.
+#[derive(Clone, Copy, Default)]
+struct NameHash;
+
+impl std::hash::BuildHasher for NameHash {
+    type Hasher = NameHasher;
+    fn build_hasher(&self) -> NameHasher {
+        NameHasher(0)
+    }
+}
+
+struct NameHasher(u64);
+
+impl std::hash::Hasher for NameHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        const K: u64 = 0x9E37_79B9_7F4A_7C15;
+        let mut chunks = bytes.chunks_exact(8);
+        for c in &mut chunks {
+            let w = u64::from_le_bytes(c.try_into().expect("8 bytes"));
+            self.0 = (self.0.rotate_left(5) ^ w).wrapping_mul(K);
+        }
+        let rest = chunks.remainder();
+        if !rest.is_empty() {
+            let mut w = [0u8; 8];
+            w[..rest.len()].copy_from_slice(rest);
+            self.0 = (self.0.rotate_left(5) ^ u64::from_le_bytes(w)).wrapping_mul(K);
+        }
+    }
+
+    fn write_u8(&mut self, b: u8) {
+        self.0 = (self.0.rotate_left(5) ^ u64::from(b)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    }
+
+    fn write_usize(&mut self, n: usize) {
+        self.0 = (self.0.rotate_left(5) ^ n as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    }
+}
+
+/// `str::trim`, with a fast path for the usual name without surrounding white space.
+fn trim(s: &str) -> &str {
+    let b = s.as_bytes();
+    match (b.first(), b.last()) {
+        (Some(f), Some(l)) if !f.is_ascii_whitespace() && !l.is_ascii_whitespace() => s,
+        _ => s.trim(),
     }
 }

@@ -5,33 +5,121 @@ use std::path::Path;
 
 use crate::document::Document;
 use crate::error::{Error, ErrorKind};
-use crate::tree::{Node, NodeData};
+use crate::tree::{Node, NodeData, StrRef};
 
+/// The bytes an attribute value cannot hold as they are: markup, the quote, and white
+/// space other than the space (parsers normalise raw white-space characters to spaces).
+const ATTR_SPECIAL: [bool; 256] = special(b"&<>\"\n\r\t");
+/// The bytes character data cannot hold as they are.
+const TEXT_SPECIAL: [bool; 256] = special(b"&<>");
+
+const fn special(bytes: &[u8]) -> [bool; 256] {
+    let mut table = [false; 256];
+    let mut i = 0;
+    while i < bytes.len() {
+        table[bytes[i] as usize] = true;
+        i += 1;
+    }
+    table
+}
+
+const LO: u64 = 0x0101_0101_0101_0101;
+
+/// Marks the bytes of `x` below `n` (`n` at most 128); no mark means there is none.
+fn bytes_below(x: u64, n: u8) -> u64 {
+    x.wrapping_sub(LO * u64::from(n)) & !x & (LO << 7)
+}
+
+/// Marks the bytes of `x` equal to `b`; no mark means there is none.
+fn bytes_equal(x: u64, b: u8) -> u64 {
+    bytes_below(x ^ (LO * u64::from(b)), 1)
+}
+
+/// Whether eight bytes hold one of [`ATTR_SPECIAL`]. `"` and `&` differ only in bit 2,
+/// `<` and `>` only in bit 1, so two compares cover those four; `\t`, `\n`, `\r` are
+/// below 14 (the other bytes below 14 are rare enough to only cost the slow path).
+fn attr_word_is_special(w: u64) -> bool {
+    (bytes_equal(w | (LO * 0x04), b'&') | bytes_equal(w | (LO * 0x02), b'>') | bytes_below(w, 14))
+        != 0
+}
+
+fn text_word_is_special(w: u64) -> bool {
+    (bytes_equal(w, b'&') | bytes_equal(w | (LO * 0x02), b'>')) != 0
+}
+
+#[cfg(test)]
 fn escape_attr(out: &mut String, value: &str) {
-    for c in value.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            // Parsers normalise raw white-space characters in attributes to spaces.
-            '\n' => out.push_str("&#10;"),
-            '\r' => out.push_str("&#13;"),
-            '\t' => out.push_str("&#9;"),
-            c => out.push(c),
+    if is_clean(value.as_bytes(), &ATTR_SPECIAL, attr_word_is_special) {
+        out.push_str(value);
+    } else {
+        escape_with(out, value, &ATTR_SPECIAL);
+    }
+}
+
+/// [`escape_attr`] for the value `r` of the string buffer `strings`. A value shorter than
+/// a word (most are) is checked as one word read from the buffer, the bytes past its end
+/// replaced by a harmless one.
+fn escape_attr_in(out: &mut String, strings: &str, r: StrRef) {
+    let (start, len) = (r.start as usize, r.len as usize);
+    let value = &strings[start..start + len];
+    let clean = match strings.as_bytes().get(start..start + 8) {
+        Some(w) if len < 8 => {
+            let w = u64::from_le_bytes(w.try_into().expect("8 bytes"));
+            let keep = (1u64 << (8 * len)) - 1;
+            !attr_word_is_special((w & keep) | ((LO * u64::from(b'a')) & !keep))
         }
+        _ => is_clean(value.as_bytes(), &ATTR_SPECIAL, attr_word_is_special),
+    };
+    if clean {
+        out.push_str(value);
+    } else {
+        escape_with(out, value, &ATTR_SPECIAL);
     }
 }
 
 fn escape_text(out: &mut String, text: &str) {
-    for c in text.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            c => out.push(c),
+    if is_clean(text.as_bytes(), &TEXT_SPECIAL, text_word_is_special) {
+        out.push_str(text);
+    } else {
+        escape_with(out, text, &TEXT_SPECIAL);
+    }
+}
+
+/// Whether no byte of `bytes` needs escaping: eight bytes at a time (the last word may
+/// overlap the one before), bytewise below eight bytes.
+fn is_clean(bytes: &[u8], special: &[bool; 256], word_is_special: fn(u64) -> bool) -> bool {
+    let word = |b: &[u8]| u64::from_le_bytes(b.try_into().expect("8 bytes"));
+    if bytes.len() < 8 {
+        return !bytes.iter().any(|&b| special[b as usize]);
+    }
+    let mut words = bytes.chunks_exact(8);
+    if words.any(|w| word_is_special(word(w))) {
+        return false;
+    }
+    words.remainder().is_empty() || !word_is_special(word(&bytes[bytes.len() - 8..]))
+}
+
+/// Copies `text` to `out` with the bytes marked in `special` escaped. They are all ASCII,
+/// so the runs between them (usually the whole text) are copied whole, and cutting there
+/// always lands on a character boundary.
+fn escape_with(out: &mut String, text: &str, special: &[bool; 256]) {
+    let mut done = 0;
+    for (i, b) in text.bytes().enumerate() {
+        if special[b as usize] {
+            out.push_str(&text[done..i]);
+            out.push_str(match b {
+                b'&' => "&amp;",
+                b'<' => "&lt;",
+                b'>' => "&gt;",
+                b'"' => "&quot;",
+                b'\n' => "&#10;",
+                b'\r' => "&#13;",
+                _ => "&#9;",
+            });
+            done = i + 1;
         }
     }
+    out.push_str(&text[done..]);
 }
 
 impl Document {
@@ -43,7 +131,11 @@ impl Document {
     /// # Ok::<(), mjcf_forge::Errors>(())
     /// ```
     pub fn to_xml_string(&self) -> String {
-        let mut out = String::with_capacity(self.strings.len() + self.attrs.len() * 8);
+        // Enough for every model of the wheel corpora (about three quarters used on average):
+        // growing the buffer would copy it.
+        let mut out = String::with_capacity(
+            self.strings.len() + self.attrs.len() * 12 + self.tree.count() * 16,
+        );
         self.write_node(&mut out, self.root, None);
         out
     }
@@ -56,7 +148,9 @@ impl Document {
     /// # Ok::<(), mjcf_forge::Errors>(())
     /// ```
     pub fn to_pretty_string(&self) -> String {
-        let mut out = String::with_capacity(self.strings.len() * 2 + self.attrs.len() * 8);
+        let mut out = String::with_capacity(
+            self.strings.len() + self.attrs.len() * 12 + self.tree.count() * 48,
+        );
         self.write_node(&mut out, self.root, Some(0));
         out.push('\n');
         out
@@ -81,26 +175,39 @@ impl Document {
                 }
             }
             NodeData::Element { tag, .. } => {
-                let tag = self.names.resolve(tag);
-                out.push('<');
-                out.push_str(tag);
+                // Vocabulary names come pre-rendered (` name="`, `<tag`, `</tag>`).
+                let markup = self.names.markup(tag);
+                match &markup {
+                    Some(m) => out.push_str(m.open),
+                    None => {
+                        out.push('<');
+                        out.push_str(self.names.resolve(tag));
+                    }
+                }
                 for a in self.attr_slice(node) {
-                    out.push(' ');
-                    out.push_str(self.names.resolve(a.name));
-                    out.push_str("=\"");
-                    escape_attr(out, self.str(a.value));
+                    match self.names.markup(a.name) {
+                        Some(m) => out.push_str(m.attr),
+                        None => {
+                            out.push(' ');
+                            out.push_str(self.names.resolve(a.name));
+                            out.push_str("=\"");
+                        }
+                    }
+                    escape_attr_in(out, &self.strings, a.value);
                     out.push('"');
                 }
-                let mut kids = self.tree.children(node).peekable();
-                if kids.peek().is_none() {
+                let Some(first) = self.tree.first_child(node) else {
                     out.push_str("/>");
                     return;
-                }
+                };
                 out.push('>');
                 // Mixed content (text inside) is written inline to keep the text exact.
-                let has_text = self.tree.children(node).any(|k| !self.is_element(k));
-                let child_indent = if has_text { None } else { indent.map(|i| i + 1) };
-                for kid in kids {
+                let child_indent = indent
+                    .filter(|_| self.tree.children(node).all(|k| self.is_element(k)))
+                    .map(|i| i + 1);
+                let mut next = Some(first);
+                while let Some(kid) = next {
+                    next = self.tree.next_sibling(kid);
                     if let Some(i) = child_indent {
                         out.push('\n');
                         push_indent(out, i);
@@ -111,9 +218,14 @@ impl Document {
                     out.push('\n');
                     push_indent(out, i);
                 }
-                out.push_str("</");
-                out.push_str(tag);
-                out.push('>');
+                match &markup {
+                    Some(m) => out.push_str(m.close),
+                    None => {
+                        out.push_str("</");
+                        out.push_str(self.names.resolve(tag));
+                        out.push('>');
+                    }
+                }
             }
         }
     }
@@ -128,7 +240,10 @@ fn push_indent(out: &mut String, level: usize) {
 /// Writes bytes to `path` through a temporary file in the same folder and a rename.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     let fail = |e: std::io::Error| {
-        Error::bare(ErrorKind::Write { path: path.to_path_buf(), reason: e.to_string() })
+        Error::bare(ErrorKind::Write {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        })
     };
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
@@ -139,4 +254,72 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     tmp.as_file().sync_all().map_err(fail)?;
     tmp.persist(path).map_err(|e| fail(e.error))?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn escapes_like_a_byte_loop() {
+        let naive = |s: &str, attr: bool| {
+            let mut out = String::new();
+            for c in s.chars() {
+                match c {
+                    '&' => out.push_str("&amp;"),
+                    '<' => out.push_str("&lt;"),
+                    '>' => out.push_str("&gt;"),
+                    '"' if attr => out.push_str("&quot;"),
+                    '\n' if attr => out.push_str("&#10;"),
+                    '\r' if attr => out.push_str("&#13;"),
+                    '\t' if attr => out.push_str("&#9;"),
+                    c => out.push(c),
+                }
+            }
+            out
+        };
+        let mut samples: Vec<String> = [
+            "",
+            "a",
+            "0 0 1",
+            "1234567",
+            "12345678",
+            "123456789",
+            "\u{e9}t\u{e9}",
+            "\u{1F600}x",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        for special in ["&", "<", ">", "\"", "\n", "\r", "\t", "\u{b}", "\u{0}", "'"] {
+            for len in 0..20 {
+                for at in 0..=len {
+                    let mut s: String = "0123456789abcdefghij"[..len].to_string();
+                    s.insert_str(at, special);
+                    samples.push(s);
+                }
+            }
+        }
+        for s in &samples {
+            let (mut a, mut t) = (String::new(), String::new());
+            escape_attr(&mut a, s);
+            escape_text(&mut t, s);
+            assert_eq!(a, naive(s, true), "{s:?}");
+            assert_eq!(t, naive(s, false), "{s:?}");
+            // In a buffer, with bytes after it that must not count.
+            for tail in ["", "x", "&&&&&&&&", "\"\n<>", "01234567"] {
+                let buf = format!("ab{s}{tail}");
+                let mut b = String::new();
+                escape_attr_in(
+                    &mut b,
+                    &buf,
+                    StrRef {
+                        start: 2,
+                        len: s.len() as u32,
+                    },
+                );
+                assert_eq!(b, naive(s, true), "{s:?} then {tail:?}");
+            }
+        }
+    }
 }
