@@ -12,12 +12,18 @@ fn robosuite_models() -> Vec<PathBuf> {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let list = std::fs::read_to_string(root.join(".cache/corpus/models.txt"))
         .expect(".cache/corpus/models.txt: run scripts/setup.sh first");
-    list.lines().filter(|l| l.contains("/robosuite-")).map(|l| root.join(l)).collect()
+    list.lines()
+        .filter(|l| l.contains("/robosuite-"))
+        .map(|l| root.join(l))
+        .collect()
 }
 
 fn whole_corpus(c: &mut Criterion) {
     let files = robosuite_models();
-    let bytes: u64 = files.iter().map(|f| std::fs::metadata(f).unwrap().len()).sum();
+    let bytes: u64 = files
+        .iter()
+        .map(|f| std::fs::metadata(f).unwrap().len())
+        .sum();
     let mut group = c.benchmark_group("robosuite_corpus");
     group.throughput(Throughput::Bytes(bytes));
     group.sample_size(20);
@@ -41,14 +47,21 @@ fn whole_corpus(c: &mut Criterion) {
 
 fn small_operations(c: &mut Criterion) {
     let files = robosuite_models();
-    let panda = files.iter().find(|f| f.ends_with("robots/panda/robot.xml")).expect("panda robot");
+    let panda = files
+        .iter()
+        .find(|f| f.ends_with("robots/panda/robot.xml"))
+        .expect("panda robot");
     let doc = Document::load(panda).unwrap();
     let xml_len = doc.to_xml_string().len() as u64;
     let mut group = c.benchmark_group("panda_robot");
     group.throughput(Throughput::Bytes(xml_len));
     group.bench_function("clone", |b| b.iter(|| std::hint::black_box(doc.clone())));
-    group.bench_function("write_compact", |b| b.iter(|| std::hint::black_box(doc.to_xml_string())));
-    group.bench_function("write_pretty", |b| b.iter(|| std::hint::black_box(doc.to_pretty_string())));
+    group.bench_function("write_compact", |b| {
+        b.iter(|| std::hint::black_box(doc.to_xml_string()))
+    });
+    group.bench_function("write_pretty", |b| {
+        b.iter(|| std::hint::black_box(doc.to_pretty_string()))
+    });
     group.finish();
 }
 

@@ -31,10 +31,16 @@ fn parts() -> Parts {
         robot: load("robots/panda/robot.xml"),
         mount: load("bases/rethink_mount.xml"),
         gripper: load("grippers/panda_gripper.xml"),
-        objects: ["objects/can.xml", "objects/milk.xml", "objects/bread.xml", "objects/cereal.xml", "objects/lemon.xml"]
-            .iter()
-            .map(|p| load(p))
-            .collect(),
+        objects: [
+            "objects/can.xml",
+            "objects/milk.xml",
+            "objects/bread.xml",
+            "objects/cereal.xml",
+            "objects/lemon.xml",
+        ]
+        .iter()
+        .map(|p| load(p))
+        .collect(),
     }
 }
 
@@ -44,12 +50,32 @@ fn assemble(p: &Parts) -> Document {
     let mut robot = XmlModel::new(p.robot.clone(), "robot0").unwrap();
     let gripper = XmlModel::new(p.gripper.clone(), "gripper0").unwrap();
     let mount = XmlModel::new(p.mount.clone(), "mount0").unwrap();
-    robot.merge_all(&[(&gripper, Some("robot0_right_hand")), (&mount, Some("robot0_base"))], false).unwrap();
-    let objects: Vec<XmlModel> =
-        p.objects.iter().enumerate().map(|(i, o)| XmlModel::new(o.clone(), format!("object{i}")).unwrap()).collect();
+    robot
+        .merge_all(
+            &[
+                (&gripper, Some("robot0_right_hand")),
+                (&mount, Some("robot0_base")),
+            ],
+            false,
+        )
+        .unwrap();
+    let objects: Vec<XmlModel> = p
+        .objects
+        .iter()
+        .enumerate()
+        .map(|(i, o)| XmlModel::new(o.clone(), format!("object{i}")).unwrap())
+        .collect();
     let mut scene = p.arena.clone();
-    let mut parts = vec![MergePart { doc: robot.document(), into: None, prefix: "robot0_" }];
-    parts.extend(objects.iter().map(|o| MergePart { doc: o.document(), into: None, prefix: o.naming_prefix() }));
+    let mut parts = vec![MergePart {
+        doc: robot.document(),
+        into: None,
+        prefix: "robot0_",
+    }];
+    parts.extend(objects.iter().map(|o| MergePart {
+        doc: o.document(),
+        into: None,
+        prefix: o.naming_prefix(),
+    }));
     scene.merge_all(&parts, false).unwrap();
     scene
 }
@@ -58,10 +84,16 @@ fn scene(c: &mut Criterion) {
     let p = parts();
     let mut group = c.benchmark_group("lift_scene");
     group.throughput(Throughput::Elements(1));
-    group.bench_function("assemble", |b| b.iter(|| std::hint::black_box(assemble(&p))));
+    group.bench_function("assemble", |b| {
+        b.iter(|| std::hint::black_box(assemble(&p)))
+    });
     let built = assemble(&p);
-    group.bench_function("assemble_and_write", |b| b.iter(|| std::hint::black_box(assemble(&p).to_xml_string())));
-    group.bench_function("write_scene", |b| b.iter(|| std::hint::black_box(built.to_xml_string())));
+    group.bench_function("assemble_and_write", |b| {
+        b.iter(|| std::hint::black_box(assemble(&p).to_xml_string()))
+    });
+    group.bench_function("write_scene", |b| {
+        b.iter(|| std::hint::black_box(built.to_xml_string()))
+    });
     group.finish();
 }
 
@@ -75,7 +107,9 @@ fn operations(c: &mut Criterion) {
             std::hint::black_box(d)
         })
     });
-    group.bench_function("clone", |b| b.iter(|| std::hint::black_box(p.robot.clone())));
+    group.bench_function("clone", |b| {
+        b.iter(|| std::hint::black_box(p.robot.clone()))
+    });
     let mut gripper = p.gripper.clone();
     gripper.apply_prefix("gripper0_").unwrap();
     let mut robot = p.robot.clone();
@@ -83,7 +117,12 @@ fn operations(c: &mut Criterion) {
     group.bench_function("merge_gripper", |b| {
         b.iter(|| {
             let mut r = robot.clone();
-            r.merge(&gripper, Some("robot0_right_hand"), &MergeOptions::default()).unwrap();
+            r.merge(
+                &gripper,
+                Some("robot0_right_hand"),
+                &MergeOptions::default(),
+            )
+            .unwrap();
             std::hint::black_box(r)
         })
     });

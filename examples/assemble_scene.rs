@@ -2,7 +2,6 @@
 
 use std::path::PathBuf;
 
-
 use mjcf_forge::{Document, MergePart, MujocoModel, XmlModel};
 
 fn rs(rel: &str) -> PathBuf {
@@ -27,10 +26,16 @@ fn parts() -> Parts {
         robot: load("robots/panda/robot.xml"),
         mount: load("bases/rethink_mount.xml"),
         gripper: load("grippers/panda_gripper.xml"),
-        objects: ["objects/can.xml", "objects/milk.xml", "objects/bread.xml", "objects/cereal.xml", "objects/lemon.xml"]
-            .iter()
-            .map(|p| load(p))
-            .collect(),
+        objects: [
+            "objects/can.xml",
+            "objects/milk.xml",
+            "objects/bread.xml",
+            "objects/cereal.xml",
+            "objects/lemon.xml",
+        ]
+        .iter()
+        .map(|p| load(p))
+        .collect(),
     }
 }
 
@@ -40,18 +45,41 @@ fn assemble(p: &Parts) -> Document {
     let mut robot = XmlModel::new(p.robot.clone(), "robot0").unwrap();
     let gripper = XmlModel::new(p.gripper.clone(), "gripper0").unwrap();
     let mount = XmlModel::new(p.mount.clone(), "mount0").unwrap();
-    robot.merge_all(&[(&gripper, Some("robot0_right_hand")), (&mount, Some("robot0_base"))], false).unwrap();
-    let objects: Vec<XmlModel> =
-        p.objects.iter().enumerate().map(|(i, o)| XmlModel::new(o.clone(), format!("object{i}")).unwrap()).collect();
+    robot
+        .merge_all(
+            &[
+                (&gripper, Some("robot0_right_hand")),
+                (&mount, Some("robot0_base")),
+            ],
+            false,
+        )
+        .unwrap();
+    let objects: Vec<XmlModel> = p
+        .objects
+        .iter()
+        .enumerate()
+        .map(|(i, o)| XmlModel::new(o.clone(), format!("object{i}")).unwrap())
+        .collect();
     let mut scene = p.arena.clone();
-    let mut parts = vec![MergePart { doc: robot.document(), into: None, prefix: "robot0_" }];
-    parts.extend(objects.iter().map(|o| MergePart { doc: o.document(), into: None, prefix: o.naming_prefix() }));
+    let mut parts = vec![MergePart {
+        doc: robot.document(),
+        into: None,
+        prefix: "robot0_",
+    }];
+    parts.extend(objects.iter().map(|o| MergePart {
+        doc: o.document(),
+        into: None,
+        prefix: o.naming_prefix(),
+    }));
     scene.merge_all(&parts, false).unwrap();
     scene
 }
 
 fn main() {
-    let n: usize = std::env::args().nth(1).and_then(|a| a.parse().ok()).unwrap_or(100);
+    let n: usize = std::env::args()
+        .nth(1)
+        .and_then(|a| a.parse().ok())
+        .unwrap_or(100);
     let p = parts();
     let start = std::time::Instant::now();
     let mut bytes = 0;
@@ -63,5 +91,8 @@ fn main() {
             bytes += scene.node_count();
         }
     }
-    println!("{n} scenes, {bytes} bytes, {:.1} us per scene", start.elapsed().as_secs_f64() * 1e6 / n as f64);
+    println!(
+        "{n} scenes, {bytes} bytes, {:.1} us per scene",
+        start.elapsed().as_secs_f64() * 1e6 / n as f64
+    );
 }

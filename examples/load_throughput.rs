@@ -14,7 +14,10 @@ fn main() {
         runs = args[1].parse().expect("--runs N");
         args.drain(..2);
     }
-    let bytes: u64 = args.iter().map(|f| std::fs::metadata(f).expect(f).len()).sum();
+    let bytes: u64 = args
+        .iter()
+        .map(|f| std::fs::metadata(f).expect(f).len())
+        .sum();
     let mut best = f64::INFINITY;
     let mut out_chars = 0usize;
     for _ in 0..runs.max(1) {

@@ -4,7 +4,10 @@
 fn main() -> std::process::ExitCode {
     let mut failed = false;
     for path in std::env::args().skip(1) {
-        match mjcf_forge::Document::load(&path).map_err(|e| e.to_string()).and_then(|d| d.validate().map_err(|e| e.to_string())) {
+        match mjcf_forge::Document::load(&path)
+            .map_err(|e| e.to_string())
+            .and_then(|d| d.validate().map_err(|e| e.to_string()))
+        {
             Ok(()) => {}
             Err(e) => {
                 eprintln!("{e}");
@@ -12,5 +15,9 @@ fn main() -> std::process::ExitCode {
             }
         }
     }
-    if failed { std::process::ExitCode::FAILURE } else { std::process::ExitCode::SUCCESS }
+    if failed {
+        std::process::ExitCode::FAILURE
+    } else {
+        std::process::ExitCode::SUCCESS
+    }
 }

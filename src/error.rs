@@ -21,7 +21,12 @@ pub struct Location {
 impl Location {
     /// A location with no include chain.
     pub fn new(file: Arc<Path>, line: u32, col: u32) -> Location {
-        Location { file, line, col, included_from: Vec::new() }
+        Location {
+            file,
+            line,
+            col,
+            included_from: Vec::new(),
+        }
     }
 }
 
@@ -90,7 +95,11 @@ impl fmt::Display for ErrorKind {
                 write!(f, "include cycle: {}", names.join(" -> "))
             }
             ErrorKind::IncludedTwice(p) => {
-                write!(f, "file '{}' is already included (MuJoCo allows each file once)", p.display())
+                write!(
+                    f,
+                    "file '{}' is already included (MuJoCo allows each file once)",
+                    p.display()
+                )
             }
             ErrorKind::EmptyInclude(p) => {
                 write!(f, "included file '{}' inserts no element", p.display())
@@ -98,7 +107,10 @@ impl fmt::Display for ErrorKind {
             ErrorKind::UnknownClass(c) => write!(f, "unknown default class '{c}'"),
             ErrorKind::RepeatedClass(c) => write!(f, "repeated default class name '{c}'"),
             ErrorKind::RenamedMainClass(c) => {
-                write!(f, "top-level default class 'main' cannot be renamed (found '{c}')")
+                write!(
+                    f,
+                    "top-level default class 'main' cannot be renamed (found '{c}')"
+                )
             }
             ErrorKind::Inexpressible(msg) => write!(f, "cannot inline defaults exactly: {msg}"),
             ErrorKind::Invalid(msg) => f.write_str(msg),
@@ -128,11 +140,17 @@ pub struct Error {
 
 impl Error {
     pub(crate) fn at(location: Location, kind: ErrorKind) -> Error {
-        Error { location: Some(location), kind }
+        Error {
+            location: Some(location),
+            kind,
+        }
     }
 
     pub(crate) fn bare(kind: ErrorKind) -> Error {
-        Error { location: None, kind }
+        Error {
+            location: None,
+            kind,
+        }
     }
 }
 

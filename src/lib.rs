@@ -27,10 +27,10 @@ mod defaults;
 mod document;
 mod error;
 pub mod geometry;
-#[cfg(feature = "mujoco")]
-pub mod mujoco;
 mod merge;
 mod model;
+#[cfg(feature = "mujoco")]
+pub mod mujoco;
 mod names;
 mod paths;
 mod prefix;
@@ -43,8 +43,8 @@ pub mod vocab;
 mod write;
 
 pub use document::{Document, Section};
-pub use merge::{MergeOptions, MergePart, MergeReport};
-pub use model::{MujocoModel, XmlModel, XmlModelOptions};
 pub use error::{Error, ErrorKind, Errors, Location};
+pub use merge::{MergeOptions, MergePart, MergeReport};
+pub use model::{MujocoModel, Offsets, XmlModel, XmlModelOptions};
 pub use tree::Node;
 pub use write::write_atomic;

@@ -135,18 +135,33 @@ fn main() -> ExitCode {
                 None => inline_one_input(&inputs, output.as_deref(), options),
             }
         }
-        Command::Prefix { input, prefix, output, compact, validate } => {
+        Command::Prefix {
+            input,
+            prefix,
+            output,
+            compact,
+            validate,
+        } => {
             if validate && let Err(e) = require_mujoco() {
                 eprintln!("mjcf-forge: --validate: {e}");
                 return ExitCode::from(USAGE);
             }
-            let result = Document::load(&input).map_err(|e| e.to_string()).and_then(|mut doc| {
-                doc.apply_prefix(&prefix).map_err(|e| e.to_string())?;
-                emit(&doc, output.as_deref(), InlineOptions { compact, validate })
-            });
+            let result = Document::load(&input)
+                .map_err(|e| e.to_string())
+                .and_then(|mut doc| {
+                    doc.apply_prefix(&prefix).map_err(|e| e.to_string())?;
+                    emit(&doc, output.as_deref(), InlineOptions { compact, validate })
+                });
             finish(&[result])
         }
-        Command::Merge { base, parts, fuse_keys, output, compact, validate } => {
+        Command::Merge {
+            base,
+            parts,
+            fuse_keys,
+            output,
+            compact,
+            validate,
+        } => {
             if validate && let Err(e) = require_mujoco() {
                 eprintln!("mjcf-forge: --validate: {e}");
                 return ExitCode::from(USAGE);
@@ -158,19 +173,35 @@ fn main() -> ExitCode {
                     return ExitCode::from(USAGE);
                 }
             };
-            finish(&[merge(&base, &specs, fuse_keys, output.as_deref(), InlineOptions { compact, validate })])
+            finish(&[merge(
+                &base,
+                &specs,
+                fuse_keys,
+                output.as_deref(),
+                InlineOptions { compact, validate },
+            )])
         }
-        Command::Info { input, prefix, json } => {
+        Command::Info {
+            input,
+            prefix,
+            json,
+        } => {
             if !json {
                 eprintln!("mjcf-forge: info prints JSON only: add --json");
                 return ExitCode::from(USAGE);
             }
-            let result = Document::load(&input).map_err(|e| e.to_string()).and_then(|doc| {
-                let options = XmlModelOptions { contact_geom_rgba: None, ..XmlModelOptions::default() };
-                let model = XmlModel::with_prefix(doc, &prefix, options).map_err(|e| e.to_string())?;
-                println!("{}", model.info_json());
-                Ok(())
-            });
+            let result = Document::load(&input)
+                .map_err(|e| e.to_string())
+                .and_then(|doc| {
+                    let options = XmlModelOptions {
+                        contact_geom_rgba: None,
+                        ..XmlModelOptions::default()
+                    };
+                    let model =
+                        XmlModel::with_prefix(doc, &prefix, options).map_err(|e| e.to_string())?;
+                    println!("{}", model.info_json());
+                    Ok(())
+                });
             finish(&[result])
         }
         Command::Compile { input, json } => compile(&input, json),
@@ -187,10 +218,17 @@ struct PartSpec {
 impl PartSpec {
     fn parse(spec: &str) -> Result<PartSpec, String> {
         let mut it = spec.splitn(3, ':');
-        let file = it.next().filter(|f| !f.is_empty()).ok_or_else(|| format!("--part '{spec}': no file"))?;
+        let file = it
+            .next()
+            .filter(|f| !f.is_empty())
+            .ok_or_else(|| format!("--part '{spec}': no file"))?;
         let prefix = it.next().unwrap_or_default().to_string();
         let body = it.next().filter(|b| !b.is_empty()).map(str::to_string);
-        Ok(PartSpec { file: PathBuf::from(file), prefix, body })
+        Ok(PartSpec {
+            file: PathBuf::from(file),
+            prefix,
+            body,
+        })
     }
 }
 
@@ -214,8 +252,13 @@ fn merge(
         .collect();
     for (spec, doc) in parts.iter().zip(loaded) {
         let doc = doc?;
-        let merge_options = MergeOptions { fuse_keys, part_prefix: spec.prefix.clone() };
-        let report = scene.merge(&doc, spec.body.as_deref(), &merge_options).map_err(|e| e.to_string())?;
+        let merge_options = MergeOptions {
+            fuse_keys,
+            part_prefix: spec.prefix.clone(),
+        };
+        let report = scene
+            .merge(&doc, spec.body.as_deref(), &merge_options)
+            .map_err(|e| e.to_string())?;
         for w in report.warnings {
             eprintln!("warning: {w}");
         }
@@ -228,7 +271,11 @@ fn emit(doc: &Document, output: Option<&Path>, options: InlineOptions) -> Result
     if options.validate {
         validate(doc)?;
     }
-    let text = if options.compact { doc.to_xml_string() } else { doc.to_pretty_string() };
+    let text = if options.compact {
+        doc.to_xml_string()
+    } else {
+        doc.to_pretty_string()
+    };
     match output {
         Some(path) => mjcf_forge::write_atomic(path, text.as_bytes()).map_err(|e| e.to_string()),
         None => {

@@ -70,7 +70,10 @@ const MUST_AGREE: [(&str, &str); 12] = [
 fn compiler_settings(doc: &Document) -> Compiler<'_> {
     let compiler = crate::names::sym("compiler");
     let mut out = Compiler(Vec::new());
-    for c in doc.elements(doc.root).filter(|&n| doc.tag_sym(n) == Some(compiler)) {
+    for c in doc
+        .elements(doc.root)
+        .filter(|&n| doc.tag_sym(n) == Some(compiler))
+    {
         for (k, v) in doc.attrs(c) {
             out.0.retain(|(name, _, _)| *name != k);
             out.0.push((k, v.trim(), c));
@@ -85,7 +88,10 @@ struct Compiler<'a>(Vec<(&'a str, &'a str, Node)>);
 
 impl<'a> Compiler<'a> {
     fn get(&self, attr: &str) -> Option<(&'a str, Node)> {
-        self.0.iter().find(|(k, _, _)| *k == attr).map(|&(_, v, n)| (v, n))
+        self.0
+            .iter()
+            .find(|(k, _, _)| *k == attr)
+            .map(|&(_, v, n)| (v, n))
     }
 }
 
@@ -93,10 +99,13 @@ fn same_value(a: &str, b: &str) -> bool {
     let ta: Vec<&str> = a.split_ascii_whitespace().collect();
     let tb: Vec<&str> = b.split_ascii_whitespace().collect();
     ta.len() == tb.len()
-        && ta.iter().zip(&tb).all(|(x, y)| match (x.parse::<f64>(), y.parse::<f64>()) {
-            (Ok(p), Ok(q)) => p == q,
-            _ => x == y,
-        })
+        && ta
+            .iter()
+            .zip(&tb)
+            .all(|(x, y)| match (x.parse::<f64>(), y.parse::<f64>()) {
+                (Ok(p), Ok(q)) => p == q,
+                _ => x == y,
+            })
 }
 
 /// The shortest text that reads back as `x` (plain or with an exponent).
@@ -171,12 +180,19 @@ fn actuator_states(doc: &Document, act: Node) -> Result<usize, String> {
             _ => 1,
         },
         "position" => {
-            let tc = doc.attr(act, "timeconst").and_then(|t| t.trim().parse::<f64>().ok()).unwrap_or(0.0);
+            let tc = doc
+                .attr(act, "timeconst")
+                .and_then(|t| t.trim().parse::<f64>().ok())
+                .unwrap_or(0.0);
             usize::from(tc > 0.0)
         }
         "intvelocity" | "cylinder" | "muscle" => 1,
         "motor" | "velocity" | "damper" | "adhesion" => 0,
-        other => return Err(format!("activation size of <{other}> actuators is not known")),
+        other => {
+            return Err(format!(
+                "activation size of <{other}> actuators is not known"
+            ));
+        }
     })
 }
 
@@ -222,10 +238,10 @@ impl Layout {
                 "joint" | "freejoint" => self.joints.push(k),
                 "body" => bodies.push(k),
                 "frame" => self.collect(doc, k, bodies),
-                t @ ("replicate" | "composite" | "flexcomp" | "attach") => {
-                    if self.opaque.is_none() {
-                        self.opaque = Some((k, format!("<{t}> creates objects at compile time")));
-                    }
+                t @ ("replicate" | "composite" | "flexcomp" | "attach")
+                    if self.opaque.is_none() =>
+                {
+                    self.opaque = Some((k, format!("<{t}> creates objects at compile time")));
                 }
                 _ => {}
             }
@@ -247,7 +263,12 @@ struct Import {
 
 impl Import {
     fn new(file_offset: u32, keep_map: bool) -> Import {
-        Import { file_offset, strings_at: None, syms: Vec::new(), map: keep_map.then(AHashMap::new) }
+        Import {
+            file_offset,
+            strings_at: None,
+            syms: Vec::new(),
+            map: keep_map.then(AHashMap::new),
+        }
     }
 
     fn sym(&mut self, doc: &mut Document, other: &Document, sym: Sym) -> Sym {
@@ -268,7 +289,10 @@ impl Import {
             doc.strings.push_str(&other.strings);
             at
         });
-        StrRef { start: r.start + at, len: r.len }
+        StrRef {
+            start: r.start + at,
+            len: r.len,
+        }
     }
 }
 
@@ -291,7 +315,8 @@ fn keys_of(doc: &Document) -> Vec<Key> {
             node: k,
             name: doc.attr(k, "name").map(str::to_string),
             vectors: KEY_VECTORS.map(|v| {
-                doc.attr(k, v).map(|s| s.split_ascii_whitespace().map(str::to_string).collect())
+                doc.attr(k, v)
+                    .map(|s| s.split_ascii_whitespace().map(str::to_string).collect())
             }),
         })
         .collect()
@@ -323,7 +348,11 @@ impl Document {
         into: Option<&str>,
         options: &MergeOptions,
     ) -> Result<MergeReport, Errors> {
-        let part = MergePart { doc: part, into, prefix: &options.part_prefix };
+        let part = MergePart {
+            doc: part,
+            into,
+            prefix: &options.part_prefix,
+        };
         self.merge_all(&[part], options.fuse_keys)
     }
 
@@ -343,7 +372,11 @@ impl Document {
     /// assert!(scene.find_body("a_cube").is_some() && scene.find_body("b_cube").is_some());
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
-    pub fn merge_all(&mut self, parts: &[MergePart<'_>], fuse_keys: bool) -> Result<MergeReport, Errors> {
+    pub fn merge_all(
+        &mut self,
+        parts: &[MergePart<'_>],
+        fuse_keys: bool,
+    ) -> Result<MergeReport, Errors> {
         let clashes = self.name_clashes(&parts.iter().map(|p| p.doc).collect::<Vec<_>>());
         if !clashes.is_empty() {
             return Err(Errors(clashes));
@@ -354,7 +387,10 @@ impl Document {
         let mut report = MergeReport::default();
         let mut run = |doc: &mut Document| -> Result<(), Errors> {
             for p in parts {
-                let options = MergeOptions { fuse_keys, part_prefix: p.prefix.to_string() };
+                let options = MergeOptions {
+                    fuse_keys,
+                    part_prefix: p.prefix.to_string(),
+                };
                 let r = doc.merge_in_place(p.doc, p.into, &options)?;
                 report.warnings.extend(r.warnings);
                 report.shared_assets += r.shared_assets;
@@ -390,8 +426,11 @@ impl Document {
         let base_keys = keys_of(self);
         let part_keys = keys_of(part);
         let has_keys = !base_keys.is_empty() || !part_keys.is_empty();
-        let (base_layout, part_layout) =
-            if has_keys { (Layout::of(self), Layout::of(part)) } else { (Layout::default(), Layout::default()) };
+        let (base_layout, part_layout) = if has_keys {
+            (Layout::of(self), Layout::of(part))
+        } else {
+            (Layout::default(), Layout::default())
+        };
 
         let target = match into {
             None => None,
@@ -400,7 +439,9 @@ impl Document {
                 None => {
                     return Err(Error::at(
                         self.location(self.root),
-                        ErrorKind::Invalid(format!("merge target body '{name}' is not in the base model")),
+                        ErrorKind::Invalid(format!(
+                            "merge target body '{name}' is not in the base model"
+                        )),
                     )
                     .into());
                 }
@@ -482,7 +523,15 @@ impl Document {
         }
         if has_keys {
             let map = imp.map.take().unwrap_or_default();
-            self.remap_keys(&base_layout, &base_keys, part, &part_layout, &part_keys, &map, options)?;
+            self.remap_keys(
+                &base_layout,
+                &base_keys,
+                part,
+                &part_layout,
+                &part_keys,
+                &map,
+                options,
+            )?;
         }
         Ok(report)
     }
@@ -491,8 +540,10 @@ impl Document {
     pub fn find_body(&self, name: &str) -> Option<Node> {
         static SYMS: std::sync::OnceLock<(Sym, Sym)> = std::sync::OnceLock::new();
         let world = self.find_section(Section::Worldbody)?;
-        let &(body, name_sym) = SYMS.get_or_init(|| (crate::names::sym("body"), crate::names::sym("name")));
-        self.descendants(world).find(|&n| self.tag_sym(n) == Some(body) && self.attr_sym(n, name_sym) == Some(name))
+        let &(body, name_sym) =
+            SYMS.get_or_init(|| (crate::names::sym("body"), crate::names::sym("name")));
+        self.descendants(world)
+            .find(|&n| self.tag_sym(n) == Some(body) && self.attr_sym(n, name_sym) == Some(name))
     }
 
     fn has_free_joint(&self, node: Node) -> bool {
@@ -529,9 +580,18 @@ impl Document {
                     let value = imp.string(self, other, a.value);
                     self.attrs.push(Attr { name, value });
                 }
-                NodeData::Element { tag, attrs: crate::tree::AttrRange { start, len: attrs.len } }
+                NodeData::Element {
+                    tag,
+                    attrs: crate::tree::AttrRange {
+                        start,
+                        len: attrs.len,
+                    },
+                }
             }
-            NodeData::Text { text, cdata } => NodeData::Text { text: imp.string(self, other, text), cdata },
+            NodeData::Text { text, cdata } => NodeData::Text {
+                text: imp.string(self, other, text),
+                cdata,
+            },
         };
         let new = self.tree.append_new(parent, data);
         let mut span = other.spans[Tree::index(node)];
@@ -561,15 +621,23 @@ impl Document {
         let theirs = compiler_settings(part);
         let same = |k: &str| ours.get(k).map(|v| v.0) == theirs.get(k).map(|v| v.0);
         let others = ["eulerseq", "autolimits", "inertiafromgeom"];
-        if same("angle") || !MUST_AGREE.iter().all(|(k, _)| same(k)) || !others.iter().all(|k| same(k)) {
+        if same("angle")
+            || !MUST_AGREE.iter().all(|(k, _)| same(k))
+            || !others.iter().all(|k| same(k))
+        {
             return;
         }
-        let (Ok(mine), Ok(target)) = (Angles::of(self), Angles::of(part)) else { return };
+        let (Ok(mine), Ok(target)) = (Angles::of(self), Angles::of(part)) else {
+            return;
+        };
         if mine.degrees == target.degrees {
             return;
         }
         self.convert_angles(mine.degrees, target.degrees);
-        let compilers: Vec<Node> = self.elements(self.root).filter(|&n| self.tag(n) == "compiler").collect();
+        let compilers: Vec<Node> = self
+            .elements(self.root)
+            .filter(|&n| self.tag(n) == "compiler")
+            .collect();
         for &c in &compilers {
             self.remove_attr(c, "angle");
         }
@@ -608,10 +676,16 @@ impl Document {
     fn convert_compiler(&self, part: &mut Document, errors: &mut Vec<Error>) {
         let base = compiler_settings(self);
         let theirs = compiler_settings(part);
-        let value = |m: &Compiler<'_>, k: &str, d: &str| m.get(k).map_or_else(|| d.to_string(), |(v, _)| v.to_string());
+        let value = |m: &Compiler<'_>, k: &str, d: &str| {
+            m.get(k)
+                .map_or_else(|| d.to_string(), |(v, _)| v.to_string())
+        };
         // inertiafromgeom "true" ignores <inertial>; under the base's "auto" the same model is
         // the part without its <inertial> elements.
-        let (bi, pi) = (value(&base, "inertiafromgeom", "auto"), value(&theirs, "inertiafromgeom", "auto"));
+        let (bi, pi) = (
+            value(&base, "inertiafromgeom", "auto"),
+            value(&theirs, "inertiafromgeom", "auto"),
+        );
         let drop_inertials = pi == "true" && bi == "auto";
         for (attr, default) in MUST_AGREE {
             if attr == "inertiafromgeom" && drop_inertials {
@@ -628,13 +702,19 @@ impl Document {
                 ));
             }
         }
-        let (ba, pa) = (value(&base, "autolimits", "true"), value(&theirs, "autolimits", "true"));
+        let (ba, pa) = (
+            value(&base, "autolimits", "true"),
+            value(&theirs, "autolimits", "true"),
+        );
         drop(theirs);
         if !errors.is_empty() {
             return;
         }
         if drop_inertials {
-            let inertials: Vec<Node> = part.descendants(part.root).filter(|&n| part.tag(n) == "inertial").collect();
+            let inertials: Vec<Node> = part
+                .descendants(part.root)
+                .filter(|&n| part.tag(n) == "inertial")
+                .collect();
             for n in inertials {
                 part.remove(n);
             }
@@ -658,9 +738,17 @@ impl Document {
     /// Every `euler` becomes the `quat` it means under `angles` (for a base with another
     /// Euler sequence).
     fn rewrite_euler_as_quat(&mut self, angles: &Angles) {
-        let nodes: Vec<Node> = self.descendants(self.root).filter(|&n| self.attr(n, "euler").is_some()).collect();
+        let nodes: Vec<Node> = self
+            .descendants(self.root)
+            .filter(|&n| self.attr(n, "euler").is_some())
+            .collect();
         for n in nodes {
-            let e: Vec<f64> = self.attr(n, "euler").unwrap_or_default().split_ascii_whitespace().filter_map(|t| t.parse().ok()).collect();
+            let e: Vec<f64> = self
+                .attr(n, "euler")
+                .unwrap_or_default()
+                .split_ascii_whitespace()
+                .filter_map(|t| t.parse().ok())
+                .collect();
             if e.len() != 3 || self.tag(n) == "replicate" {
                 continue;
             }
@@ -677,7 +765,11 @@ impl Document {
         if from_degrees == to_degrees {
             return;
         }
-        let factor = if from_degrees { std::f64::consts::PI / 180.0 } else { 180.0 / std::f64::consts::PI };
+        let factor = if from_degrees {
+            std::f64::consts::PI / 180.0
+        } else {
+            180.0 / std::f64::consts::PI
+        };
         let convert = |v: &str, which: &dyn Fn(usize) -> bool| -> String {
             v.split_ascii_whitespace()
                 .enumerate()
@@ -731,7 +823,9 @@ impl Document {
         let value = if autolimits { "true" } else { "false" };
         let nodes: Vec<Node> = self.descendants(self.root).collect();
         for n in nodes {
-            if !matches!(self.tag(n), "joint" | "spatial" | "fixed") && self.parent(n).is_none_or(|p| self.tag(p) != "actuator") {
+            if !matches!(self.tag(n), "joint" | "spatial" | "fixed")
+                && self.parent(n).is_none_or(|p| self.tag(p) != "actuator")
+            {
                 continue;
             }
             for (range, flag) in PAIRS {
@@ -753,7 +847,10 @@ impl Document {
                 let bv = b.and_then(|b| self.attr(b, k)).map(str::to_string);
                 if tag == "size" && k.starts_with("nuser_") {
                     let pv: i64 = v.trim().parse().unwrap_or(-1);
-                    let cur: i64 = bv.as_deref().and_then(|x| x.trim().parse().ok()).unwrap_or(-1);
+                    let cur: i64 = bv
+                        .as_deref()
+                        .and_then(|x| x.trim().parse().ok())
+                        .unwrap_or(-1);
                     if pv > cur {
                         let b = match b {
                             Some(b) => b,
@@ -778,7 +875,8 @@ impl Document {
                     "{}: the part's <{} {k}=\"{v}\"> is ignored: the base's {} wins",
                     part.location(p),
                     part.tag(p),
-                    bv.map(|x| format!("\"{x}\"")).unwrap_or_else(|| "value (MuJoCo's default)".into())
+                    bv.map(|x| format!("\"{x}\""))
+                        .unwrap_or_else(|| "value (MuJoCo's default)".into())
                 ));
             }
             for pk in part.elements(p) {
@@ -791,17 +889,27 @@ impl Document {
 
     /// Residual default classes of a part (see `defaults`): the same name must mean the same.
     fn check_residual_defaults(&self, part: &Document, errors: &mut Vec<Error>) {
-        let Some(ours) = self.elements(self.root).find(|&n| self.tag(n) == "default") else { return };
-        for section in part.elements(part.root).filter(|&n| part.tag(n) == "default") {
+        let Some(ours) = self.elements(self.root).find(|&n| self.tag(n) == "default") else {
+            return;
+        };
+        for section in part
+            .elements(part.root)
+            .filter(|&n| part.tag(n) == "default")
+        {
             for class in part.elements(section) {
                 let name = part.attr(class, "class").unwrap_or_default();
-                if let Some(c) = self.elements(ours).find(|&c| self.attr(c, "class") == Some(name)) {
-                    if !self.same_subtree(c, part, class) {
-                        errors.push(part.error_at(
-                            class,
-                            ErrorKind::Invalid(format!("default class '{name}' differs from the base's at {}", self.location(c))),
-                        ));
-                    }
+                if let Some(c) = self
+                    .elements(ours)
+                    .find(|&c| self.attr(c, "class") == Some(name))
+                    && !self.same_subtree(c, part, class)
+                {
+                    errors.push(part.error_at(
+                        class,
+                        ErrorKind::Invalid(format!(
+                            "default class '{name}' differs from the base's at {}",
+                            self.location(c)
+                        )),
+                    ));
                 }
             }
         }
@@ -825,7 +933,10 @@ impl Document {
         let mut imp = Import::new(file_offset, false);
         for class in part.elements(section).collect::<Vec<_>>() {
             let name = part.attr(class, "class").unwrap_or_default();
-            if self.elements(dest).any(|c| self.attr(c, "class") == Some(name)) {
+            if self
+                .elements(dest)
+                .any(|c| self.attr(c, "class") == Some(name))
+            {
                 continue;
             }
             self.import(part, class, dest, &mut imp);
@@ -847,7 +958,11 @@ impl Document {
         }
         let ka: Vec<Node> = self.children(a).collect();
         let kb: Vec<Node> = other.children(b).collect();
-        ka.len() == kb.len() && ka.iter().zip(&kb).all(|(&p, &q)| self.same_subtree(p, other, q))
+        ka.len() == kb.len()
+            && ka
+                .iter()
+                .zip(&kb)
+                .all(|(&p, &q)| self.same_subtree(p, other, q))
     }
 
     /// The name of an asset: its `name`, else the one MuJoCo derives from its file.
@@ -856,14 +971,18 @@ impl Document {
         self.attr_sym(n, s.name).or_else(|| {
             let tag = self.tag_sym(n)?;
             let named = [s.mesh, s.texture, s.hfield, s.skin].contains(&tag);
-            self.attr_sym(n, s.file).filter(|_| named).and_then(crate::validate::file_stem)
+            self.attr_sym(n, s.file)
+                .filter(|_| named)
+                .and_then(crate::validate::file_stem)
         })
     }
 
     /// For each asset of the part, in order: whether the base already has it (same tag,
     /// name and content); an asset with a base name but other content is an error naming both.
     fn asset_decisions(&self, part: &Document, errors: &mut Vec<Error>) -> Vec<bool> {
-        let Some(theirs) = part.find_section(Section::Asset) else { return Vec::new() };
+        let Some(theirs) = part.find_section(Section::Asset) else {
+            return Vec::new();
+        };
         let mut index: AHashMap<(Sym, &str), Node> = AHashMap::with_capacity(64);
         if let Some(assets) = self.find_section(Section::Asset) {
             for n in self.elements(assets) {
@@ -940,9 +1059,17 @@ impl Offsets {
                 })
                 .collect()
         };
-        let jw: Vec<(usize, usize)> = layout.joints.iter().map(|&j| joint_widths(doc, j)).collect();
+        let jw: Vec<(usize, usize)> = layout
+            .joints
+            .iter()
+            .map(|&j| joint_widths(doc, j))
+            .collect();
         let act = if need_act {
-            layout.actuators.iter().map(|&a| actuator_states(doc, a)).collect::<Result<Vec<_>, _>>()?
+            layout
+                .actuators
+                .iter()
+                .map(|&a| actuator_states(doc, a))
+                .collect::<Result<Vec<_>, _>>()?
         } else {
             vec![0; layout.actuators.len()]
         };
@@ -974,7 +1101,11 @@ impl Offsets {
 
 impl Document {
     /// The world pose of a body as written (through enclosing frames), quaternion normalized.
-    fn written_world_pose(&self, body: Node, angles: &Angles) -> Result<([f64; 3], [f64; 4]), String> {
+    fn written_world_pose(
+        &self,
+        body: Node,
+        angles: &Angles,
+    ) -> Result<([f64; 3], [f64; 4]), String> {
         let mut chain = vec![body];
         let mut p = self.parent(body);
         while let Some(n) = p {
@@ -997,7 +1128,13 @@ impl Document {
     /// What a state-vector item holds when no key gives it: `qpos0` for joints (the joint's
     /// `ref`, the unit quaternion, or a free body's written pose), zero velocities, controls
     /// and activations, and a mocap body's written pose.
-    fn default_tokens(&self, v: usize, item: Node, width: usize, angles: &Angles) -> Result<Vec<String>, String> {
+    fn default_tokens(
+        &self,
+        v: usize,
+        item: Node,
+        width: usize,
+        angles: &Angles,
+    ) -> Result<Vec<String>, String> {
         let zeros = || vec!["0".to_string(); width];
         match v {
             0 => {
@@ -1010,16 +1147,28 @@ impl Document {
                     }
                     4 => Ok(["1", "0", "0", "0"].map(String::from).to_vec()),
                     _ => {
-                        let r: f64 = self.attr(item, "ref").and_then(|r| r.trim().parse().ok()).unwrap_or(0.0);
-                        let hinge = self.attr(item, "type").map(str::trim).unwrap_or("hinge") == "hinge";
-                        let r = if hinge && angles.degrees { r * std::f64::consts::PI / 180.0 } else { r };
+                        let r: f64 = self
+                            .attr(item, "ref")
+                            .and_then(|r| r.trim().parse().ok())
+                            .unwrap_or(0.0);
+                        let hinge =
+                            self.attr(item, "type").map(str::trim).unwrap_or("hinge") == "hinge";
+                        let r = if hinge && angles.degrees {
+                            r * std::f64::consts::PI / 180.0
+                        } else {
+                            r
+                        };
                         Ok(vec![fmt_num(r)])
                     }
                 }
             }
             4 | 5 => {
                 let (p, q) = self.written_world_pose(item, angles)?;
-                Ok(if v == 4 { p.iter().map(|&x| fmt_num(x)).collect() } else { q.iter().map(|&x| fmt_num(x)).collect() })
+                Ok(if v == 4 {
+                    p.iter().map(|&x| fmt_num(x)).collect()
+                } else {
+                    q.iter().map(|&x| fmt_num(x)).collect()
+                })
             }
             _ => Ok(zeros()),
         }
@@ -1039,31 +1188,41 @@ impl Document {
         for (doc, layout) in [(&*self, base_layout), (part, part_layout)] {
             if let Some((n, why)) = &layout.opaque {
                 return Err(doc
-                    .error_at(*n, ErrorKind::Invalid(format!("cannot remap keyframes: {why}")))
+                    .error_at(
+                        *n,
+                        ErrorKind::Invalid(format!("cannot remap keyframes: {why}")),
+                    )
                     .into());
             }
         }
-        let need_act = base_keys.iter().chain(part_keys).any(|k| k.vectors[2].is_some());
-        let located = |doc: &Document, n: Node, e: String| -> Errors { doc.error_at(n, ErrorKind::Invalid(e)).into() };
-        let base_off = Offsets::of(self, base_layout, need_act).map_err(|e| located(self, self.root, e))?;
-        let part_off = Offsets::of(part, part_layout, need_act).map_err(|e| located(part, part.root, e))?;
+        let need_act = base_keys
+            .iter()
+            .chain(part_keys)
+            .any(|k| k.vectors[2].is_some());
+        let located = |doc: &Document, n: Node, e: String| -> Errors {
+            doc.error_at(n, ErrorKind::Invalid(e)).into()
+        };
+        let base_off =
+            Offsets::of(self, base_layout, need_act).map_err(|e| located(self, self.root, e))?;
+        let part_off =
+            Offsets::of(part, part_layout, need_act).map_err(|e| located(part, part.root, e))?;
         // Keys must fit their own model, as MuJoCo requires.
         let mut errors = Vec::new();
         for (doc, keys, off) in [(&*self, base_keys, &base_off), (part, part_keys, &part_off)] {
             for k in keys {
                 for (v, vec) in k.vectors.iter().enumerate() {
-                    if let Some(vec) = vec {
-                        if vec.len() != off.len(v) {
-                            errors.push(doc.error_at(
-                                k.node,
-                                ErrorKind::Invalid(format!(
-                                    "key {} has {} values, the model needs {}",
-                                    KEY_VECTORS[v],
-                                    vec.len(),
-                                    off.len(v)
-                                )),
-                            ));
-                        }
+                    if let Some(vec) = vec
+                        && vec.len() != off.len(v)
+                    {
+                        errors.push(doc.error_at(
+                            k.node,
+                            ErrorKind::Invalid(format!(
+                                "key {} has {} values, the model needs {}",
+                                KEY_VECTORS[v],
+                                vec.len(),
+                                off.len(v)
+                            )),
+                        ));
                     }
                 }
             }
@@ -1077,37 +1236,50 @@ impl Document {
         let angles = Angles::of(self).map_err(|e| located(self, self.root, e))?;
         let mut from_part: AHashMap<Node, usize> = AHashMap::new();
         let mut from_base: AHashMap<Node, usize> = AHashMap::new();
-        for items in [&part_layout.joints, &part_layout.actuators, &part_layout.mocap] {
+        for items in [
+            &part_layout.joints,
+            &part_layout.actuators,
+            &part_layout.mocap,
+        ] {
             for (j, n) in items.iter().enumerate() {
                 if let Some(&m) = map.get(n) {
                     from_part.insert(m, j);
                 }
             }
         }
-        for items in [&base_layout.joints, &base_layout.actuators, &base_layout.mocap] {
+        for items in [
+            &base_layout.joints,
+            &base_layout.actuators,
+            &base_layout.mocap,
+        ] {
             for (j, n) in items.iter().enumerate() {
                 from_base.insert(*n, j);
             }
         }
         let origin = |n: Node| -> Option<Origin> {
-            from_base.get(&n).map(|&i| Origin::Base(i)).or_else(|| from_part.get(&n).map(|&i| Origin::Part(i)))
+            from_base
+                .get(&n)
+                .map(|&i| Origin::Base(i))
+                .or_else(|| from_part.get(&n).map(|&i| Origin::Part(i)))
         };
 
         // Which keys become one: each base key, with the part key fused into it if asked.
-        let mut groups: Vec<(Option<&Key>, Option<&Key>)> = base_keys.iter().map(|k| (Some(k), None)).collect();
+        let mut groups: Vec<(Option<&Key>, Option<&Key>)> =
+            base_keys.iter().map(|k| (Some(k), None)).collect();
         for pk in part_keys {
             let fused = options.fuse_keys
                 && pk.name.as_deref().is_some_and(|n| {
                     let stripped = n.strip_prefix(options.part_prefix.as_str()).unwrap_or(n);
-                    groups.iter().any(|(b, p)| p.is_none() && b.and_then(|b| b.name.as_deref()) == Some(stripped))
+                    groups.iter().any(|(b, p)| {
+                        p.is_none() && b.and_then(|b| b.name.as_deref()) == Some(stripped)
+                    })
                 });
             if fused {
                 let n = pk.name.as_deref().unwrap_or_default();
                 let stripped = n.strip_prefix(options.part_prefix.as_str()).unwrap_or(n);
-                if let Some(g) = groups
-                    .iter_mut()
-                    .find(|(b, p)| p.is_none() && b.and_then(|b| b.name.as_deref()) == Some(stripped))
-                {
+                if let Some(g) = groups.iter_mut().find(|(b, p)| {
+                    p.is_none() && b.and_then(|b| b.name.as_deref()) == Some(stripped)
+                }) {
                     g.1 = Some(pk);
                 }
             } else {
@@ -1125,8 +1297,10 @@ impl Document {
                     attrs.push((k.to_string(), v.to_string()));
                 }
             }
-            for v in 0..6 {
-                if bk.and_then(|k| k.vectors[v].as_ref()).is_none() && pk.and_then(|k| k.vectors[v].as_ref()).is_none() {
+            for (v, vector_name) in KEY_VECTORS.iter().enumerate() {
+                if bk.and_then(|k| k.vectors[v].as_ref()).is_none()
+                    && pk.and_then(|k| k.vectors[v].as_ref()).is_none()
+                {
                     continue;
                 }
                 let items: &[Node] = match v {
@@ -1137,14 +1311,18 @@ impl Document {
                 let mut tokens: Vec<String> = Vec::new();
                 for &item in items {
                     let given = match origin(item) {
-                        Some(Origin::Base(i)) => bk.and_then(|k| k.vectors[v].as_ref()).map(|vec| {
-                            let (at, w) = base_off.vector(v)[i];
-                            vec[at..at + w].to_vec()
-                        }),
-                        Some(Origin::Part(i)) => pk.and_then(|k| k.vectors[v].as_ref()).map(|vec| {
-                            let (at, w) = part_off.vector(v)[i];
-                            vec[at..at + w].to_vec()
-                        }),
+                        Some(Origin::Base(i)) => {
+                            bk.and_then(|k| k.vectors[v].as_ref()).map(|vec| {
+                                let (at, w) = base_off.vector(v)[i];
+                                vec[at..at + w].to_vec()
+                            })
+                        }
+                        Some(Origin::Part(i)) => {
+                            pk.and_then(|k| k.vectors[v].as_ref()).map(|vec| {
+                                let (at, w) = part_off.vector(v)[i];
+                                vec[at..at + w].to_vec()
+                            })
+                        }
                         None => None,
                     };
                     match given {
@@ -1153,17 +1331,20 @@ impl Document {
                             let width = match v {
                                 0 => joint_widths(self, item).0,
                                 1 => joint_widths(self, item).1,
-                                2 => actuator_states(self, item).map_err(|e| located(self, item, e))?,
+                                2 => actuator_states(self, item)
+                                    .map_err(|e| located(self, item, e))?,
                                 3 => 1,
                                 4 => 3,
                                 _ => 4,
                             };
-                            let d = self.default_tokens(v, item, width, &angles).map_err(|e| located(self, item, e))?;
+                            let d = self
+                                .default_tokens(v, item, width, &angles)
+                                .map_err(|e| located(self, item, e))?;
                             tokens.extend(d);
                         }
                     }
                 }
-                attrs.push((KEY_VECTORS[v].to_string(), tokens.join(" ")));
+                attrs.push((vector_name.to_string(), tokens.join(" ")));
             }
             new_keys.push(attrs);
         }
@@ -1171,9 +1352,15 @@ impl Document {
         // Replace the keys: the base's in place of the old ones, the part's after them.
         let section = self.section(Section::Keyframe);
         let origins: Vec<Option<Node>> = groups.iter().map(|(b, _)| b.map(|k| k.node)).collect();
-        let old: Vec<Node> = self.elements(section).filter(|&k| self.tag(k) == "key").collect();
+        let old: Vec<Node> = self
+            .elements(section)
+            .filter(|&k| self.tag(k) == "key")
+            .collect();
         for (attrs, base_node) in new_keys.iter().zip(origins) {
-            let refs: Vec<(&str, &str)> = attrs.iter().map(|(k, v)| (k.as_str(), v.as_str())).collect();
+            let refs: Vec<(&str, &str)> = attrs
+                .iter()
+                .map(|(k, v)| (k.as_str(), v.as_str()))
+                .collect();
             let key = self.append_element(section, "key", &refs);
             if let Some(b) = base_node {
                 let span = self.spans[Tree::index(b)];

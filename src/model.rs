@@ -38,7 +38,10 @@ pub trait MujocoModel {
     }
     /// [`MujocoModel::correct_naming`] of each value of a map.
     fn correct_naming_map(&self, names: &BTreeMap<String, String>) -> BTreeMap<String, String> {
-        names.iter().map(|(k, v)| (k.clone(), self.correct_naming(v))).collect()
+        names
+            .iter()
+            .map(|(k, v)| (k.clone(), self.correct_naming(v)))
+            .collect()
     }
     /// The one top-level body.
     fn root_body(&self) -> &str;
@@ -98,13 +101,17 @@ impl Default for XmlModelOptions {
     }
 }
 
-/// Offsets of a model, computed from its geometry or set by hand.
+/// Where a model sits, computed from its geometry or set by hand (see [`MujocoModel`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-struct Offsets {
-    base: [f64; 3],
-    bottom: [f64; 3],
-    top: [f64; 3],
-    horizontal_radius: f64,
+pub struct Offsets {
+    /// The root body's position in its parent.
+    pub base: [f64; 3],
+    /// From the root body's origin down to the lowest point, in the root's frame.
+    pub bottom: [f64; 3],
+    /// From the root body's origin up to the highest point, in the root's frame.
+    pub top: [f64; 3],
+    /// The largest horizontal distance of the geometry from the root's z axis.
+    pub horizontal_radius: f64,
 }
 
 /// One instance of an MJCF model (robosuite's `MujocoXMLModel`): the document with every
@@ -189,7 +196,10 @@ impl Lists {
                 list.extend(name(n));
             }
         }
-        for (section, list) in [(Section::Actuator, &mut l.actuators), (Section::Sensor, &mut l.sensors)] {
+        for (section, list) in [
+            (Section::Actuator, &mut l.actuators),
+            (Section::Sensor, &mut l.sensors),
+        ] {
             if let Some(s) = doc.find_section(section) {
                 list.extend(doc.elements(s).filter_map(name));
             }
@@ -199,7 +209,9 @@ impl Lists {
 }
 
 fn group_of(doc: &Document, geom: Node) -> i64 {
-    doc.attr_sym(geom, Syms::get().group).and_then(|v| v.trim().parse().ok()).unwrap_or(0)
+    doc.attr_sym(geom, Syms::get().group)
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap_or(0)
 }
 
 /// Names this module looks up often, interned once.
@@ -248,14 +260,21 @@ impl XmlModel {
     }
 
     /// An instance whose names all get exactly `prefix` (which may be empty).
-    pub fn with_prefix(mut doc: Document, prefix: &str, options: XmlModelOptions) -> Result<XmlModel, Errors> {
+    pub fn with_prefix(
+        mut doc: Document,
+        prefix: &str,
+        options: XmlModelOptions,
+    ) -> Result<XmlModel, Errors> {
         let prefix = prefix.to_string();
         let world = doc.section(Section::Worldbody);
         let roots = doc.top_level_bodies(world);
         if roots.len() != 1 {
             return Err(Error::at(
                 doc.location(world),
-                ErrorKind::Invalid(format!("expected exactly one top-level body in <worldbody>, found {}", roots.len())),
+                ErrorKind::Invalid(format!(
+                    "expected exactly one top-level body in <worldbody>, found {}",
+                    roots.len()
+                )),
             )
             .into());
         }
@@ -279,7 +298,11 @@ impl XmlModel {
                     1 => format!("g{vis}_vis"),
                     _ => continue,
                 };
-                if grp == 0 { col += 1 } else { vis += 1 }
+                if grp == 0 {
+                    col += 1
+                } else {
+                    vis += 1
+                }
                 let value = doc.push_str(&name);
                 doc.set_attr_ref(g, syms.name, value);
             }
@@ -358,9 +381,8 @@ impl XmlModel {
     /// position, and the bounds of every geom below it in the root's frame with the tree as
     /// written (primitives exactly, meshes from their vertices; planes and height fields
     /// left out). An unreadable mesh file is the error.
-    pub fn try_offsets(&self) -> Result<([f64; 3], [f64; 3], [f64; 3], f64), String> {
-        let o = self.offsets.get_or_init(|| self.compute_offsets()).clone()?;
-        Ok((o.base, o.bottom, o.top, o.horizontal_radius))
+    pub fn try_offsets(&self) -> Result<Offsets, String> {
+        self.offsets.get_or_init(|| self.compute_offsets()).clone()
     }
 
     fn compute_offsets(&self) -> Result<Offsets, String> {
@@ -375,7 +397,11 @@ impl XmlModel {
             base,
             bottom: [0.0, 0.0, if finite { bounds.min[2] } else { 0.0 }],
             top: [0.0, 0.0, if finite { bounds.max[2] } else { 0.0 }],
-            horizontal_radius: if finite { bounds.horizontal_radius } else { 0.0 },
+            horizontal_radius: if finite {
+                bounds.horizontal_radius
+            } else {
+                0.0
+            },
         })
     }
 
@@ -384,7 +410,10 @@ impl XmlModel {
             let computed = self.compute_offsets().unwrap_or_default();
             self.offsets = OnceLock::from(Ok(computed));
         }
-        self.offsets.get_mut().and_then(|o| o.as_mut().ok()).expect("offsets set above")
+        self.offsets
+            .get_mut()
+            .and_then(|o| o.as_mut().ok())
+            .expect("offsets set above")
     }
 
     /// Overrides the computed bottom offset.
@@ -409,16 +438,29 @@ impl XmlModel {
 
     /// Merges another instance into this one: into the world body, or into this model's
     /// body named `into` (a full, prefixed name). Lists grow by the other's.
-    pub fn merge(&mut self, other: &XmlModel, into: Option<&str>, fuse_keys: bool) -> Result<MergeReport, Errors> {
+    pub fn merge(
+        &mut self,
+        other: &XmlModel,
+        into: Option<&str>,
+        fuse_keys: bool,
+    ) -> Result<MergeReport, Errors> {
         self.merge_all(&[(other, into)], fuse_keys)
     }
 
     /// Merges several instances in order (each into the world body or into a body of this
     /// model), checking every name once up front (see [`Document::merge_all`]).
-    pub fn merge_all(&mut self, others: &[(&XmlModel, Option<&str>)], fuse_keys: bool) -> Result<MergeReport, Errors> {
+    pub fn merge_all(
+        &mut self,
+        others: &[(&XmlModel, Option<&str>)],
+        fuse_keys: bool,
+    ) -> Result<MergeReport, Errors> {
         let parts: Vec<crate::merge::MergePart<'_>> = others
             .iter()
-            .map(|(m, into)| crate::merge::MergePart { doc: &m.doc, into: *into, prefix: &m.prefix })
+            .map(|(m, into)| crate::merge::MergePart {
+                doc: &m.doc,
+                into: *into,
+                prefix: &m.prefix,
+            })
             .collect();
         let report = self.doc.merge_all(&parts, fuse_keys)?;
         // The model's extent and lists changed with the merge.
@@ -426,7 +468,6 @@ impl XmlModel {
         self.lists = OnceLock::new();
         Ok(report)
     }
-
 }
 
 impl Document {
@@ -503,19 +544,23 @@ impl MujocoModel for XmlModel {
     }
     /// NaN when the geometry cannot be read (see [`XmlModel::try_offsets`]).
     fn base_offset(&self) -> [f64; 3] {
-        self.try_offsets().map(|o| o.0).unwrap_or([f64::NAN; 3])
+        self.try_offsets().map(|o| o.base).unwrap_or([f64::NAN; 3])
     }
     /// NaN when the geometry cannot be read (see [`XmlModel::try_offsets`]).
     fn bottom_offset(&self) -> [f64; 3] {
-        self.try_offsets().map(|o| o.1).unwrap_or([f64::NAN; 3])
+        self.try_offsets()
+            .map(|o| o.bottom)
+            .unwrap_or([f64::NAN; 3])
     }
     /// NaN when the geometry cannot be read (see [`XmlModel::try_offsets`]).
     fn top_offset(&self) -> [f64; 3] {
-        self.try_offsets().map(|o| o.2).unwrap_or([f64::NAN; 3])
+        self.try_offsets().map(|o| o.top).unwrap_or([f64::NAN; 3])
     }
     /// NaN when the geometry cannot be read (see [`XmlModel::try_offsets`]).
     fn horizontal_radius(&self) -> f64 {
-        self.try_offsets().map(|o| o.3).unwrap_or(f64::NAN)
+        self.try_offsets()
+            .map(|o| o.horizontal_radius)
+            .unwrap_or(f64::NAN)
     }
 }
 
@@ -539,15 +584,27 @@ fn json_str(s: &str) -> String {
 }
 
 fn json_list(v: &[String]) -> String {
-    format!("[{}]", v.iter().map(|s| json_str(s)).collect::<Vec<_>>().join(", "))
+    format!(
+        "[{}]",
+        v.iter().map(|s| json_str(s)).collect::<Vec<_>>().join(", ")
+    )
 }
 
 fn json_num(x: f64) -> String {
-    if x.is_finite() { format!("{x}") } else { "null".to_string() }
+    if x.is_finite() {
+        format!("{x}")
+    } else {
+        "null".to_string()
+    }
 }
 
 fn json_vec3(v: [f64; 3]) -> String {
-    format!("[{}, {}, {}]", json_num(v[0]), json_num(v[1]), json_num(v[2]))
+    format!(
+        "[{}, {}, {}]",
+        json_num(v[0]),
+        json_num(v[1]),
+        json_num(v[2])
+    )
 }
 
 impl XmlModel {
@@ -564,7 +621,10 @@ impl XmlModel {
         let maps = |m: &BTreeMap<String, String>| {
             format!(
                 "{{{}}}",
-                m.iter().map(|(k, v)| format!("{}: {}", json_str(k), json_str(v))).collect::<Vec<_>>().join(", ")
+                m.iter()
+                    .map(|(k, v)| format!("{}: {}", json_str(k), json_str(v)))
+                    .collect::<Vec<_>>()
+                    .join(", ")
             )
         };
         let geoms = format!(

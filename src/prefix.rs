@@ -58,7 +58,12 @@ enum Rename {
     /// One name (an identifier or a reference): `old` is its text, trimmed.
     One { node: Node, name: Sym, old: StrRef },
     /// A space-separated list of names of one namespace.
-    List { node: Node, name: Sym, old: StrRef, ns: Ns },
+    List {
+        node: Node,
+        name: Sym,
+        old: StrRef,
+        ns: Ns,
+    },
     /// An asset named after its file gets `prefix + stem` as its name.
     Named { node: Node, stem: String },
 }
@@ -66,11 +71,16 @@ enum Rename {
 /// The part of `r` (whose text is `text`) without surrounding white space.
 fn trimmed(text: &str, r: StrRef) -> StrRef {
     let b = text.as_bytes();
-    if b.first().is_none_or(|c| !c.is_ascii_whitespace()) && b.last().is_none_or(|c| !c.is_ascii_whitespace()) {
+    if b.first().is_none_or(|c| !c.is_ascii_whitespace())
+        && b.last().is_none_or(|c| !c.is_ascii_whitespace())
+    {
         return r;
     }
     let lead = text.len() - text.trim_start().len();
-    StrRef { start: r.start + lead as u32, len: text.trim().len() as u32 }
+    StrRef {
+        start: r.start + lead as u32,
+        len: text.trim().len() as u32,
+    }
 }
 
 impl Document {
@@ -114,7 +124,7 @@ impl Document {
         let mut edits: Vec<Rename> = Vec::new();
         let mut stack: Vec<(Node, Kind)> = vec![(self.root, Kind::root())];
         let renamed = |ns: Ns, v: &str| -> bool {
-            !v.is_empty() && !(ns == Ns::Body && v == "world") && !keep(ns, v)
+            !(v.is_empty() || (ns == Ns::Body && v == "world") || keep(ns, v))
         };
         while let Some((node, kind)) = stack.pop() {
             let mut has_name = false;
@@ -128,23 +138,36 @@ impl Document {
                 continue;
             }
             for a in self.attr_slice(node) {
-                let Some(&(_, attr_kind)) = naming.iter().find(|(s, _)| *s == a.name) else { continue };
+                let Some(&(_, attr_kind)) = naming.iter().find(|(s, _)| *s == a.name) else {
+                    continue;
+                };
                 match attr_kind {
                     AttrKind::Id(ns) | AttrKind::Ref(ns) => {
                         has_name |= matches!(attr_kind, AttrKind::Id(_));
                         let old = trimmed(self.str(a.value), a.value);
                         if renamed(ns, self.str(old)) {
-                            edits.push(Rename::One { node, name: a.name, old });
+                            edits.push(Rename::One {
+                                node,
+                                name: a.name,
+                                old,
+                            });
                         }
                     }
-                    AttrKind::RefList(ns) => edits.push(Rename::List { node, name: a.name, old: a.value, ns }),
+                    AttrKind::RefList(ns) => edits.push(Rename::List {
+                        node,
+                        name: a.name,
+                        old: a.value,
+                        ns,
+                    }),
                     AttrKind::ObjType { name_attr } => {
-                        if let (Some(t), Some(ns)) = (crate::names::known(name_attr), ns_of_objtype(self.str(a.value))) {
-                            if let Some(r) = self.attr_ref(node, t) {
-                                let old = trimmed(self.str(r), r);
-                                if renamed(ns, self.str(old)) {
-                                    edits.push(Rename::One { node, name: t, old });
-                                }
+                        if let (Some(t), Some(ns)) = (
+                            crate::names::known(name_attr),
+                            ns_of_objtype(self.str(a.value)),
+                        ) && let Some(r) = self.attr_ref(node, t)
+                        {
+                            let old = trimmed(self.str(r), r);
+                            if renamed(ns, self.str(old)) {
+                                edits.push(Rename::One { node, name: t, old });
                             }
                         }
                     }
@@ -179,10 +202,16 @@ impl Document {
             let (node, name) = match e {
                 Rename::One { node, name, old } => {
                     self.strings.push_str(prefix);
-                    self.strings.extend_from_within(old.start as usize..(old.start + old.len) as usize);
+                    self.strings
+                        .extend_from_within(old.start as usize..(old.start + old.len) as usize);
                     (node, name)
                 }
-                Rename::List { node, name, old, ns } => {
+                Rename::List {
+                    node,
+                    name,
+                    old,
+                    ns,
+                } => {
                     let text = self.str(old).to_string();
                     for (i, t) in text.split_ascii_whitespace().enumerate() {
                         if i > 0 {
@@ -201,7 +230,10 @@ impl Document {
                     (node, name_sym)
                 }
             };
-            let value = StrRef { start: start as u32, len: (self.strings.len() - start) as u32 };
+            let value = StrRef {
+                start: start as u32,
+                len: (self.strings.len() - start) as u32,
+            };
             self.set_attr_ref(node, name, value);
         }
         Ok(())
@@ -211,7 +243,10 @@ impl Document {
 impl Document {
     /// The value of an attribute, as a range of the string buffer.
     fn attr_ref(&self, node: Node, name: Sym) -> Option<StrRef> {
-        self.attr_slice(node).iter().find(|a| a.name == name).map(|a| a.value)
+        self.attr_slice(node)
+            .iter()
+            .find(|a| a.name == name)
+            .map(|a| a.value)
     }
 }
 
@@ -233,7 +268,9 @@ fn name_attrs(kind: Kind) -> &'static [(Sym, AttrKind)] {
                     .spec()
                     .attrs
                     .iter()
-                    .filter(|a| !matches!(a.kind, AttrKind::Plain | AttrKind::File | AttrKind::ObjName))
+                    .filter(|a| {
+                        !matches!(a.kind, AttrKind::Plain | AttrKind::File | AttrKind::ObjName)
+                    })
                     .filter_map(|a| crate::names::known(a.name).map(|s| (s, a.kind)))
                     .collect()
             })

@@ -551,7 +551,12 @@ impl Builder {
                 included_at: None,
             }],
             chain: Vec::new(),
-            chain_display: vec![name.to_path_buf()],
+            // The main file joins both chains when the first include is met; a text has
+            // no file to be part of a cycle.
+            chain_display: match main {
+                Main::File { .. } => vec![name.to_path_buf()],
+                Main::Text => Vec::new(),
+            },
             seen: Vec::new(),
             display_dir: display_dir.to_path_buf(),
             main_to_canonicalize: match main {
@@ -781,6 +786,8 @@ impl Builder {
             )
             .into());
         }
+        // What follows the root element is not read: MuJoCo (tinyxml2's root element) ignores
+        // it as well.
         Ok(inserted)
     }
 

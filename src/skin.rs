@@ -81,26 +81,46 @@ fn parse_skn(bytes: &[u8]) -> Result<Skn, String> {
         let n = c.count()?;
         let vertid = c.i32s(n)?;
         let vertweight = c.f32s(n)?;
-        bones.push(Bone { body, bindpos, bindquat, vertid, vertweight });
+        bones.push(Bone {
+            body,
+            bindpos,
+            bindquat,
+            vertid,
+            vertweight,
+        });
     }
     if c.at != bytes.len() {
         return Err(format!("{} bytes after the last bone", bytes.len() - c.at));
     }
-    Ok(Skn { vertex, texcoord, face, bones })
+    Ok(Skn {
+        vertex,
+        texcoord,
+        face,
+        bones,
+    })
 }
 
 /// float32 attributes: the shortest text that reads back as the same float32.
 fn f32_list(v: &[f32]) -> String {
-    v.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(" ")
+    v.iter()
+        .map(|x| format!("{x}"))
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 /// double attributes fed from float32 data: the float32's exact value as a double.
 fn f32_as_f64_list(v: &[f32]) -> String {
-    v.iter().map(|&x| format!("{}", f64::from(x))).collect::<Vec<_>>().join(" ")
+    v.iter()
+        .map(|&x| format!("{}", f64::from(x)))
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 fn i32_list(v: &[i32]) -> String {
-    v.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(" ")
+    v.iter()
+        .map(|x| x.to_string())
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 impl Document {
@@ -109,12 +129,16 @@ impl Document {
         let skins: Vec<Node> = self
             .descendants(self.root)
             .filter(|&n| self.tag(n) == "skin" && self.attr(n, "file").is_some())
-            .filter(|&n| self.parent(n).is_some_and(|p| matches!(self.tag(p), "asset" | "deformable")))
+            .filter(|&n| {
+                self.parent(n)
+                    .is_some_and(|p| matches!(self.tag(p), "asset" | "deformable"))
+            })
             .collect();
         for skin in skins {
             let file = self.attr(skin, "file").unwrap_or_default().to_string();
             let bad = |reason: String| ErrorKind::Invalid(format!("skin file '{file}': {reason}"));
-            let bytes = std::fs::read(&file).map_err(|e| self.error_at(skin, bad(e.to_string())))?;
+            let bytes =
+                std::fs::read(&file).map_err(|e| self.error_at(skin, bad(e.to_string())))?;
             let skn = parse_skn(&bytes).map_err(|e| self.error_at(skin, bad(e)))?;
             self.remove_attr(skin, "file");
             self.set_attr(skin, "vertex", &f32_list(&skn.vertex));

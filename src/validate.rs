@@ -4,9 +4,9 @@ use ahash::AHashMap;
 
 use crate::document::Document;
 use crate::error::{Error, ErrorKind, Errors};
+use crate::names::Sym;
 use crate::prefix::{name_from_file, ns_of_objtype};
 use crate::schema::Kind;
-use crate::names::Sym;
 use crate::tree::Node;
 use crate::vocab::{AttrKind, Ns};
 
@@ -60,11 +60,18 @@ impl Document {
                     }),
                     AttrKind::RefList(ns) => {
                         for t in value.split_ascii_whitespace() {
-                            refs.push(Reference { node, attr: name.to_string(), ns, name: t.to_string() });
+                            refs.push(Reference {
+                                node,
+                                attr: name.to_string(),
+                                ns,
+                                name: t.to_string(),
+                            });
                         }
                     }
                     AttrKind::ObjType { name_attr } => {
-                        if let (Some(ns), Some(target)) = (ns_of_objtype(value), self.attr(node, name_attr)) {
+                        if let (Some(ns), Some(target)) =
+                            (ns_of_objtype(value), self.attr(node, name_attr))
+                        {
                             refs.push(Reference {
                                 node,
                                 attr: name_attr.to_string(),
@@ -78,7 +85,10 @@ impl Document {
             }
             if !declared {
                 // Assets without a name are named after their file.
-                if let Some(stem) = self.attr(node, "file").and_then(|f| name_from_file(self.tag(node), f)) {
+                if let Some(stem) = self
+                    .attr(node, "file")
+                    .and_then(|f| name_from_file(self.tag(node), f))
+                {
                     let ns = match self.tag(node) {
                         "mesh" => Ns::Mesh,
                         "texture" => Ns::Texture,
@@ -153,7 +163,10 @@ impl Document {
     /// the others with both contents' positions.
     pub(crate) fn name_clashes(&self, parts: &[&Document]) -> Vec<Error> {
         let shared = |ns: Ns| {
-            matches!(ns, Ns::Mesh | Ns::Texture | Ns::Material | Ns::Hfield | Ns::Skin | Ns::Default)
+            matches!(
+                ns,
+                Ns::Mesh | Ns::Texture | Ns::Material | Ns::Hfield | Ns::Skin | Ns::Default
+            )
         };
         let theirs: Vec<Vec<(Ns, &str, Node)>> = parts
             .iter()
@@ -176,10 +189,10 @@ impl Document {
             }
         }
         for (ns, name, node) in self.declared_names() {
-            if let Some(e) = seen.get_mut(&(ns, name)) {
-                if e.0 == usize::MAX {
-                    *e = (0, Some(node));
-                }
+            if let Some(e) = seen.get_mut(&(ns, name))
+                && e.0 == usize::MAX
+            {
+                *e = (0, Some(node));
             }
         }
         let mut errors = Vec::new();
@@ -190,7 +203,11 @@ impl Document {
                     *e = (i + 1, Some(node));
                     continue;
                 };
-                let first = if e.0 == 0 { self.location(at) } else { parts[e.0 - 1].location(at) };
+                let first = if e.0 == 0 {
+                    self.location(at)
+                } else {
+                    parts[e.0 - 1].location(at)
+                };
                 let msg = format!("duplicate {} name '{name}' (first at {first})", ns.as_str());
                 errors.push(parts[i].error_at(node, ErrorKind::Invalid(msg)));
             }
@@ -205,22 +222,20 @@ impl Document {
         let mut stack: Vec<(Node, Kind)> = vec![(self.root, Kind::root())];
         while let Some((node, kind)) = stack.pop() {
             let mut declared = false;
-            if let Some((id, ns)) = id_attr(kind) {
-                if let Some(a) = self.attr_slice(node).iter().find(|a| a.name == id) {
-                    declared = true;
-                    let v = trim(self.str(a.value));
-                    if !v.is_empty() {
-                        out.push((ns, v, node));
-                    }
+            if let Some((id, ns)) = id_attr(kind)
+                && let Some(a) = self.attr_slice(node).iter().find(|a| a.name == id)
+            {
+                declared = true;
+                let v = trim(self.str(a.value));
+                if !v.is_empty() {
+                    out.push((ns, v, node));
                 }
             }
-            if !declared {
-                if let Some(ns) = named_after_file(kind) {
-                    static FILE: std::sync::OnceLock<Sym> = std::sync::OnceLock::new();
-                    let file = *FILE.get_or_init(|| crate::names::sym("file"));
-                    if let Some(stem) = self.attr_sym(node, file).and_then(file_stem) {
-                        out.push((ns, stem, node));
-                    }
+            if !declared && let Some(ns) = named_after_file(kind) {
+                static FILE: std::sync::OnceLock<Sym> = std::sync::OnceLock::new();
+                let file = *FILE.get_or_init(|| crate::names::sym("file"));
+                if let Some(stem) = self.attr_sym(node, file).and_then(file_stem) {
+                    out.push((ns, stem, node));
                 }
             }
             let n = stack.len();
@@ -263,10 +278,14 @@ fn id_attr(kind: Kind) -> Option<(Sym, Ns)> {
     let table = TABLE.get_or_init(|| {
         (0..crate::vocab::elements().len())
             .map(|i| {
-                Kind(i as u16).spec().attrs.iter().find_map(|a| match a.kind {
-                    AttrKind::Id(ns) => crate::names::known(a.name).map(|s| (s, ns)),
-                    _ => None,
-                })
+                Kind(i as u16)
+                    .spec()
+                    .attrs
+                    .iter()
+                    .find_map(|a| match a.kind {
+                        AttrKind::Id(ns) => crate::names::known(a.name).map(|s| (s, ns)),
+                        _ => None,
+                    })
             })
             .collect()
     });

@@ -7,17 +7,32 @@ use std::process::Command;
 use common::{Pair, judge, root, scratch};
 
 fn forge(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_mjcf-forge")).current_dir(root()).args(args).output().unwrap()
+    Command::new(env!("CARGO_BIN_EXE_mjcf-forge"))
+        .current_dir(root())
+        .args(args)
+        .output()
+        .unwrap()
 }
 
 #[test]
 fn prefix_writes_a_model_that_compiles_the_same_with_prefixed_names() {
     let dir = scratch("cli_prefix");
     let out = dir.join("refs.xml");
-    let o = forge(&["prefix", "corpora/prefix/references_everywhere.xml", "--prefix", "r1_", "-o", out.to_str().unwrap()]);
+    let o = forge(&[
+        "prefix",
+        "corpora/prefix/references_everywhere.xml",
+        "--prefix",
+        "r1_",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let failed = judge(
-        &[Pair { a: root().join("corpora/prefix/references_everywhere.xml"), b: out, prefix: "r1_".into() }],
+        &[Pair {
+            a: root().join("corpora/prefix/references_everywhere.xml"),
+            b: out,
+            prefix: "r1_".into(),
+        }],
         &dir,
     );
     assert!(failed.is_empty(), "{failed:?}");
@@ -25,7 +40,12 @@ fn prefix_writes_a_model_that_compiles_the_same_with_prefixed_names() {
 
 #[test]
 fn merge_parses_parts_and_reports_a_missing_body() {
-    let o = forge(&["merge", "corpora/merge/arm_with_keys.xml", "--part", "corpora/merge/gripper_radian.xml:g_:nobody"]);
+    let o = forge(&[
+        "merge",
+        "corpora/merge/arm_with_keys.xml",
+        "--part",
+        "corpora/merge/gripper_radian.xml:g_:nobody",
+    ]);
     assert_eq!(o.status.code(), Some(1));
     assert_eq!(
         String::from_utf8_lossy(&o.stderr).trim_end(),
@@ -37,10 +57,18 @@ fn merge_parses_parts_and_reports_a_missing_body() {
 #[test]
 fn merge_refuses_a_name_clash_with_every_position() {
     // The same part twice without prefixes: every name of the second copy clashes.
-    let o = forge(&["merge", "corpora/merge/arm_with_keys.xml", "--part", "corpora/merge/arm_with_keys.xml"]);
+    let o = forge(&[
+        "merge",
+        "corpora/merge/arm_with_keys.xml",
+        "--part",
+        "corpora/merge/arm_with_keys.xml",
+    ]);
     assert_eq!(o.status.code(), Some(1));
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("duplicate body name 'base' (first at corpora/merge/arm_with_keys.xml:4:5)"), "{err}");
+    assert!(
+        err.contains("duplicate body name 'base' (first at corpora/merge/arm_with_keys.xml:4:5)"),
+        "{err}"
+    );
     assert!(err.lines().count() >= 8, "every clash is reported: {err}");
 }
 
@@ -63,7 +91,10 @@ fn merge_output_keeps_the_parts() {
     let xml = std::fs::read_to_string(&out).unwrap();
     assert!(xml.contains("<body name=\"g_palm\""));
     assert!(xml.contains("<key name=\"home\""));
-    assert!(!xml.contains("name=\"g_home\""), "the part's home key is fused into the scene's");
+    assert!(
+        !xml.contains("name=\"g_home\""),
+        "the part's home key is fused into the scene's"
+    );
     let cases = format!(
         "[{{\"merged\": \"{}\", \"base\": \"corpora/merge/arm_with_keys.xml\", \"parts\": [{{\"path\": \"corpora/merge/gripper_radian.xml\", \"prefix\": \"g_\", \"body\": \"hand\"}}, {{\"path\": \"corpora/merge/free_objects_with_key.xml\", \"prefix\": \"obj_\", \"body\": null}}], \"fused\": {{\"home\": [\"\", \"g_\"]}}}}]",
         out.display()
@@ -78,12 +109,21 @@ fn merge_output_keeps_the_parts() {
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&j.stdout);
-    assert!(j.status.success() && stdout.trim_end().ends_with("1 passed, 0 failed"), "{stdout}");
+    assert!(
+        j.status.success() && stdout.trim_end().ends_with("1 passed, 0 failed"),
+        "{stdout}"
+    );
 }
 
 #[test]
 fn info_lists_the_model_tier_view() {
-    let o = forge(&["info", "corpora/merge/arm_with_keys.xml", "--prefix", "a0_", "--json"]);
+    let o = forge(&[
+        "info",
+        "corpora/merge/arm_with_keys.xml",
+        "--prefix",
+        "a0_",
+        "--json",
+    ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let json = String::from_utf8_lossy(&o.stdout);
     for expected in [
@@ -100,5 +140,8 @@ fn info_lists_the_model_tier_view() {
     }
     let o = forge(&["info", "corpora/merge/free_objects_with_key.xml", "--json"]);
     assert_eq!(o.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("expected exactly one top-level body in <worldbody>, found 3"));
+    assert!(
+        String::from_utf8_lossy(&o.stderr)
+            .contains("expected exactly one top-level body in <worldbody>, found 3")
+    );
 }

@@ -16,16 +16,31 @@ fn inline_and_judge(models: &[PathBuf], dir: &Path) {
     for (i, model) in models.iter().enumerate() {
         match Document::load(model) {
             Ok(doc) => {
-                let out = dir.join(format!("{i:03}_{}", model.file_name().unwrap().to_string_lossy()));
+                let out = dir.join(format!(
+                    "{i:03}_{}",
+                    model.file_name().unwrap().to_string_lossy()
+                ));
                 doc.write_file(&out).unwrap();
-                pairs.push(Pair { a: model.clone(), b: out, prefix: String::new() });
+                pairs.push(Pair {
+                    a: model.clone(),
+                    b: out,
+                    prefix: String::new(),
+                });
             }
             Err(e) => load_errors.push(format!("{}: {e}", model.display())),
         }
     }
-    assert!(load_errors.is_empty(), "models that failed to load:\n{}", load_errors.join("\n"));
+    assert!(
+        load_errors.is_empty(),
+        "models that failed to load:\n{}",
+        load_errors.join("\n")
+    );
     let failed = judge(&pairs, dir);
-    assert!(failed.is_empty(), "judge found differences:\n{}", failed.join("\n"));
+    assert!(
+        failed.is_empty(),
+        "judge found differences:\n{}",
+        failed.join("\n")
+    );
 }
 
 fn feature_models() -> Vec<PathBuf> {
@@ -55,11 +70,20 @@ fn output_has_no_default_class_left() {
         let doc = Document::load(model).unwrap();
         let xml = doc.to_xml_string();
         // The one exception is documented: residual classes for values MJCF cannot write.
-        let residual_only = xml.matches("<default").count() == xml.matches("class=\"mjcf-forge-residual-").count() / 2 + 1
+        let residual_only = xml.matches("<default").count()
+            == xml.matches("class=\"mjcf-forge-residual-").count() / 2 + 1
             || !xml.contains("<default");
-        assert!(!xml.contains("childclass="), "{}: childclass left", model.display());
+        assert!(
+            !xml.contains("childclass="),
+            "{}: childclass left",
+            model.display()
+        );
         if xml.contains("<default") {
-            assert!(xml.contains("mjcf-forge-residual-"), "{}: a <default> is left", model.display());
+            assert!(
+                xml.contains("mjcf-forge-residual-"),
+                "{}: a <default> is left",
+                model.display()
+            );
         }
         let _ = residual_only;
     }
@@ -72,7 +96,12 @@ fn write_reload_write_gives_the_same_bytes() {
         let first = doc.to_pretty_string();
         let again = Document::from_str(&first, model.parent().unwrap()).unwrap();
         assert_eq!(first, again.to_pretty_string(), "{}", model.display());
-        assert_eq!(doc.to_xml_string(), again.to_xml_string(), "{}", model.display());
+        assert_eq!(
+            doc.to_xml_string(),
+            again.to_xml_string(),
+            "{}",
+            model.display()
+        );
     }
 }
 
@@ -83,7 +112,11 @@ fn every_file_reference_is_absolute() {
         for node in doc.descendants(doc.root()) {
             for (name, value) in doc.attrs(node) {
                 if name == "file" || (name.starts_with("file") && doc.tag(node) == "texture") {
-                    assert!(Path::new(value).is_absolute(), "{}: {name}={value}", model.display());
+                    assert!(
+                        Path::new(value).is_absolute(),
+                        "{}: {name}={value}",
+                        model.display()
+                    );
                 }
             }
         }
@@ -112,7 +145,11 @@ fn error_cases_give_their_exact_messages() {
             Ok(_) => wrong.push(format!("{}: loaded without error", relative.display())),
             Err(e) => {
                 if e.to_string().trim_end() != expected.trim_end() {
-                    wrong.push(format!("{}:\n  expected: {}\n  got:      {e}", relative.display(), expected.trim_end()));
+                    wrong.push(format!(
+                        "{}:\n  expected: {}\n  got:      {e}",
+                        relative.display(),
+                        expected.trim_end()
+                    ));
                 }
             }
         }

@@ -14,11 +14,15 @@ use common::{python, root, scratch};
 use mjcf_forge::{Document, MergeOptions, XmlModel, XmlModelOptions};
 
 fn rs(rel: &str) -> PathBuf {
-    root().join(".cache/corpus/robosuite-1.5.2/robosuite/models/assets").join(rel)
+    root()
+        .join(".cache/corpus/robosuite-1.5.2/robosuite/models/assets")
+        .join(rel)
 }
 
 fn dm(rel: &str) -> PathBuf {
-    root().join(".cache/corpus/dm_control-1.0.50/dm_control").join(rel)
+    root()
+        .join(".cache/corpus/dm_control-1.0.50/dm_control")
+        .join(rel)
 }
 
 fn ours(rel: &str) -> PathBuf {
@@ -39,11 +43,23 @@ struct Part {
 }
 
 fn part(path: PathBuf, idn: &str, into: Option<&str>) -> Part {
-    Part { path, idn: Some(idn.to_string()), into: into.map(str::to_string), plain: false, with: Vec::new() }
+    Part {
+        path,
+        idn: Some(idn.to_string()),
+        into: into.map(str::to_string),
+        plain: false,
+        with: Vec::new(),
+    }
 }
 
 fn base(path: PathBuf) -> Part {
-    Part { path, idn: None, into: None, plain: true, with: Vec::new() }
+    Part {
+        path,
+        idn: None,
+        into: None,
+        plain: true,
+        with: Vec::new(),
+    }
 }
 
 /// One scene: its parts merged in order into the first, which is the base.
@@ -60,7 +76,10 @@ fn instance(p: &Part) -> Document {
     let mut doc = match &p.idn {
         None => doc,
         Some(idn) => {
-            let options = XmlModelOptions { contact_geom_rgba: None, ..XmlModelOptions::default() };
+            let options = XmlModelOptions {
+                contact_geom_rgba: None,
+                ..XmlModelOptions::default()
+            };
             match XmlModel::with_options(doc.clone(), idn, options) {
                 Ok(m) if !p.plain => m.into_document(),
                 _ => {
@@ -73,7 +92,8 @@ fn instance(p: &Part) -> Document {
     };
     for w in &p.with {
         let d = instance(w);
-        doc.merge(&d, w.into.as_deref(), &MergeOptions::default()).unwrap();
+        doc.merge(&d, w.into.as_deref(), &MergeOptions::default())
+            .unwrap();
     }
     doc
 }
@@ -95,14 +115,20 @@ fn build(case: &Case, dir: &Path) -> String {
             doc.write_file(&file).unwrap();
             (file, String::new())
         };
-        let options = MergeOptions { fuse_keys: case.fuse_keys, part_prefix: prefix.clone() };
+        let options = MergeOptions {
+            fuse_keys: case.fuse_keys,
+            part_prefix: prefix.clone(),
+        };
         scene
             .merge(&doc, p.into.as_deref(), &options)
             .unwrap_or_else(|e| panic!("{}: merging {}:\n{e}", case.name, p.path.display()));
         parts_json.push(format!(
             "{{\"path\": \"{}\", \"prefix\": \"{judge_prefix}\", \"body\": {}}}",
             file.display(),
-            p.into.as_ref().map(|b| format!("\"{b}\"")).unwrap_or_else(|| "null".into())
+            p.into
+                .as_ref()
+                .map(|b| format!("\"{b}\""))
+                .unwrap_or_else(|| "null".into())
         ));
         fused_prefixes.push(format!("\"{prefix}\""));
     }
@@ -124,15 +150,26 @@ fn build(case: &Case, dir: &Path) -> String {
 
 fn cases() -> Vec<Case> {
     let mut cases = Vec::new();
-    let robots = ["iiwa", "jaco", "kinova3", "panda", "sawyer", "ur5e", "xarm7", "spot_arm"];
-    let grippers = ["panda_gripper", "rethink_gripper", "robotiq_gripper_140", "jaco_three_finger_gripper"];
+    let robots = [
+        "iiwa", "jaco", "kinova3", "panda", "sawyer", "ur5e", "xarm7", "spot_arm",
+    ];
+    let grippers = [
+        "panda_gripper",
+        "rethink_gripper",
+        "robotiq_gripper_140",
+        "jaco_three_finger_gripper",
+    ];
     for r in robots {
         for g in grippers {
             cases.push(Case {
                 name: format!("{r}_with_{g}"),
                 parts: vec![
                     part(rs(&format!("robots/{r}/robot.xml")), "robot0", None),
-                    part(rs(&format!("grippers/{g}.xml")), "gripper0", Some("robot0_right_hand")),
+                    part(
+                        rs(&format!("grippers/{g}.xml")),
+                        "gripper0",
+                        Some("robot0_right_hand"),
+                    ),
                 ],
                 fuse_keys: false,
             });
@@ -149,26 +186,57 @@ fn cases() -> Vec<Case> {
             fuse_keys: false,
         });
     }
-    let objects = ["objects/can.xml", "objects/milk.xml", "objects/bread.xml", "objects/cereal.xml", "objects/lemon.xml"];
-    for (r, g) in [("panda", "panda_gripper"), ("sawyer", "rethink_gripper"), ("iiwa", "robotiq_gripper_140"), ("ur5e", "robotiq_gripper_140"), ("kinova3", "robotiq_gripper_140")] {
+    let objects = [
+        "objects/can.xml",
+        "objects/milk.xml",
+        "objects/bread.xml",
+        "objects/cereal.xml",
+        "objects/lemon.xml",
+    ];
+    for (r, g) in [
+        ("panda", "panda_gripper"),
+        ("sawyer", "rethink_gripper"),
+        ("iiwa", "robotiq_gripper_140"),
+        ("ur5e", "robotiq_gripper_140"),
+        ("kinova3", "robotiq_gripper_140"),
+    ] {
         let mut robot = part(rs(&format!("robots/{r}/robot.xml")), "robot0", None);
-        robot.with.push(part(rs(&format!("grippers/{g}.xml")), "gripper0", Some("robot0_right_hand")));
-        robot.with.push(part(rs("bases/rethink_mount.xml"), "mount0", Some("robot0_base")));
+        robot.with.push(part(
+            rs(&format!("grippers/{g}.xml")),
+            "gripper0",
+            Some("robot0_right_hand"),
+        ));
+        robot.with.push(part(
+            rs("bases/rethink_mount.xml"),
+            "mount0",
+            Some("robot0_base"),
+        ));
         let mut parts = vec![base(rs("arenas/table_arena.xml")), robot];
         for (i, o) in objects.iter().enumerate() {
             parts.push(part(rs(o), &format!("object{i}"), None));
         }
-        cases.push(Case { name: format!("lift_like_{r}"), parts, fuse_keys: false });
+        cases.push(Case {
+            name: format!("lift_like_{r}"),
+            parts,
+            fuse_keys: false,
+        });
     }
     for (arena, model) in [
         ("arenas/table_arena.xml", "suite/cartpole.xml"),
         ("arenas/table_arena.xml", "suite/acrobot.xml"),
         ("arenas/empty_arena.xml", "suite/reacher.xml"),
         ("arenas/bins_arena.xml", "suite/finger.xml"),
-        ("arenas/empty_arena.xml", "mujoco/testing/assets/cartpole.xml"),
+        (
+            "arenas/empty_arena.xml",
+            "mujoco/testing/assets/cartpole.xml",
+        ),
     ] {
         cases.push(Case {
-            name: format!("dm_{}_in_{}", Path::new(model).file_stem().unwrap().to_string_lossy(), Path::new(arena).file_stem().unwrap().to_string_lossy()),
+            name: format!(
+                "dm_{}_in_{}",
+                Path::new(model).file_stem().unwrap().to_string_lossy(),
+                Path::new(arena).file_stem().unwrap().to_string_lossy()
+            ),
             parts: vec![base(rs(arena)), part(dm(model), "dm0", None)],
             fuse_keys: false,
         });
@@ -179,7 +247,10 @@ fn cases() -> Vec<Case> {
             name: format!("arm_degrees_gripper_radians_fused_{fuse}"),
             parts: vec![
                 base(ours("arm_with_keys.xml")),
-                Part { plain: true, ..part(ours("gripper_radian.xml"), "g0", Some("hand")) },
+                Part {
+                    plain: true,
+                    ..part(ours("gripper_radian.xml"), "g0", Some("hand"))
+                },
             ],
             fuse_keys: fuse,
         });
@@ -210,7 +281,14 @@ fn merged_scenes_keep_every_part_s_physics() {
     let dir = scratch("merge");
     let cases = cases();
     assert!(cases.len() >= 50, "{} cases", cases.len());
-    let json = format!("[\n{}\n]\n", cases.iter().map(|c| build(c, &dir)).collect::<Vec<_>>().join(",\n"));
+    let json = format!(
+        "[\n{}\n]\n",
+        cases
+            .iter()
+            .map(|c| build(c, &dir))
+            .collect::<Vec<_>>()
+            .join(",\n")
+    );
     let file = dir.join("cases.json");
     std::fs::write(&file, json).unwrap();
     let out = Command::new(python())

@@ -16,8 +16,15 @@ fn merge_error(part: &str, prefix: &str, into: Option<&str>) -> String {
     let before = base.to_xml_string();
     let mut part = load(part);
     part.apply_prefix(prefix).unwrap();
-    let err = base.merge(&part, into, &MergeOptions::default()).unwrap_err().to_string();
-    assert_eq!(before, base.to_xml_string(), "a failed merge changes nothing");
+    let err = base
+        .merge(&part, into, &MergeOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        before,
+        base.to_xml_string(),
+        "a failed merge changes nothing"
+    );
     err
 }
 
@@ -40,7 +47,11 @@ fn compiler_settings_without_exact_conversion_are_refused() {
 #[test]
 fn a_free_body_only_goes_into_the_world() {
     assert_eq!(
-        merge_error("corpora/errors/merge/part_free_body.xml", "p_", Some("hand")),
+        merge_error(
+            "corpora/errors/merge/part_free_body.xml",
+            "p_",
+            Some("hand")
+        ),
         "corpora/errors/merge/part_free_body.xml:3:5: <body> has a free joint: it can only be merged into the world body, not into 'hand'"
     );
 }

@@ -13,12 +13,23 @@ fn prefix_and_judge(models: &[PathBuf], dir: &std::path::Path, prefix: &str) {
     for (i, model) in models.iter().enumerate() {
         let mut doc = Document::load(model).unwrap_or_else(|e| panic!("{}: {e}", model.display()));
         doc.apply_prefix(prefix).unwrap();
-        let out = dir.join(format!("{i:03}_{}", model.file_name().unwrap().to_string_lossy()));
+        let out = dir.join(format!(
+            "{i:03}_{}",
+            model.file_name().unwrap().to_string_lossy()
+        ));
         doc.write_file(&out).unwrap();
-        pairs.push(Pair { a: model.clone(), b: out, prefix: prefix.to_string() });
+        pairs.push(Pair {
+            a: model.clone(),
+            b: out,
+            prefix: prefix.to_string(),
+        });
     }
     let failed = judge(&pairs, dir);
-    assert!(failed.is_empty(), "judge found differences:\n{}", failed.join("\n"));
+    assert!(
+        failed.is_empty(),
+        "judge found differences:\n{}",
+        failed.join("\n")
+    );
 }
 
 #[test]

