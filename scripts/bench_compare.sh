@@ -5,7 +5,7 @@
 # Needs scripts/setup_robosuite.sh (run here if missing).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
-RUNS="${RUNS:-20}"
+RUNS="${RUNS:-50}"
 bash scripts/setup_robosuite.sh >/dev/null
 cargo build --release --quiet --example load_throughput
 rs_json="$(.cache/venv-robosuite/bin/python scripts/bench_robosuite.py --runs "$RUNS")"
