@@ -250,15 +250,62 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
         _ => Path::new("."),
     };
     let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(fail)?;
+    // A temporary file is private; the output gets the permissions of the file it replaces,
+    // or those of a newly created file (0666 less the umask).
+    let permissions = match std::fs::metadata(path) {
+        Ok(m) => m.permissions(),
+        Err(_) => new_file_permissions(dir).map_err(fail)?,
+    };
+    tmp.as_file().set_permissions(permissions).map_err(fail)?;
     tmp.write_all(bytes).map_err(fail)?;
     tmp.as_file().sync_all().map_err(fail)?;
     tmp.persist(path).map_err(|e| fail(e.error))?;
     Ok(())
 }
 
+/// The permissions a file newly created in `dir` gets (0666 less the umask), found by
+/// creating one: the standard library has no way to read the umask.
+fn new_file_permissions(dir: &Path) -> std::io::Result<std::fs::Permissions> {
+    let probe = tempfile::Builder::new()
+        .prefix(".mjcf-forge-probe")
+        .tempfile_in(dir)?;
+    let path = probe.path().to_path_buf();
+    drop(probe);
+    let file = std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&path)?;
+    let permissions = file.metadata()?.permissions();
+    drop(file);
+    std::fs::remove_file(&path)?;
+    Ok(permissions)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[cfg(unix)]
+    #[test]
+    fn outputs_are_not_private_files() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out.xml");
+        write_atomic(&out, b"<mujoco/>").unwrap();
+        let mode = std::fs::metadata(&out).unwrap().permissions().mode() & 0o777;
+        let fresh = dir.path().join("fresh");
+        std::fs::write(&fresh, b"").unwrap();
+        assert_eq!(
+            mode,
+            std::fs::metadata(&fresh).unwrap().permissions().mode() & 0o777
+        );
+        std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o640)).unwrap();
+        write_atomic(&out, b"<mujoco/>").unwrap();
+        assert_eq!(
+            std::fs::metadata(&out).unwrap().permissions().mode() & 0o777,
+            0o640
+        );
+    }
 
     #[test]
     fn escapes_like_a_byte_loop() {
