@@ -4,81 +4,12 @@
 //!
 //! `cargo bench --bench model`
 
-use std::path::PathBuf;
-
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use mjcf_forge::{Document, MergeOptions, MergePart, MujocoModel, XmlModel};
+use mjcf_forge::MergeOptions;
 
-fn rs(rel: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join(".cache/corpus/robosuite-1.5.2/robosuite/models/assets")
-        .join(rel)
-}
-
-/// The parts of robosuite's Lift task, loaded once.
-struct Parts {
-    arena: Document,
-    robot: Document,
-    mount: Document,
-    gripper: Document,
-    objects: Vec<Document>,
-}
-
-fn parts() -> Parts {
-    let load = |p: &str| Document::load(rs(p)).unwrap();
-    Parts {
-        arena: load("arenas/table_arena.xml"),
-        robot: load("robots/panda/robot.xml"),
-        mount: load("bases/rethink_mount.xml"),
-        gripper: load("grippers/panda_gripper.xml"),
-        objects: [
-            "objects/can.xml",
-            "objects/milk.xml",
-            "objects/bread.xml",
-            "objects/cereal.xml",
-            "objects/lemon.xml",
-        ]
-        .iter()
-        .map(|p| load(p))
-        .collect(),
-    }
-}
-
-/// Builds the scene the way robosuite does: instances with prefixes, gripper into the
-/// robot's hand, mount under its base, robot and objects into the arena.
-fn assemble(p: &Parts) -> Document {
-    let mut robot = XmlModel::new(p.robot.clone(), "robot0").unwrap();
-    let gripper = XmlModel::new(p.gripper.clone(), "gripper0").unwrap();
-    let mount = XmlModel::new(p.mount.clone(), "mount0").unwrap();
-    robot
-        .merge_all(
-            &[
-                (&gripper, Some("robot0_right_hand")),
-                (&mount, Some("robot0_base")),
-            ],
-            false,
-        )
-        .unwrap();
-    let objects: Vec<XmlModel> = p
-        .objects
-        .iter()
-        .enumerate()
-        .map(|(i, o)| XmlModel::new(o.clone(), format!("object{i}")).unwrap())
-        .collect();
-    let mut scene = p.arena.clone();
-    let mut parts = vec![MergePart {
-        doc: robot.document(),
-        into: None,
-        prefix: "robot0_",
-    }];
-    parts.extend(objects.iter().map(|o| MergePart {
-        doc: o.document(),
-        into: None,
-        prefix: o.naming_prefix(),
-    }));
-    scene.merge_all(&parts, false).unwrap();
-    scene
-}
+#[path = "lift_scene.rs"]
+mod lift_scene;
+use lift_scene::{assemble, parts};
 
 fn scene(c: &mut Criterion) {
     let p = parts();
