@@ -125,9 +125,8 @@ fn main() -> ExitCode {
             validate,
         } => {
             // Without MuJoCo, fail before loading anything rather than once per model.
-            if validate && let Err(e) = require_mujoco() {
-                eprintln!("mjcf-forge: --validate: {e}");
-                return ExitCode::from(USAGE);
+            if let Some(code) = refuse_validate_without_mujoco(validate) {
+                return code;
             }
             let options = InlineOptions { compact, validate };
             match out_dir {
@@ -142,9 +141,8 @@ fn main() -> ExitCode {
             compact,
             validate,
         } => {
-            if validate && let Err(e) = require_mujoco() {
-                eprintln!("mjcf-forge: --validate: {e}");
-                return ExitCode::from(USAGE);
+            if let Some(code) = refuse_validate_without_mujoco(validate) {
+                return code;
             }
             let result = Document::load(&input)
                 .map_err(|e| e.to_string())
@@ -162,9 +160,8 @@ fn main() -> ExitCode {
             compact,
             validate,
         } => {
-            if validate && let Err(e) = require_mujoco() {
-                eprintln!("mjcf-forge: --validate: {e}");
-                return ExitCode::from(USAGE);
+            if let Some(code) = refuse_validate_without_mujoco(validate) {
+                return code;
             }
             let specs: Vec<PartSpec> = match parts.iter().map(|p| PartSpec::parse(p)).collect() {
                 Ok(s) => s,
@@ -418,6 +415,19 @@ fn finish(results: &[Result<(), String>]) -> ExitCode {
 }
 
 // ------------------------------------------------------------------- compile, validate
+
+/// With `--validate` in a build without MuJoCo: the usage error, said once before any model
+/// is loaded (rather than once per model).
+fn refuse_validate_without_mujoco(validate: bool) -> Option<ExitCode> {
+    if !validate {
+        return None;
+    }
+    let Err(e) = require_mujoco() else {
+        return None;
+    };
+    eprintln!("mjcf-forge: --validate: {e}");
+    Some(ExitCode::from(USAGE))
+}
 
 /// `Ok` when this binary can compile with MuJoCo, else the reason it cannot.
 fn require_mujoco() -> Result<(), String> {
