@@ -487,3 +487,51 @@ fn inline_validate_refuses_a_bad_model_and_writes_nothing() {
         "temporary files left behind"
     );
 }
+
+#[test]
+fn prefix_and_merge_validate_their_output_with_mujoco() {
+    let dir = scratch("cli_validate_model_tier");
+    let out = dir.join("scene.xml");
+    let merged = forge(&[
+        "merge",
+        "corpora/merge/arm_with_keys.xml",
+        "--part",
+        "corpora/merge/gripper_radian.xml:g_:hand",
+        "--validate",
+        "-o",
+        path_arg(&out),
+    ]);
+    assert!(merged.status.success(), "{}", stderr(&merged));
+    assert!(out.exists());
+    let prefixed = forge(&[
+        "prefix",
+        "corpora/merge/arm_with_keys.xml",
+        "--prefix",
+        "p_",
+        "--validate",
+    ]);
+    assert!(prefixed.status.success(), "{}", stderr(&prefixed));
+    assert!(stdout(&prefixed).contains("name=\"p_hand\""));
+    // A merge whose result MuJoCo refuses (a flex without its bodies) writes nothing.
+    let bad = dir.join("bad.xml");
+    std::fs::write(
+        &bad,
+        r#"<mujoco><deformable><flex name="f" dim="1" body="nowhere nowhere2" vertex="0 0 0 1 0 0" element="0 1"/></deformable></mujoco>"#,
+    )
+    .unwrap();
+    let refused = dir.join("refused.xml");
+    let o = forge(&[
+        "merge",
+        "corpora/merge/arm_with_keys.xml",
+        "--part",
+        &format!("{}:b_", path_arg(&bad)),
+        "--validate",
+        "-o",
+        path_arg(&refused),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        !refused.exists(),
+        "nothing is written for a model MuJoCo refuses"
+    );
+}
