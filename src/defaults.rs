@@ -861,13 +861,18 @@ impl Resolver<'_> {
                 ));
             }
         }
+        Ok(self.attr_set(out))
+    }
+
+    /// Attribute pairs as a class dummy, their values added to the document's strings.
+    fn attr_set(&mut self, pairs: Vec<(&str, String)>) -> AttrSet {
         let mut set = AttrSet::default();
-        for (k, v) in out {
+        for (k, v) in pairs {
             let name = self.doc.intern(k);
             let value = self.doc.push_str(&v);
             set.set(name, value);
         }
-        Ok(set)
+        set
     }
 
     fn gaintype(&self, control: &AttrSet) -> String {
@@ -993,13 +998,7 @@ impl Resolver<'_> {
                 ));
             }
         }
-        let mut set = AttrSet::default();
-        for (k, v) in out {
-            let name = self.doc.intern(k);
-            let value = self.doc.push_str(&v);
-            set.set(name, value);
-        }
-        Ok(set)
+        Ok(self.attr_set(out))
     }
 }
 

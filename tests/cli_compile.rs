@@ -7,31 +7,11 @@ mod common;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use common::{python, root, scratch, wheel_models};
+use common::{forge, path_arg, python, root, scratch, stderr, stdout, wheel_models};
 use mjcf_forge::Document;
-
-fn forge(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mjcf-forge"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .expect("run mjcf-forge")
-}
-
-fn stdout(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-fn path_arg(p: &Path) -> &str {
-    p.to_str().expect("UTF-8 test path")
-}
 
 /// A JSON value of the flat objects both sides print.
 #[derive(Debug, Clone, PartialEq, Eq)]

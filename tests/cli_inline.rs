@@ -4,31 +4,9 @@
 mod common;
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-use common::{root, scratch};
+use common::{forge, path_arg, root, scratch, stderr, stdout};
 use mjcf_forge::Document;
-
-/// Runs the binary from the repository root, so paths in messages are as in the .err files.
-fn forge(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mjcf-forge"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .expect("run mjcf-forge")
-}
-
-fn stdout(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-fn path_arg(p: &Path) -> &str {
-    p.to_str().expect("UTF-8 test path")
-}
 
 /// The names in a folder, sorted.
 fn listing(dir: &Path) -> Vec<String> {

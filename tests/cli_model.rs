@@ -4,15 +4,7 @@ mod common;
 
 use std::process::Command;
 
-use common::{Pair, judge, root, scratch};
-
-fn forge(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_mjcf-forge"))
-        .current_dir(root())
-        .args(args)
-        .output()
-        .unwrap()
-}
+use common::{Pair, forge, judge, root, scratch};
 
 #[test]
 fn prefix_writes_a_model_that_compiles_the_same_with_prefixed_names() {

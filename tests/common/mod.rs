@@ -88,3 +88,27 @@ pub fn judge(pairs: &[Pair], scratch_dir: &Path) -> Vec<String> {
     }
     failed
 }
+
+/// Runs the binary from the repository root, so paths in messages are as in the .err files.
+pub fn forge(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_mjcf-forge"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("run mjcf-forge")
+}
+
+/// A run's standard output as text.
+pub fn stdout(out: &std::process::Output) -> String {
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// A run's standard error as text.
+pub fn stderr(out: &std::process::Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// A test path as a command-line argument.
+pub fn path_arg(p: &Path) -> &str {
+    p.to_str().expect("UTF-8 test path")
+}
