@@ -600,6 +600,15 @@ impl Builder {
     /// is dropped, its children inserted in the include's place). Returns how many elements
     /// were inserted under `parent`.
     fn parse(&mut self, bytes: &[u8], file: u32, parent: Option<Node>) -> Result<usize, Errors> {
+        // XML has no NUL character; copied through, it would make the output unreadable.
+        if let Some(at) = bytes.iter().position(|&b| b == 0) {
+            let (line, col) = Lines::new(bytes).line_col(at);
+            return Err(Error::at(
+                self.loc(file, line, col),
+                ErrorKind::Syntax("NUL byte (not allowed in XML)".into()),
+            )
+            .into());
+        }
         let mut lines = Lines::new(bytes);
         // Checked once here, the text lets tags, attribute values and character data be
         // taken as slices below without checking each piece again; text that is not UTF-8
@@ -800,6 +809,9 @@ impl Builder {
     /// [`Builder::parse`], which handles everything and words the errors.
     fn parse_fast(&mut self, src: &str, file: u32, parent: Option<Node>) -> Option<usize> {
         let bytes = src.as_bytes();
+        if bytes.contains(&0) {
+            return None; // `parse` reports it
+        }
         if bytes.starts_with(b"\xEF\xBB\xBF") {
             return None; // a byte order mark: quick-xml skips it
         }
