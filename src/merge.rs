@@ -119,10 +119,6 @@ pub(crate) fn fmt_num(x: f64) -> String {
 struct Syms {
     name: Sym,
     file: Sym,
-    mesh: Sym,
-    texture: Sym,
-    hfield: Sym,
-    skin: Sym,
     euler: Sym,
     axisangle: Sym,
     joint: Sym,
@@ -139,10 +135,6 @@ fn syms() -> &'static Syms {
         Syms {
             name: s("name"),
             file: s("file"),
-            mesh: s("mesh"),
-            texture: s("texture"),
-            hfield: s("hfield"),
-            skin: s("skin"),
             euler: s("euler"),
             axisangle: s("axisangle"),
             joint: s("joint"),
@@ -969,11 +961,8 @@ impl Document {
     fn asset_name(&self, n: Node) -> Option<&str> {
         let s = syms();
         self.attr_sym(n, s.name).or_else(|| {
-            let tag = self.tag_sym(n)?;
-            let named = [s.mesh, s.texture, s.hfield, s.skin].contains(&tag);
-            self.attr_sym(n, s.file)
-                .filter(|_| named)
-                .and_then(crate::validate::file_stem)
+            crate::prefix::named_after_file_tag(self.tag(n))?;
+            self.attr_sym(n, s.file).and_then(crate::prefix::file_stem)
         })
     }
 

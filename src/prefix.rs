@@ -39,18 +39,28 @@ pub(crate) fn ns_of_objtype(keyword: &str) -> Option<Ns> {
     })
 }
 
-/// The name MuJoCo gives an asset that has a `file` but no `name`: the file name without
-/// its folder and extension. `None` for kinds MuJoCo does not name that way.
-pub(crate) fn name_from_file(tag: &str, file: &str) -> Option<String> {
-    if !matches!(tag, "mesh" | "texture" | "hfield" | "skin") {
-        return None;
+/// The namespace of an element kind that MuJoCo names after its file when it has no
+/// `name` (mesh, texture, height field, skin assets).
+pub(crate) fn named_after_file(kind: Kind) -> Option<Ns> {
+    named_after_file_tag(kind.spec().name)
+}
+
+/// [`named_after_file`] by tag, for the asset kinds (whose tag is their kind's name).
+pub(crate) fn named_after_file_tag(tag: &str) -> Option<Ns> {
+    match tag {
+        "mesh" => Some(Ns::Mesh),
+        "texture" => Some(Ns::Texture),
+        "hfield" => Some(Ns::Hfield),
+        "skin" => Some(Ns::Skin),
+        _ => None,
     }
+}
+
+/// The file name without folder and extension: the name MuJoCo gives such an asset.
+pub(crate) fn file_stem(file: &str) -> Option<&str> {
     let base = file.rsplit(['/', '\\']).next().unwrap_or(file);
-    let stem = match base.rfind('.') {
-        Some(i) => &base[..i],
-        None => base,
-    };
-    (!stem.is_empty()).then(|| stem.to_string())
+    let stem = base.rfind('.').map_or(base, |i| &base[..i]);
+    (!stem.is_empty()).then_some(stem)
 }
 
 /// One rename to apply.
@@ -129,7 +139,8 @@ impl Document {
         while let Some((node, kind)) = stack.pop() {
             let mut has_name = false;
             let naming = name_attrs(kind);
-            if naming.is_empty() && !kind.is_named_after_file() {
+            let file_named = named_after_file(kind);
+            if naming.is_empty() && file_named.is_none() {
                 for kid in self.elements(node) {
                     if let Some(k) = self.tag_sym(kid).and_then(|t| kind.child(t)) {
                         stack.push((kid, k));
@@ -174,19 +185,15 @@ impl Document {
                     AttrKind::Plain | AttrKind::File | AttrKind::ObjName => {}
                 }
             }
-            if !has_name && kind.is_named_after_file() {
+            if let Some(ns) = file_named.filter(|_| !has_name) {
                 // An asset named after its file gets that name explicitly, prefixed.
-                let tag = self.tag(node);
-                if let Some(stem) = self.attr(node, "file").and_then(|f| name_from_file(tag, f)) {
-                    let ns = match tag {
-                        "mesh" => Ns::Mesh,
-                        "texture" => Ns::Texture,
-                        "hfield" => Ns::Hfield,
-                        _ => Ns::Skin,
-                    };
-                    if renamed(ns, &stem) {
-                        edits.push(Rename::Named { node, stem });
-                    }
+                if let Some(stem) = self.attr(node, "file").and_then(file_stem)
+                    && renamed(ns, stem)
+                {
+                    edits.push(Rename::Named {
+                        node,
+                        stem: stem.to_string(),
+                    });
                 }
             }
             for kid in self.elements(node) {
@@ -250,16 +257,9 @@ impl Document {
     }
 }
 
-impl Kind {
-    /// Whether MuJoCo names an unnamed element of this kind after its file.
-    fn is_named_after_file(self) -> bool {
-        matches!(self.spec().name, "mesh" | "texture" | "hfield" | "skin")
-    }
-}
-
 /// The attributes of a kind that hold names (identifiers, references, name lists, object
 /// types), computed once per kind.
-fn name_attrs(kind: Kind) -> &'static [(Sym, AttrKind)] {
+pub(crate) fn name_attrs(kind: Kind) -> &'static [(Sym, AttrKind)] {
     static TABLE: std::sync::OnceLock<Vec<Vec<(Sym, AttrKind)>>> = std::sync::OnceLock::new();
     let table = TABLE.get_or_init(|| {
         (0..crate::vocab::elements().len())

@@ -5,7 +5,7 @@ use ahash::AHashMap;
 use crate::document::Document;
 use crate::error::{Error, ErrorKind, Errors};
 use crate::names::Sym;
-use crate::prefix::{name_from_file, ns_of_objtype};
+use crate::prefix::{file_stem, name_attrs, named_after_file, named_after_file_tag, ns_of_objtype};
 use crate::schema::Kind;
 use crate::tree::Node;
 use crate::vocab::{AttrKind, Ns};
@@ -85,17 +85,11 @@ impl Document {
             }
             if !declared {
                 // Assets without a name are named after their file.
-                if let Some(stem) = self
-                    .attr(node, "file")
-                    .and_then(|f| name_from_file(self.tag(node), f))
-                {
-                    let ns = match self.tag(node) {
-                        "mesh" => Ns::Mesh,
-                        "texture" => Ns::Texture,
-                        "hfield" => Ns::Hfield,
-                        _ => Ns::Skin,
-                    };
-                    self.declare(&mut ids, &mut errors, node, ns, &stem);
+                if let (Some(ns), Some(stem)) = (
+                    named_after_file_tag(self.tag(node)),
+                    self.attr(node, "file").and_then(file_stem),
+                ) {
+                    self.declare(&mut ids, &mut errors, node, ns, stem);
                 }
             }
             let kids: Vec<(Node, Kind)> = self
@@ -250,46 +244,12 @@ impl Document {
     }
 }
 
-/// The file name without folder and extension, as MuJoCo names an asset after its file.
-pub(crate) fn file_stem(file: &str) -> Option<&str> {
-    let base = file.rsplit(['/', '\\']).next().unwrap_or(file);
-    let stem = base.rfind('.').map_or(base, |i| &base[..i]);
-    (!stem.is_empty()).then_some(stem)
-}
-
-/// The namespace of an element kind that MuJoCo names after its file when unnamed.
-pub(crate) fn named_after_file(kind: Kind) -> Option<Ns> {
-    match kind.spec().name.as_bytes().first() {
-        Some(b'm' | b't' | b'h' | b's') => {}
-        _ => return None,
-    }
-    match kind.spec().name {
-        "mesh" => Some(Ns::Mesh),
-        "texture" => Some(Ns::Texture),
-        "hfield" => Some(Ns::Hfield),
-        "skin" => Some(Ns::Skin),
-        _ => None,
-    }
-}
-
-/// The attribute that declares a kind's name, and its namespace (computed once per kind).
+/// The attribute that declares a kind's name, and its namespace.
 fn id_attr(kind: Kind) -> Option<(Sym, Ns)> {
-    static TABLE: std::sync::OnceLock<Vec<Option<(Sym, Ns)>>> = std::sync::OnceLock::new();
-    let table = TABLE.get_or_init(|| {
-        (0..crate::vocab::elements().len())
-            .map(|i| {
-                Kind(i as u16)
-                    .spec()
-                    .attrs
-                    .iter()
-                    .find_map(|a| match a.kind {
-                        AttrKind::Id(ns) => crate::names::known(a.name).map(|s| (s, ns)),
-                        _ => None,
-                    })
-            })
-            .collect()
-    });
-    table.get(kind.0 as usize).copied().flatten()
+    name_attrs(kind).iter().find_map(|&(s, k)| match k {
+        AttrKind::Id(ns) => Some((s, ns)),
+        _ => None,
+    })
 }
 
 /// A hasher for short names: one multiply per 8 bytes. The keys are model names, not
