@@ -42,7 +42,15 @@ pub(crate) fn ns_of_objtype(keyword: &str) -> Option<Ns> {
 /// The namespace of an element kind that MuJoCo names after its file when it has no
 /// `name` (mesh, texture, height field, skin assets).
 pub(crate) fn named_after_file(kind: Kind) -> Option<Ns> {
-    named_after_file_tag(kind.spec().name)
+    // Asked for every element of every walk: a table, not a string match.
+    static TABLE: std::sync::OnceLock<Vec<Option<Ns>>> = std::sync::OnceLock::new();
+    let table = TABLE.get_or_init(|| {
+        crate::vocab::elements()
+            .iter()
+            .map(|e| named_after_file_tag(e.name))
+            .collect()
+    });
+    table.get(kind.0 as usize).copied().flatten()
 }
 
 /// [`named_after_file`] by tag, for the asset kinds (whose tag is their kind's name).

@@ -244,12 +244,23 @@ impl Document {
     }
 }
 
-/// The attribute that declares a kind's name, and its namespace.
+/// The attribute that declares a kind's name, and its namespace (read off the
+/// name-attribute table once per kind: the walks here run for every merge).
 fn id_attr(kind: Kind) -> Option<(Sym, Ns)> {
-    name_attrs(kind).iter().find_map(|&(s, k)| match k {
-        AttrKind::Id(ns) => Some((s, ns)),
-        _ => None,
-    })
+    static TABLE: std::sync::OnceLock<Vec<Option<(Sym, Ns)>>> = std::sync::OnceLock::new();
+    let table = TABLE.get_or_init(|| {
+        (0..crate::vocab::elements().len())
+            .map(|i| {
+                name_attrs(Kind(i as u16))
+                    .iter()
+                    .find_map(|&(s, k)| match k {
+                        AttrKind::Id(ns) => Some((s, ns)),
+                        _ => None,
+                    })
+            })
+            .collect()
+    });
+    table.get(kind.0 as usize).copied().flatten()
 }
 
 /// A hasher for short names: one multiply per 8 bytes. The keys are model names, not
