@@ -28,18 +28,25 @@ pub struct WriteOptions {
     pub validate: bool,
 }
 
-/// Writes a finished document (validated first when asked) to a file or standard output.
-/// The output is written only when everything before it succeeded, and atomically, so a
-/// failure leaves the old file intact.
-pub fn emit(doc: &Document, output: Option<&Path>, options: WriteOptions) -> Result<(), String> {
+/// The text of a finished document, validated first when asked: what every command that
+/// writes a model writes, once everything that can fail has run.
+pub fn render(doc: &Document, options: WriteOptions) -> Result<String, String> {
     if options.validate {
         validate(doc)?;
     }
-    let text = if options.compact {
+    Ok(if options.compact {
         doc.to_xml_string()
     } else {
         doc.to_pretty_string()
-    };
+    })
+}
+
+/// Writes a finished document (validated first when asked) to a file or standard output.
+/// The output is written only when everything before it succeeded, and atomically, so a
+/// failure leaves the old file intact (see [`mjcf_forge::write_atomic`] for symlinks and
+/// special files).
+pub fn emit(doc: &Document, output: Option<&Path>, options: WriteOptions) -> Result<(), String> {
+    let text = render(doc, options)?;
     match output {
         Some(path) => mjcf_forge::write_atomic(path, text.as_bytes()).map_err(|e| e.to_string()),
         None => write_stdout(text.as_bytes()),
