@@ -248,8 +248,11 @@ fn is_plain_path(link: &Path) -> bool {
 #[derive(Debug)]
 pub struct OutputDir {
     path: PathBuf,
-    /// Held open for the one sync at the end.
+    /// Held open for the one sync at the end (and, on Linux, to create files in).
     handle: File,
+    /// Set once unnamed temporary files turn out not to work here.
+    #[cfg(target_os = "linux")]
+    no_unnamed_files: std::sync::atomic::AtomicBool,
 }
 
 impl OutputDir {
@@ -272,6 +275,8 @@ impl OutputDir {
         Ok(OutputDir {
             path: path.to_path_buf(),
             handle,
+            #[cfg(target_os = "linux")]
+            no_unnamed_files: std::sync::atomic::AtomicBool::new(false),
         })
     }
 
@@ -297,11 +302,15 @@ impl OutputDir {
     }
 
     /// Writes `bytes` as the file `relative_name` (which may name a subfolder:
-    /// `assets/cube.stl`), replacing it atomically. On any error the temporary file is
-    /// removed and the error names the final file.
+    /// `assets/cube.stl`, created when missing), replacing it atomically. On any error
+    /// nothing is left behind and the error names the final file.
     pub fn write(&self, relative_name: &str, bytes: &[u8]) -> Result<(), Error> {
         let path = self.final_path(relative_name)?;
         let fail = |e: std::io::Error| write_error(&path, &e);
+        #[cfg(target_os = "linux")]
+        if self.write_unnamed(relative_name, bytes).map_err(fail)? {
+            return Ok(());
+        }
         let folder = folder_of(&path);
         let mut tmp = match TempFile::create_in(folder) {
             Ok(tmp) => tmp,
@@ -315,6 +324,66 @@ impl OutputDir {
         tmp.file.write_all(bytes).map_err(fail)?;
         tmp.persist(&path).map_err(fail)?;
         Ok(())
+    }
+
+    /// Linux: writes the file without a name (`O_TMPFILE`) and links it under its final
+    /// name once complete: one directory entry per file, as a plain write makes, instead
+    /// of a temporary one plus a rename; and a process killed mid-write leaves nothing at
+    /// all (an unnamed file vanishes with it). `Ok(false)` when this cannot be done here
+    /// (the name exists already, which a link cannot replace; a filesystem without
+    /// `O_TMPFILE`; no `/proc`): the caller then writes through a named temporary file.
+    #[cfg(target_os = "linux")]
+    fn write_unnamed(&self, relative_name: &str, bytes: &[u8]) -> std::io::Result<bool> {
+        use rustix::fs::{AtFlags, CWD, Mode, OFlags};
+        use rustix::io::Errno;
+        use std::os::fd::AsRawFd as _;
+        if self.no_unnamed_files.load(Ordering::Relaxed) {
+            return Ok(false);
+        }
+        let folder = match Path::new(relative_name).parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        let open = || {
+            rustix::fs::openat(
+                &self.handle,
+                folder,
+                OFlags::WRONLY | OFlags::TMPFILE | OFlags::CLOEXEC,
+                // The umask applies, as for any new file.
+                Mode::from_raw_mode(0o666),
+            )
+        };
+        let fd = match open() {
+            Ok(fd) => fd,
+            Err(Errno::NOENT) if folder != Path::new(".") => {
+                std::fs::create_dir_all(self.path.join(folder))?;
+                open()?
+            }
+            Err(Errno::OPNOTSUPP | Errno::ISDIR | Errno::INVAL) => {
+                self.no_unnamed_files.store(true, Ordering::Relaxed);
+                return Ok(false);
+            }
+            Err(e) => return Err(e.into()),
+        };
+        let mut file = File::from(fd);
+        file.write_all(bytes)?;
+        let fd_path = format!("/proc/self/fd/{}", file.as_raw_fd());
+        match rustix::fs::linkat(
+            CWD,
+            fd_path.as_str(),
+            &self.handle,
+            relative_name,
+            AtFlags::SYMLINK_FOLLOW,
+        ) {
+            Ok(()) => Ok(true),
+            Err(Errno::EXIST) => Ok(false),
+            Err(Errno::NOENT) => {
+                // No /proc to name the file by.
+                self.no_unnamed_files.store(true, Ordering::Relaxed);
+                Ok(false)
+            }
+            Err(e) => Err(e.into()),
+        }
     }
 
     /// Whether `relative_name` is already there (a file written by an earlier run, or by
@@ -470,6 +539,29 @@ mod tests {
         }
         assert_eq!(listing(&dir.path().join("d")), ["taken"]);
         assert!(listing(&dir.path().join("d/taken")).is_empty());
+    }
+
+    /// A second run into the same folder replaces the first one's files (a link cannot
+    /// replace a name, so this takes the rename path) and leaves nothing else.
+    #[test]
+    fn a_rerun_replaces_files_atomically() {
+        let dir = tempfile::tempdir().unwrap();
+        for round in ["one", "two"] {
+            let outputs = OutputDir::create(dir.path()).unwrap();
+            outputs.write("a.xml", round.as_bytes()).unwrap();
+            outputs.write("assets/b.bin", round.as_bytes()).unwrap();
+            outputs.finish().unwrap();
+            assert_eq!(
+                std::fs::read(dir.path().join("a.xml")).unwrap(),
+                round.as_bytes()
+            );
+            assert_eq!(
+                std::fs::read(dir.path().join("assets/b.bin")).unwrap(),
+                round.as_bytes()
+            );
+        }
+        assert_eq!(listing(dir.path()), ["a.xml", "assets"]);
+        assert_eq!(listing(&dir.path().join("assets")), ["b.bin"]);
     }
 
     #[test]
