@@ -47,5 +47,5 @@ pub use document::{Document, Section};
 pub use error::{Error, ErrorKind, Errors, Location};
 pub use merge::{MergeOptions, MergePart, MergeReport};
 pub use model::{MujocoModel, Offsets, XmlModel, XmlModelOptions};
-pub use output::{OutputDir, write_atomic};
+pub use output::{AssetStore, OutputDir, TarWriter, write_atomic};
 pub use tree::Node;
