@@ -42,6 +42,9 @@ enum Command {
     /// Load a model as `inline` does, compile it with MuJoCo and print its sizes
     /// (needs the `mujoco` feature).
     Compile(cli::compile::Args),
+    /// Write a model as a folder that can be moved: the model, its file references
+    /// rewritten to `assets/<content hash>.<ext>`, and those files.
+    Export(cli::export::Args),
 }
 
 fn main() -> ExitCode {
@@ -51,5 +54,6 @@ fn main() -> ExitCode {
         Command::Merge(args) => cli::merge::run(args),
         Command::Info(args) => cli::info::run(args),
         Command::Compile(args) => cli::compile::run(args),
+        Command::Export(args) => cli::export::run(args),
     }
 }

@@ -2,6 +2,7 @@
 //! finished document is written, how problems are reported, and `--validate`.
 
 pub mod compile;
+pub mod export;
 pub mod info;
 pub mod inline;
 pub mod merge;
