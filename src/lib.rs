@@ -36,6 +36,7 @@ pub mod output;
 mod paths;
 mod prefix;
 mod read;
+pub mod scene;
 mod schema;
 mod skin;
 mod tree;
