@@ -40,6 +40,8 @@ pub(crate) struct Randomizer {
     pub(crate) location: Location,
     /// The randomizer's index (its random stream).
     pub(crate) index: usize,
+    /// The attribute names a file (choices are absolute paths).
+    pub(crate) file: bool,
 }
 
 /// How values are drawn. Numeric bounds hold one value per drawn component (a single value
@@ -69,9 +71,9 @@ pub(crate) enum Dist {
 }
 
 /// MuJoCo's value of an attribute an element does not write (checked against `mjSpec`'s
-/// defaults by `tests/scene_judge.rs`), for scaling or keeping components of a value
-/// that is not written.
-pub(crate) const MUJOCO_DEFAULTS: &[(&str, &str, &str)] = &[
+/// defaults by `tests/scene_batch.rs`), for scaling or keeping components of a value
+/// that is not written: `(element, attribute, value)`.
+pub const MUJOCO_DEFAULTS: &[(&str, &str, &str)] = &[
     ("geom", "friction", "1 0.005 0.0001"),
     ("geom", "rgba", "0.5 0.5 0.5 1"),
     ("geom", "solref", "0.02 1"),
@@ -156,6 +158,25 @@ impl Draws {
 }
 
 impl Randomizer {
+    /// File choices rewritten to the store's relocatable names.
+    pub(crate) fn relocate_files(
+        &mut self,
+        store: &crate::output::AssetStore,
+    ) -> Result<(), Errors> {
+        if let Dist::Choice {
+            values,
+            prefixed: false,
+            ..
+        } = &mut self.dist
+            && self.file
+        {
+            for v in values.iter_mut() {
+                *v = store.relocate_file(std::path::Path::new(v.as_str()))?;
+            }
+        }
+        Ok(())
+    }
+
     /// Whether this randomizer can select elements of `part`.
     pub(crate) fn applies_to_part(&self, part: &str) -> bool {
         self.part.as_deref().is_none_or(|p| p == part)
