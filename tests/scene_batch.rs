@@ -282,6 +282,21 @@ fn bad_scenes_are_refused_with_positions_and_nothing_written() {
 }
 
 #[test]
+fn spliced_text_is_the_written_document() {
+    // The fast path (template text with the variant's values and objects spliced in)
+    // against the document path (clone, merge, write), byte for byte.
+    for scene in [Scene::demo().unwrap(), Scene::load(lift5()).unwrap()] {
+        for i in 0..150 {
+            let (xml, params) = scene.variant_xml(i).unwrap();
+            let v = scene.variant(i).unwrap();
+            assert_eq!(params, v.params, "variant {i}");
+            assert!(xml == v.xml(), "variant {i} differs:\n{xml}\n{}", v.xml());
+        }
+        assert!(scene.splices(), "{}: not spliced", scene.file().display());
+    }
+}
+
+#[test]
 fn scene_from_json_is_the_scene_from_toml() {
     let dir = root().join("corpora/scenes/demo");
     let toml_text = std::fs::read_to_string(dir.join("demo.toml")).unwrap();
@@ -459,7 +474,7 @@ overlap = "allow"
 "#;
         let scene = Scene::from_toml_str(text, &dir).unwrap();
         let v = scene.variant(0).unwrap();
-        let err = mjcf_forge::scene::check_variant(&v, &v.xml(), &dir).unwrap_err();
+        let err = mjcf_forge::scene::check_variant(0, &v.params, &v.xml(), &dir).unwrap_err();
         assert!(err.starts_with("variant 0: geom pile"), "{err}");
         assert!(err.contains("interpenetrates"), "{err}");
     }

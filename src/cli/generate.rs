@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
-use mjcf_forge::scene::{Scene, Variant};
+use mjcf_forge::scene::{Params, Scene};
 use mjcf_forge::{AssetStore, OutputDir, TarWriter};
 use rayon::prelude::*;
 
@@ -252,18 +252,18 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
         let made: Vec<Result<(u64, String, String, Duration), String>> = (at..end)
             .into_par_iter()
             .map(|i| {
-                let v = scene.variant(i).map_err(|e| e.to_string())?;
-                let xml = if args.pretty {
-                    v.document.to_pretty_string()
+                let (xml, params) = if args.pretty {
+                    let v = scene.variant(i).map_err(|e| e.to_string())?;
+                    (v.document.to_pretty_string(), v.params)
                 } else {
-                    v.xml()
+                    scene.variant_xml(i).map_err(|e| e.to_string())?
                 };
                 let took = match (&check_dir, args.validate) {
-                    (Some(dir), true) => check(&v, &xml, dir)?,
+                    (Some(dir), true) => check(i, &params, &xml, dir)?,
                     _ => Duration::ZERO,
                 };
                 let file = format!("{i:09}.xml");
-                let json = v.params.to_json(i, Some(&file));
+                let json = params.to_json(i, Some(&file));
                 if let Sink::Dir { out, .. } = &sink {
                     out.write(&file, xml.as_bytes())
                         .map_err(|e| e.to_string())?;
@@ -298,14 +298,14 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
 }
 
 #[cfg(feature = "mujoco")]
-fn check(v: &Variant, xml: &str, dir: &Path) -> Result<Duration, String> {
+fn check(i: u64, params: &Params, xml: &str, dir: &Path) -> Result<Duration, String> {
     let t = Instant::now();
-    mjcf_forge::scene::check_variant(v, xml, dir)?;
+    mjcf_forge::scene::check_variant(i, params, xml, dir)?;
     Ok(t.elapsed())
 }
 
 #[cfg(not(feature = "mujoco"))]
-fn check(_: &Variant, _: &str, _: &Path) -> Result<Duration, String> {
+fn check(_: u64, _: &Params, _: &str, _: &Path) -> Result<Duration, String> {
     Err(super::NO_MUJOCO.to_owned())
 }
 
