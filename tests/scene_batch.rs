@@ -138,6 +138,29 @@ fn bytes_do_not_depend_on_threads_shards_or_sink() {
     let xml = tar_member(&tar1.stdout, "000000042.xml").expect("member 000000042.xml");
     assert_eq!(xml, outputs[0]["000000042.xml"]);
 
+    // Shards to tar files: each its own NAME-KKKKKK.tar holding its share.
+    let tars = dir.join("tars");
+    std::fs::create_dir_all(&tars).unwrap();
+    for k in 0..3 {
+        ok(&forge(&[
+            "generate",
+            "-n",
+            "60",
+            "--start",
+            "5",
+            "--shard",
+            &format!("{k}/3"),
+            "-o",
+            tars.join("run.tar").to_str().unwrap(),
+        ]));
+    }
+    let middle = std::fs::read(tars.join("run-000001.tar")).unwrap();
+    assert_eq!(
+        tar_member(&middle, "000000042.xml").unwrap(),
+        outputs[0]["000000042.xml"]
+    );
+    assert!(tar_member(&middle, "000000005.xml").is_none());
+
     // The library gives the same variant as the command line.
     let v = Scene::demo().unwrap().variant(42).unwrap();
     assert_eq!(v.xml().as_bytes(), outputs[0]["000000042.xml"]);

@@ -30,7 +30,8 @@ pub struct Args {
     /// How many variants (indices START..START+N).
     #[arg(short = 'n', long = "count", default_value_t = 10)]
     count: u64,
-    /// A folder, a `.tar` file, or `-` for a tar stream on standard output.
+    /// A folder, a `.tar` file (with `--shard K/N`: `NAME-KKKKKK.tar`), or `-` for a tar
+    /// stream on standard output.
     #[arg(short, long)]
     output: PathBuf,
     /// Seed (overrides the scene file's).
@@ -344,6 +345,15 @@ fn open_sink(
         Some(dir)
     } else {
         None
+    };
+    // Shards writing tar files each write their own, named as WebDataset shards are.
+    let sharded_name;
+    let output = if sharded && output != Path::new("-") {
+        let stem = output.file_stem().unwrap_or_default().to_string_lossy();
+        sharded_name = output.with_file_name(format!("{stem}-{k:06}.tar"));
+        sharded_name.as_path()
+    } else {
+        output
     };
     let (writer, file, label): (Box<dyn Write + Send + Sync>, _, PathBuf) =
         if output == Path::new("-") {
