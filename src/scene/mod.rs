@@ -360,6 +360,74 @@ impl Scene {
         Ok((v.xml(), v.params))
     }
 
+    /// Makes variants `range` as XML in parallel, in chunks of `chunk`, and hands each to
+    /// `sink` in index order, so memory stays bounded however long the range. A variant
+    /// that fails is handed over as its error; `sink` stops everything by returning an
+    /// error.
+    ///
+    /// ```
+    /// let scene = mjcf_forge::scene::Scene::demo()?;
+    /// let mut seen = Vec::new();
+    /// scene.stream(10..20, 4, |i, made| {
+    ///     let (xml, _params) = made?;
+    ///     seen.push((i, xml.len()));
+    ///     Ok::<(), mjcf_forge::Errors>(())
+    /// })?;
+    /// assert_eq!(seen.iter().map(|s| s.0).collect::<Vec<_>>(), (10..20).collect::<Vec<_>>());
+    /// # Ok::<(), mjcf_forge::Errors>(())
+    /// ```
+    pub fn stream<E>(
+        &self,
+        range: Range<u64>,
+        chunk: u64,
+        mut sink: impl FnMut(u64, Result<(String, Params), Errors>) -> Result<(), E>,
+    ) -> Result<(), E> {
+        let chunk = chunk.max(1);
+        let mut at = range.start;
+        while at < range.end {
+            let end = (at + chunk).min(range.end);
+            let made: Vec<_> = (at as usize..end as usize)
+                .into_par_iter()
+                .map(|i| self.variant_xml(i as u64))
+                .collect();
+            for (i, m) in (at..end).zip(made) {
+                sink(i, m)?;
+            }
+            at = end;
+        }
+        Ok(())
+    }
+
+    /// Writes variants `range` to `out` as a tar stream in the layout of `generate -o -`
+    /// (the variants' XML with file references as the scene has them: absolute unless
+    /// [`Scene::relocate_assets`] was called, whose store then writes the `assets/`
+    /// members first with [`crate::AssetStore::write_to_tar`]).
+    ///
+    /// ```
+    /// let scene = mjcf_forge::scene::Scene::demo()?;
+    /// let mut tar = mjcf_forge::TarWriter::new(Vec::new(), "memory");
+    /// scene.write_tar(0..3, &mut tar)?;
+    /// let bytes = tar.finish()?;
+    /// assert!(bytes.len() > 3 * 2 * 512);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn write_tar<W: std::io::Write>(
+        &self,
+        range: Range<u64>,
+        tar: &mut crate::output::TarWriter<W>,
+    ) -> Result<(), Errors> {
+        self.stream(range, 512, |i, made| {
+            let (xml, params) = made?;
+            let file = format!("{i:09}.xml");
+            tar.append(&file, xml.as_bytes())?;
+            tar.append(
+                &format!("{i:09}.json"),
+                params.to_json(i, Some(&file)).as_bytes(),
+            )?;
+            Ok(())
+        })
+    }
+
     /// Whether [`Scene::variant_xml`] writes by splicing text (rather than building each
     /// variant's document) for every object instance made so far.
     pub fn splices(&self) -> bool {
