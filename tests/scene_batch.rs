@@ -279,6 +279,46 @@ fn spliced_text_is_the_written_document() {
 }
 
 #[test]
+fn text_that_looks_like_a_marker_takes_the_document_path() {
+    // A base whose own text holds the characters splicing uses as markers: variants are
+    // still exact (written from the document), just not spliced.
+    let dir = scratch("scene_marker_text");
+    let demo = root().join("corpora/scenes/demo");
+    let arena = std::fs::read_to_string(demo.join("arena.xml"))
+        .unwrap()
+        .replace(
+            "</mujoco>",
+            "<custom><text name=\"note\" data=\"\u{E000}0\u{E001}\"/></custom></mujoco>",
+        );
+    std::fs::write(dir.join("arena.xml"), arena).unwrap();
+    for model in ["box.xml", "sphere.xml"] {
+        std::fs::copy(demo.join(model), dir.join(model)).unwrap();
+    }
+    let text = r#"
+base = "arena.xml"
+[[objects]]
+name = "o"
+pool = ["box.xml", "sphere.xml"]
+count = 3
+[objects.placement]
+on = "table_top"
+x = [-0.3, 0.3]
+y = [-0.3, 0.3]
+[[randomize]]
+kind = "light"
+attribute = "diffuse"
+uniform = [[0, 0, 0], [1, 1, 1]]
+"#;
+    let scene = Scene::from_toml_str(text, &dir).unwrap();
+    for i in 0..5 {
+        let (xml, _) = scene.variant_xml(i).unwrap();
+        assert_eq!(xml, scene.variant(i).unwrap().xml());
+        assert!(xml.contains("data=\"\u{E000}0\u{E001}\""));
+    }
+    assert!(!scene.splices());
+}
+
+#[test]
 fn scene_from_json_is_the_scene_from_toml() {
     let dir = root().join("corpora/scenes/demo");
     let toml_text = std::fs::read_to_string(dir.join("demo.toml")).unwrap();

@@ -434,7 +434,18 @@ fn group(
             .elements(root)
             .any(|k| matches!(doc.tag(k), "joint" | "freejoint"));
         if g.free_joint && !has_joint {
-            doc.append_element(root, "freejoint", &[("name", "joint0")]);
+            // Named joint0 as robosuite names an object's first joint, or the first free
+            // jointN when the model already uses that name.
+            let taken: Vec<&str> = doc
+                .descendants(doc.root())
+                .filter(|&n| matches!(doc.tag(n), "joint" | "freejoint"))
+                .filter_map(|n| doc.attr(n, "name"))
+                .collect();
+            let name = (0..)
+                .map(|k| format!("joint{k}"))
+                .find(|n| !taken.contains(&n.as_str()))
+                .expect("a free name exists");
+            doc.append_element(root, "freejoint", &[("name", &name)]);
         }
         let bounds = match geometry::subtree_bounds(&doc, root, |_, _| true) {
             Ok(b) if b.min.iter().chain(&b.max).all(|x| x.is_finite()) => b,

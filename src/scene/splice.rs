@@ -84,6 +84,13 @@ fn hole(doc: &mut Document, holes: &mut Vec<(Node, String)>, node: Node, attr: &
     holes.push((node, attr.to_string()));
 }
 
+/// Whether a document's own text has what this module uses as markers (then its variants
+/// take the document path rather than risk reading the document's text as a marker).
+fn has_markers(doc: &Document) -> bool {
+    let text = doc.to_xml_string();
+    text.contains(HOLE_OPEN) || text.contains(HOLE_CLOSE) || text.contains(INSERT_TAG)
+}
+
 /// Cuts markers out of written text.
 fn cut(text: &str, holes: &[(Node, String)]) -> Option<Pieces> {
     let mut out = String::with_capacity(text.len());
@@ -131,6 +138,9 @@ impl Template {
             Section::from_tag(template.tag(s)) == keys && template.elements(s).next().is_some()
         }) {
             return None; // merging remaps keys
+        }
+        if has_markers(template) {
+            return None;
         }
         let mut doc = template.clone();
         let mut holes = Vec::new();
@@ -221,6 +231,9 @@ impl Fragments {
         template_doc: &Document,
         template: &Template,
     ) -> Option<Fragments> {
+        if has_markers(doc) {
+            return None;
+        }
         let mut copy = doc.clone();
         super::place::clear_orientation(&mut copy, root);
         let mut holes = Vec::new();
