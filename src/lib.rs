@@ -35,6 +35,7 @@ mod names;
 mod paths;
 mod prefix;
 mod read;
+pub mod scene;
 mod schema;
 mod skin;
 mod tree;
