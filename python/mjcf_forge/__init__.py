@@ -16,6 +16,9 @@ from ._mjcf_forge import (
     MergeReport,
     MjcfError,
     Model,
+    Scene,
+    Variant,
+    VariantIterator,
     __version__,
 )
 
@@ -25,5 +28,8 @@ __all__ = [
     "MergeReport",
     "MjcfError",
     "Model",
+    "Scene",
+    "Variant",
+    "VariantIterator",
     "__version__",
 ]

@@ -8,6 +8,7 @@
 mod document;
 mod errors;
 mod model;
+mod scene;
 
 use pyo3::prelude::*;
 
@@ -20,6 +21,9 @@ fn _mjcf_forge(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<document::PyElement>()?;
     m.add_class::<document::PyMergeReport>()?;
     m.add_class::<model::PyModel>()?;
+    m.add_class::<scene::PyScene>()?;
+    m.add_class::<scene::PyVariant>()?;
+    m.add_class::<scene::PyVariantIter>()?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

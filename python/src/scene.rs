@@ -1,0 +1,360 @@
+//! `Scene`, `Variant` and the variant stream: the batch tier.
+//!
+//! A `Scene` is an `Arc` of the library's `Scene` (`Send + Sync`), so Python threads share
+//! one and every call releases the GIL. `Scene.variants` runs a producer thread that makes
+//! a window of variants at a time on a rayon pool and hands them over through a bounded
+//! channel, so at most about two windows exist at once however many indices are asked for,
+//! and they arrive in index order because each window is collected in order.
+
+use std::path::PathBuf;
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
+use std::sync::{Arc, Mutex, OnceLock};
+
+use mjcf_forge::scene::{Scene, Variant};
+use pyo3::exceptions::{PyImportError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use rayon::prelude::*;
+
+use crate::document::PyDocument;
+use crate::errors::{Failure, catch, run};
+
+/// A randomized scene description, loaded once: every model file read once and the part
+/// that never changes assembled once. ``scene.variant(i)`` is variant ``i``; all of its
+/// randomness comes from ``(seed, i)``, so it is the same bytes in any process, on any
+/// thread, in any order.
+///
+/// Build one with :meth:`Scene.load` (a TOML scene file, or the built-in demo scene) or
+/// :meth:`Scene.from_dict` (the same description as a Python ``dict``). Safe to share
+/// between threads; every call releases the GIL.
+///
+/// Example::
+///
+///     scene = Scene.load("lift5.toml")
+///     v = scene.variant(12)
+///     v.xml             # the MJCF text, assets referenced by absolute path
+///     v.params          # {'objects': [...], 'randomized': [...]}
+///     model = v.compile()   # mujoco.MjModel
+///     for v in scene.variants(range(10_000), threads=2):
+///         ...
+#[pyclass(name = "Scene", module = "mjcf_forge", frozen)]
+pub(crate) struct PyScene {
+    scene: Arc<Scene>,
+}
+
+/// What a worker makes for one index: the variant and its text forms, so that the Python
+/// side only wraps them.
+struct Made {
+    variant: Variant,
+    xml: String,
+    params_json: String,
+}
+
+fn make(scene: &Scene, index: u64) -> Result<Made, Failure> {
+    catch(|| {
+        let variant = scene.variant(index)?;
+        let xml = variant.xml();
+        let params_json = variant.params_json();
+        Ok(Made {
+            variant,
+            xml,
+            params_json,
+        })
+    })
+}
+
+#[pymethods]
+impl PyScene {
+    /// Loads a TOML scene file (paths in it are relative to it); without ``path``, the
+    /// built-in demo scene (our own models, no file needed).
+    #[staticmethod]
+    #[pyo3(signature = (path = None))]
+    fn load(py: Python<'_>, path: Option<PathBuf>) -> PyResult<PyScene> {
+        let scene = run(py, || {
+            Ok(match path {
+                Some(path) => Scene::load(&path)?,
+                None => Scene::demo()?,
+            })
+        })?;
+        Ok(PyScene {
+            scene: Arc::new(scene),
+        })
+    }
+
+    /// The built-in demo scene (the same as ``Scene.load()``).
+    #[staticmethod]
+    fn demo(py: Python<'_>) -> PyResult<PyScene> {
+        Self::load(py, None)
+    }
+
+    /// A scene from TOML text; model paths are relative to ``base_dir``.
+    #[staticmethod]
+    #[pyo3(signature = (text, base_dir = PathBuf::from(".")))]
+    fn from_toml(py: Python<'_>, text: &str, base_dir: PathBuf) -> PyResult<PyScene> {
+        let text = text.to_owned();
+        let scene = run(py, move || Ok(Scene::from_toml_str(&text, &base_dir)?))?;
+        Ok(PyScene {
+            scene: Arc::new(scene),
+        })
+    }
+
+    /// A scene from a ``dict`` with the keys of the TOML scene file (``seed``, ``base``,
+    /// ``fixture``, ``objects``, ``randomize``); model paths are relative to ``base_dir``.
+    /// Lets Python code build or tweak a description, e.g. one read with ``tomllib`` and
+    /// given another seed or pool.
+    #[staticmethod]
+    #[pyo3(signature = (description, base_dir = PathBuf::from(".")))]
+    fn from_dict(
+        py: Python<'_>,
+        description: &Bound<'_, PyDict>,
+        base_dir: PathBuf,
+    ) -> PyResult<PyScene> {
+        let json: String = py
+            .import("json")?
+            .getattr("dumps")?
+            .call1((description,))
+            .map_err(|e| {
+                PyValueError::new_err(format!("the scene description is not JSON data: {e}"))
+            })?
+            .extract()?;
+        let scene = run(py, move || Ok(Scene::from_json_str(&json, &base_dir)?))?;
+        Ok(PyScene {
+            scene: Arc::new(scene),
+        })
+    }
+
+    /// The seed: variant ``i`` draws every random number from ``(seed, i)``.
+    #[getter]
+    fn seed(&self) -> u64 {
+        self.scene.seed()
+    }
+
+    /// The scene file this scene was read from (a label for the demo and for text).
+    #[getter]
+    fn file(&self) -> PathBuf {
+        self.scene.file().to_path_buf()
+    }
+
+    /// The model files the scene uses, absolute (empty for the built-in demo).
+    #[getter]
+    fn model_files(&self) -> Vec<PathBuf> {
+        self.scene.model_files().to_vec()
+    }
+
+    /// A copy of the template every variant starts from: the base with the fixtures.
+    #[getter]
+    fn template(&self, py: Python<'_>) -> PyResult<PyDocument> {
+        run(py, || Ok(self.scene.template().clone())).map(PyDocument::new)
+    }
+
+    /// Variant ``index`` (made with the GIL released). Raises :class:`MjcfError` when it
+    /// cannot be made, e.g. a group whose objects find no place (the message names the
+    /// group, the region and the index).
+    fn variant(&self, py: Python<'_>, index: u64) -> PyResult<PyVariant> {
+        let scene = self.scene.clone();
+        run(py, move || make(&scene, index)).map(PyVariant::from)
+    }
+
+    /// Variants for ``indices`` (a ``range`` or any iterable of ints), made on
+    /// ``threads`` Rust threads (default: one per core) with the GIL released, yielded in
+    /// the order of ``indices``. Memory stays bounded: variants are made ``window`` at a
+    /// time (default ``8 * threads``, at least 16) and at most one window waits to be
+    /// taken. The bytes of each variant do not depend on ``threads`` or ``window``.
+    ///
+    /// A variant that cannot be made raises :class:`MjcfError` when its turn comes, and
+    /// ends the iteration.
+    #[pyo3(signature = (indices, threads = None, window = None))]
+    fn variants(
+        &self,
+        indices: &Bound<'_, PyAny>,
+        threads: Option<usize>,
+        window: Option<usize>,
+    ) -> PyResult<PyVariantIter> {
+        let indices: Vec<u64> = indices
+            .try_iter()?
+            .map(|i| i.and_then(|i| i.extract::<u64>()))
+            .collect::<PyResult<_>>()?;
+        if threads == Some(0) || window == Some(0) {
+            return Err(PyValueError::new_err(
+                "threads and window must be at least 1",
+            ));
+        }
+        let pool = match threads {
+            Some(n) => Some(
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(n)
+                    .thread_name(|i| format!("mjcf-forge-variants-{i}"))
+                    .build()
+                    .map_err(|e| Failure(vec![format!("cannot start {n} threads: {e}")]))?,
+            ),
+            None => None,
+        };
+        let workers = threads.unwrap_or_else(rayon::current_num_threads);
+        let window = window.unwrap_or((8 * workers).max(16));
+        let (tx, rx) = sync_channel(window);
+        let scene = self.scene.clone();
+        std::thread::Builder::new()
+            .name("mjcf-forge-variants".into())
+            .spawn(move || produce(scene, indices, pool, window, tx))
+            .map_err(|e| Failure(vec![format!("cannot start the producer thread: {e}")]))?;
+        Ok(PyVariantIter {
+            rx: Mutex::new(Some(rx)),
+        })
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<mjcf_forge.Scene file={:?} seed={}>",
+            self.scene.file().display().to_string(),
+            self.scene.seed()
+        )
+    }
+}
+
+/// The producer: windows of variants made in parallel, sent in order; stops when the
+/// receiver is gone (the Python iterator was dropped) or after the first failure.
+fn produce(
+    scene: Arc<Scene>,
+    indices: Vec<u64>,
+    pool: Option<rayon::ThreadPool>,
+    window: usize,
+    tx: SyncSender<Result<Made, Failure>>,
+) {
+    for chunk in indices.chunks(window) {
+        let make_all = || -> Vec<Result<Made, Failure>> {
+            chunk.par_iter().map(|&i| make(&scene, i)).collect()
+        };
+        let made = match &pool {
+            Some(pool) => pool.install(make_all),
+            None => make_all(),
+        };
+        for result in made {
+            let failed = result.is_err();
+            if tx.send(result).is_err() || failed {
+                return;
+            }
+        }
+    }
+}
+
+/// An iterator over variants made on Rust threads (see :meth:`Scene.variants`).
+#[pyclass(name = "VariantIterator", module = "mjcf_forge", frozen)]
+pub(crate) struct PyVariantIter {
+    /// `None` once exhausted or failed.
+    rx: Mutex<Option<Receiver<Result<Made, Failure>>>>,
+}
+
+#[pymethods]
+impl PyVariantIter {
+    fn __iter__(slf: Py<Self>) -> Py<Self> {
+        slf
+    }
+
+    fn __next__(&self, py: Python<'_>) -> PyResult<Option<PyVariant>> {
+        // Waiting for the next variant releases the GIL: the workers never need it.
+        let next = py.detach(|| {
+            let mut rx = self.rx.lock().unwrap_or_else(|p| p.into_inner());
+            let got = rx.as_ref().and_then(|r| r.recv().ok());
+            if !matches!(got, Some(Ok(_))) {
+                *rx = None; // exhausted or failed: later calls stop at once
+            }
+            got
+        });
+        match next {
+            Some(Ok(made)) => Ok(Some(made.into())),
+            Some(Err(failure)) => Err(failure.into()),
+            None => Ok(None),
+        }
+    }
+}
+
+/// One variant of a :class:`Scene`: its ``index``, its MJCF text ``xml`` (assets
+/// referenced by absolute path), and ``params``, everything that was drawn for it.
+#[pyclass(name = "Variant", module = "mjcf_forge", frozen)]
+pub(crate) struct PyVariant {
+    variant: Variant,
+    xml: String,
+    params_json: String,
+    /// The `str` made once on first access (the XML of a scene is tens of kilobytes).
+    xml_str: OnceLock<Py<pyo3::types::PyString>>,
+}
+
+impl From<Made> for PyVariant {
+    fn from(made: Made) -> PyVariant {
+        PyVariant {
+            variant: made.variant,
+            xml: made.xml,
+            params_json: made.params_json,
+            xml_str: OnceLock::new(),
+        }
+    }
+}
+
+#[pymethods]
+impl PyVariant {
+    /// The variant's index.
+    #[getter]
+    fn index(&self) -> u64 {
+        self.variant.index
+    }
+
+    /// The variant as compact MJCF text.
+    #[getter]
+    fn xml(&self, py: Python<'_>) -> Py<pyo3::types::PyString> {
+        self.xml_str
+            .get_or_init(|| pyo3::types::PyString::new(py, &self.xml).unbind())
+            .clone_ref(py)
+    }
+
+    /// What was drawn, as a new ``dict``: ``objects`` (for each placed object its
+    /// ``group``, ``slot``, ``model``, ``prefix``, root ``body``, ``pos`` and ``quat`` as
+    /// written in the XML) and ``randomized`` (each randomized attribute with its
+    /// element's kind, name, part and value); the manifest line of ``mjcf-forge
+    /// generate`` without the file name.
+    #[getter]
+    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        py.import("json")?
+            .getattr("loads")?
+            .call1((self.params_json.as_str(),))
+    }
+
+    /// ``params`` as the JSON text it comes from.
+    #[getter]
+    fn params_json(&self) -> &str {
+        &self.params_json
+    }
+
+    /// A copy of the variant's :class:`Document` (to edit before writing or compiling).
+    #[getter]
+    fn document(&self, py: Python<'_>) -> PyResult<PyDocument> {
+        run(py, || Ok(self.variant.document.clone())).map(PyDocument::new)
+    }
+
+    /// Writes the indented XML to ``path`` atomically.
+    fn write(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        run(py, || Ok(self.variant.document.write_file(&path)?))
+    }
+
+    /// Compiles the variant with MuJoCo (``mujoco.MjModel.from_xml_string``); needs the
+    /// ``mujoco`` package. Asset files are found by their absolute paths.
+    fn compile<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let mujoco = py.import("mujoco").map_err(|e| {
+            PyImportError::new_err(format!(
+                "Variant.compile() needs the mujoco package (pip install mujoco): {e}"
+            ))
+        })?;
+        mujoco
+            .getattr("MjModel")?
+            .getattr("from_xml_string")?
+            .call1((self.xml(py),))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<mjcf_forge.Variant index={} objects={} xml_bytes={}>",
+            self.variant.index,
+            self.variant.params.objects.len(),
+            self.xml.len()
+        )
+    }
+}
