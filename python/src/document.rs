@@ -92,11 +92,13 @@ impl PyDocument {
     }
 
     /// Reads MJCF text. ``base_dir`` plays the part of the main file's folder: includes
-    /// and asset files are found from there. Positions in errors name ``<string>``.
+    /// and asset files are found from there (default: the current folder). Positions in
+    /// errors name ``<string>``.
     #[staticmethod]
-    #[pyo3(signature = (xml, base_dir = PathBuf::from(".")))]
-    fn from_string(py: Python<'_>, xml: &str, base_dir: PathBuf) -> PyResult<PyDocument> {
+    #[pyo3(signature = (xml, base_dir = None))]
+    fn from_string(py: Python<'_>, xml: &str, base_dir: Option<PathBuf>) -> PyResult<PyDocument> {
         let xml = xml.to_owned();
+        let base_dir = base_dir.unwrap_or_else(|| PathBuf::from("."));
         run(py, move || Ok(Document::from_str(&xml, &base_dir)?)).map(PyDocument::new)
     }
 
@@ -133,20 +135,20 @@ impl PyDocument {
     /// over (identical assets shared, compiler settings converted where exact).
     ///
     /// ``fuse_keys`` makes the part's keyframe ``part_prefix + N`` one with this
-    /// document's key ``N``. Returns a :class:`MergeReport`; raises :class:`MjcfError`
+    /// document's key ``N`` (``part_prefix``: the prefix the part's names carry). Returns a :class:`MergeReport`; raises :class:`MjcfError`
     /// (all name clashes at once, with positions), leaving this document unchanged.
-    #[pyo3(signature = (other, body = None, *, fuse_keys = false, part_prefix = String::new()))]
+    #[pyo3(signature = (other, body = None, *, fuse_keys = false, part_prefix = None))]
     fn merge(
         &self,
         py: Python<'_>,
         other: &PyDocument,
         body: Option<String>,
         fuse_keys: bool,
-        part_prefix: String,
+        part_prefix: Option<String>,
     ) -> PyResult<PyMergeReport> {
         let options = MergeOptions {
             fuse_keys,
-            part_prefix,
+            part_prefix: part_prefix.unwrap_or_default(),
         };
         run(py, || {
             // A copy of the part first: it may be this very document (merging a model with

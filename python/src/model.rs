@@ -52,6 +52,9 @@ fn numpy_array<'py>(py: Python<'py>, values: &[f64]) -> PyResult<Bound<'py, PyAn
 #[pymethods]
 impl PyModel {
     #[new]
+    #[pyo3(text_signature = "(source, idn=None, *, prefix=None, name=None, \
+        contact_geom_rgba=(0.0, 0.5, 0.0, 1.0), name_unnamed_geoms=True, \
+        exclude_from_prefixing=())")]
     #[pyo3(signature = (
         source,
         idn = None,

@@ -87,11 +87,13 @@ impl PyScene {
         Self::load(py, None)
     }
 
-    /// A scene from TOML text; model paths are relative to ``base_dir``.
+    /// A scene from TOML text; model paths are relative to ``base_dir`` (default: the
+    /// current folder).
     #[staticmethod]
-    #[pyo3(signature = (text, base_dir = PathBuf::from(".")))]
-    fn from_toml(py: Python<'_>, text: &str, base_dir: PathBuf) -> PyResult<PyScene> {
+    #[pyo3(signature = (text, base_dir = None))]
+    fn from_toml(py: Python<'_>, text: &str, base_dir: Option<PathBuf>) -> PyResult<PyScene> {
         let text = text.to_owned();
+        let base_dir = base_dir.unwrap_or_else(|| PathBuf::from("."));
         let scene = run(py, move || Ok(Scene::from_toml_str(&text, &base_dir)?))?;
         Ok(PyScene {
             scene: Arc::new(scene),
@@ -99,16 +101,17 @@ impl PyScene {
     }
 
     /// A scene from a ``dict`` with the keys of the TOML scene file (``seed``, ``base``,
-    /// ``fixture``, ``objects``, ``randomize``); model paths are relative to ``base_dir``.
-    /// Lets Python code build or tweak a description, e.g. one read with ``tomllib`` and
+    /// ``fixture``, ``objects``, ``randomize``); model paths are relative to ``base_dir``
+    /// (default: the current folder). Lets Python code build or tweak a description, e.g. one read with ``tomllib`` and
     /// given another seed or pool.
     #[staticmethod]
-    #[pyo3(signature = (description, base_dir = PathBuf::from(".")))]
+    #[pyo3(signature = (description, base_dir = None))]
     fn from_dict(
         py: Python<'_>,
         description: &Bound<'_, PyDict>,
-        base_dir: PathBuf,
+        base_dir: Option<PathBuf>,
     ) -> PyResult<PyScene> {
+        let base_dir = base_dir.unwrap_or_else(|| PathBuf::from("."));
         let json: String = py
             .import("json")?
             .getattr("dumps")?
