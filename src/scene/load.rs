@@ -383,7 +383,19 @@ fn group(
             continue;
         };
         if doc.attr(root, "name").is_none() {
-            doc.set_attr(root, "name", "object");
+            // The manifest names each object by its root body; an unnamed one gets the
+            // first of root, root1, root2... that no body uses (robosuite's objects
+            // wrap a body named "object" in an unnamed one).
+            let taken: Vec<&str> = doc
+                .descendants(root)
+                .filter(|&n| doc.tag(n) == "body")
+                .filter_map(|n| doc.attr(n, "name"))
+                .collect();
+            let name = (0..)
+                .map(|k| if k == 0 { "root".to_string() } else { format!("root{k}") })
+                .find(|n| !taken.contains(&n.as_str()))
+                .expect("a free name exists");
+            doc.set_attr(root, "name", &name);
         }
         let has_joint = doc
             .elements(root)
