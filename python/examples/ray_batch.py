@@ -89,13 +89,26 @@ def run_batch(scene_path: Optional[str], n: int, shards: int) -> dict:
     }
 
 
+def start_local_ray(num_cpus: int = 2) -> None:
+    """A local Ray instance whose workers can import this file's functions (Ray ships a
+    task by reference to its module, so the workers need this folder on their path)."""
+    here = str(Path(__file__).resolve().parent)
+    path = os.pathsep.join(p for p in (here, os.environ.get("PYTHONPATH")) if p)
+    ray.init(
+        num_cpus=num_cpus,
+        include_dashboard=False,
+        log_to_driver=False,
+        runtime_env={"env_vars": {"PYTHONPATH": path}},
+    )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("scene", nargs="?", help="scene file (default: the built-in demo)")
     parser.add_argument("-n", type=int, default=2000)
     parser.add_argument("--shards", type=int, default=8)
     args = parser.parse_args()
-    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    start_local_ray()
     try:
         result = run_batch(args.scene and str(Path(args.scene).resolve()), args.n, args.shards)
     finally:

@@ -205,6 +205,21 @@ impl PyScene {
         })
     }
 
+    /// Seconds spent in Rust making ``indices`` one at a time on this thread (variant, XML
+    /// and parameters, exactly what :meth:`variant` makes) without making any Python
+    /// object: the baseline against which the benchmarks measure the cost of crossing
+    /// into Python per variant. Not part of the API.
+    fn _rust_seconds(&self, py: Python<'_>, indices: Vec<u64>) -> PyResult<f64> {
+        run(py, || {
+            let start = std::time::Instant::now();
+            for &i in &indices {
+                // Dropped at once, as a Python caller drops a variant it has read.
+                std::hint::black_box(make(&self.scene, i)?);
+            }
+            Ok(start.elapsed().as_secs_f64())
+        })
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "<mjcf_forge.Scene file={:?} seed={}>",
