@@ -86,11 +86,12 @@ impl PyModel {
             }
         };
         enum Source {
-            Doc(Document),
+            // Boxed: the document is large and the enum lives only for this call.
+            Doc(Box<Document>),
             Path(PathBuf),
         }
         let source = if let Ok(doc) = source.cast::<PyDocument>() {
-            Source::Doc(doc.get().snapshot())
+            Source::Doc(Box::new(doc.get().snapshot()))
         } else {
             Source::Path(source.extract::<PathBuf>().map_err(|_| {
                 PyTypeError::new_err("Model(source, ...): source is a Document or a path")
@@ -104,7 +105,7 @@ impl PyModel {
         };
         let model = run(py, move || {
             let doc = match source {
-                Source::Doc(doc) => doc,
+                Source::Doc(doc) => *doc,
                 Source::Path(path) => Document::load(&path)?,
             };
             Ok(XmlModel::with_prefix(doc, &prefix, options)?)
