@@ -32,6 +32,7 @@ mod model;
 #[cfg(feature = "mujoco")]
 pub mod mujoco;
 mod names;
+pub mod output;
 mod paths;
 mod prefix;
 mod read;
@@ -47,5 +48,5 @@ pub use document::{Document, Section};
 pub use error::{Error, ErrorKind, Errors, Location};
 pub use merge::{MergeOptions, MergePart, MergeReport};
 pub use model::{MujocoModel, Offsets, XmlModel, XmlModelOptions};
+pub use output::{AssetStore, OutputDir, TarWriter, write_atomic};
 pub use tree::Node;
-pub use write::write_atomic;

@@ -76,6 +76,8 @@ pub struct Scene {
     randomizers: Vec<Randomizer>,
     /// Every model file the scene uses, as absolute paths (for exporting its assets).
     model_files: Vec<PathBuf>,
+    /// No instance prefix begins another, so names of different instances never clash.
+    prefixes_apart: bool,
 }
 
 /// One element a randomizer sets, with what the manifest says of it.
@@ -317,7 +319,16 @@ impl Scene {
                     prefix,
                 })
                 .collect();
-            doc.merge_all(&merge, false)?;
+            // Each instance was checked against the template when it was made; instances
+            // cannot clash with each other when no prefix begins another.
+            if !self.prefixes_apart {
+                let docs: Vec<&Document> = parts.iter().map(|(d, _)| d).collect();
+                let clashes = doc.name_clashes(&docs);
+                if !clashes.is_empty() {
+                    return Err(Errors(clashes));
+                }
+            }
+            doc.merge_unchecked(&merge, false)?;
         }
         Ok(Variant {
             index,
