@@ -129,7 +129,7 @@ def per_variant(fn, indices) -> float:
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--rounds", type=int, default=10)
     ap.add_argument("--forge", type=int, default=1000, help="mjcf_forge variants per round")
     ap.add_argument("--robosuite", type=int, default=20, help="robosuite variants per round")
     args = ap.parse_args()
