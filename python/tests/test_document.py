@@ -225,3 +225,28 @@ def test_merging_a_document_into_itself_does_not_deadlock():
     doc = Document.from_string('<mujoco><worldbody><body name="a"/></worldbody></mujoco>')
     with pytest.raises(MjcfError):
         doc.merge(doc)  # every name clashes, but it returns
+
+
+def test_prefix_and_merge_equal_the_command_lines_bytes(forge_cli, tmp_path):
+    # The command line's outputs are judged by MuJoCo in tests/merge_judge.rs and
+    # tests/prefix_judge.rs; the same operations from Python give the same bytes.
+    cli = subprocess.run(
+        [str(forge_cli), "merge", str(TABLE),
+         "--part", f"{PANDA}:robot0_", "--part", f"{GRIPPER}:gripper0_:robot0_right_hand"],
+        check=True, capture_output=True, text=True,
+    ).stdout
+    scene = Document.load(TABLE)
+    robot, gripper = Document.load(PANDA), Document.load(GRIPPER)
+    robot.prefix("robot0_")
+    gripper.prefix("gripper0_")
+    scene.merge(robot, part_prefix="robot0_")
+    scene.merge(gripper, body="robot0_right_hand", part_prefix="gripper0_")
+    assert scene.to_xml(pretty=True) == cli
+    cli = subprocess.run(
+        [str(forge_cli), "prefix", str(PANDA), "--prefix", "r1_"],
+        check=True, capture_output=True, text=True,
+    ).stdout
+    assert robot.to_xml(pretty=True) != cli  # a different prefix, a different text
+    again = Document.load(PANDA)
+    again.prefix("r1_")
+    assert again.to_xml(pretty=True) == cli

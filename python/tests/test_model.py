@@ -122,3 +122,21 @@ def test_model_errors():
     with pytest.raises(MjcfError):
         robot.merge(Model(GRIPPER, "g"), body="robot0_no_such_body")
     assert robot.to_xml() == before
+
+
+@pytest.mark.parametrize("path", [PANDA, GRIPPER, *OBJECTS[:2]], ids=lambda p: p.stem)
+def test_model_tells_what_the_command_lines_info_tells(path, forge_cli):
+    import subprocess
+
+    cli = json.loads(subprocess.run(
+        [str(forge_cli), "info", str(path), "--prefix", "m0_", "--json"],
+        check=True, capture_output=True, text=True,
+    ).stdout)
+    model = Model(path, "m0")
+    assert json.loads(model.info_json()) == cli
+    for key in ["name", "naming_prefix", "root_body", "bodies", "joints", "actuators", "sites",
+                "sensors", "contact_geoms", "visual_geoms"]:
+        assert getattr(model, key) == cli[key], key
+    np.testing.assert_allclose(model.bottom_offset, cli["bottom_offset"], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(model.top_offset, cli["top_offset"], rtol=0, atol=1e-12)
+    assert model.horizontal_radius == pytest.approx(cli["horizontal_radius"], abs=1e-12)
