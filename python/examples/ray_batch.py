@@ -1,8 +1,10 @@
 """A large batch of scene variants as Ray tasks, one shard each, checked byte for byte
 against one process making them all.
 
-Each task loads the scene itself (a scene file is small; loading reads every model once)
-and makes its shard's contiguous index range with ``scene.variants``. Variant ``i``
+The driver puts the ``Scene`` into Ray's object store once; a ``Scene`` pickles as its
+description (file, TOML text or dict), so each worker loads it again from the model files
+(shared storage on a cluster) rather than receiving them. Each task makes its shard's
+contiguous index range with ``scene.variants``. Variant ``i``
 depends on ``(seed, i)`` only, so the shards put together are exactly what one process
 makes, whatever the number of shards, their order or the machines they ran on. Each task
 returns its shard as a tar archive in memory laid out as WebDataset shards are
@@ -21,8 +23,6 @@ import os
 import tarfile
 import time
 from pathlib import Path
-from typing import Optional
-
 import ray
 
 import mjcf_forge
@@ -39,9 +39,8 @@ def shard_bounds(n: int, shards: int) -> list[tuple[int, int]]:
     return bounds
 
 
-def make_shard(scene_path: Optional[str], start: int, stop: int, threads: int = 1) -> bytes:
+def make_shard(scene: mjcf_forge.Scene, start: int, stop: int, threads: int = 1) -> bytes:
     """Variants [start, stop) as an uncompressed tar: per variant NNNNNNNNN.xml and .json."""
-    scene = mjcf_forge.Scene.load(scene_path)
     buffer = io.BytesIO()
     with tarfile.open(fileobj=buffer, mode="w", format=tarfile.USTAR_FORMAT) as tar:
         for variant in scene.variants(range(start, stop), threads=threads):
@@ -55,8 +54,8 @@ def make_shard(scene_path: Optional[str], start: int, stop: int, threads: int = 
 
 
 @ray.remote(num_cpus=1)
-def make_shard_task(scene_path: Optional[str], start: int, stop: int) -> bytes:
-    return make_shard(scene_path, start, stop)
+def make_shard_task(scene: mjcf_forge.Scene, start: int, stop: int) -> bytes:
+    return make_shard(scene, start, stop)
 
 
 def members(archives: list[bytes]) -> list[tuple[str, bytes]]:
@@ -68,14 +67,15 @@ def members(archives: list[bytes]) -> list[tuple[str, bytes]]:
     return out
 
 
-def run_batch(scene_path: Optional[str], n: int, shards: int) -> dict:
+def run_batch(scene: mjcf_forge.Scene, n: int, shards: int) -> dict:
     """Makes the batch on Ray and in this process; returns the comparison."""
     t = time.perf_counter()
-    refs = [make_shard_task.remote(scene_path, a, b) for a, b in shard_bounds(n, shards)]
+    scene_ref = ray.put(scene)
+    refs = [make_shard_task.remote(scene_ref, a, b) for a, b in shard_bounds(n, shards)]
     sharded = ray.get(refs)
     ray_s = time.perf_counter() - t
     t = time.perf_counter()
-    single = make_shard(scene_path, 0, n, threads=os.cpu_count() or 1)
+    single = make_shard(scene, 0, n, threads=os.cpu_count() or 1)
     local_s = time.perf_counter() - t
     got, want = members(sharded), members([single])
     return {
@@ -110,7 +110,7 @@ def main() -> None:
     args = parser.parse_args()
     start_local_ray()
     try:
-        result = run_batch(args.scene and str(Path(args.scene).resolve()), args.n, args.shards)
+        result = run_batch(mjcf_forge.Scene.load(args.scene), args.n, args.shards)
     finally:
         ray.shutdown()
     print(result)

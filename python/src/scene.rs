@@ -10,10 +10,11 @@ use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::sync::{Arc, Mutex, OnceLock};
 
+use mjcf_forge::Document;
 use mjcf_forge::scene::{Scene, Variant};
 use pyo3::exceptions::{PyImportError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyTuple};
 use rayon::prelude::*;
 
 use crate::document::PyDocument;
@@ -26,7 +27,8 @@ use crate::errors::{Failure, catch, run};
 ///
 /// Build one with :meth:`Scene.load` (a TOML scene file, or the built-in demo scene) or
 /// :meth:`Scene.from_dict` (the same description as a Python ``dict``). Safe to share
-/// between threads; every call releases the GIL.
+/// between threads; every call releases the GIL. A scene pickles as its description (Ray
+/// tasks and multiprocessing workers load it again from the same model files).
 ///
 /// Example::
 ///
@@ -40,6 +42,27 @@ use crate::errors::{Failure, catch, run};
 #[pyclass(name = "Scene", module = "mjcf_forge", frozen)]
 pub(crate) struct PyScene {
     scene: Arc<Scene>,
+    /// Where the scene came from, so that pickling (Ray, multiprocessing) can load it again
+    /// on the other side instead of shipping every model.
+    source: Source,
+}
+
+/// What a scene was loaded from (its pickled form).
+#[derive(Clone)]
+enum Source {
+    Demo,
+    File(PathBuf),
+    Toml(String, PathBuf),
+    Json(String, PathBuf),
+}
+
+impl PyScene {
+    fn new(scene: Scene, source: Source) -> PyScene {
+        PyScene {
+            scene: Arc::new(scene),
+            source,
+        }
+    }
 }
 
 /// What a worker makes for one index: the variant and its text forms, so that the Python
@@ -70,15 +93,17 @@ impl PyScene {
     #[staticmethod]
     #[pyo3(signature = (path = None))]
     fn load(py: Python<'_>, path: Option<PathBuf>) -> PyResult<PyScene> {
+        let source = match &path {
+            Some(p) => Source::File(absolute(p.clone())),
+            None => Source::Demo,
+        };
         let scene = run(py, || {
-            Ok(match path {
-                Some(path) => Scene::load(&path)?,
+            Ok(match &path {
+                Some(path) => Scene::load(path)?,
                 None => Scene::demo()?,
             })
         })?;
-        Ok(PyScene {
-            scene: Arc::new(scene),
-        })
+        Ok(PyScene::new(scene, source))
     }
 
     /// The built-in demo scene (the same as ``Scene.load()``).
@@ -94,10 +119,8 @@ impl PyScene {
     fn from_toml(py: Python<'_>, text: &str, base_dir: Option<PathBuf>) -> PyResult<PyScene> {
         let text = text.to_owned();
         let base_dir = base_dir.unwrap_or_else(|| PathBuf::from("."));
-        let scene = run(py, move || Ok(Scene::from_toml_str(&text, &base_dir)?))?;
-        Ok(PyScene {
-            scene: Arc::new(scene),
-        })
+        let scene = run(py, || Ok(Scene::from_toml_str(&text, &base_dir)?))?;
+        Ok(PyScene::new(scene, Source::Toml(text, absolute(base_dir))))
     }
 
     /// A scene from a ``dict`` with the keys of the TOML scene file (``seed``, ``base``,
@@ -120,10 +143,8 @@ impl PyScene {
                 PyValueError::new_err(format!("the scene description is not JSON data: {e}"))
             })?
             .extract()?;
-        let scene = run(py, move || Ok(Scene::from_json_str(&json, &base_dir)?))?;
-        Ok(PyScene {
-            scene: Arc::new(scene),
-        })
+        let scene = run(py, || Ok(Scene::from_json_str(&json, &base_dir)?))?;
+        Ok(PyScene::new(scene, Source::Json(json, absolute(base_dir))))
     }
 
     /// The seed: variant ``i`` draws every random number from ``(seed, i)``.
@@ -220,6 +241,23 @@ impl PyScene {
         })
     }
 
+    /// Pickling (Ray, multiprocessing) ships the description, not the models: the copy
+    /// loads the same file, text or dict again (so the other side needs the model files
+    /// at the same paths, as a cluster with shared storage has them).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let cls = py.get_type::<PyScene>();
+        let (make, args) = match &self.source {
+            Source::Demo => (cls.getattr("load")?, PyTuple::empty(py)),
+            Source::File(path) => (cls.getattr("load")?, (path,).into_pyobject(py)?),
+            Source::Toml(text, dir) => (cls.getattr("from_toml")?, (text, dir).into_pyobject(py)?),
+            Source::Json(json, dir) => {
+                let dict = py.import("json")?.getattr("loads")?.call1((json,))?;
+                (cls.getattr("from_dict")?, (dict, dir).into_pyobject(py)?)
+            }
+        };
+        PyTuple::new(py, [make, args.into_any()])
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "<mjcf_forge.Scene file={:?} seed={}>",
@@ -227,6 +265,12 @@ impl PyScene {
             self.scene.seed()
         )
     }
+}
+
+/// A path made absolute for the pickled form, so that a copy loaded in another process
+/// (another current folder) finds the same files. Messages keep the path as given.
+fn absolute(path: PathBuf) -> PathBuf {
+    std::path::absolute(&path).unwrap_or(path)
 }
 
 /// The producer: windows of variants made in parallel, sent in order; stops when the
@@ -288,11 +332,14 @@ impl PyVariantIter {
 
 /// One variant of a :class:`Scene`: its ``index``, its MJCF text ``xml`` (assets
 /// referenced by absolute path), and ``params``, everything that was drawn for it.
+/// Picklable (as its index, XML and parameters).
 #[pyclass(name = "Variant", module = "mjcf_forge", frozen)]
 pub(crate) struct PyVariant {
-    variant: Variant,
+    index: u64,
+    document: Document,
     xml: String,
     params_json: String,
+    objects: usize,
     /// The `str` made once on first access (the XML of a scene is tens of kilobytes).
     xml_str: OnceLock<Py<pyo3::types::PyString>>,
 }
@@ -300,7 +347,9 @@ pub(crate) struct PyVariant {
 impl From<Made> for PyVariant {
     fn from(made: Made) -> PyVariant {
         PyVariant {
-            variant: made.variant,
+            index: made.variant.index,
+            objects: made.variant.params.objects.len(),
+            document: made.variant.document,
             xml: made.xml,
             params_json: made.params_json,
             xml_str: OnceLock::new(),
@@ -313,7 +362,7 @@ impl PyVariant {
     /// The variant's index.
     #[getter]
     fn index(&self) -> u64 {
-        self.variant.index
+        self.index
     }
 
     /// The variant as compact MJCF text.
@@ -345,12 +394,12 @@ impl PyVariant {
     /// A copy of the variant's :class:`Document` (to edit before writing or compiling).
     #[getter]
     fn document(&self, py: Python<'_>) -> PyResult<PyDocument> {
-        run(py, || Ok(self.variant.document.clone())).map(PyDocument::new)
+        run(py, || Ok(self.document.clone())).map(PyDocument::new)
     }
 
     /// Writes the indented XML to ``path`` atomically.
     fn write(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
-        run(py, || Ok(self.variant.document.write_file(&path)?))
+        run(py, || Ok(self.document.write_file(&path)?))
     }
 
     /// Compiles the variant with MuJoCo (``mujoco.MjModel.from_xml_string``); needs the
@@ -370,9 +419,45 @@ impl PyVariant {
     fn __repr__(&self) -> String {
         format!(
             "<mjcf_forge.Variant index={} objects={} xml_bytes={}>",
-            self.variant.index,
-            self.variant.params.objects.len(),
+            self.index,
+            self.objects,
             self.xml.len()
         )
+    }
+
+    /// Pickling (Ray, multiprocessing) ships the index, the XML and the parameters; the
+    /// copy reads its document back from the XML (paths in it are absolute).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let restore = py.get_type::<PyVariant>().getattr("_restore")?;
+        let args = (
+            self.index,
+            self.xml(py),
+            self.params_json.as_str(),
+            self.objects,
+            self.document.model_dir().to_path_buf(),
+        )
+            .into_pyobject(py)?;
+        PyTuple::new(py, [restore, args.into_any()])
+    }
+
+    /// The inverse of ``__reduce__`` (not part of the API).
+    #[staticmethod]
+    fn _restore(
+        py: Python<'_>,
+        index: u64,
+        xml: String,
+        params_json: String,
+        objects: usize,
+        model_dir: PathBuf,
+    ) -> PyResult<PyVariant> {
+        let document = run(py, || Ok(Document::from_str(&xml, &model_dir)?))?;
+        Ok(PyVariant {
+            index,
+            document,
+            xml,
+            params_json,
+            objects,
+            xml_str: OnceLock::new(),
+        })
     }
 }

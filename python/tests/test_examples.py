@@ -9,6 +9,7 @@ import pytest
 
 import bounds
 from conftest import ROOT
+from mjcf_forge import Scene
 
 DEMO = ROOT / "corpora" / "scenes" / "demo" / "demo.toml"
 
@@ -112,9 +113,9 @@ def test_ray_shards_equal_one_process_byte_for_byte():
     assert ray_batch.shard_bounds(10, 3) == [(0, 4), (4, 7), (7, 10)]
     ray_batch.start_local_ray(num_cpus=2)
     try:
-        result = ray_batch.run_batch(str(DEMO), 300, 4)
+        result = ray_batch.run_batch(Scene.load(DEMO), 300, 4)
         # Another split of the same range: the same bytes again.
-        again = ray_batch.run_batch(str(DEMO), 300, 7)
+        again = ray_batch.run_batch(Scene.load(DEMO), 300, 7)
     finally:
         ray.shutdown()
     assert result["identical"] and result["members"] == 600

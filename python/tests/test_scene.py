@@ -156,3 +156,28 @@ def test_bad_stream_arguments():
         scene.variants([-1])
     with pytest.raises(TypeError):
         scene.variants(5)
+
+
+def test_scenes_and_variants_pickle(tmp_path, monkeypatch):
+    import pickle
+
+    description = tomllib.loads(DEMO_TOML.read_text())
+    monkeypatch.chdir(DEMO_DIR)  # relative paths: the pickled copy must not depend on the folder
+    scenes = [
+        Scene.load(),
+        Scene.load("demo.toml"),
+        Scene.from_toml(DEMO_TOML.read_text()),
+        Scene.from_dict(description),
+    ]
+    expected = [s.variant(9).xml for s in scenes]
+    blobs = [pickle.dumps(s) for s in scenes]
+    monkeypatch.chdir(tmp_path)
+    for blob, xml in zip(blobs, expected):
+        copy = pickle.loads(blob)
+        assert copy.variant(9).xml == xml
+    v = scenes[1].variant(4)
+    w = pickle.loads(pickle.dumps(v))
+    assert (w.index, w.xml, w.params, repr(w)) == (v.index, v.xml, v.params, repr(v))
+    # The copy's document is read back from the XML: the same model, the same text.
+    assert w.document.to_xml() == v.xml
+    assert w.compile().nbody == v.compile().nbody
