@@ -45,6 +45,9 @@ enum Command {
     /// Write a model as a folder that can be moved: the model, its file references
     /// rewritten to `assets/<content hash>.<ext>`, and those files.
     Export(cli::export::Args),
+    /// Make seeded variants of a scene (a TOML scene file, or the built-in demo): a folder
+    /// with one XML per variant, `manifest.jsonl` and `assets/`, a `.tar` file, or `-`.
+    Generate(cli::generate::Args),
 }
 
 fn main() -> ExitCode {
@@ -55,5 +58,6 @@ fn main() -> ExitCode {
         Command::Info(args) => cli::info::run(args),
         Command::Compile(args) => cli::compile::run(args),
         Command::Export(args) => cli::export::run(args),
+        Command::Generate(args) => cli::generate::run(args),
     }
 }

@@ -3,6 +3,7 @@
 
 pub mod compile;
 pub mod export;
+pub mod generate;
 pub mod info;
 pub mod inline;
 pub mod merge;

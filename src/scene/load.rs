@@ -805,6 +805,7 @@ fn randomizer(
         shared: r.shared,
         location: src.location(r.kind.span()),
         index,
+        file: matches!(attr_spec.kind, AttrKind::File),
     })
 }
 

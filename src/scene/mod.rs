@@ -24,6 +24,8 @@
 //! The scene file is TOML; `corpora/scenes/demo/demo.toml` is a commented example and the
 //! README describes every key.
 
+#[cfg(feature = "mujoco")]
+mod check;
 mod demo;
 mod load;
 mod params;
@@ -43,6 +45,8 @@ use crate::error::{Error, ErrorKind, Errors, Location};
 use crate::merge::MergePart;
 use crate::tree::Node;
 
+#[cfg(feature = "mujoco")]
+pub use check::{PENETRATION_TOLERANCE, check_variant};
 pub use params::{Params, PlacedObject, RandomizedValue};
 
 use place::Placement;
@@ -251,6 +255,26 @@ impl Scene {
     /// The model files the scene uses (absolute; empty for the built-in demo).
     pub fn model_files(&self) -> &[PathBuf] {
         &self.model_files
+    }
+
+    /// Rewrites every file reference of the scene (template, object models, file choices
+    /// of randomizers) to the store's relocatable names, so that variants written into the
+    /// store's folder compile wherever the folder goes.
+    pub fn relocate_assets(&mut self, store: &crate::output::AssetStore) -> Result<(), Errors> {
+        store.relocate(&mut self.template)?;
+        for group in &mut self.groups {
+            for model in &mut group.pool {
+                store.relocate(&mut model.doc)?;
+            }
+            // Instances made before were made from the models as they were.
+            for slot in &mut group.instances {
+                *slot = OnceLock::new();
+            }
+        }
+        for r in &mut self.randomizers {
+            r.relocate_files(store)?;
+        }
+        Ok(())
     }
 
     /// Variant `index`: the same document and parameters for the same seed and index,
