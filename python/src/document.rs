@@ -126,6 +126,7 @@ impl PyDocument {
     /// Prefixes every name in place (bodies, joints, geoms, assets, classes, ...) and every
     /// reference to it, following MuJoCo's schema; references to ``world`` stay.
     fn prefix(&self, py: Python<'_>, prefix: &str) -> PyResult<()> {
+        check_xml_text("prefix", prefix)?;
         let prefix = prefix.to_owned();
         run(py, || Ok(write(&self.doc).apply_prefix(&prefix)?))
     }
@@ -353,6 +354,8 @@ impl PyElement {
     /// sequences of numbers (lists, tuples, numpy arrays) space-separated.
     fn set(&self, key: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
         let text = attr_text(value)?;
+        check_xml_name("attribute name", key)?;
+        check_xml_text("attribute value", &text)?;
         catch(|| {
             write(&self.doc).set_attr(self.node, key, &text);
             Ok(())
@@ -470,10 +473,14 @@ impl PyElement {
     /// :meth:`set` takes them); returns it.
     #[pyo3(signature = (tag, attrib = None))]
     fn append(&self, tag: &str, attrib: Option<&Bound<'_, PyDict>>) -> PyResult<PyElement> {
+        check_xml_name("tag", tag)?;
         let mut pairs = Vec::new();
         if let Some(attrib) = attrib {
             for (k, v) in attrib.iter() {
-                pairs.push((k.extract::<String>()?, attr_text(&v)?));
+                let (k, v) = (k.extract::<String>()?, attr_text(&v)?);
+                check_xml_name("attribute name", &k)?;
+                check_xml_text("attribute value", &v)?;
+                pairs.push((k, v));
             }
         }
         let refs: Vec<(&str, &str)> = pairs
@@ -519,6 +526,36 @@ impl PyElement {
             doc: self.doc.clone(),
             node,
         }
+    }
+}
+
+/// Refuses a tag or attribute name that XML cannot carry (the library writes names as
+/// given, and a file with `<bad tag>` in it would not read back).
+pub(crate) fn check_xml_name(what: &str, name: &str) -> Result<(), Failure> {
+    let start_ok = |c: char| c.is_alphabetic() || c == '_' || c == ':';
+    let ok = name.chars().next().is_some_and(start_ok)
+        && name
+            .chars()
+            .all(|c| start_ok(c) || c.is_alphanumeric() || matches!(c, '-' | '.'));
+    if ok {
+        Ok(())
+    } else {
+        Err(Failure(vec![format!("{what} {name:?} is not an XML name")]))
+    }
+}
+
+/// Refuses text XML 1.0 cannot carry (NUL and the other control characters but tab and
+/// line ends): written out, it would make a file that neither we nor MuJoCo can read.
+pub(crate) fn check_xml_text(what: &str, text: &str) -> Result<(), Failure> {
+    match text
+        .chars()
+        .find(|&c| c.is_control() && !matches!(c, '\t' | '\n' | '\r'))
+    {
+        None => Ok(()),
+        Some(c) => Err(Failure(vec![format!(
+            "{what} {text:?} holds the character U+{:04X}, which XML cannot carry",
+            c as u32
+        )])),
     }
 }
 

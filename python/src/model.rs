@@ -85,6 +85,7 @@ impl PyModel {
                 ));
             }
         };
+        crate::document::check_xml_text("prefix", &prefix)?;
         enum Source {
             // Boxed: the document is large and the enum lives only for this call.
             Doc(Box<Document>),

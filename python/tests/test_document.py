@@ -250,3 +250,24 @@ def test_prefix_and_merge_equal_the_command_lines_bytes(forge_cli, tmp_path):
     again = Document.load(PANDA)
     again.prefix("r1_")
     assert again.to_xml(pretty=True) == cli
+
+
+def test_names_and_text_xml_cannot_carry_are_refused():
+    doc = Document.from_string('<mujoco><worldbody><body name="b"/></worldbody></mujoco>')
+    body = doc.find("body", "b")
+    before = doc.to_xml()
+    for bad in [
+        lambda: body.set("a b", 1),
+        lambda: body.set("1x", 1),
+        lambda: body.set("pos", "0\x000"),
+        lambda: body.append("bad tag"),
+        lambda: body.append("site", {"name": "\x01"}),
+        lambda: doc.prefix("p\x00"),
+        lambda: mjcf_forge.Model(doc, prefix="\x02"),
+    ]:
+        with pytest.raises(MjcfError) as err:
+            bad()
+        assert "XML" in str(err.value) and len(err.value.errors) == 1
+    assert doc.to_xml() == before
+    body.set("user", "tab\tand\nnewline")  # allowed in XML, escaped when written
+    assert Document.from_string(doc.to_xml()).find("body", "b")["user"] == "tab\tand\nnewline"
