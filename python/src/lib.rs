@@ -12,6 +12,20 @@ mod scene;
 
 use pyo3::prelude::*;
 
+/// Panics on purpose inside the edge where every call runs, with the GIL released
+/// (`detached=True`) or held: the tests' proof that a panic reaches Python as an
+/// `MjcfError`, never as PyO3's `PanicException`. Not part of the API.
+#[pyfunction]
+#[pyo3(signature = (detached = true))]
+fn _panic_for_tests(py: Python<'_>, detached: bool) -> PyResult<()> {
+    let work = || -> Result<(), errors::Failure> { panic!("deliberate panic for the tests") };
+    if detached {
+        errors::run(py, work)
+    } else {
+        Ok(errors::catch(work)?)
+    }
+}
+
 /// MuJoCo MJCF models loaded exactly as MuJoCo reads them, prefixed, merged into scenes,
 /// and written back; randomized scene variants generated in Rust threads.
 #[pymodule]
@@ -24,6 +38,7 @@ fn _mjcf_forge(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::PyScene>()?;
     m.add_class::<scene::PyVariant>()?;
     m.add_class::<scene::PyVariantIter>()?;
+    m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

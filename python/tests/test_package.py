@@ -84,3 +84,18 @@ def test_help_shows_real_defaults():
 def test_one_exception_type_derives_from_value_error():
     assert issubclass(mjcf_forge.MjcfError, ValueError)
     assert mjcf_forge.MjcfError.__module__ == "mjcf_forge"
+
+
+def test_a_rust_panic_reaches_python_as_mjcf_error():
+    import pytest
+
+    from mjcf_forge import _mjcf_forge
+
+    for detached in (True, False):
+        with pytest.raises(mjcf_forge.MjcfError) as err:
+            _mjcf_forge._panic_for_tests(detached=detached)
+        assert err.value.errors == [
+            "internal error in mjcf-forge (please report it): deliberate panic for the tests"
+        ]
+    # The module still works afterwards.
+    assert mjcf_forge.Document.from_string("<mujoco/>").to_xml() == "<mujoco/>"
