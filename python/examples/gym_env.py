@@ -9,8 +9,9 @@ which MuJoCo-side randomization (one compiled model) cannot do.
 
 The variant index comes from the environment's own random generator (``self.np_random``,
 which ``reset(seed=...)`` seeds), so seeding reproduces the scene and the episode exactly,
-and every unseeded reset draws a new scene. Making and compiling a variant takes about a
-millisecond, so it fits in every reset.
+and every unseeded reset draws a new scene. Making a variant takes tens of microseconds;
+MuJoCo compiling it takes a few milliseconds for the demo scene (more with meshes), so a
+new scene fits in every reset.
 
 Run: .cache/venv/bin/python python/examples/gym_env.py [SCENE.toml] [--episodes N]
 """
