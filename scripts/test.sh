@@ -14,7 +14,7 @@ echo "== cargo clippy"
 cargo clippy --all-targets -- -D warnings
 cargo clippy --all-targets --features mujoco -- -D warnings
 # The Python bindings crate (the workspace's other member; not built by the commands above).
-cargo clippy -p mjcf-forge-python --all-targets -- -D warnings
+PYO3_PYTHON="$PWD/.cache/venv/bin/python" cargo clippy -p mjcf-forge-python --all-targets -- -D warnings
 echo "== cargo test (default features)"
 cargo test --all-targets
 echo "== cargo test --features mujoco (with doctests)"
