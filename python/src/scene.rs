@@ -182,8 +182,9 @@ impl PyScene {
     /// Variants for ``indices`` (a ``range`` or any iterable of ints), made on
     /// ``threads`` Rust threads (default: one per core) with the GIL released, yielded in
     /// the order of ``indices``. Memory stays bounded: variants are made ``window`` at a
-    /// time (default ``8 * threads``, at least 16) and at most one window waits to be
-    /// taken. The bytes of each variant do not depend on ``threads`` or ``window``.
+    /// time (default ``8 * threads``, at least 16), and at most one finished window waits
+    /// to be taken while the next is made. The bytes of each variant do not depend on
+    /// ``threads`` or ``window``.
     ///
     /// A variant that cannot be made raises :class:`MjcfError` when its turn comes, and
     /// ends the iteration.
