@@ -211,6 +211,11 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
     scene.relocate_assets(&store).map_err(|e| e.to_string())?;
     let lo = args.start + args.count * k / n;
     let hi = args.start + args.count * (k + 1) / n;
+    // A scene that cannot make even its first variant (say, a region too small for its
+    // objects) is refused before anything is written.
+    if lo < hi {
+        scene.variant(lo).map_err(|e| e.to_string())?;
+    }
     let mut sink = open_sink(
         &args.output,
         &store,

@@ -75,12 +75,23 @@ impl Source<'_> {
     }
 }
 
-/// Builds a scene from TOML text named `file` (its folder holds the models).
+/// Builds a scene from TOML text named `file` (its folder holds the models). Problems in
+/// the scene file come in the order of their positions.
 pub(crate) fn from_toml(
     text: &str,
     file: Arc<Path>,
     models: &dyn ModelSource,
 ) -> Result<Scene, Errors> {
+    build(text, file.clone(), models).map_err(|mut e| {
+        e.0.sort_by_key(|e| match &e.location {
+            Some(l) if l.file == file => (0, l.line, l.col),
+            _ => (1, 0, 0),
+        });
+        e
+    })
+}
+
+fn build(text: &str, file: Arc<Path>, models: &dyn ModelSource) -> Result<Scene, Errors> {
     let src = Source {
         text,
         file: file.clone(),

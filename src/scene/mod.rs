@@ -48,6 +48,7 @@ use crate::tree::Node;
 #[cfg(feature = "mujoco")]
 pub use check::{PENETRATION_TOLERANCE, check_variant};
 pub use params::{Params, PlacedObject, RandomizedValue};
+pub use randomize::MUJOCO_DEFAULTS;
 
 use place::Placement;
 use randomize::Randomizer;

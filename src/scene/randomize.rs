@@ -71,9 +71,9 @@ pub(crate) enum Dist {
 }
 
 /// MuJoCo's value of an attribute an element does not write (checked against `mjSpec`'s
-/// defaults by `tests/scene_judge.rs`), for scaling or keeping components of a value
-/// that is not written.
-pub(crate) const MUJOCO_DEFAULTS: &[(&str, &str, &str)] = &[
+/// defaults by `tests/scene_batch.rs`), for scaling or keeping components of a value
+/// that is not written: `(element, attribute, value)`.
+pub const MUJOCO_DEFAULTS: &[(&str, &str, &str)] = &[
     ("geom", "friction", "1 0.005 0.0001"),
     ("geom", "rgba", "0.5 0.5 0.5 1"),
     ("geom", "solref", "0.02 1"),
