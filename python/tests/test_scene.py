@@ -221,3 +221,20 @@ def test_variants_are_what_the_command_lines_generate_makes(forge_cli, tmp_path)
         v.write(ours)
         assert judge.compare(out / line.pop("file"), ours) == []
         assert line == v.params
+
+
+@pytest.mark.parametrize(
+    "case", sorted((ROOT / "corpora" / "scenes" / "errors").glob("*.toml")), ids=lambda p: p.stem
+)
+def test_bad_scene_files_give_the_command_lines_lines(case, monkeypatch):
+    # corpora/scenes/errors/*.err are what `mjcf-forge generate CASE -n 3` prints
+    # (tests/scene_batch.rs); from Python the same lines are the MjcfError's, raised by
+    # the load or by the first variant that cannot be made.
+    monkeypatch.chdir(ROOT)
+    expected = case.with_suffix(".err").read_text().rstrip("\n").split("\n")
+    with pytest.raises(MjcfError) as err:
+        scene = Scene.load(os.path.relpath(case, ROOT))
+        for i in range(3):
+            scene.variant(i)
+    assert err.value.errors == expected
+    assert str(err.value) == "\n".join(expected)
