@@ -62,24 +62,24 @@ fn lift5() -> String {
         .to_string()
 }
 
+/// `generate -n 60 --start 5` of the demo scene with more arguments.
+fn demo60(more: &[&str]) -> Output {
+    let mut args = vec!["generate", "-n", "60", "--start", "5"];
+    args.extend_from_slice(more);
+    let out = forge(&args);
+    ok(&out);
+    out
+}
+
 #[test]
 fn bytes_do_not_depend_on_threads_shards_or_sink() {
     let dir = scratch("scene_determinism");
+    let path = |name: &str| dir.join(name).display().to_string();
     let mut outputs = Vec::new();
     for threads in ["1", "2", "4"] {
-        let out = dir.join(format!("t{threads}"));
-        ok(&forge(&[
-            "generate",
-            "-n",
-            "60",
-            "--start",
-            "5",
-            "--threads",
-            threads,
-            "-o",
-            out.to_str().unwrap(),
-        ]));
-        outputs.push(files(&out));
+        let out = path(&format!("t{threads}"));
+        demo60(&["--threads", threads, "-o", &out]);
+        outputs.push(files(Path::new(&out)));
     }
     assert_eq!(outputs[0].len(), 60 + 1, "60 variants and the manifest");
     assert!(outputs[0].contains_key("000000005.xml") && outputs[0].contains_key("000000064.xml"));
@@ -88,21 +88,11 @@ fn bytes_do_not_depend_on_threads_shards_or_sink() {
 
     // Three shards into one folder: the same variant files, and the shard manifests in
     // order are the single manifest.
-    let shared = dir.join("shards");
+    let shared = path("shards");
     for k in 0..3 {
-        ok(&forge(&[
-            "generate",
-            "-n",
-            "60",
-            "--start",
-            "5",
-            "--shard",
-            &format!("{k}/3"),
-            "-o",
-            shared.to_str().unwrap(),
-        ]));
+        demo60(&["--shard", &format!("{k}/3"), "-o", &shared]);
     }
-    let mut sharded = files(&shared);
+    let mut sharded = files(Path::new(&shared));
     let manifests: Vec<u8> = (0..3)
         .flat_map(|k| sharded.remove(&format!("manifest-{k}-of-3.jsonl")).unwrap())
         .collect();
@@ -111,51 +101,43 @@ fn bytes_do_not_depend_on_threads_shards_or_sink() {
     assert_eq!(sharded, single);
 
     // The tar stream: the same bytes for 1 and 4 threads, and its members are the files.
-    let tar1 = forge(&[
-        "generate",
-        "-n",
-        "60",
-        "--start",
-        "5",
-        "--threads",
-        "1",
-        "-o",
-        "-",
-    ]);
-    let tar4 = forge(&[
-        "generate",
-        "-n",
-        "60",
-        "--start",
-        "5",
-        "--threads",
-        "4",
-        "-o",
-        "-",
-    ]);
-    ok(&tar1);
+    let tar1 = demo60(&["--threads", "1", "-o", "-"]);
+    let tar4 = demo60(&["--threads", "4", "-o", "-"]);
     assert_eq!(tar1.stdout, tar4.stdout);
     let xml = tar_member(&tar1.stdout, "000000042.xml").expect("member 000000042.xml");
     assert_eq!(xml, outputs[0]["000000042.xml"]);
 
-    // The library gives the same variant as the command line.
-    let v = Scene::demo().unwrap().variant(42).unwrap();
+    // Shards to tar files: each its own NAME-KKKKKK.tar holding its share.
+    std::fs::create_dir_all(path("tars")).unwrap();
+    for k in 0..3 {
+        demo60(&["--shard", &format!("{k}/3"), "-o", &path("tars/run.tar")]);
+    }
+    let middle = std::fs::read(path("tars/run-000001.tar")).unwrap();
+    assert_eq!(
+        tar_member(&middle, "000000042.xml").unwrap(),
+        outputs[0]["000000042.xml"]
+    );
+    assert!(tar_member(&middle, "000000005.xml").is_none());
+
+    // The library gives the same variant as the command line, and so does its tar.
+    let scene = Scene::demo().unwrap();
+    let v = scene.variant(42).unwrap();
     assert_eq!(v.xml().as_bytes(), outputs[0]["000000042.xml"]);
+    let mut tar = mjcf_forge::TarWriter::new(Vec::new(), "memory");
+    scene.write_tar(5..65, &mut tar).unwrap();
+    let lib_tar = tar.finish().unwrap();
+    assert_eq!(
+        tar_member(&lib_tar, "000000042.json"),
+        tar_member(&tar1.stdout, "000000042.json")
+    );
 
     // Another seed gives other variants.
-    let other = dir.join("seed");
-    ok(&forge(&[
-        "generate",
-        "-n",
-        "60",
-        "--start",
-        "5",
-        "--seed",
-        "8",
-        "-o",
-        other.to_str().unwrap(),
-    ]));
-    assert_ne!(files(&other)["000000042.xml"], outputs[0]["000000042.xml"]);
+    let other = path("seed");
+    demo60(&["--seed", "8", "-o", &other]);
+    assert_ne!(
+        files(Path::new(&other))["000000042.xml"],
+        outputs[0]["000000042.xml"]
+    );
 }
 
 /// A member of a ustar archive.
@@ -279,6 +261,61 @@ fn bad_scenes_are_refused_with_positions_and_nothing_written() {
     // The same problems from the library, as one error list.
     let err = Scene::load(root().join("corpora/scenes/errors/bad_values.toml")).unwrap_err();
     assert_eq!(err.0.len(), 6);
+}
+
+#[test]
+fn spliced_text_is_the_written_document() {
+    // The fast path (template text with the variant's values and objects spliced in)
+    // against the document path (clone, merge, write), byte for byte.
+    for scene in [Scene::demo().unwrap(), Scene::load(lift5()).unwrap()] {
+        for i in 0..150 {
+            let (xml, params) = scene.variant_xml(i).unwrap();
+            let v = scene.variant(i).unwrap();
+            assert_eq!(params, v.params, "variant {i}");
+            assert!(xml == v.xml(), "variant {i} differs:\n{xml}\n{}", v.xml());
+        }
+        assert!(scene.splices(), "{}: not spliced", scene.file().display());
+    }
+}
+
+#[test]
+fn text_that_looks_like_a_marker_takes_the_document_path() {
+    // A base whose own text holds the characters splicing uses as markers: variants are
+    // still exact (written from the document), just not spliced.
+    let dir = scratch("scene_marker_text");
+    let demo = root().join("corpora/scenes/demo");
+    let arena = std::fs::read_to_string(demo.join("arena.xml"))
+        .unwrap()
+        .replace(
+            "</mujoco>",
+            "<custom><text name=\"note\" data=\"\u{E000}0\u{E001}\"/></custom></mujoco>",
+        );
+    std::fs::write(dir.join("arena.xml"), arena).unwrap();
+    for model in ["box.xml", "sphere.xml"] {
+        std::fs::copy(demo.join(model), dir.join(model)).unwrap();
+    }
+    let text = r#"
+base = "arena.xml"
+[[objects]]
+name = "o"
+pool = ["box.xml", "sphere.xml"]
+count = 3
+[objects.placement]
+on = "table_top"
+x = [-0.3, 0.3]
+y = [-0.3, 0.3]
+[[randomize]]
+kind = "light"
+attribute = "diffuse"
+uniform = [[0, 0, 0], [1, 1, 1]]
+"#;
+    let scene = Scene::from_toml_str(text, &dir).unwrap();
+    for i in 0..5 {
+        let (xml, _) = scene.variant_xml(i).unwrap();
+        assert_eq!(xml, scene.variant(i).unwrap().xml());
+        assert!(xml.contains("data=\"\u{E000}0\u{E001}\""));
+    }
+    assert!(!scene.splices());
 }
 
 #[test]
@@ -459,7 +496,7 @@ overlap = "allow"
 "#;
         let scene = Scene::from_toml_str(text, &dir).unwrap();
         let v = scene.variant(0).unwrap();
-        let err = mjcf_forge::scene::check_variant(&v, &v.xml(), &dir).unwrap_err();
+        let err = mjcf_forge::scene::check_variant(0, &v.params, &v.xml(), &dir).unwrap_err();
         assert!(err.starts_with("variant 0: geom pile"), "{err}");
         assert!(err.contains("interpenetrates"), "{err}");
     }
