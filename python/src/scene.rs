@@ -11,7 +11,7 @@ use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::sync::{Arc, Mutex, OnceLock};
 
 use mjcf_forge::Document;
-use mjcf_forge::scene::{Scene, Variant};
+use mjcf_forge::scene::Scene;
 use pyo3::exceptions::{PyImportError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -65,23 +65,25 @@ impl PyScene {
     }
 }
 
-/// What a worker makes for one index: the variant and its text forms, so that the Python
-/// side only wraps them.
+/// What a worker makes for one index: the variant's text forms, so that the Python side
+/// only wraps them. The XML comes from the library's fastest path (`variant_xml`: the
+/// template's text with the variant's values spliced in, where the scene allows); the
+/// document is only built if Python asks for it.
 struct Made {
-    variant: Variant,
+    index: u64,
     xml: String,
     params_json: String,
+    objects: usize,
 }
 
 fn make(scene: &Scene, index: u64) -> Result<Made, Failure> {
     catch(|| {
-        let variant = scene.variant(index)?;
-        let xml = variant.xml();
-        let params_json = variant.params_json();
+        let (xml, params) = scene.variant_xml(index)?;
         Ok(Made {
-            variant,
+            index,
+            params_json: params.to_json(index, None),
+            objects: params.objects.len(),
             xml,
-            params_json,
         })
     })
 }
@@ -175,8 +177,8 @@ impl PyScene {
     /// cannot be made, e.g. a group whose objects find no place (the message names the
     /// group, the region and the index).
     fn variant(&self, py: Python<'_>, index: u64) -> PyResult<PyVariant> {
-        let scene = self.scene.clone();
-        run(py, move || make(&scene, index)).map(PyVariant::from)
+        run(py, || make(&self.scene, index))
+            .map(|made| PyVariant::new(made, Origin::Scene(self.scene.clone())))
     }
 
     /// Variants for ``indices`` (a ``range`` or any iterable of ints), made on
@@ -224,6 +226,7 @@ impl PyScene {
             .map_err(|e| Failure(vec![format!("cannot start the producer thread: {e}")]))?;
         Ok(PyVariantIter {
             rx: Mutex::new(Some(rx)),
+            scene: self.scene.clone(),
         })
     }
 
@@ -305,6 +308,8 @@ fn produce(
 pub(crate) struct PyVariantIter {
     /// `None` once exhausted or failed.
     rx: Mutex<Option<Receiver<Result<Made, Failure>>>>,
+    /// For the variants' documents, made on demand.
+    scene: Arc<Scene>,
 }
 
 #[pymethods]
@@ -324,7 +329,10 @@ impl PyVariantIter {
             got
         });
         match next {
-            Some(Ok(made)) => Ok(Some(made.into())),
+            Some(Ok(made)) => Ok(Some(PyVariant::new(
+                made,
+                Origin::Scene(self.scene.clone()),
+            ))),
             Some(Err(failure)) => Err(failure.into()),
             None => Ok(None),
         }
@@ -333,27 +341,61 @@ impl PyVariantIter {
 
 /// One variant of a :class:`Scene`: its ``index``, its MJCF text ``xml`` (assets
 /// referenced by absolute path), and ``params``, everything that was drawn for it.
-/// Picklable (as its index, XML and parameters).
+/// Picklable (as its index, XML and parameters). Its :attr:`document` is built only
+/// when asked for.
 #[pyclass(name = "Variant", module = "mjcf_forge", frozen)]
 pub(crate) struct PyVariant {
     index: u64,
-    document: Document,
     xml: String,
     params_json: String,
     objects: usize,
+    /// Where the document comes from when asked for.
+    origin: Origin,
+    /// The document, built on first use: most callers only want the XML.
+    document: OnceLock<Document>,
     /// The `str` made once on first access (the XML of a scene is tens of kilobytes).
     xml_str: OnceLock<Py<pyo3::types::PyString>>,
 }
 
-impl From<Made> for PyVariant {
-    fn from(made: Made) -> PyVariant {
+/// How a variant's document is made on demand.
+enum Origin {
+    /// Made again by the scene (the same document the XML was written from).
+    Scene(Arc<Scene>),
+    /// Read back from the XML (an unpickled variant); the folder relative paths use.
+    Text(PathBuf),
+}
+
+impl PyVariant {
+    fn new(made: Made, origin: Origin) -> PyVariant {
         PyVariant {
-            index: made.variant.index,
-            objects: made.variant.params.objects.len(),
-            document: made.variant.document,
+            index: made.index,
             xml: made.xml,
             params_json: made.params_json,
+            objects: made.objects,
+            origin,
+            document: OnceLock::new(),
             xml_str: OnceLock::new(),
+        }
+    }
+
+    /// The document, built on first call (GIL released by the caller).
+    fn doc(&self) -> Result<&Document, Failure> {
+        if let Some(doc) = self.document.get() {
+            return Ok(doc);
+        }
+        let doc = match &self.origin {
+            Origin::Scene(scene) => scene.variant(self.index)?.document,
+            Origin::Text(dir) => Document::from_str(&self.xml, dir)?,
+        };
+        // Another thread may have built it meanwhile: either copy is the same document.
+        Ok(self.document.get_or_init(|| doc))
+    }
+
+    /// The folder the variant's relative paths (if any) are resolved from.
+    fn model_dir(&self) -> PathBuf {
+        match &self.origin {
+            Origin::Scene(scene) => scene.template().model_dir().to_path_buf(),
+            Origin::Text(dir) => dir.clone(),
         }
     }
 }
@@ -395,12 +437,12 @@ impl PyVariant {
     /// A copy of the variant's :class:`Document` (to edit before writing or compiling).
     #[getter]
     fn document(&self, py: Python<'_>) -> PyResult<PyDocument> {
-        run(py, || Ok(self.document.clone())).map(PyDocument::new)
+        run(py, || Ok(self.doc()?.clone())).map(PyDocument::new)
     }
 
     /// Writes the indented XML to ``path`` atomically.
     fn write(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
-        run(py, || Ok(self.document.write_file(&path)?))
+        run(py, || Ok(self.doc()?.write_file(&path)?))
     }
 
     /// Compiles the variant with MuJoCo (``mujoco.MjModel.from_xml_string``); needs the
@@ -435,7 +477,7 @@ impl PyVariant {
             self.xml(py),
             self.params_json.as_str(),
             self.objects,
-            self.document.model_dir().to_path_buf(),
+            self.model_dir(),
         )
             .into_pyobject(py)?;
         PyTuple::new(py, [restore, args.into_any()])
@@ -451,14 +493,16 @@ impl PyVariant {
         objects: usize,
         model_dir: PathBuf,
     ) -> PyResult<PyVariant> {
-        let document = run(py, || Ok(Document::from_str(&xml, &model_dir)?))?;
-        Ok(PyVariant {
+        let made = Made {
             index,
-            document,
             xml,
             params_json,
             objects,
-            xml_str: OnceLock::new(),
-        })
+        };
+        let variant = PyVariant::new(made, Origin::Text(model_dir));
+        // Read the document now: a pickled variant that does not read back is an error
+        // at unpickling, not later.
+        run(py, || variant.doc().map(|_| ()))?;
+        Ok(variant)
     }
 }
