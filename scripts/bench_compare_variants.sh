@@ -16,7 +16,10 @@
 #  4. robosuite 1.5.2 building the same randomized scene with its own classes,
 #     scripts/bench_robosuite_variants.py (read its docstring: best and median of RUNS
 #     variants, one build each).
-# mjcf-forge figures are the best of REPEATS processes of N variants each.
+# Measurements 1-3 run in REPEATS interleaved rounds; the best of each is kept (mjcf-forge:
+# processes of N variants each). Each mjcf-forge process also reports its CPU time
+# (user + sys, /usr/bin/time) per variant, and robosuite's script its CPU time per
+# variant: on a shared machine that ratio moves less than the wall-clock one.
 #
 # Prints each measurement, then the ratios:
 #  - forge variants/s / robosuite variants/s (against robosuite's best variant, the
@@ -87,73 +90,84 @@ rm -rf "$SCRATCH"
 mkdir -p "$SCRATCH"
 trap 'rm -rf "$SCRATCH"' EXIT
 
-# One generate run; prints its --json summary (which goes to stderr with -o -).
+# One generate run; prints its --json summary (which goes to stderr with -o -) with the
+# process's CPU time per variant added (user + sys from /usr/bin/time, scene load included).
 forge() { # threads(or "all") output
-  local threads=() summary
+  local threads=() summary cpu
   [[ "$1" == all ]] || threads=(--threads "$1")
+  cpu="$(mktemp)"
   if [[ "$2" == - ]]; then
-    summary="$("$BIN" generate "$SCENE" -n "$N" -o - "${threads[@]}" --json 2>&1 >/dev/null)"
+    summary="$(/usr/bin/time -o "$cpu" -f '%U %S' "$BIN" generate "$SCENE" -n "$N" -o - "${threads[@]}" --json 2>&1 >/dev/null)"
   else
     rm -rf "$2"
-    summary="$("$BIN" generate "$SCENE" -n "$N" -o "$2" "${threads[@]}" --json)"
+    summary="$(/usr/bin/time -o "$cpu" -f '%U %S' "$BIN" generate "$SCENE" -n "$N" -o "$2" "${threads[@]}" --json)"
     local files
     files="$(find "$2" -maxdepth 1 -name '*.xml' | wc -l)"
     [[ "$files" == "$N" ]] || { echo "bench_compare_variants: $files XML files in $2, expected $N" >&2; exit 1; }
     rm -rf "$2"
   fi
-  grep '^{' <<<"$summary" || { echo "bench_compare_variants: no summary: $summary" >&2; exit 1; }
-}
-
-# Best (highest variants/s) of REPEATS processes.
-best_forge() {
-  local best="" line
-  for _ in $(seq "$REPEATS"); do
-    line="$(forge "$1" "$2")"
-    best="$("$PY" -c '
+  summary="$(grep '^{' <<<"$summary")" || { echo "bench_compare_variants: no summary from generate" >&2; exit 1; }
+  "$PY" -c '
 import json, sys
-a = json.loads(sys.argv[1])
-assert a["variants"] == int(sys.argv[3]) and not a["failures"], a
-b = json.loads(sys.argv[2]) if sys.argv[2] else None
-print(json.dumps(a if b is None or a["variants_per_second"] > b["variants_per_second"] else b))
-' "$line" "$best" "$N")"
-  done
-  echo "$best"
+s = json.loads(sys.argv[1])
+assert s["variants"] == int(sys.argv[3]) and not s["failures"], s
+user, system = (float(v) for v in sys.argv[2].split())
+s["cpu_ms_per_variant"] = (user + system) * 1e3 / s["variants"]
+print(json.dumps(s))
+' "$summary" "$(tail -1 "$cpu")" "$N"
+  rm -f "$cpu"
 }
 
-stream1="$(best_forge 1 -)"
-streamA="$(best_forge all -)"
-files1="$(best_forge 1 "$SCRATCH/out")"
-filesA="$(best_forge all "$SCRATCH/out")"
-bytes_per_file="$("$PY" -c 'import json,sys; s=json.loads(sys.argv[1]); print(round(s["xml_bytes"]/s["variants"]))' "$stream1")"
-
-# The filesystem's own cost per file: a plain loop, same count, same size, same disk.
-fsjson="$("$PY" - "$SCRATCH/fs" "$N" "$bytes_per_file" "$REPEATS" <<'PY'
+# The filesystem's own cost per file, one run: a plain loop creating N files of SIZE bytes
+# in an empty folder on the same disk, then one syncfs.
+fs_loop() { # size
+  "$PY" - "$SCRATCH/fs" "$N" "$1" <<'PY'
 import ctypes, json, os, shutil, sys, time
-folder, n, size, repeats = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
+folder, n, size = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
 data = (b"<mujoco>" + b"x" * size)[:size]
 libc = ctypes.CDLL(None, use_errno=True)
-best = best_unsynced = float("inf")
-for _ in range(repeats):
-    shutil.rmtree(folder, ignore_errors=True)
-    os.makedirs(folder)
-    t0 = time.perf_counter()
-    for i in range(n):
-        fd = os.open(os.path.join(folder, f"{i:09}.xml"), os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
-        os.write(fd, data)
-        os.close(fd)
-    t1 = time.perf_counter()
-    dfd = os.open(folder, os.O_RDONLY)
-    if libc.syncfs(dfd) != 0:
-        raise OSError(ctypes.get_errno(), "syncfs")
-    os.close(dfd)
-    t2 = time.perf_counter()
-    best, best_unsynced = min(best, t2 - t0), min(best_unsynced, t1 - t0)
-    assert len(os.listdir(folder)) == n
+shutil.rmtree(folder, ignore_errors=True)
+os.makedirs(folder)
+t0 = time.perf_counter()
+for i in range(n):
+    fd = os.open(os.path.join(folder, f"{i:09}.xml"), os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+    os.write(fd, data)
+    os.close(fd)
+t1 = time.perf_counter()
+dfd = os.open(folder, os.O_RDONLY)
+if libc.syncfs(dfd) != 0:
+    raise OSError(ctypes.get_errno(), "syncfs")
+os.close(dfd)
+t2 = time.perf_counter()
+assert len(os.listdir(folder)) == n
 shutil.rmtree(folder)
-print(json.dumps({"files": n, "bytes_per_file": size, "ms_per_file": best / n * 1e3,
-                  "ms_per_file_unsynced": best_unsynced / n * 1e3}))
+print(json.dumps({"files": n, "bytes_per_file": size, "ms_per_file": (t2 - t0) / n * 1e3,
+                  "ms_per_file_unsynced": (t1 - t0) / n * 1e3}))
 PY
-)"
+}
+
+# Keeps the better of two JSON lines by KEY (higher, or lower with "low").
+better() { # new best key [low]
+  "$PY" -c '
+import json, sys
+a = json.loads(sys.argv[1]); b = json.loads(sys.argv[2]) if sys.argv[2] else None
+key, low = sys.argv[3], len(sys.argv) > 4
+print(json.dumps(a if b is None or (a[key] < b[key] if low else a[key] > b[key]) else b))
+' "$@"
+}
+
+# REPEATS rounds, each measurement once per round (interleaved, so all see the same
+# machine); the best of each is kept (highest variants/s; lowest ms per file).
+stream1="" streamA="" files1="" filesA="" fsjson=""
+bytes_per_file=""
+for _ in $(seq "$REPEATS"); do
+  stream1="$(better "$(forge 1 -)" "$stream1" variants_per_second)"
+  streamA="$(better "$(forge all -)" "$streamA" variants_per_second)"
+  [[ -n "$bytes_per_file" ]] || bytes_per_file="$("$PY" -c 'import json,sys; s=json.loads(sys.argv[1]); print(round(s["xml_bytes"]/s["variants"]))' "$stream1")"
+  files1="$(better "$(forge 1 "$SCRATCH/out")" "$files1" variants_per_second)"
+  fsjson="$(better "$(fs_loop "$bytes_per_file")" "$fsjson" ms_per_file low)"
+  filesA="$(better "$(forge all "$SCRATCH/out")" "$filesA" variants_per_second)"
+done
 
 rs="$("$PY" scripts/bench_robosuite_variants.py --runs "$RUNS" 2>/dev/null)"
 
@@ -174,6 +188,10 @@ for label, s in (("1 thread", s1), ("all threads", sa)):
     print(f"streamed, {label}: {rate(s):.0f} variants/s = {rate(s) / rs['variants_per_s']:.0f}x robosuite's best "
           f"({rs['variants_per_s']:.1f}/s), {rate(s) / rs['variants_per_s_median']:.0f}x its median "
           f"({rs['variants_per_s_median']:.1f}/s)")
+print(f"CPU time per variant (process user + sys): mjcf-forge streamed, 1 thread {s1['cpu_ms_per_variant']:.3f} ms "
+      f"(scene load included), robosuite median {rs['median_cpu_ms_per_variant']:.3f} ms (best "
+      f"{rs['cpu_ms_per_variant']:.3f} ms): {rs['median_cpu_ms_per_variant'] / s1['cpu_ms_per_variant']:.0f}x "
+      f"({rs['cpu_ms_per_variant'] / s1['cpu_ms_per_variant']:.0f}x against robosuite's best)")
 print(f"all threads / 1 thread: streamed {rate(sa) / rate(s1):.2f}x, to files {rate(fa) / rate(f1):.2f}x")
 fs_ms, fs_uns = fs["ms_per_file"], fs["ms_per_file_unsynced"]
 for label, f, s in (("1 thread", f1, s1), ("all threads", fa, sa)):

@@ -6,7 +6,10 @@ placement sampling), up to task.get_xml().
 
 Prints one JSON object on stdout:
   variants_per_s (1 / best), ms_per_variant (best), median_ms_per_variant,
-  variants_per_s_median, mean_ms_per_variant, runs, seed, what, output_chars_mean,
+  variants_per_s_median, mean_ms_per_variant, cpu_ms_per_variant (best),
+  median_cpu_ms_per_variant, mean_cpu_ms_per_variant (process CPU time,
+  time.process_time, less sensitive than wall time to other processes on a shared
+  machine), runs, seed, what, output_chars_mean,
   placements_checked, stubs, robosuite, python, numpy.
 
 Setup: scripts/setup_robosuite.sh, then
@@ -194,11 +197,12 @@ def main() -> int:
         xml, placements = build(args.seed, args.runs)
     check_variant(xml, placements)
 
-    times, chars = [], []
+    times, cpu_times, chars = [], [], []
     for i in range(args.runs):
-        t0 = time.perf_counter()
+        c0, t0 = time.process_time(), time.perf_counter()
         xml, placements = build(args.seed, i)
         times.append(time.perf_counter() - t0)
+        cpu_times.append(time.process_time() - c0)
         chars.append(len(xml))
         if args.dump is not None and i < 2:
             args.dump.mkdir(parents=True, exist_ok=True)
@@ -215,6 +219,9 @@ def main() -> int:
         "median_ms_per_variant": round(median * 1e3, 3),
         "variants_per_s_median": round(1.0 / median, 2),
         "mean_ms_per_variant": round(statistics.fmean(times) * 1e3, 3),
+        "cpu_ms_per_variant": round(min(cpu_times) * 1e3, 3),
+        "median_cpu_ms_per_variant": round(statistics.median(cpu_times) * 1e3, 3),
+        "mean_cpu_ms_per_variant": round(statistics.fmean(cpu_times) * 1e3, 3),
         "runs": args.runs,
         "seed": args.seed,
         "what": ("robosuite 1.5.2 classes, per variant (hard reset up to get_xml): Panda + RethinkMount + "
