@@ -169,7 +169,11 @@ for _ in $(seq "$REPEATS"); do
   filesA="$(better "$(forge all "$SCRATCH/out")" "$filesA" variants_per_second)"
 done
 
-rs="$("$PY" scripts/bench_robosuite_variants.py --runs "$RUNS" 2>/dev/null)"
+# robosuite logs macro warnings on stderr: shown only when the script fails.
+rs_err="$(mktemp)"
+rs="$("$PY" scripts/bench_robosuite_variants.py --runs "$RUNS" 2>"$rs_err")" \
+  || { cat "$rs_err" >&2; rm -f "$rs_err"; echo "bench_compare_variants: bench_robosuite_variants.py failed" >&2; exit 1; }
+rm -f "$rs_err"
 
 echo "mjcf-forge streamed, 1 thread:     $stream1"
 echo "mjcf-forge streamed, all threads:  $streamA"
