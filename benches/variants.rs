@@ -1,7 +1,9 @@
 //! Criterion benches of the batch tier over `benches/scenes/lift5.toml` (robosuite's table
 //! arena, Panda with gripper and mount, 5 objects drawn from 6 robosuite object models,
 //! placed without overlap, random z rotation and colours; `scripts/setup.sh` first):
-//! a variant made and written as compact XML, on one thread and on all cores.
+//! a variant made as compact XML (`variant_xml`, what `generate` writes), on one thread and
+//! on all cores, and through the document path (`variant` + `to_xml_string`) for
+//! comparison.
 //!
 //! `cargo bench --bench variants`: throughput in variants per second. The scene is loaded
 //! once, outside the timings, as `generate` loads it once per run.
@@ -36,6 +38,13 @@ fn variants(c: &mut Criterion) {
     let mut next = 0u64;
     group.bench_function("one_thread", |b| {
         b.iter(|| {
+            let v = scene.variant_xml(next).unwrap();
+            next += 1;
+            black_box(v)
+        })
+    });
+    group.bench_function("one_thread_document_path", |b| {
+        b.iter(|| {
             let v = scene.variant(next).unwrap();
             next += 1;
             black_box(v.document.to_xml_string())
@@ -56,7 +65,7 @@ fn variants(c: &mut Criterion) {
             let bytes: usize = pool.install(|| {
                 (start..start + BATCH)
                     .into_par_iter()
-                    .map(|i| scene.variant(i).unwrap().document.to_xml_string().len())
+                    .map(|i| scene.variant_xml(i).unwrap().0.len())
                     .sum()
             });
             start += BATCH;

@@ -350,14 +350,32 @@ impl Scene {
     /// # Ok::<(), mjcf_forge::Errors>(())
     /// ```
     pub fn variant_xml(&self, index: u64) -> Result<(String, Params), Errors> {
+        let mut xml = String::new();
+        let params = self.variant_xml_into(index, &mut xml)?;
+        Ok((xml, params))
+    }
+
+    /// [`Scene::variant_xml`] into `out` (cleared first), whose memory is reused: a batch
+    /// that keeps its buffers does not allocate a new text per variant.
+    ///
+    /// ```
+    /// let scene = mjcf_forge::scene::Scene::demo()?;
+    /// let mut xml = String::new();
+    /// let params = scene.variant_xml_into(3, &mut xml)?;
+    /// assert_eq!((xml, params), scene.variant_xml(3)?);
+    /// # Ok::<(), mjcf_forge::Errors>(())
+    /// ```
+    pub fn variant_xml_into(&self, index: u64, out: &mut String) -> Result<Params, Errors> {
         if let Some(splice) = &self.splice {
             let drawn = self.draw(index)?;
-            if let Some(xml) = splice.write(&drawn) {
-                return Ok((xml, drawn.params));
+            if splice.write(&drawn, out) {
+                return Ok(drawn.params);
             }
         }
         let v = self.variant(index)?;
-        Ok((v.xml(), v.params))
+        out.clear();
+        out.push_str(&v.xml());
+        Ok(v.params)
     }
 
     /// Makes variants `range` as XML in parallel, in chunks of `chunk`, and hands each to

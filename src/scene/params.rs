@@ -109,6 +109,12 @@ impl Params {
 /// A JSON string literal (RFC 8259 escapes).
 fn json_str(out: &mut String, s: &str) {
     out.push('"');
+    // Names, numbers and paths rarely need escapes: copy them whole when they do not.
+    if !s.bytes().any(|b| b < 0x20 || b == b'"' || b == b'\\') {
+        out.push_str(s);
+        out.push('"');
+        return;
+    }
     for c in s.chars() {
         match c {
             '"' => out.push_str("\\\""),

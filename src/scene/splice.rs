@@ -171,32 +171,40 @@ impl Template {
 
     /// The variant's text, or `None` when one of its objects cannot be spliced or a hole
     /// has no value.
-    pub(crate) fn write(&self, drawn: &Drawn<'_>) -> Option<String> {
+    /// The variant's text into `out` (cleared first; its capacity is reused), or `false`
+    /// (with `out` unspecified) when one of its objects cannot be spliced or a hole has no
+    /// value.
+    pub(crate) fn write(&self, drawn: &Drawn<'_>, out: &mut String) -> bool {
+        out.clear();
+        self.write_into(drawn, out).is_some()
+    }
+
+    fn write_into(&self, drawn: &Drawn<'_>, out: &mut String) -> Option<()> {
         let mut extra = 0;
         for (inst, _) in &drawn.placed {
             extra += inst.fragments.as_ref()?.len();
         }
-        let mut out = String::with_capacity(self.pieces.text.len() + extra + 1024);
+        out.reserve(self.pieces.text.len() + extra + 1024);
         let mut done = 0;
         for (at, cut) in &self.pieces.cuts {
             out.push_str(&self.pieces.text[done..*at]);
             done = *at;
             match cut {
                 Cut::Hole(node, attr) => {
-                    crate::write::escape_attr(&mut out, drawn.template.get(*node, attr)?);
+                    crate::write::escape_attr(out, drawn.template.get(*node, attr)?);
                 }
                 Cut::Insert(i) => {
                     for (inst, overlay) in &drawn.placed {
                         let fragments = inst.fragments.as_ref()?;
                         for (_, p) in fragments.parts.iter().filter(|(j, _)| j == i) {
-                            p.write(&mut out, overlay)?;
+                            p.write(out, overlay)?;
                         }
                     }
                 }
             }
         }
         out.push_str(&self.pieces.text[done..]);
-        Some(out)
+        Some(())
     }
 
     fn insertion_point(&self, tag: &str) -> Option<usize> {
