@@ -8,9 +8,8 @@
 mod common;
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
-use common::{python, root, scratch};
+use common::{root, run_each_judge, scratch};
 use mjcf_forge::{Document, MergeOptions, XmlModel, XmlModelOptions};
 
 fn rs(rel: &str) -> PathBuf {
@@ -291,17 +290,24 @@ fn merged_scenes_keep_every_part_s_physics() {
     );
     let file = dir.join("cases.json");
     std::fs::write(&file, json).unwrap();
-    let out = Command::new(python())
-        .arg(root().join("tests/judge/merge_judge.py"))
-        .arg("--cases")
-        .arg(&file)
-        .output()
-        .expect("run the merge judge");
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let runs = run_each_judge(|_| {
+        vec![
+            root().join("tests/judge/merge_judge.py").into(),
+            "--cases".into(),
+            file.clone().into(),
+        ]
+    });
     let expected = format!("{} passed, 0 failed", cases.len());
-    assert!(
-        out.status.success() && stdout.lines().last() == Some(expected.as_str()),
-        "merge judge:\n{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let mut failed = Vec::new();
+    for (j, out) in runs {
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        if !(out.status.success() && stdout.lines().last() == Some(expected.as_str())) {
+            failed.push(format!(
+                "merge judge, MuJoCo {}:\n{stdout}\n{}",
+                j.version,
+                String::from_utf8_lossy(&out.stderr)
+            ));
+        }
+    }
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
 }
