@@ -16,5 +16,6 @@ echo "== cargo test (default features)"
 cargo test --all-targets
 echo "== cargo test --features mujoco (with doctests)"
 cargo test --features mujoco
-echo "== judge self-tests"
+echo "== judge self-tests (MuJoCo 3.17.0 and 4.0.0)"
 .cache/venv/bin/python -m pytest tests/judge -q -p no:cacheprovider
+.cache/venv-mj4/bin/python -m pytest tests/judge -q -p no:cacheprovider

@@ -664,10 +664,45 @@ impl Resolver<'_> {
             }
             attrs.push((n, v));
         }
+        self.drop_overridden_range(&tag_name, own, &mut attrs);
         // Keep the element's own attribute order first, inherited ones after.
         let position = |n: Sym| own.iter().position(|(m, _)| *m == n).unwrap_or(usize::MAX);
         attrs.sort_by_key(|(n, _)| position(*n));
         Ok((next, out_tag, attrs))
+    }
+
+    /// A shortcut's explicit range (`ctrlrange`, `actrange` for `intvelocity`, `posrange`
+    /// for `pid`) or `inheritrange` overrides the other one inherited from its class: the
+    /// inherited one is dropped from `attrs`. This is MuJoCo 4.0.0's rule (changelog 4.0.0,
+    /// bug fix 60; corpora/features/actuator_range_overrides_inheritrange.xml). MuJoCo 3.17.0
+    /// rejects such an element (`ctrlrange and inheritrange cannot both be defined`), so no
+    /// model that 3.17.0 compiles is changed by it; without it, what we write would be
+    /// rejected by 4.0.0 too, although 4.0.0 compiles the input.
+    fn drop_overridden_range(
+        &self,
+        tag: &str,
+        own: &[(Sym, StrRef)],
+        attrs: &mut Vec<(Sym, StrRef)>,
+    ) {
+        let ranges: &[&str] = match tag {
+            "position" => &["ctrlrange"],
+            "intvelocity" => &["actrange"],
+            "pid" => &["ctrlrange", "posrange"],
+            _ => return,
+        };
+        let Some(inheritrange) = crate::names::known("inheritrange") else {
+            return;
+        };
+        let ranges: Vec<Sym> = ranges
+            .iter()
+            .filter_map(|r| crate::names::known(r))
+            .collect();
+        let is_own = |n: Sym| own.iter().any(|(m, _)| *m == n);
+        if ranges.iter().any(|r| is_own(*r)) && !is_own(inheritrange) {
+            attrs.retain(|(n, _)| *n != inheritrange);
+        } else if is_own(inheritrange) && !ranges.iter().any(|r| is_own(*r)) {
+            attrs.retain(|(n, _)| !ranges.contains(n));
+        }
     }
 
     /// For an actuator tag: the kind its attributes are read as (the vocabulary's element of

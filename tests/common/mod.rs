@@ -72,6 +72,25 @@ impl Judge {
     }
 }
 
+/// The one MuJoCo version that reads a case of ours, from its marker
+/// `mjcf-forge-judge: <version>-only` (a case about a difference between versions: the
+/// other versions must reject its input, which the judge checks, and judge nothing else).
+pub fn only_version(case: &Path) -> Option<String> {
+    const MARKER: &str = "mjcf-forge-judge: ";
+    let text = std::fs::read_to_string(case).ok()?;
+    let at = text.find(MARKER)? + MARKER.len();
+    let version = text[at..]
+        .split_whitespace()
+        .next()?
+        .strip_suffix("-only")?;
+    assert!(
+        JUDGES.iter().any(|j| j.version == version),
+        "{}: no judge for MuJoCo {version}",
+        case.display()
+    );
+    Some(version.to_string())
+}
+
 /// Runs `script args...` under every judging MuJoCo at once (one process each) and returns
 /// each judge with its output, in [`JUDGES`] order.
 pub fn run_each_judge(
@@ -134,7 +153,18 @@ pub fn judge(pairs: &[Pair], scratch_dir: &Path) -> Vec<String> {
         let body: String = pairs
             .iter()
             .filter(|p| j.judges_input(&p.a, &own))
-            .map(|p| format!("{}\t{}\t{}\n", p.a.display(), p.b.display(), p.prefix))
+            .map(|p| {
+                let mode = match only_version(&p.a) {
+                    Some(v) if v != j.version => "a-rejected",
+                    _ => "same",
+                };
+                format!(
+                    "{}\t{}\t{}\t{mode}\n",
+                    p.a.display(),
+                    p.b.display(),
+                    p.prefix
+                )
+            })
             .collect();
         counts.push(body.lines().count());
         std::fs::write(scratch_dir.join(format!("pairs-{}.tsv", j.version)), body).unwrap();
