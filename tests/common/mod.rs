@@ -17,6 +17,21 @@ pub fn python() -> PathBuf {
     JUDGES[0].python()
 }
 
+/// The Python whose MuJoCo is the one this test build links: 4.0.0's venv with the feature
+/// `mujoco-c` (its default library), else 3.17.0's.
+pub fn python_linked() -> PathBuf {
+    linked_judge().python()
+}
+
+/// The judge of the MuJoCo version this test build links (see [`python_linked`]).
+pub fn linked_judge() -> &'static Judge {
+    if cfg!(feature = "mujoco-c") {
+        &JUDGES[1]
+    } else {
+        &JUDGES[0]
+    }
+}
+
 /// One MuJoCo version that judges outputs: its venv (made by scripts/setup.sh) and the list
 /// of wheel models that compile under it.
 pub struct Judge {
