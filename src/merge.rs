@@ -1251,6 +1251,20 @@ impl Document {
         let mut errors = Vec::new();
         for (doc, keys, off) in [(&*self, base_keys, &base_off), (part, part_keys, &part_off)] {
             for k in keys {
+                // MuJoCo 4.0.0's plastic state (one block per plastic joint, tendon and flex)
+                // has a layout we do not model: refused rather than copied onto the wrong slots.
+                if doc.attr(k.node, "plastic").is_some() {
+                    errors.push(
+                        doc.error_at(
+                            k.node,
+                            ErrorKind::Invalid(
+                                "key plastic (MuJoCo 4.0's plastic state) cannot be remapped onto \
+                             the merged model; remove it before merging"
+                                    .to_string(),
+                            ),
+                        ),
+                    );
+                }
                 for (v, vec) in k.vectors.iter().enumerate() {
                     if let Some(vec) = vec
                         && vec.len() != off.len(v)

@@ -86,3 +86,17 @@ fn identical_assets_are_shared_and_base_settings_win_with_warnings() {
     assert_eq!(xml.matches("<material name=\"red\"").count(), 1);
     assert!(xml.contains("<size nuser_geom=\"2\"/>"));
 }
+
+#[test]
+fn keys_with_plastic_state_are_refused() {
+    // MuJoCo 4.0.0 reads this part (one plastic value for the yielding joint); its layout in
+    // the merged model is not modelled, so the merge refuses instead of copying it.
+    assert_eq!(
+        merge_error(
+            "corpora/errors/merge/part_key_plastic.xml",
+            "p_",
+            Some("hand")
+        ),
+        "corpora/errors/merge/part_key_plastic.xml:9:5: key plastic (MuJoCo 4.0's plastic state) cannot be remapped onto the merged model; remove it before merging"
+    );
+}
