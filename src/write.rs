@@ -47,8 +47,8 @@ fn text_word_is_special(w: u64) -> bool {
     (bytes_equal(w, b'&') | bytes_equal(w | (LO * 0x02), b'>')) != 0
 }
 
-#[cfg(test)]
-fn escape_attr(out: &mut String, value: &str) {
+/// Appends `value` escaped for a double-quoted attribute.
+pub(crate) fn escape_attr(out: &mut String, value: &str) {
     if is_clean(value.as_bytes(), &ATTR_SPECIAL, attr_word_is_special) {
         out.push_str(value);
     } else {
@@ -162,7 +162,7 @@ impl Document {
         write_atomic(path.as_ref(), self.to_pretty_string().as_bytes())
     }
 
-    fn write_node(&self, out: &mut String, node: Node, indent: Option<usize>) {
+    pub(crate) fn write_node(&self, out: &mut String, node: Node, indent: Option<usize>) {
         match *self.tree.data(node) {
             NodeData::Text { text, cdata } => {
                 let text = self.str(text);
