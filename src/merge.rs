@@ -732,11 +732,49 @@ impl Document {
             value(&theirs, "inertiafromgeom", "auto"),
         );
         let drop_inertials = pi == "true" && bi == "auto";
+        // Builds with MuJoCo convert a part with another inertiagrouprange: each body that
+        // infers its inertia gets it written out as MuJoCo compiles the part alone.
+        #[cfg(mjcf_mujoco)]
+        {
+            let (b, p) = (
+                value(&base, "inertiagrouprange", "0 5"),
+                value(&theirs, "inertiagrouprange", "0 5"),
+            );
+            if !same_value(&b, &p) && bi != "true" && pi != "true" {
+                let at = theirs
+                    .get("inertiagrouprange")
+                    .map_or(part.root, |(_, n)| n);
+                let at = part.location(at);
+                if let Err(e) = crate::mujoco::write_inertials(part) {
+                    errors.push(Error::at(
+                        at,
+                        ErrorKind::Invalid(format!(
+                            "cannot merge: compiler inertiagrouprange=\"{p}\" differs from the \
+                             base's \"{b}\" and the part's inertias could not be written out: {e}"
+                        )),
+                    ));
+                    return;
+                }
+            }
+        }
+        let theirs = compiler_settings(part);
         for (attr, default) in MUST_AGREE {
             if attr == "inertiafromgeom" && drop_inertials {
                 continue;
             }
             let (b, p) = (value(&base, attr, default), value(&theirs, attr, default));
+            // inertiagrouprange only picks the geoms a body's inertia is inferred from: a part
+            // none of whose bodies infers one (each body with geoms has its <inertial>, and
+            // <inertial> counts in the merged model: inertiafromgeom is not "true") compiles
+            // the same under any range. `mujoco::write_inertials` makes a part so.
+            if attr == "inertiagrouprange"
+                && !same_value(&b, &p)
+                && bi != "true"
+                && pi != "true"
+                && part.bodies_inferring_inertia().is_empty()
+            {
+                continue;
+            }
             if !same_value(&b, &p) {
                 let at = theirs.get(attr).map(|(_, n)| n).unwrap_or(part.root);
                 errors.push(part.error_at(
@@ -778,6 +816,28 @@ impl Document {
         if ba != pa {
             part.make_limits_explicit(pa == "true");
         }
+    }
+
+    /// The bodies whose mass and inertia MuJoCo infers from their geoms (under
+    /// `inertiafromgeom="auto"`): those without an `<inertial>` that have a geom, directly or
+    /// in a `<frame>` (or `<replicate>`) inside them.
+    pub(crate) fn bodies_inferring_inertia(&self) -> Vec<Node> {
+        let has_geom = |body: Node| {
+            let mut stack: Vec<Node> = self.elements(body).collect();
+            while let Some(n) = stack.pop() {
+                match self.tag(n) {
+                    "geom" => return true,
+                    "frame" | "replicate" => stack.extend(self.elements(n)),
+                    _ => {}
+                }
+            }
+            false
+        };
+        self.descendants(self.root)
+            .filter(|&n| self.tag(n) == "body")
+            .filter(|&b| !self.elements(b).any(|c| self.tag(c) == "inertial"))
+            .filter(|&b| has_geom(b))
+            .collect()
     }
 
     /// Every `euler` becomes the `quat` it means under `angles` (for a base with another

@@ -216,6 +216,110 @@ pub fn compile_str(xml: &str, dir: &Path) -> Result<CompiledModel, CompileError>
     load_xml(&name, Some(&vfs))
 }
 
+/// Writes an explicit `<inertial>` (mass, pos, quat, diaginertia, at full precision, as
+/// MuJoCo compiles `doc` alone) into every body that infers its inertia from its geoms, so
+/// that the document compiles to the same masses and inertias whatever the compiler's
+/// `inertiagrouprange`: what lets [`Document::merge`](crate::Document::merge) take a part
+/// whose range differs from the base's. Returns how many bodies got one.
+///
+/// Refuses documents whose compiled bodies are not their `<body>` elements one to one
+/// (`<replicate>`, `<attach>`, `<composite>`, `<flexcomp>`, `fusestatic`), and documents
+/// with `inertiafromgeom="true"` (which ignores `<inertial>`).
+///
+/// ```
+/// use mjcf_forge::Document;
+/// use mjcf_forge::mujoco::write_inertials;
+///
+/// let mut doc = Document::from_str(r#"<mujoco><compiler inertiagrouprange="1 5"/><worldbody>
+///   <body name="b"><freejoint/><geom size="0.1" group="1"/><geom size="0.5" group="0"/></body>
+///   </worldbody></mujoco>"#, ".")?;
+/// assert_eq!(write_inertials(&mut doc)?, 1);
+/// assert!(doc.to_xml_string().contains("<inertial "));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn write_inertials(doc: &mut crate::Document) -> Result<usize, CompileError> {
+    let refused = ["replicate", "attach", "composite", "flexcomp"];
+    if let Some(n) = doc
+        .descendants(doc.root())
+        .find(|&n| refused.contains(&doc.tag(n)))
+    {
+        return Err(CompileError::local(format!(
+            "{}: <{}> makes bodies when MuJoCo compiles; explicit inertials are written for \
+             plain <body> elements only",
+            doc.location(n),
+            doc.tag(n)
+        )));
+    }
+    for c in doc
+        .elements(doc.root())
+        .filter(|&c| doc.tag(c) == "compiler")
+    {
+        let setting = |k: &str, bad: &str| doc.attr(c, k).is_some_and(|v| v.trim() == bad);
+        if setting("inertiafromgeom", "true") || setting("fusestatic", "true") {
+            return Err(CompileError::local(format!(
+                "{}: compiler inertiafromgeom=\"true\" or fusestatic=\"true\": explicit \
+                 inertials would not carry the compiled inertia",
+                doc.location(c)
+            )));
+        }
+    }
+    let targets = doc.bodies_inferring_inertia();
+    if targets.is_empty() {
+        return Ok(0);
+    }
+    let model = compile_str(&doc.to_xml_string(), doc.model_dir())?;
+    // MuJoCo numbers bodies depth first in document order, the world body first.
+    let bodies: Vec<crate::tree::Node> = doc
+        .descendants(doc.root())
+        .filter(|&n| doc.tag(n) == "body")
+        .collect();
+    let names = model.names(ObjType::Body);
+    if names.len() != bodies.len() + 1 {
+        return Err(CompileError::local(format!(
+            "MuJoCo compiled {} bodies from {} <body> elements",
+            names.len() - 1,
+            bodies.len()
+        )));
+    }
+    for (i, &b) in bodies.iter().enumerate() {
+        if doc.attr(b, "name").is_some_and(|n| n != names[i + 1]) {
+            return Err(CompileError::local(format!(
+                "{}: body {:?} compiled as {:?}: bodies do not match one to one",
+                doc.location(b),
+                doc.attr(b, "name").unwrap_or(""),
+                names[i + 1]
+            )));
+        }
+    }
+    let (mass, ipos, iquat, inertia) = (
+        model.body_mass(),
+        model.body_ipos(),
+        model.body_iquat(),
+        model.body_inertia(),
+    );
+    let list = |v: &[f64]| {
+        v.iter()
+            .map(|x| format!("{x:?}"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    for &b in &targets {
+        let id = 1 + bodies
+            .iter()
+            .position(|&n| n == b)
+            .expect("a body of the document");
+        let attrs = [
+            ("pos", list(&ipos[3 * id..3 * id + 3])),
+            ("quat", list(&iquat[4 * id..4 * id + 4])),
+            ("mass", list(&mass[id..id + 1])),
+            ("diaginertia", list(&inertia[3 * id..3 * id + 3])),
+        ];
+        let attrs: Vec<(&str, &str)> = attrs.iter().map(|(k, v)| (*k, v.as_str())).collect();
+        doc.append_element(b, "inertial", &attrs);
+    }
+    Ok(targets.len())
+}
+
 /// Runs `mj_loadXML` and wraps the result.
 fn load_xml(path: &CStr, vfs: Option<&sys::Vfs>) -> Result<CompiledModel, CompileError> {
     let mut buf = vec![0 as c_char; ERROR_BUF_LEN];
@@ -560,6 +664,10 @@ model_arrays! {
     body_mass: f64, |m| model_size!(m, nbody);
     /// Body principal moments of inertia (`nbody x 3`).
     body_inertia: f64, |m| model_size!(m, nbody) * 3;
+    /// Positions of the bodies' inertial frames in the body frames (`nbody x 3`).
+    body_ipos: f64, |m| model_size!(m, nbody) * 3;
+    /// Orientations of the bodies' inertial frames in the body frames (`nbody x 4`).
+    body_iquat: f64, |m| model_size!(m, nbody) * 4;
     /// Parent body ids (`nbody`; the world body is its own parent).
     body_parentid: i32, |m| model_size!(m, nbody);
     /// Per body, the id of its top-level ancestor (the body itself at the top).

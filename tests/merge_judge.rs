@@ -272,6 +272,20 @@ fn cases() -> Vec<Case> {
         ],
         fuse_keys: false,
     });
+    // A part with inertiagrouprange="4 5" into a base with "0 5": builds with MuJoCo write
+    // the inferred inertias out (mujoco::write_inertials); without MuJoCo it is refused
+    // (merge_rules).
+    if cfg!(mjcf_mujoco) {
+        cases.push(Case {
+            name: "objects_inertiagroups_4_5_into_arm".into(),
+            parts: vec![
+                base(ours("arm_with_keys.xml")),
+                part(ours("objects_inertiagroups_4_5.xml"), "obj", None),
+                part(rs("grippers/panda_gripper.xml"), "gripper0", Some("hand")),
+            ],
+            fuse_keys: false,
+        });
+    }
     cases
 }
 

@@ -100,3 +100,30 @@ fn keys_with_plastic_state_are_refused() {
         "corpora/errors/merge/part_key_plastic.xml:9:5: key plastic (MuJoCo 4.0's plastic state) cannot be remapped onto the merged model; remove it before merging"
     );
 }
+
+/// Without MuJoCo, a part with another inertiagrouprange merges only when none of its bodies
+/// infers its inertia from geoms; builds with MuJoCo write those inertias out instead
+/// (merge_judge: objects_inertiagroups_4_5_into_arm).
+#[test]
+fn inertiagrouprange_converts_when_no_body_infers_inertia() {
+    let mut base = load("corpora/errors/merge/base.xml");
+    let part = Document::from_str(
+        r#"<mujoco><compiler inertiagrouprange="4 5"/><worldbody>
+  <body name="w" pos="0 0 1"><freejoint/><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>
+    <geom size="0.1" group="1"/></body>
+  <body name="empty"/>
+</worldbody></mujoco>"#,
+        root(),
+    )
+    .unwrap();
+    base.merge(&part, None, &MergeOptions::default()).unwrap();
+}
+
+#[cfg(not(mjcf_mujoco))]
+#[test]
+fn inertiagrouprange_with_inferred_inertia_is_refused_without_mujoco() {
+    assert_eq!(
+        merge_error("corpora/merge/objects_inertiagroups_4_5.xml", "p_", None),
+        "corpora/merge/objects_inertiagroups_4_5.xml:7:3: cannot merge: compiler inertiagrouprange=\"4 5\" differs from the base's \"0 5\" and has no exact conversion"
+    );
+}
