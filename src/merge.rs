@@ -66,6 +66,16 @@ const MUST_AGREE: [(&str, &str); 12] = [
     ("coordinate", "local"),
 ];
 
+/// Compiler mass settings whose whole effect is the compiled bodies' masses and inertias,
+/// with MuJoCo's default (under which they change nothing).
+#[cfg(mjcf_mujoco)]
+const INERTIA_ONLY: [(&str, &str); 4] = [
+    ("boundmass", "0"),
+    ("boundinertia", "0"),
+    ("settotalmass", "-1"),
+    ("balanceinertia", "false"),
+];
+
 /// The effective value of each `compiler` attribute (later elements win).
 fn compiler_settings(doc: &Document) -> Compiler<'_> {
     let compiler = crate::names::sym("compiler");
@@ -732,34 +742,65 @@ impl Document {
             value(&theirs, "inertiafromgeom", "auto"),
         );
         let drop_inertials = pi == "true" && bi == "auto";
-        // Builds with MuJoCo convert a part with another inertiagrouprange: each body that
-        // infers its inertia gets it written out as MuJoCo compiles the part alone.
+        // Builds with MuJoCo convert mass settings: each body's inertia is written out as
+        // MuJoCo compiles the part alone, after which the setting changes nothing. That is
+        // exact when the merged model reads <inertial> (inertiafromgeom not "true") and the
+        // base leaves the setting at MuJoCo's default (no bound, no rescaling of its own).
         #[cfg(mjcf_mujoco)]
-        {
-            let (b, p) = (
-                value(&base, "inertiagrouprange", "0 5"),
-                value(&theirs, "inertiagrouprange", "0 5"),
-            );
-            if !same_value(&b, &p) && bi != "true" && pi != "true" {
-                let at = theirs
-                    .get("inertiagrouprange")
-                    .map_or(part.root, |(_, n)| n);
-                let at = part.location(at);
-                if let Err(e) = crate::mujoco::write_inertials(part) {
-                    errors.push(Error::at(
-                        at,
-                        ErrorKind::Invalid(format!(
-                            "cannot merge: compiler inertiagrouprange=\"{p}\" differs from the \
-                             base's \"{b}\" and the part's inertias could not be written out: {e}"
-                        )),
-                    ));
-                    return;
+        let converted: Vec<&str> = {
+            let mut all = Vec::new();
+            let mut converted = Vec::new();
+            if bi != "true" && pi != "true" {
+                for (attr, default) in INERTIA_ONLY {
+                    let (b, p) = (value(&base, attr, default), value(&theirs, attr, default));
+                    if !same_value(&b, &p) && same_value(&b, default) {
+                        all.push(attr);
+                    }
+                }
+                if pi == "false" && bi == "auto" {
+                    all.push("inertiafromgeom");
+                }
+                let (b, p) = (
+                    value(&base, "inertiagrouprange", "0 5"),
+                    value(&theirs, "inertiagrouprange", "0 5"),
+                );
+                let range = !same_value(&b, &p);
+                // A base with "false" reads only <inertial>: the part's inferred ones suffice.
+                let auto_to_false = pi == "auto" && bi == "false";
+                if range || auto_to_false || !all.is_empty() {
+                    let names = all
+                        .iter()
+                        .copied()
+                        .chain(range.then_some("inertiagrouprange"))
+                        .chain(auto_to_false.then_some("inertiafromgeom"))
+                        .collect::<Vec<_>>();
+                    let at = part.location(theirs.get(names[0]).map_or(part.root, |(_, n)| n));
+                    let written = if all.is_empty() {
+                        crate::mujoco::write_inertials(part)
+                    } else {
+                        crate::mujoco::write_all_inertials(part)
+                    };
+                    if let Err(e) = written {
+                        errors.push(Error::at(
+                            at,
+                            ErrorKind::Invalid(format!(
+                                "cannot merge: compiler {} differ(s) from the base's and the \
+                                 part's inertias could not be written out: {e}",
+                                names.join(", ")
+                            )),
+                        ));
+                        return;
+                    }
+                    converted = names;
                 }
             }
-        }
+            converted
+        };
+        #[cfg(not(mjcf_mujoco))]
+        let converted: Vec<&str> = Vec::new();
         let theirs = compiler_settings(part);
         for (attr, default) in MUST_AGREE {
-            if attr == "inertiafromgeom" && drop_inertials {
+            if (attr == "inertiafromgeom" && drop_inertials) || converted.contains(&attr) {
                 continue;
             }
             let (b, p) = (value(&base, attr, default), value(&theirs, attr, default));

@@ -238,6 +238,30 @@ pub fn compile_str(xml: &str, dir: &Path) -> Result<CompiledModel, CompileError>
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn write_inertials(doc: &mut crate::Document) -> Result<usize, CompileError> {
+    write_inertials_of(doc, false)
+}
+
+/// Like [`write_inertials`], but for every body whose compiled mass or inertia is not zero or
+/// that has geoms or an `<inertial>` of its own (which is replaced): afterwards the compiler's
+/// mass settings (`settotalmass`, `boundmass`, `boundinertia`, `balanceinertia`,
+/// `inertiafromgeom="false"`) have nothing left to change when left at MuJoCo's defaults, so
+/// a part authored with them merges exactly into a base without them.
+///
+/// ```
+/// use mjcf_forge::Document;
+/// use mjcf_forge::mujoco::write_all_inertials;
+///
+/// let mut doc = Document::from_str(r#"<mujoco><compiler settotalmass="3"/><worldbody>
+///   <body name="b"><freejoint/><geom size="0.1"/></body></worldbody></mujoco>"#, ".")?;
+/// assert_eq!(write_all_inertials(&mut doc)?, 1);
+/// assert!(doc.to_xml_string().contains(r#"mass="3.0""#));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn write_all_inertials(doc: &mut crate::Document) -> Result<usize, CompileError> {
+    write_inertials_of(doc, true)
+}
+
+fn write_inertials_of(doc: &mut crate::Document, all: bool) -> Result<usize, CompileError> {
     let refused = ["replicate", "attach", "composite", "flexcomp"];
     if let Some(n) = doc
         .descendants(doc.root())
@@ -263,8 +287,8 @@ pub fn write_inertials(doc: &mut crate::Document) -> Result<usize, CompileError>
             )));
         }
     }
-    let targets = doc.bodies_inferring_inertia();
-    if targets.is_empty() {
+    let inferring = doc.bodies_inferring_inertia();
+    if inferring.is_empty() && !all {
         return Ok(0);
     }
     let model = compile_str(&doc.to_xml_string(), doc.model_dir())?;
@@ -303,7 +327,27 @@ pub fn write_inertials(doc: &mut crate::Document) -> Result<usize, CompileError>
             .collect::<Vec<_>>()
             .join(" ")
     };
+    let own_inertial =
+        |doc: &crate::Document, b| doc.elements(b).find(|&c| doc.tag(c) == "inertial");
+    let targets: Vec<crate::tree::Node> = if all {
+        bodies
+            .iter()
+            .enumerate()
+            .filter(|&(i, &b)| {
+                let id = i + 1;
+                let nonzero =
+                    mass[id] != 0.0 || inertia[3 * id..3 * id + 3].iter().any(|&x| x != 0.0);
+                nonzero || inferring.contains(&b) || own_inertial(doc, b).is_some()
+            })
+            .map(|(_, &b)| b)
+            .collect()
+    } else {
+        inferring
+    };
     for &b in &targets {
+        if let Some(old) = own_inertial(doc, b) {
+            doc.remove(old);
+        }
         let id = 1 + bodies
             .iter()
             .position(|&n| n == b)

@@ -285,6 +285,17 @@ fn cases() -> Vec<Case> {
             ],
             fuse_keys: false,
         });
+        // Mass settings (settotalmass, boundmass, boundinertia, balanceinertia) and
+        // inertiafromgeom="false" in the parts, MuJoCo's defaults in the base.
+        cases.push(Case {
+            name: "objects_mass_settings_into_arm".into(),
+            parts: vec![
+                base(ours("arm_with_keys.xml")),
+                part(ours("objects_mass_settings.xml"), "m", None),
+                part(ours("objects_inertia_from_inertials_only.xml"), "f", None),
+            ],
+            fuse_keys: false,
+        });
     }
     cases
 }

@@ -36,6 +36,9 @@ fn same_asset_name_with_other_content_names_both_origins() {
     );
 }
 
+/// Without MuJoCo, mass settings have no conversion (builds with MuJoCo write the part's
+/// inertias out: merge_judge, objects_mass_settings_into_arm).
+#[cfg(not(mjcf_mujoco))]
 #[test]
 fn compiler_settings_without_exact_conversion_are_refused() {
     assert_eq!(
@@ -125,5 +128,26 @@ fn inertiagrouprange_with_inferred_inertia_is_refused_without_mujoco() {
     assert_eq!(
         merge_error("corpora/merge/objects_inertiagroups_4_5.xml", "p_", None),
         "corpora/merge/objects_inertiagroups_4_5.xml:7:3: cannot merge: compiler inertiagrouprange=\"4 5\" differs from the base's \"0 5\" and has no exact conversion"
+    );
+}
+
+/// A base that rescales or bounds masses itself would change the part's written inertias
+/// too: refused in every build, naming the setting.
+#[test]
+fn mass_settings_of_the_base_are_never_converted() {
+    let mut base = Document::from_str(
+        r#"<mujoco><compiler settotalmass="5"/><worldbody><body name="hand" pos="0 0 1">
+  <joint name="wrist"/><geom size="0.05"/></body></worldbody></mujoco>"#,
+        root(),
+    )
+    .unwrap();
+    let part = load("corpora/errors/merge/part_settotalmass.xml");
+    let err = base
+        .merge(&part, None, &MergeOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        err,
+        "corpora/errors/merge/part_settotalmass.xml:2:3: cannot merge: compiler settotalmass=\"2\" differs from the base's \"5\" and has no exact conversion"
     );
 }
