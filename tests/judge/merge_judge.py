@@ -409,6 +409,10 @@ SLICES: dict[str, Slice] = {
 # ---------------------------------------------------------------------------
 # Not compared, with the reason.  Everything else is.
 # ---------------------------------------------------------------------------
+# Arrays this MuJoCo no longer has (4.0.0 removed flexvert equalities: flex_vertmetric,
+# flex_vertedgenum, flex_vertedge, ...) are dropped from the tables.
+SLICES = {k: v for k, v in SLICES.items() if hasattr(mujoco.MjModel, k)}
+
 EXCLUDED: dict[str, str] = {
     "names_map": "hash table of names; the names themselves are matched",
     "dof_Madr": "address in the sparse mass matrix: a whole-model layout",
