@@ -1,11 +1,11 @@
-//! Build script: only does something with the cargo feature `mujoco`.
+//! Build script: only does something with the cargo feature `mujoco` or `mujoco-c`.
 //!
-//! With the feature, the crate links MuJoCo's C library through `mujoco-rs`, taking the
-//! library from the PyPI wheel `mujoco==3.17.0` that `scripts/setup.sh` installs into the
-//! repository's `.cache/venv`. The wheel ships the versioned file `libmujoco.so.3.17.0`
-//! only; `.cargo/config.toml` points mujoco-rs (`MUJOCO_DYNAMIC_LINK_DIR`) at a committed
-//! linker script named `libmujoco.so` that redirects `-lmujoco` to that versioned name.
-//! This script:
+//! With `mujoco` (MuJoCo 3.17.0), the crate links MuJoCo's C library through `mujoco-rs`,
+//! taking the library from the PyPI wheel `mujoco==3.17.0` that `scripts/setup.sh` installs
+//! into the repository's `.cache/venv`. The wheel ships the versioned file
+//! `libmujoco.so.3.17.0` only; `.cargo/config.toml` points mujoco-rs
+//! (`MUJOCO_DYNAMIC_LINK_DIR`) at a committed linker script named `libmujoco.so` that
+//! redirects `-lmujoco` to that versioned name. This script:
 //!
 //! 1. finds the wheel's directory (or `MJCF_FORGE_MUJOCO_LIB_DIR` when set),
 //! 2. stops the build with a message naming `scripts/setup.sh` when the library is missing,
@@ -13,7 +13,14 @@
 //! 4. embeds it as an rpath in every binary, test and example of this package, so they run
 //!    without `LD_LIBRARY_PATH`.
 //!
-//! Without the feature it prints nothing but its own rerun condition, so the default build
+//! With `mujoco-c` (the MuJoCo a user has; MuJoCo 4.0.0 by default), there is no mujoco-rs:
+//! `src/mujoco_shim.c` is compiled against the headers of a MuJoCo directory laid out like
+//! the wheel's `mujoco/` package (`include/mujoco/mujoco.h` and one `libmujoco.so.X.Y.Z`):
+//! `MJCF_FORGE_MUJOCO_DIR` when set, else the 4.0.0 wheel that `scripts/setup.sh` installs
+//! into `.cache/venv-mj4`. That library is linked by its file name, with an rpath.
+//!
+//! Either feature sets the cfg `mjcf_mujoco`, which the code tests for "built with MuJoCo".
+//! Without them it prints nothing but its own rerun conditions, so the default build
 //! neither needs nor looks for MuJoCo.
 
 use std::env;
@@ -25,11 +32,32 @@ const MUJOCO_VERSION: &str = "3.17.0";
 /// Overrides the directory that holds `libmujoco.so.<MUJOCO_VERSION>`.
 const LIB_DIR_VAR: &str = "MJCF_FORGE_MUJOCO_LIB_DIR";
 
+/// `mujoco-c`: the MuJoCo directory (headers in `include/`, the library beside them).
+const MUJOCO_DIR_VAR: &str = "MJCF_FORGE_MUJOCO_DIR";
+
 fn main() {
     println!("cargo::rerun-if-changed=build.rs");
-    if env::var_os("CARGO_FEATURE_MUJOCO").is_none() {
+    println!("cargo::rustc-check-cfg=cfg(mjcf_mujoco)");
+    let with_rs = env::var_os("CARGO_FEATURE_MUJOCO").is_some();
+    let with_c = env::var_os("CARGO_FEATURE_MUJOCO_C").is_some();
+    if with_rs && with_c {
+        eprintln!(
+            "\nerror: the cargo features `mujoco` (MuJoCo 3.17.0 through mujoco-rs) and `mujoco-c` \
+             (the MuJoCo in {MUJOCO_DIR_VAR}, 4.0.0 by default) each link a MuJoCo library; \
+             enable one of them.\n"
+        );
+        std::process::exit(1);
+    }
+    if with_c {
+        println!("cargo::rustc-cfg=mjcf_mujoco");
+        #[cfg(feature = "mujoco-c")]
+        build_shim();
         return;
     }
+    if !with_rs {
+        return;
+    }
+    println!("cargo::rustc-cfg=mjcf_mujoco");
     println!("cargo::rerun-if-env-changed={LIB_DIR_VAR}");
 
     let manifest_dir = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").expect("set by cargo"));
@@ -95,4 +123,71 @@ fn missing_library(manifest_dir: &Path, lib_name: &str, looked_in: Option<&Path>
          (Or set {LIB_DIR_VAR} to a directory that holds {lib_name}.)\n"
     );
     std::process::exit(1);
+}
+
+/// `mujoco-c`: compiles the shim against the chosen MuJoCo's headers and links its library.
+#[cfg(feature = "mujoco-c")]
+fn build_shim() {
+    println!("cargo::rerun-if-env-changed={MUJOCO_DIR_VAR}");
+    println!("cargo::rerun-if-changed=src/mujoco_shim.c");
+    let manifest_dir = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").expect("set by cargo"));
+    let dir = match env::var_os(MUJOCO_DIR_VAR) {
+        Some(dir) => PathBuf::from(dir),
+        None => {
+            let venv_lib = manifest_dir.join(".cache/venv-mj4/lib");
+            let mut candidates: Vec<PathBuf> = std::fs::read_dir(&venv_lib)
+                .map(|rd| {
+                    rd.filter_map(Result::ok)
+                        .filter(|e| e.file_name().to_string_lossy().starts_with("python3"))
+                        .map(|e| e.path().join("site-packages/mujoco"))
+                        .collect()
+                })
+                .unwrap_or_default();
+            candidates.sort();
+            candidates
+                .into_iter()
+                .find(|d| d.join("include/mujoco/mujoco.h").is_file())
+                .unwrap_or_else(|| {
+                    manifest_dir.join(".cache/venv-mj4/lib/python3.*/site-packages/mujoco")
+                })
+        }
+    };
+    let dir = dir.canonicalize().unwrap_or(dir);
+    let include = dir.join("include");
+    // The versioned library (`libmujoco.so.4.0.0`), else a plain `libmujoco.so`.
+    let mut libs: Vec<String> = std::fs::read_dir(&dir)
+        .map(|rd| {
+            rd.filter_map(Result::ok)
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .filter(|n| n.starts_with("libmujoco.so"))
+                .collect()
+        })
+        .unwrap_or_default();
+    libs.sort_by_key(|n| std::cmp::Reverse(n.len()));
+    let (true, Some(lib)) = (include.join("mujoco/mujoco.h").is_file(), libs.first()) else {
+        eprintln!(
+            "\nerror: the cargo feature `mujoco-c` needs a MuJoCo directory with \
+             include/mujoco/mujoco.h and libmujoco.so.X.Y.Z; {} has not both.\n\
+             Run `scripts/setup.sh` in the repository root (it installs the PyPI wheel \
+             mujoco==4.0.0 into .cache/venv-mj4), or set {MUJOCO_DIR_VAR} to the `mujoco` \
+             folder of your installation (e.g. .../site-packages/mujoco).\n",
+            dir.display()
+        );
+        std::process::exit(1);
+    };
+    println!("cargo::rerun-if-changed={}", dir.join(lib).display());
+    println!(
+        "cargo::rerun-if-changed={}",
+        include.join("mujoco/mujoco.h").display()
+    );
+    cc::Build::new()
+        .file("src/mujoco_shim.c")
+        .include(&include)
+        .warnings(true)
+        .compile("mjcf_forge_mujoco_shim");
+    println!("cargo::rustc-link-search=native={}", dir.display());
+    println!("cargo::rustc-link-lib=dylib:+verbatim={lib}");
+    if env::var("CARGO_CFG_TARGET_OS").unwrap_or_default() != "windows" {
+        println!("cargo::rustc-link-arg=-Wl,-rpath,{}", dir.display());
+    }
 }

@@ -9,7 +9,8 @@ some models take seconds to compile meshes).
 Writes (paths relative to the repo root, sorted):
   .cache/corpus/models.txt    one path per line: compiles on its own
   .cache/corpus/rejected.txt  path<TAB>MuJoCo's first error line
-and prints the counts per corpus.
+and prints the counts per corpus. Run with another venv's Python (another MuJoCo
+version) and ``--suffix -mj4``, it writes models-mj4.txt and rejected-mj4.txt.
 """
 from __future__ import annotations
 
@@ -53,6 +54,15 @@ def try_compile(path: str) -> tuple[str, str | None]:
 
 
 def main() -> int:
+    suffix = ""
+    if len(sys.argv) == 3 and sys.argv[1] == "--suffix":
+        suffix = sys.argv[2]
+    elif len(sys.argv) != 1:
+        print("usage: list_models.py [--suffix S]", file=sys.stderr)
+        return 2
+    import mujoco
+
+    version = mujoco.__version__
     corpora = sorted(p for p in CORPUS.iterdir() if p.is_dir()) if CORPUS.is_dir() else []
     if not corpora:
         print(f"list_models: no corpus under {CORPUS} (run scripts/setup.sh)", file=sys.stderr)
@@ -82,18 +92,20 @@ def main() -> int:
 
     ok = [p for p in candidates if results[p] is None]
     bad = [p for p in candidates if results[p] is not None]
-    (CORPUS / "models.txt").write_text("".join(p + "\n" for p in ok))
-    (CORPUS / "rejected.txt").write_text("".join(f"{p}\t{results[p]}\n" for p in bad))
+    models_txt = f"models{suffix}.txt"
+    rejected_txt = f"rejected{suffix}.txt"
+    (CORPUS / models_txt).write_text("".join(p + "\n" for p in ok))
+    (CORPUS / rejected_txt).write_text("".join(f"{p}\t{results[p]}\n" for p in bad))
 
     for corpus in corpora:
         rel = str(corpus.relative_to(ROOT)) + os.sep
         n_all = sum(p.startswith(rel) for p in candidates)
         n_ok = sum(p.startswith(rel) for p in ok)
-        print(f"list_models: {corpus.name}: {n_ok} of {n_all} <mujoco> XML files compile")
+        print(f"list_models: MuJoCo {version}: {corpus.name}: {n_ok} of {n_all} <mujoco> XML files compile")
     print(
-        f"list_models: {len(ok)} of {len(candidates) + not_mujoco} XML files compile "
+        f"list_models: MuJoCo {version}: {len(ok)} of {len(candidates) + not_mujoco} XML files compile "
         f"({len(bad)} rejected by MuJoCo, {not_mujoco} not <mujoco>) "
-        f"-> .cache/corpus/models.txt, .cache/corpus/rejected.txt"
+        f"-> .cache/corpus/{models_txt}, .cache/corpus/{rejected_txt}"
     )
     return 0
 

@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
 # Sets up the MuJoCo judge environment (idempotent; fast when already done):
-#   .cache/venv                      python venv with scripts/requirements.txt
+#   .cache/venv                      python venv with scripts/requirements.txt (MuJoCo 3.17.0)
+#   .cache/venv-mj4                  python venv with scripts/requirements-mj4.txt (MuJoCo 4.0.0)
 #   .cache/wheels/                   robosuite + dm-control wheels (pip download --no-deps)
 #   .cache/corpus/<name>-<version>/  each wheel unzipped whole (meshes/textures included)
 #   .cache/corpus/models.txt         XML models that compile on their own with MuJoCo
 #   .cache/corpus/rejected.txt       the others, with MuJoCo's first error line
+#   .cache/corpus/models-mj4.txt     the same two lists under MuJoCo 4.0.0
+#   .cache/corpus/rejected-mj4.txt
 #   the Python package mjcf_forge     built from this checkout (maturin) into .cache/venv,
 #                                    with scripts/requirements-python.txt (maturin,
 #                                    gymnasium, ray) for its examples and tests
@@ -16,7 +19,6 @@ ROOT="$(pwd)"
 CACHE="$ROOT/.cache"
 VENV="$CACHE/venv"
 PY="$VENV/bin/python"
-REQ="$ROOT/scripts/requirements.txt"
 PYTHON="${PYTHON:-python3}"
 
 # Corpora: pip name, version, unpack dir name.
@@ -27,20 +29,31 @@ CORPORA=(
 
 mkdir -p "$CACHE/wheels" "$CACHE/corpus"
 
-# 1. venv + pinned requirements (skipped when the stamp matches requirements.txt).
-if [[ ! -x "$PY" ]]; then
-  echo "setup: creating venv $VENV"
-  "$PYTHON" -m venv "$VENV"
-fi
-req_sha="$(sha256sum "$REQ" | cut -d' ' -f1)"
-stamp="$VENV/.requirements.sha256"
-if [[ -f "$stamp" && "$(cat "$stamp")" == "$req_sha" ]]; then
-  echo "setup: venv up to date"
-else
-  echo "setup: installing $REQ"
-  "$PY" -m pip install --quiet --disable-pip-version-check -r "$REQ"
-  echo "$req_sha" > "$stamp"
-fi
+# 1. one venv per judged MuJoCo version: directory, requirements, list suffix. Each is
+#    (re)installed only when its stamp does not match its requirements file.
+VENVS=(
+  "venv requirements.txt"
+  "venv-mj4 requirements-mj4.txt"
+)
+for entry in "${VENVS[@]}"; do
+  read -r venv_dir req_file <<<"$entry"
+  venv="$CACHE/$venv_dir"
+  req="$ROOT/scripts/$req_file"
+  if [[ ! -x "$venv/bin/python" ]]; then
+    echo "setup: creating venv $venv"
+    "$PYTHON" -m venv "$venv"
+  fi
+  sha="$(sha256sum "$req" | cut -d' ' -f1)"
+  stamp="$venv/.requirements.sha256"
+  if [[ -f "$stamp" && "$(cat "$stamp")" == "$sha" ]]; then
+    echo "setup: $venv_dir up to date"
+  else
+    echo "setup: installing $req into $venv_dir"
+    "$venv/bin/python" -m pip install --quiet --disable-pip-version-check -r "$req"
+    echo "$sha" > "$stamp"
+  fi
+done
+req_sha="$(cat "$ROOT/scripts/requirements.txt" "$ROOT/scripts/requirements-mj4.txt" | sha256sum | cut -d' ' -f1)"
 
 # 1b. the Python package's tools (own stamp: requirements.txt keys the corpus listing).
 PYREQ="$ROOT/scripts/requirements-python.txt"
@@ -95,16 +108,19 @@ for entry in "${CORPORA[@]}"; do
   touch "$dest/.unpacked"
 done
 
-# 3. list models that compile with MuJoCo (redone when the script, the
+# 3. list models that compile with each MuJoCo (redone when the script, the
 #    requirements or the corpora change).
 models_key="$( { sha256sum "$ROOT/scripts/list_models.py"; echo "$req_sha"; printf '%s\n' "${CORPORA[@]}"; } | sha256sum | cut -d' ' -f1)"
 models_stamp="$CACHE/corpus/.models.sha256"
-if [[ -f "$models_stamp" && "$(cat "$models_stamp")" == "$models_key" \
-      && -f "$CACHE/corpus/models.txt" && -f "$CACHE/corpus/rejected.txt" ]]; then
-  echo "setup: models.txt up to date: $(wc -l <"$CACHE/corpus/models.txt") models compile," \
-       "$(wc -l <"$CACHE/corpus/rejected.txt") rejected"
+lists=(models.txt rejected.txt models-mj4.txt rejected-mj4.txt)
+all_lists=1
+for f in "${lists[@]}"; do [[ -f "$CACHE/corpus/$f" ]] || all_lists=0; done
+if [[ -f "$models_stamp" && "$(cat "$models_stamp")" == "$models_key" && $all_lists == 1 ]]; then
+  echo "setup: models.txt up to date: $(wc -l <"$CACHE/corpus/models.txt") models compile with 3.17.0," \
+       "$(wc -l <"$CACHE/corpus/models-mj4.txt") with 4.0.0"
 else
   rm -f "$models_stamp"
   "$PY" "$ROOT/scripts/list_models.py"
+  "$CACHE/venv-mj4/bin/python" "$ROOT/scripts/list_models.py" --suffix -mj4
   echo "$models_key" > "$models_stamp"
 fi

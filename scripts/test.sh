@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Runs every test of mjcf-forge (the README's test command; .ci/run calls it):
 # formatting, clippy, the Rust tests with and without the `mujoco` feature (real MuJoCo
-# judges every output), the judge's own tests, and the Python package's tests (setup has
-# built and installed it into .cache/venv). Sets up first (idempotent).
+# 3.17.0 and 4.0.0 judge every output), the `mujoco-c` build against MuJoCo 4.0.0, the
+# judge's own tests under both versions, and the Python package's tests (setup has built and
+# installed it into .cache/venv). Sets up first (idempotent).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
@@ -13,13 +14,19 @@ cargo fmt --all -- --check
 echo "== cargo clippy"
 cargo clippy --all-targets -- -D warnings
 cargo clippy --all-targets --features mujoco -- -D warnings
+# The `mujoco-c` build (MuJoCo 4.0.0 through our own shim) in its own target folder, so
+# the two MuJoCo builds do not evict each other's artifacts.
+CARGO_TARGET_DIR=target/mujoco-c cargo clippy --all-targets --features mujoco-c -- -D warnings
 # The Python bindings crate (the workspace's other member; not built by the commands above).
 PYO3_PYTHON="$PWD/.cache/venv/bin/python" cargo clippy -p mjcf-forge-python --all-targets -- -D warnings
 echo "== cargo test (default features)"
 cargo test --all-targets
 echo "== cargo test --features mujoco (with doctests)"
 cargo test --features mujoco
-echo "== judge self-tests"
+echo "== cargo test --features mujoco-c (MuJoCo 4.0.0: the FFI and compile --json against Python 4.0.0)"
+CARGO_TARGET_DIR=target/mujoco-c cargo test --features mujoco-c --lib --test mujoco_compile --test cli_compile
+echo "== judge self-tests (MuJoCo 3.17.0 and 4.0.0)"
 .cache/venv/bin/python -m pytest tests/judge -q -p no:cacheprovider
+.cache/venv-mj4/bin/python -m pytest tests/judge -q -p no:cacheprovider
 echo "== python package (pytest: API, errors, threads, MuJoCo judge, Gymnasium, Ray)"
 .cache/venv/bin/python -m pytest python/tests -q -p no:cacheprovider

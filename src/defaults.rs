@@ -502,6 +502,9 @@ impl Resolver<'_> {
             let i = slot_index(slot).expect("non-actuator slot");
             merged.0.clear();
             merged.0.extend_from_slice(&self.classes[class].slots[i].0);
+            if slot == DefaultSlot::Texture {
+                self.reset_gridlayout(&mut merged, &own);
+            }
             self.apply(&mut merged, &own, Some(kind.spec()));
         }
         // Own attributes keep their place; inherited ones follow in class order.
@@ -553,6 +556,40 @@ impl Resolver<'_> {
             out,
             text: std::mem::take(&mut self.scratch.text),
         };
+    }
+
+    /// A texture that writes its own `gridsize`, other than its class's, does not take the
+    /// class's `gridlayout` (the layout belongs to the class's grid). MuJoCo 3.17.0 and 4.0.0
+    /// both compile such a texture (4.0.0's changelog, bug fix 60, names the reset); writing
+    /// the class's layout next to the new size is rejected by both (`gridlayout length must
+    /// match gridsize`). corpora/features/default_texture_gridsize_resets_layout.xml.
+    fn reset_gridlayout(&self, class_set: &mut AttrSet, own: &[(Sym, StrRef)]) {
+        let (Some(gridsize), Some(gridlayout)) = (
+            crate::names::known("gridsize"),
+            crate::names::known("gridlayout"),
+        ) else {
+            return;
+        };
+        let own_value = |n: Sym| own.iter().find(|(m, _)| *m == n).map(|(_, v)| *v);
+        let Some(size) = own_value(gridsize) else {
+            return;
+        };
+        if own_value(gridlayout).is_some() {
+            return;
+        }
+        let numbers = |v: StrRef| -> Vec<f64> {
+            self.doc
+                .str(v)
+                .split_ascii_whitespace()
+                .map(|t| t.parse().unwrap_or(f64::NAN))
+                .collect()
+        };
+        let same = class_set
+            .get(gridsize)
+            .is_some_and(|c| numbers(c) == numbers(size));
+        if !same {
+            class_set.remove(gridlayout);
+        }
     }
 
     /// Applies an actuator element (in a class, or a real one) onto the class dummy `slot`;
@@ -664,10 +701,45 @@ impl Resolver<'_> {
             }
             attrs.push((n, v));
         }
+        self.drop_overridden_range(&tag_name, own, &mut attrs);
         // Keep the element's own attribute order first, inherited ones after.
         let position = |n: Sym| own.iter().position(|(m, _)| *m == n).unwrap_or(usize::MAX);
         attrs.sort_by_key(|(n, _)| position(*n));
         Ok((next, out_tag, attrs))
+    }
+
+    /// A shortcut's explicit range (`ctrlrange`, `actrange` for `intvelocity`, `posrange`
+    /// for `pid`) or `inheritrange` overrides the other one inherited from its class: the
+    /// inherited one is dropped from `attrs`. This is MuJoCo 4.0.0's rule (changelog 4.0.0,
+    /// bug fix 60; corpora/features/actuator_range_overrides_inheritrange.xml). MuJoCo 3.17.0
+    /// rejects such an element (`ctrlrange and inheritrange cannot both be defined`), so no
+    /// model that 3.17.0 compiles is changed by it; without it, what we write would be
+    /// rejected by 4.0.0 too, although 4.0.0 compiles the input.
+    fn drop_overridden_range(
+        &self,
+        tag: &str,
+        own: &[(Sym, StrRef)],
+        attrs: &mut Vec<(Sym, StrRef)>,
+    ) {
+        let ranges: &[&str] = match tag {
+            "position" => &["ctrlrange"],
+            "intvelocity" => &["actrange"],
+            "pid" => &["ctrlrange", "posrange"],
+            _ => return,
+        };
+        let Some(inheritrange) = crate::names::known("inheritrange") else {
+            return;
+        };
+        let ranges: Vec<Sym> = ranges
+            .iter()
+            .filter_map(|r| crate::names::known(r))
+            .collect();
+        let is_own = |n: Sym| own.iter().any(|(m, _)| *m == n);
+        if ranges.iter().any(|r| is_own(*r)) && !is_own(inheritrange) {
+            attrs.retain(|(n, _)| *n != inheritrange);
+        } else if is_own(inheritrange) && !ranges.iter().any(|r| is_own(*r)) {
+            attrs.retain(|(n, _)| !ranges.contains(n));
+        }
     }
 
     /// For an actuator tag: the kind its attributes are read as (the vocabulary's element of

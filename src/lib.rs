@@ -18,9 +18,9 @@
 //! );
 //! # Ok::<(), mjcf_forge::Errors>(())
 //! ```
-#![cfg_attr(not(feature = "mujoco"), forbid(unsafe_code))]
+#![cfg_attr(not(mjcf_mujoco), forbid(unsafe_code))]
 // The one FFI module, `mujoco`, opts back in; everything else stays safe.
-#![cfg_attr(feature = "mujoco", deny(unsafe_code))]
+#![cfg_attr(mjcf_mujoco, deny(unsafe_code))]
 #![warn(missing_docs)]
 
 mod defaults;
@@ -29,7 +29,7 @@ mod error;
 pub mod geometry;
 mod merge;
 mod model;
-#[cfg(feature = "mujoco")]
+#[cfg(mjcf_mujoco)]
 pub mod mujoco;
 mod names;
 pub mod output;

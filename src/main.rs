@@ -7,8 +7,8 @@
 //!
 //! Each subcommand lives in its own file under `src/cli/` with its `Args` and `run`;
 //! adding one is that file plus one variant of [`Command`] and one arm of its dispatch.
-#![cfg_attr(not(feature = "mujoco"), forbid(unsafe_code))]
-#![cfg_attr(feature = "mujoco", deny(unsafe_code))]
+#![cfg_attr(not(mjcf_mujoco), forbid(unsafe_code))]
+#![cfg_attr(mjcf_mujoco, deny(unsafe_code))]
 
 mod cli;
 

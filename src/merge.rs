@@ -66,6 +66,16 @@ const MUST_AGREE: [(&str, &str); 12] = [
     ("coordinate", "local"),
 ];
 
+/// Compiler mass settings whose whole effect is the compiled bodies' masses and inertias,
+/// with MuJoCo's default (under which they change nothing).
+#[cfg(mjcf_mujoco)]
+const INERTIA_ONLY: [(&str, &str); 4] = [
+    ("boundmass", "0"),
+    ("boundinertia", "0"),
+    ("settotalmass", "-1"),
+    ("balanceinertia", "false"),
+];
+
 /// The effective value of each `compiler` attribute (later elements win).
 fn compiler_settings(doc: &Document) -> Compiler<'_> {
     let compiler = crate::names::sym("compiler");
@@ -732,11 +742,80 @@ impl Document {
             value(&theirs, "inertiafromgeom", "auto"),
         );
         let drop_inertials = pi == "true" && bi == "auto";
+        // Builds with MuJoCo convert mass settings: each body's inertia is written out as
+        // MuJoCo compiles the part alone, after which the setting changes nothing. That is
+        // exact when the merged model reads <inertial> (inertiafromgeom not "true") and the
+        // base leaves the setting at MuJoCo's default (no bound, no rescaling of its own).
+        #[cfg(mjcf_mujoco)]
+        let converted: Vec<&str> = {
+            let mut all = Vec::new();
+            let mut converted = Vec::new();
+            if bi != "true" && pi != "true" {
+                for (attr, default) in INERTIA_ONLY {
+                    let (b, p) = (value(&base, attr, default), value(&theirs, attr, default));
+                    if !same_value(&b, &p) && same_value(&b, default) {
+                        all.push(attr);
+                    }
+                }
+                if pi == "false" && bi == "auto" {
+                    all.push("inertiafromgeom");
+                }
+                let (b, p) = (
+                    value(&base, "inertiagrouprange", "0 5"),
+                    value(&theirs, "inertiagrouprange", "0 5"),
+                );
+                let range = !same_value(&b, &p);
+                // A base with "false" reads only <inertial>: the part's inferred ones suffice.
+                let auto_to_false = pi == "auto" && bi == "false";
+                if range || auto_to_false || !all.is_empty() {
+                    let names = all
+                        .iter()
+                        .copied()
+                        .chain(range.then_some("inertiagrouprange"))
+                        .chain(auto_to_false.then_some("inertiafromgeom"))
+                        .collect::<Vec<_>>();
+                    let at = part.location(theirs.get(names[0]).map_or(part.root, |(_, n)| n));
+                    let written = if all.is_empty() {
+                        crate::mujoco::write_inertials(part)
+                    } else {
+                        crate::mujoco::write_all_inertials(part)
+                    };
+                    if let Err(e) = written {
+                        errors.push(Error::at(
+                            at,
+                            ErrorKind::Invalid(format!(
+                                "cannot merge: compiler {} differ(s) from the base's and the \
+                                 part's inertias could not be written out: {e}",
+                                names.join(", ")
+                            )),
+                        ));
+                        return;
+                    }
+                    converted = names;
+                }
+            }
+            converted
+        };
+        #[cfg(not(mjcf_mujoco))]
+        let converted: Vec<&str> = Vec::new();
+        let theirs = compiler_settings(part);
         for (attr, default) in MUST_AGREE {
-            if attr == "inertiafromgeom" && drop_inertials {
+            if (attr == "inertiafromgeom" && drop_inertials) || converted.contains(&attr) {
                 continue;
             }
             let (b, p) = (value(&base, attr, default), value(&theirs, attr, default));
+            // inertiagrouprange only picks the geoms a body's inertia is inferred from: a part
+            // none of whose bodies infers one (each body with geoms has its <inertial>, and
+            // <inertial> counts in the merged model: inertiafromgeom is not "true") compiles
+            // the same under any range. `mujoco::write_inertials` makes a part so.
+            if attr == "inertiagrouprange"
+                && !same_value(&b, &p)
+                && bi != "true"
+                && pi != "true"
+                && part.bodies_inferring_inertia().is_empty()
+            {
+                continue;
+            }
             if !same_value(&b, &p) {
                 let at = theirs.get(attr).map(|(_, n)| n).unwrap_or(part.root);
                 errors.push(part.error_at(
@@ -778,6 +857,28 @@ impl Document {
         if ba != pa {
             part.make_limits_explicit(pa == "true");
         }
+    }
+
+    /// The bodies whose mass and inertia MuJoCo infers from their geoms (under
+    /// `inertiafromgeom="auto"`): those without an `<inertial>` that have a geom, directly or
+    /// in a `<frame>` (or `<replicate>`) inside them.
+    pub(crate) fn bodies_inferring_inertia(&self) -> Vec<Node> {
+        let has_geom = |body: Node| {
+            let mut stack: Vec<Node> = self.elements(body).collect();
+            while let Some(n) = stack.pop() {
+                match self.tag(n) {
+                    "geom" => return true,
+                    "frame" | "replicate" => stack.extend(self.elements(n)),
+                    _ => {}
+                }
+            }
+            false
+        };
+        self.descendants(self.root)
+            .filter(|&n| self.tag(n) == "body")
+            .filter(|&b| !self.elements(b).any(|c| self.tag(c) == "inertial"))
+            .filter(|&b| has_geom(b))
+            .collect()
     }
 
     /// Every `euler` becomes the `quat` it means under `angles` (for a base with another
@@ -1251,6 +1352,20 @@ impl Document {
         let mut errors = Vec::new();
         for (doc, keys, off) in [(&*self, base_keys, &base_off), (part, part_keys, &part_off)] {
             for k in keys {
+                // MuJoCo 4.0.0's plastic state (one block per plastic joint, tendon and flex)
+                // has a layout we do not model: refused rather than copied onto the wrong slots.
+                if doc.attr(k.node, "plastic").is_some() {
+                    errors.push(
+                        doc.error_at(
+                            k.node,
+                            ErrorKind::Invalid(
+                                "key plastic (MuJoCo 4.0's plastic state) cannot be remapped onto \
+                             the merged model; remove it before merging"
+                                    .to_string(),
+                            ),
+                        ),
+                    );
+                }
                 for (v, vec) in k.vectors.iter().enumerate() {
                     if let Some(vec) = vec
                         && vec.len() != off.len(v)

@@ -5,9 +5,18 @@
 //! `mjModel`, or a [`CompileError`] carrying MuJoCo's own message and, when MuJoCo names
 //! one, the line of the offending element.
 //!
-//! The library is MuJoCo 3.17.0 from the PyPI wheel that `scripts/setup.sh` installs
-//! (see `build.rs`); the FFI declarations come from the `mujoco-rs` crate
-//! (`mujoco_rs::mujoco_c`), which was generated from the 3.17.0 headers. This module calls
+//! Two builds, chosen by cargo feature (see `build.rs` and the README):
+//!
+//! - `mujoco`: MuJoCo 3.17.0 from the PyPI wheel that `scripts/setup.sh` installs; the FFI
+//!   declarations come from the `mujoco-rs` crate (`mujoco_rs::mujoco_c`), which was
+//!   generated from the 3.17.0 headers.
+//! - `mujoco-c`: the MuJoCo a user has (4.0.0 from `.cache/venv-mj4` by default, or the
+//!   folder in `MJCF_FORGE_MUJOCO_DIR`), through our own shim (`src/mujoco_shim.c`), which
+//!   `build.rs` compiles against that MuJoCo's own headers: no Rust copy of `mjModel`'s
+//!   layout exists in that build; fields are read by name through MuJoCo's X-macro tables.
+//!
+//! Both go through the small private module `sys` below; everything else is shared. This
+//! module calls
 //! `mj_loadXML` itself instead of `mujoco_rs::prelude::MjModel::from_xml*`, because those
 //! read MuJoCo's error into a 100-byte buffer, which cuts longer messages short, often
 //! before the `line N` part.
@@ -50,8 +59,10 @@ use std::path::Path;
 use std::ptr::NonNull;
 use std::sync::OnceLock;
 
+#[cfg(feature = "mujoco")]
 use mujoco_rs::mujoco_c as ffi;
-use mujoco_rs::wrappers::MjVfs;
+
+use sys::{model_array, model_size};
 
 /// Bytes for MuJoCo's error (or warning) text; longer text is cut at this length.
 const ERROR_BUF_LEN: usize = 4096;
@@ -194,12 +205,9 @@ pub fn compile_str(xml: &str, dir: &Path) -> Result<CompiledModel, CompileError>
             xml.len()
         ))
     })?;
-    let mut vfs = MjVfs::new();
-    // SAFETY: `vfs` is a live VFS made by `mj_defaultVFS` (in `MjVfs::new`); adding a file
-    // through MuJoCo's own API keeps its invariants. `name` is NUL-terminated, and MuJoCo
-    // copies `len` bytes from `xml` before returning.
-    let added =
-        unsafe { ffi::mj_addBufferVFS(vfs.ffi_mut(), name.as_ptr(), xml.as_ptr().cast(), len) };
+    let mut vfs = sys::Vfs::new()
+        .ok_or_else(|| CompileError::local("could not make a MuJoCo VFS".to_owned()))?;
+    let added = vfs.add_buffer(&name, xml.as_bytes(), len);
     if added != 0 {
         return Err(CompileError::local(format!(
             "could not add the MJCF string to MuJoCo's VFS (code {added})"
@@ -208,20 +216,160 @@ pub fn compile_str(xml: &str, dir: &Path) -> Result<CompiledModel, CompileError>
     load_xml(&name, Some(&vfs))
 }
 
-/// Runs `mj_loadXML` and wraps the result.
-fn load_xml(path: &CStr, vfs: Option<&MjVfs>) -> Result<CompiledModel, CompileError> {
-    let mut buf = vec![0 as c_char; ERROR_BUF_LEN];
-    let vfs_ptr = vfs.map_or(std::ptr::null(), |v| std::ptr::from_ref(v.ffi()));
-    // SAFETY: `path` is NUL-terminated; `vfs_ptr` is null or a live VFS that outlives the
-    // call; `buf` holds `ERROR_BUF_LEN` bytes, which is what MuJoCo is told it may write.
-    let model = unsafe {
-        ffi::mj_loadXML(
-            path.as_ptr(),
-            vfs_ptr,
-            buf.as_mut_ptr(),
-            ERROR_BUF_LEN as c_int,
-        )
+/// Writes an explicit `<inertial>` (mass, pos, quat, diaginertia, at full precision, as
+/// MuJoCo compiles `doc` alone) into every body that infers its inertia from its geoms, so
+/// that the document compiles to the same masses and inertias whatever the compiler's
+/// `inertiagrouprange`: what lets [`Document::merge`](crate::Document::merge) take a part
+/// whose range differs from the base's. Returns how many bodies got one.
+///
+/// Refuses documents whose compiled bodies are not their `<body>` elements one to one
+/// (`<replicate>`, `<attach>`, `<composite>`, `<flexcomp>`, `fusestatic`), and documents
+/// with `inertiafromgeom="true"` (which ignores `<inertial>`).
+///
+/// ```
+/// use mjcf_forge::Document;
+/// use mjcf_forge::mujoco::write_inertials;
+///
+/// let mut doc = Document::from_str(r#"<mujoco><compiler inertiagrouprange="1 5"/><worldbody>
+///   <body name="b"><freejoint/><geom size="0.1" group="1"/><geom size="0.5" group="0"/></body>
+///   </worldbody></mujoco>"#, ".")?;
+/// assert_eq!(write_inertials(&mut doc)?, 1);
+/// assert!(doc.to_xml_string().contains("<inertial "));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn write_inertials(doc: &mut crate::Document) -> Result<usize, CompileError> {
+    write_inertials_of(doc, false)
+}
+
+/// Like [`write_inertials`], but for every body whose compiled mass or inertia is not zero or
+/// that has geoms or an `<inertial>` of its own (which is replaced): afterwards the compiler's
+/// mass settings (`settotalmass`, `boundmass`, `boundinertia`, `balanceinertia`,
+/// `inertiafromgeom="false"`) have nothing left to change when left at MuJoCo's defaults, so
+/// a part authored with them merges exactly into a base without them.
+///
+/// ```
+/// use mjcf_forge::Document;
+/// use mjcf_forge::mujoco::write_all_inertials;
+///
+/// let mut doc = Document::from_str(r#"<mujoco><compiler settotalmass="3"/><worldbody>
+///   <body name="b"><freejoint/><geom size="0.1"/></body></worldbody></mujoco>"#, ".")?;
+/// assert_eq!(write_all_inertials(&mut doc)?, 1);
+/// assert!(doc.to_xml_string().contains(r#"mass="3.0""#));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn write_all_inertials(doc: &mut crate::Document) -> Result<usize, CompileError> {
+    write_inertials_of(doc, true)
+}
+
+fn write_inertials_of(doc: &mut crate::Document, all: bool) -> Result<usize, CompileError> {
+    let refused = ["replicate", "attach", "composite", "flexcomp"];
+    if let Some(n) = doc
+        .descendants(doc.root())
+        .find(|&n| refused.contains(&doc.tag(n)))
+    {
+        return Err(CompileError::local(format!(
+            "{}: <{}> makes bodies when MuJoCo compiles; explicit inertials are written for \
+             plain <body> elements only",
+            doc.location(n),
+            doc.tag(n)
+        )));
+    }
+    for c in doc
+        .elements(doc.root())
+        .filter(|&c| doc.tag(c) == "compiler")
+    {
+        let setting = |k: &str, bad: &str| doc.attr(c, k).is_some_and(|v| v.trim() == bad);
+        if setting("inertiafromgeom", "true") || setting("fusestatic", "true") {
+            return Err(CompileError::local(format!(
+                "{}: compiler inertiafromgeom=\"true\" or fusestatic=\"true\": explicit \
+                 inertials would not carry the compiled inertia",
+                doc.location(c)
+            )));
+        }
+    }
+    let inferring = doc.bodies_inferring_inertia();
+    if inferring.is_empty() && !all {
+        return Ok(0);
+    }
+    let model = compile_str(&doc.to_xml_string(), doc.model_dir())?;
+    // MuJoCo numbers bodies depth first in document order, the world body first.
+    let bodies: Vec<crate::tree::Node> = doc
+        .descendants(doc.root())
+        .filter(|&n| doc.tag(n) == "body")
+        .collect();
+    let names = model.names(ObjType::Body);
+    if names.len() != bodies.len() + 1 {
+        return Err(CompileError::local(format!(
+            "MuJoCo compiled {} bodies from {} <body> elements",
+            names.len() - 1,
+            bodies.len()
+        )));
+    }
+    for (i, &b) in bodies.iter().enumerate() {
+        if doc.attr(b, "name").is_some_and(|n| n != names[i + 1]) {
+            return Err(CompileError::local(format!(
+                "{}: body {:?} compiled as {:?}: bodies do not match one to one",
+                doc.location(b),
+                doc.attr(b, "name").unwrap_or(""),
+                names[i + 1]
+            )));
+        }
+    }
+    let (mass, ipos, iquat, inertia) = (
+        model.body_mass(),
+        model.body_ipos(),
+        model.body_iquat(),
+        model.body_inertia(),
+    );
+    let list = |v: &[f64]| {
+        v.iter()
+            .map(|x| format!("{x:?}"))
+            .collect::<Vec<_>>()
+            .join(" ")
     };
+    let own_inertial =
+        |doc: &crate::Document, b| doc.elements(b).find(|&c| doc.tag(c) == "inertial");
+    let targets: Vec<crate::tree::Node> = if all {
+        bodies
+            .iter()
+            .enumerate()
+            .filter(|&(i, &b)| {
+                let id = i + 1;
+                let nonzero =
+                    mass[id] != 0.0 || inertia[3 * id..3 * id + 3].iter().any(|&x| x != 0.0);
+                nonzero || inferring.contains(&b) || own_inertial(doc, b).is_some()
+            })
+            .map(|(_, &b)| b)
+            .collect()
+    } else {
+        inferring
+    };
+    for &b in &targets {
+        if let Some(old) = own_inertial(doc, b) {
+            doc.remove(old);
+        }
+        let id = 1 + bodies
+            .iter()
+            .position(|&n| n == b)
+            .expect("a body of the document");
+        let attrs = [
+            ("pos", list(&ipos[3 * id..3 * id + 3])),
+            ("quat", list(&iquat[4 * id..4 * id + 4])),
+            ("mass", list(&mass[id..id + 1])),
+            ("diaginertia", list(&inertia[3 * id..3 * id + 3])),
+        ];
+        let attrs: Vec<(&str, &str)> = attrs.iter().map(|(k, v)| (*k, v.as_str())).collect();
+        doc.append_element(b, "inertial", &attrs);
+    }
+    Ok(targets.len())
+}
+
+/// Runs `mj_loadXML` and wraps the result.
+fn load_xml(path: &CStr, vfs: Option<&sys::Vfs>) -> Result<CompiledModel, CompileError> {
+    let mut buf = vec![0 as c_char; ERROR_BUF_LEN];
+    // SAFETY: `path` is NUL-terminated; `vfs` is None or a live VFS that outlives the call;
+    // `buf` holds `ERROR_BUF_LEN` bytes, which is what MuJoCo is told it may write.
+    let model = unsafe { sys::load_xml(path, vfs, buf.as_mut_ptr(), ERROR_BUF_LEN as c_int) };
     // MuJoCo NUL-terminates within `error_sz`; the last byte stays 0 in any case.
     buf[ERROR_BUF_LEN - 1] = 0;
     // SAFETY: `buf` is NUL-terminated (see above).
@@ -245,15 +393,15 @@ fn load_xml(path: &CStr, vfs: Option<&MjVfs>) -> Result<CompiledModel, CompileEr
 /// (mujoco-rs itself would panic there).
 fn check_version() -> Result<(), CompileError> {
     static LINKED: OnceLock<c_int> = OnceLock::new();
-    // SAFETY: `mj_version` only returns a constant.
-    let linked = *LINKED.get_or_init(|| unsafe { ffi::mj_version() });
-    if u32::try_from(linked).ok() == Some(ffi::mjVERSION_HEADER) {
+    let linked = *LINKED.get_or_init(sys::linked_version);
+    let header = sys::header_version();
+    if linked == header {
         Ok(())
     } else {
         Err(CompileError::local(format!(
-            "linked MuJoCo library has version code {linked}, expected {} (MuJoCo 3.17.0): \
-             run scripts/setup.sh",
-            ffi::mjVERSION_HEADER
+            "linked MuJoCo library has version code {linked}, expected {header} (the headers \
+             this build was made with): run scripts/setup.sh, or rebuild against the MuJoCo \
+             you link"
         )))
     }
 }
@@ -300,7 +448,7 @@ fn path_to_cstring(path: &Path) -> Result<CString, CompileError> {
 /// assert_eq!(handle.join().unwrap(), sizes);
 /// ```
 pub struct CompiledModel {
-    ptr: NonNull<ffi::mjModel>,
+    ptr: NonNull<sys::Model>,
     warnings: Option<String>,
 }
 
@@ -313,7 +461,7 @@ unsafe impl Sync for CompiledModel {}
 impl Drop for CompiledModel {
     fn drop(&mut self) {
         // SAFETY: `ptr` came from `mj_loadXML`, is owned by `self` alone and freed only here.
-        unsafe { ffi::mj_deleteModel(self.ptr.as_ptr()) }
+        unsafe { sys::delete_model(self.ptr.as_ptr()) }
     }
 }
 
@@ -404,26 +552,6 @@ impl ObjType {
             ObjType::Key => "key",
         }
     }
-
-    fn to_mjt(self) -> ffi::mjtObj {
-        use ffi::mjtObj::*;
-        match self {
-            ObjType::Body => mjOBJ_BODY,
-            ObjType::Joint => mjOBJ_JOINT,
-            ObjType::Geom => mjOBJ_GEOM,
-            ObjType::Site => mjOBJ_SITE,
-            ObjType::Camera => mjOBJ_CAMERA,
-            ObjType::Light => mjOBJ_LIGHT,
-            ObjType::Mesh => mjOBJ_MESH,
-            ObjType::Material => mjOBJ_MATERIAL,
-            ObjType::Texture => mjOBJ_TEXTURE,
-            ObjType::Tendon => mjOBJ_TENDON,
-            ObjType::Actuator => mjOBJ_ACTUATOR,
-            ObjType::Sensor => mjOBJ_SENSOR,
-            ObjType::Equality => mjOBJ_EQUALITY,
-            ObjType::Key => mjOBJ_KEY,
-        }
-    }
 }
 
 impl fmt::Display for ObjType {
@@ -462,8 +590,8 @@ macro_rules! sizes_struct {
                 [$((stringify!($field), self.$field)),*]
             }
 
-            fn from_model(m: &ffi::mjModel) -> Self {
-                Self { $($field: n(m.$field),)* }
+            fn from_model(m: &sys::Model) -> Self {
+                Self { $($field: model_size!(m, $field),)* }
             }
         }
     };
@@ -558,7 +686,7 @@ macro_rules! model_arrays {
                     // SAFETY: MuJoCo allocates `$field` with exactly this many elements
                     // (see mjmodel.h) inside the model, which lives as long as `self` and
                     // is never written after compilation.
-                    unsafe { slice_or_empty($m.$field, $len) }
+                    unsafe { slice_or_empty(model_array!($m, $field, $ty), $len) }
                 }
             )*
         }
@@ -566,55 +694,60 @@ macro_rules! model_arrays {
 }
 
 /// A size field of `mjModel` as `usize` (they are never negative).
+#[cfg(feature = "mujoco")]
 fn n(size: ffi::mjtSize) -> usize {
     usize::try_from(size).unwrap_or(0)
 }
 
 model_arrays! {
     /// Body positions relative to the parent body, 3 per body (`nbody x 3`).
-    body_pos: f64, |m| n(m.nbody) * 3;
+    body_pos: f64, |m| model_size!(m, nbody) * 3;
     /// Body orientations relative to the parent body, quaternions `w x y z` (`nbody x 4`).
-    body_quat: f64, |m| n(m.nbody) * 4;
+    body_quat: f64, |m| model_size!(m, nbody) * 4;
     /// Body masses (`nbody`).
-    body_mass: f64, |m| n(m.nbody);
+    body_mass: f64, |m| model_size!(m, nbody);
     /// Body principal moments of inertia (`nbody x 3`).
-    body_inertia: f64, |m| n(m.nbody) * 3;
+    body_inertia: f64, |m| model_size!(m, nbody) * 3;
+    /// Positions of the bodies' inertial frames in the body frames (`nbody x 3`).
+    body_ipos: f64, |m| model_size!(m, nbody) * 3;
+    /// Orientations of the bodies' inertial frames in the body frames (`nbody x 4`).
+    body_iquat: f64, |m| model_size!(m, nbody) * 4;
     /// Parent body ids (`nbody`; the world body is its own parent).
-    body_parentid: i32, |m| n(m.nbody);
+    body_parentid: i32, |m| model_size!(m, nbody);
     /// Per body, the id of its top-level ancestor (the body itself at the top).
-    body_rootid: i32, |m| n(m.nbody);
+    body_rootid: i32, |m| model_size!(m, nbody);
     /// Joint types (`mjtJoint`: 0 free, 1 ball, 2 slide, 3 hinge) (`njnt`).
-    jnt_type: i32, |m| n(m.njnt);
+    jnt_type: i32, |m| model_size!(m, njnt);
     /// Joint axes in the body frame (`njnt x 3`).
-    jnt_axis: f64, |m| n(m.njnt) * 3;
+    jnt_axis: f64, |m| model_size!(m, njnt) * 3;
     /// Joint limits (`njnt x 2`).
-    jnt_range: f64, |m| n(m.njnt) * 2;
+    jnt_range: f64, |m| model_size!(m, njnt) * 2;
     /// Geom types (`mjtGeom`) (`ngeom`).
-    geom_type: i32, |m| n(m.ngeom);
+    geom_type: i32, |m| model_size!(m, ngeom);
     /// Ids of the geoms' bodies (`ngeom`).
-    geom_bodyid: i32, |m| n(m.ngeom);
+    geom_bodyid: i32, |m| model_size!(m, ngeom);
     /// Geom size parameters (`ngeom x 3`).
-    geom_size: f64, |m| n(m.ngeom) * 3;
+    geom_size: f64, |m| model_size!(m, ngeom) * 3;
     /// Geom positions relative to their body (`ngeom x 3`).
-    geom_pos: f64, |m| n(m.ngeom) * 3;
+    geom_pos: f64, |m| model_size!(m, ngeom) * 3;
     /// Geom orientations relative to their body, `w x y z` (`ngeom x 4`).
-    geom_quat: f64, |m| n(m.ngeom) * 4;
+    geom_quat: f64, |m| model_size!(m, ngeom) * 4;
     /// Geom friction: slide, spin, roll (`ngeom x 3`).
-    geom_friction: f64, |m| n(m.ngeom) * 3;
+    geom_friction: f64, |m| model_size!(m, ngeom) * 3;
     /// Geom colors when no material is set (`ngeom x 4`).
-    geom_rgba: f32, |m| n(m.ngeom) * 4;
+    geom_rgba: f32, |m| model_size!(m, ngeom) * 4;
     /// Site positions relative to their body (`nsite x 3`).
-    site_pos: f64, |m| n(m.nsite) * 3;
+    site_pos: f64, |m| model_size!(m, nsite) * 3;
     /// Actuator gain parameters, `mjNGAIN` (10) per actuator (`nactuator x 10`).
-    actuator_gainprm: f64, |m| n(m.nactuator) * ffi::mjNGAIN as usize;
+    actuator_gainprm: f64, |m| model_size!(m, nactuator) * sys::NGAIN;
     /// Actuator bias parameters, `mjNBIAS` (10) per actuator (`nactuator x 10`).
-    actuator_biasprm: f64, |m| n(m.nactuator) * ffi::mjNBIAS as usize;
+    actuator_biasprm: f64, |m| model_size!(m, nactuator) * sys::NBIAS;
     /// Default pose (`nq`).
-    qpos0: f64, |m| n(m.nq);
+    qpos0: f64, |m| model_size!(m, nq);
     /// Keyframe times (`nkey`).
-    key_time: f64, |m| n(m.nkey);
+    key_time: f64, |m| model_size!(m, nkey);
     /// Keyframe positions (`nkey x nq`).
-    key_qpos: f64, |m| n(m.nkey) * n(m.nq);
+    key_qpos: f64, |m| model_size!(m, nkey) * model_size!(m, nq);
 }
 
 /// `len` elements at `ptr`, or an empty slice when `len` is 0 (MuJoCo may leave such
@@ -647,31 +780,10 @@ impl CompiledModel {
     /// assert!((contacts[0].dist + 0.05).abs() < 1e-9);
     /// ```
     pub fn initial_contacts(&self) -> Vec<Contact> {
-        let m = std::ptr::from_ref(self.raw());
-        // SAFETY: `m` is a live compiled model; `mj_makeData` returns null or data sized
-        // for it, which `mj_forward` fills and we free before returning. `contact` holds
-        // `ncon` entries after `mj_forward`.
-        unsafe {
-            let d = ffi::mj_makeData(m);
-            if d.is_null() {
-                return Vec::new();
-            }
-            ffi::mj_forward(m, d);
-            let n = usize::try_from((*d).ncon).unwrap_or(0);
-            let contacts = slice_or_empty((*d).contact, n)
-                .iter()
-                .map(|c| Contact {
-                    geom1: usize::try_from(c.geom[0]).unwrap_or(usize::MAX),
-                    geom2: usize::try_from(c.geom[1]).unwrap_or(usize::MAX),
-                    dist: c.dist,
-                })
-                .collect();
-            ffi::mj_deleteData(d);
-            contacts
-        }
+        sys::initial_contacts(self.raw())
     }
 
-    fn raw(&self) -> &ffi::mjModel {
+    fn raw(&self) -> &sys::Model {
         // SAFETY: `ptr` is a live model owned by `self` (see `Drop`).
         unsafe { self.ptr.as_ref() }
     }
@@ -705,28 +817,27 @@ impl CompiledModel {
     pub fn names(&self, obj: ObjType) -> Vec<String> {
         let m = self.raw();
         let count = match obj {
-            ObjType::Body => m.nbody,
-            ObjType::Joint => m.njnt,
-            ObjType::Geom => m.ngeom,
-            ObjType::Site => m.nsite,
-            ObjType::Camera => m.ncam,
-            ObjType::Light => m.nlight,
-            ObjType::Mesh => m.nmesh,
-            ObjType::Material => m.nmat,
-            ObjType::Texture => m.ntex,
-            ObjType::Tendon => m.ntendon,
-            ObjType::Actuator => m.nactuator,
-            ObjType::Sensor => m.nsensor,
-            ObjType::Equality => m.neq,
-            ObjType::Key => m.nkey,
+            ObjType::Body => model_size!(m, nbody),
+            ObjType::Joint => model_size!(m, njnt),
+            ObjType::Geom => model_size!(m, ngeom),
+            ObjType::Site => model_size!(m, nsite),
+            ObjType::Camera => model_size!(m, ncam),
+            ObjType::Light => model_size!(m, nlight),
+            ObjType::Mesh => model_size!(m, nmesh),
+            ObjType::Material => model_size!(m, nmat),
+            ObjType::Texture => model_size!(m, ntex),
+            ObjType::Tendon => model_size!(m, ntendon),
+            ObjType::Actuator => model_size!(m, nactuator),
+            ObjType::Sensor => model_size!(m, nsensor),
+            ObjType::Equality => model_size!(m, neq),
+            ObjType::Key => model_size!(m, nkey),
         };
         let count = c_int::try_from(count).unwrap_or(0);
-        let kind = obj.to_mjt() as c_int;
         (0..count)
             .map(|id| {
-                // SAFETY: the model is live; `id` is in range for `kind`; MuJoCo returns
+                // SAFETY: the model is live; `id` is in range for `obj`; MuJoCo returns
                 // null or a NUL-terminated string inside the model's names buffer.
-                let name = unsafe { ffi::mj_id2name(self.ptr.as_ptr(), kind, id) };
+                let name = unsafe { sys::id2name(m, obj, id) };
                 if name.is_null() {
                     String::new()
                 } else {
@@ -737,6 +848,20 @@ impl CompiledModel {
                 }
             })
             .collect()
+    }
+
+    /// The number of mesh vertices of the compiled model (`nmeshvert`), all meshes together.
+    ///
+    /// ```
+    /// use std::path::Path;
+    /// use mjcf_forge::mujoco::compile_str;
+    ///
+    /// let m = compile_str("<mujoco><worldbody><geom size='1'/></worldbody></mujoco>",
+    ///                     Path::new(".")).unwrap();
+    /// assert_eq!(m.mesh_vertex_count(), 0);
+    /// ```
+    pub fn mesh_vertex_count(&self) -> usize {
+        model_size!(self.raw(), nmeshvert)
     }
 
     /// The compiler's warnings, if any (MuJoCo reports them in the error buffer of a
@@ -755,7 +880,8 @@ impl CompiledModel {
         self.warnings.as_deref()
     }
 
-    /// The raw `mjModel`, read-only, for fields without an accessor here.
+    /// The raw `mjModel`, read-only, for fields without an accessor here (builds with the
+    /// feature `mujoco` only: with `mujoco-c`, no Rust copy of the layout exists).
     ///
     /// ```no_run
     /// use std::path::Path;
@@ -764,6 +890,7 @@ impl CompiledModel {
     /// let model = compile_file(Path::new("arm.xml")).unwrap();
     /// println!("timestep {}", model.ffi().opt.timestep);
     /// ```
+    #[cfg(feature = "mujoco")]
     pub fn ffi(&self) -> &ffi::mjModel {
         self.raw()
     }
@@ -817,5 +944,327 @@ mod tests {
             ]
         );
         assert_eq!(keys.len(), Sizes::LEN);
+    }
+}
+
+/// MuJoCo 3.17.0 through mujoco-rs (feature `mujoco`).
+#[cfg(feature = "mujoco")]
+mod sys {
+    use std::ffi::{CStr, c_char, c_int};
+
+    use mujoco_rs::mujoco_c as ffi;
+    use mujoco_rs::wrappers::MjVfs;
+
+    use super::{Contact, ObjType};
+
+    pub(super) type Model = ffi::mjModel;
+    pub(super) const NGAIN: usize = ffi::mjNGAIN as usize;
+    pub(super) const NBIAS: usize = ffi::mjNBIAS as usize;
+
+    /// A size field of `mjModel` as `usize`.
+    macro_rules! model_size {
+        ($m:expr, $field:ident) => {
+            crate::mujoco::n($m.$field)
+        };
+    }
+    /// An array field of `mjModel` as a pointer to `$ty`.
+    macro_rules! model_array {
+        ($m:expr, $field:ident, $ty:ty) => {
+            $m.$field.cast_const()
+        };
+    }
+    pub(super) use {model_array, model_size};
+
+    pub(super) struct Vfs(MjVfs);
+
+    impl Vfs {
+        pub(super) fn new() -> Option<Vfs> {
+            Some(Vfs(MjVfs::new()))
+        }
+
+        /// Adds `bytes` (`len` of them) under `name`; MuJoCo's return code.
+        pub(super) fn add_buffer(&mut self, name: &CStr, bytes: &[u8], len: c_int) -> c_int {
+            // SAFETY: the VFS is live (made by `mj_defaultVFS` in `MjVfs::new`); `name` is
+            // NUL-terminated; MuJoCo copies `len` (= `bytes.len()`) bytes before returning.
+            unsafe {
+                ffi::mj_addBufferVFS(self.0.ffi_mut(), name.as_ptr(), bytes.as_ptr().cast(), len)
+            }
+        }
+    }
+
+    /// # Safety
+    /// As `mj_loadXML`: `err` holds `err_len` writable bytes.
+    pub(super) unsafe fn load_xml(
+        path: &CStr,
+        vfs: Option<&Vfs>,
+        err: *mut c_char,
+        err_len: c_int,
+    ) -> *mut Model {
+        let vfs = vfs.map_or(std::ptr::null(), |v| std::ptr::from_ref(v.0.ffi()));
+        // SAFETY: see the caller's contract; `vfs` is null or live.
+        unsafe { ffi::mj_loadXML(path.as_ptr(), vfs, err, err_len) }
+    }
+
+    /// # Safety
+    /// `m` came from [`load_xml`] and is not used afterwards.
+    pub(super) unsafe fn delete_model(m: *mut Model) {
+        // SAFETY: see the contract.
+        unsafe { ffi::mj_deleteModel(m) }
+    }
+
+    pub(super) fn linked_version() -> c_int {
+        // SAFETY: `mj_version` only returns a constant.
+        unsafe { ffi::mj_version() }
+    }
+
+    pub(super) fn header_version() -> c_int {
+        ffi::mjVERSION_HEADER as c_int
+    }
+
+    /// # Safety
+    /// `id` is in range for `obj` in the live model `m`.
+    pub(super) unsafe fn id2name(m: &Model, obj: ObjType, id: c_int) -> *const c_char {
+        use ffi::mjtObj::*;
+        let kind = match obj {
+            ObjType::Body => mjOBJ_BODY,
+            ObjType::Joint => mjOBJ_JOINT,
+            ObjType::Geom => mjOBJ_GEOM,
+            ObjType::Site => mjOBJ_SITE,
+            ObjType::Camera => mjOBJ_CAMERA,
+            ObjType::Light => mjOBJ_LIGHT,
+            ObjType::Mesh => mjOBJ_MESH,
+            ObjType::Material => mjOBJ_MATERIAL,
+            ObjType::Texture => mjOBJ_TEXTURE,
+            ObjType::Tendon => mjOBJ_TENDON,
+            ObjType::Actuator => mjOBJ_ACTUATOR,
+            ObjType::Sensor => mjOBJ_SENSOR,
+            ObjType::Equality => mjOBJ_EQUALITY,
+            ObjType::Key => mjOBJ_KEY,
+        };
+        // SAFETY: see the contract.
+        unsafe { ffi::mj_id2name(std::ptr::from_ref(m), kind as c_int, id) }
+    }
+
+    pub(super) fn initial_contacts(m: &Model) -> Vec<Contact> {
+        let m = std::ptr::from_ref(m);
+        // SAFETY: `m` is a live compiled model; `mj_makeData` returns null or data sized
+        // for it, which `mj_forward` fills and we free before returning. `contact` holds
+        // `ncon` entries after `mj_forward`.
+        unsafe {
+            let d = ffi::mj_makeData(m);
+            if d.is_null() {
+                return Vec::new();
+            }
+            ffi::mj_forward(m, d);
+            let n = usize::try_from((*d).ncon).unwrap_or(0);
+            let contacts = super::slice_or_empty((*d).contact, n)
+                .iter()
+                .map(|c| Contact {
+                    geom1: usize::try_from(c.geom[0]).unwrap_or(usize::MAX),
+                    geom2: usize::try_from(c.geom[1]).unwrap_or(usize::MAX),
+                    dist: c.dist,
+                })
+                .collect();
+            ffi::mj_deleteData(d);
+            contacts
+        }
+    }
+}
+
+/// The MuJoCo a user has, through src/mujoco_shim.c (feature `mujoco-c`): the shim is
+/// compiled against that MuJoCo's headers, so nothing here knows a struct layout.
+#[cfg(feature = "mujoco-c")]
+mod sys {
+    use std::ffi::{CStr, c_char, c_int, c_void};
+    use std::ptr::NonNull;
+
+    use super::{Contact, ObjType};
+
+    /// `mjModel`, opaque: only the shim and MuJoCo look inside.
+    #[repr(C)]
+    pub(super) struct Model {
+        _opaque: [u8; 0],
+    }
+
+    /// `mjVFS`, opaque.
+    #[repr(C)]
+    struct RawVfs {
+        _opaque: [u8; 0],
+    }
+
+    /// `mjNGAIN` and `mjNBIAS` (10 in every MuJoCo 3.x and 4.0.0 header).
+    pub(super) const NGAIN: usize = 10;
+    pub(super) const NBIAS: usize = 10;
+
+    unsafe extern "C" {
+        fn mj_version() -> c_int;
+        fn mj_loadXML(
+            filename: *const c_char,
+            vfs: *const RawVfs,
+            error: *mut c_char,
+            error_sz: c_int,
+        ) -> *mut Model;
+        fn mj_deleteModel(m: *mut Model);
+        fn mj_addBufferVFS(
+            vfs: *mut RawVfs,
+            name: *const c_char,
+            buffer: *const c_void,
+            nbuffer: c_int,
+        ) -> c_int;
+        fn mj_id2name(m: *const Model, kind: c_int, id: c_int) -> *const c_char;
+        fn mjf_header_version() -> c_int;
+        fn mjf_model_size(m: *const Model, name: *const c_char) -> i64;
+        fn mjf_model_array(
+            m: *const Model,
+            name: *const c_char,
+            elem_size: *mut usize,
+        ) -> *const c_void;
+        fn mjf_vfs_new() -> *mut RawVfs;
+        fn mjf_vfs_free(vfs: *mut RawVfs);
+        fn mjf_obj_type(kind: *const c_char) -> c_int;
+        fn mjf_initial_contacts(
+            m: *const Model,
+            max: c_int,
+            geom1: *mut c_int,
+            geom2: *mut c_int,
+            dist: *mut f64,
+        ) -> c_int;
+    }
+
+    /// A size field of `mjModel` as `usize`.
+    macro_rules! model_size {
+        ($m:expr, $field:ident) => {
+            crate::mujoco::sys::size($m, concat!(stringify!($field), "\0"))
+        };
+    }
+    /// An array field of `mjModel` as a pointer to `$ty`.
+    macro_rules! model_array {
+        ($m:expr, $field:ident, $ty:ty) => {
+            crate::mujoco::sys::array::<$ty>($m, concat!(stringify!($field), "\0"))
+        };
+    }
+    pub(super) use {model_array, model_size};
+
+    /// The size field `name` (NUL-terminated). A name this MuJoCo does not have is a bug of
+    /// this module (the field lists are fixed): it panics, naming the field.
+    pub(super) fn size(m: &Model, name: &'static str) -> usize {
+        // SAFETY: `m` is live; `name` is NUL-terminated (the macros add the NUL).
+        let v = unsafe { mjf_model_size(m, name.as_ptr().cast()) };
+        usize::try_from(v).unwrap_or_else(|_| {
+            panic!(
+                "this MuJoCo's mjModel has no size field {}",
+                name.trim_end_matches('\0')
+            )
+        })
+    }
+
+    /// The array field `name` (NUL-terminated) as `*const T`, checked against the element
+    /// size MuJoCo's headers give; panics on a field this MuJoCo does not have.
+    pub(super) fn array<T>(m: &Model, name: &'static str) -> *const T {
+        let mut elem = 0usize;
+        // SAFETY: `m` is live; `name` is NUL-terminated; `elem` is writable.
+        let ptr = unsafe { mjf_model_array(m, name.as_ptr().cast(), &mut elem) };
+        let field = name.trim_end_matches('\0');
+        assert!(elem != 0, "this MuJoCo's mjModel has no array {field}");
+        assert_eq!(
+            elem,
+            std::mem::size_of::<T>(),
+            "mjModel.{field}: element size in MuJoCo's headers differs from ours"
+        );
+        ptr.cast()
+    }
+
+    /// A VFS owned by us, freed with `mj_deleteVFS`.
+    pub(super) struct Vfs(NonNull<RawVfs>);
+
+    impl Vfs {
+        pub(super) fn new() -> Option<Vfs> {
+            // SAFETY: returns null or a VFS initialised by `mj_defaultVFS`.
+            NonNull::new(unsafe { mjf_vfs_new() }).map(Vfs)
+        }
+
+        /// Adds `bytes` (`len` of them) under `name`; MuJoCo's return code.
+        pub(super) fn add_buffer(&mut self, name: &CStr, bytes: &[u8], len: c_int) -> c_int {
+            // SAFETY: the VFS is live and ours; `name` is NUL-terminated; MuJoCo copies
+            // `len` (= `bytes.len()`) bytes before returning.
+            unsafe { mj_addBufferVFS(self.0.as_ptr(), name.as_ptr(), bytes.as_ptr().cast(), len) }
+        }
+    }
+
+    impl Drop for Vfs {
+        fn drop(&mut self) {
+            // SAFETY: made by `mjf_vfs_new`, freed once, here.
+            unsafe { mjf_vfs_free(self.0.as_ptr()) }
+        }
+    }
+
+    /// # Safety
+    /// As `mj_loadXML`: `err` holds `err_len` writable bytes.
+    pub(super) unsafe fn load_xml(
+        path: &CStr,
+        vfs: Option<&Vfs>,
+        err: *mut c_char,
+        err_len: c_int,
+    ) -> *mut Model {
+        let vfs = vfs.map_or(std::ptr::null(), |v| v.0.as_ptr().cast_const());
+        // SAFETY: see the caller's contract; `vfs` is null or live.
+        unsafe { mj_loadXML(path.as_ptr(), vfs, err, err_len) }
+    }
+
+    /// # Safety
+    /// `m` came from [`load_xml`] and is not used afterwards.
+    pub(super) unsafe fn delete_model(m: *mut Model) {
+        // SAFETY: see the contract.
+        unsafe { mj_deleteModel(m) }
+    }
+
+    pub(super) fn linked_version() -> c_int {
+        // SAFETY: `mj_version` only returns a constant.
+        unsafe { mj_version() }
+    }
+
+    pub(super) fn header_version() -> c_int {
+        // SAFETY: returns a constant of the headers the shim was compiled with.
+        unsafe { mjf_header_version() }
+    }
+
+    /// # Safety
+    /// `id` is in range for `obj` in the live model `m`.
+    pub(super) unsafe fn id2name(m: &Model, obj: ObjType, id: c_int) -> *const c_char {
+        let kind = format!("{}\0", obj.as_str());
+        // SAFETY: `kind` is NUL-terminated.
+        let code = unsafe { mjf_obj_type(kind.as_ptr().cast()) };
+        // SAFETY: see the contract; `code` is MuJoCo's own mjtObj value.
+        unsafe { mj_id2name(m, code, id) }
+    }
+
+    pub(super) fn initial_contacts(m: &Model) -> Vec<Contact> {
+        let mut cap = 64;
+        loop {
+            let (mut g1, mut g2, mut dist) = (vec![0; cap], vec![0; cap], vec![0.0; cap]);
+            // SAFETY: `m` is live; the three buffers hold `cap` elements each.
+            let n = unsafe {
+                mjf_initial_contacts(
+                    m,
+                    c_int::try_from(cap).unwrap_or(c_int::MAX),
+                    g1.as_mut_ptr(),
+                    g2.as_mut_ptr(),
+                    dist.as_mut_ptr(),
+                )
+            };
+            let Ok(n) = usize::try_from(n) else {
+                return Vec::new();
+            };
+            if n <= cap {
+                return (0..n)
+                    .map(|i| Contact {
+                        geom1: usize::try_from(g1[i]).unwrap_or(usize::MAX),
+                        geom2: usize::try_from(g2[i]).unwrap_or(usize::MAX),
+                        dist: dist[i],
+                    })
+                    .collect();
+            }
+            cap = n;
+        }
     }
 }

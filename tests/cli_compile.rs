@@ -1,7 +1,7 @@
 //! `mjcf-forge compile` and `inline --validate` (cargo feature `mujoco`): sizes agree with
 //! Python MuJoCo on the whole wheel corpus; compile errors carry MuJoCo's message and the
 //! position of our element.
-#![cfg(feature = "mujoco")]
+#![cfg(mjcf_mujoco)]
 
 mod common;
 
@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use common::{forge, path_arg, python, root, scratch, stderr, stdout, wheel_models};
+use common::{forge, path_arg, python_linked, root, scratch, stderr, stdout, wheel_models};
 use mjcf_forge::Document;
 
 /// A JSON value of the flat objects both sides print.
@@ -107,7 +107,7 @@ fn python_sizes(paths: &[PathBuf], dir: &Path) -> Vec<BTreeMap<String, Value>> {
     let list = dir.join("models.txt");
     let body: String = paths.iter().map(|p| format!("{}\n", p.display())).collect();
     std::fs::write(&list, body).unwrap();
-    let out = Command::new(python())
+    let out = Command::new(python_linked())
         .arg(root().join("scripts/sizes.py"))
         .arg("--list")
         .arg(&list)

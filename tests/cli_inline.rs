@@ -357,7 +357,7 @@ fn an_unwritable_output_is_an_error_not_a_panic() {
 }
 
 /// A build without MuJoCo says so, and `--validate` then writes nothing.
-#[cfg(not(feature = "mujoco"))]
+#[cfg(not(mjcf_mujoco))]
 #[test]
 fn compile_and_validate_need_the_mujoco_feature() {
     const MESSAGE: &str = "built without the `mujoco` feature; rebuild with --features mujoco";

@@ -36,6 +36,9 @@ fn same_asset_name_with_other_content_names_both_origins() {
     );
 }
 
+/// Without MuJoCo, mass settings have no conversion (builds with MuJoCo write the part's
+/// inertias out: merge_judge, objects_mass_settings_into_arm).
+#[cfg(not(mjcf_mujoco))]
 #[test]
 fn compiler_settings_without_exact_conversion_are_refused() {
     assert_eq!(
@@ -85,4 +88,66 @@ fn identical_assets_are_shared_and_base_settings_win_with_warnings() {
     let xml = base.to_xml_string();
     assert_eq!(xml.matches("<material name=\"red\"").count(), 1);
     assert!(xml.contains("<size nuser_geom=\"2\"/>"));
+}
+
+#[test]
+fn keys_with_plastic_state_are_refused() {
+    // MuJoCo 4.0.0 reads this part (one plastic value for the yielding joint); its layout in
+    // the merged model is not modelled, so the merge refuses instead of copying it.
+    assert_eq!(
+        merge_error(
+            "corpora/errors/merge/part_key_plastic.xml",
+            "p_",
+            Some("hand")
+        ),
+        "corpora/errors/merge/part_key_plastic.xml:9:5: key plastic (MuJoCo 4.0's plastic state) cannot be remapped onto the merged model; remove it before merging"
+    );
+}
+
+/// Without MuJoCo, a part with another inertiagrouprange merges only when none of its bodies
+/// infers its inertia from geoms; builds with MuJoCo write those inertias out instead
+/// (merge_judge: objects_inertiagroups_4_5_into_arm).
+#[test]
+fn inertiagrouprange_converts_when_no_body_infers_inertia() {
+    let mut base = load("corpora/errors/merge/base.xml");
+    let part = Document::from_str(
+        r#"<mujoco><compiler inertiagrouprange="4 5"/><worldbody>
+  <body name="w" pos="0 0 1"><freejoint/><inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>
+    <geom size="0.1" group="1"/></body>
+  <body name="empty"/>
+</worldbody></mujoco>"#,
+        root(),
+    )
+    .unwrap();
+    base.merge(&part, None, &MergeOptions::default()).unwrap();
+}
+
+#[cfg(not(mjcf_mujoco))]
+#[test]
+fn inertiagrouprange_with_inferred_inertia_is_refused_without_mujoco() {
+    assert_eq!(
+        merge_error("corpora/merge/objects_inertiagroups_4_5.xml", "p_", None),
+        "corpora/merge/objects_inertiagroups_4_5.xml:7:3: cannot merge: compiler inertiagrouprange=\"4 5\" differs from the base's \"0 5\" and has no exact conversion"
+    );
+}
+
+/// A base that rescales or bounds masses itself would change the part's written inertias
+/// too: refused in every build, naming the setting.
+#[test]
+fn mass_settings_of_the_base_are_never_converted() {
+    let mut base = Document::from_str(
+        r#"<mujoco><compiler settotalmass="5"/><worldbody><body name="hand" pos="0 0 1">
+  <joint name="wrist"/><geom size="0.05"/></body></worldbody></mujoco>"#,
+        root(),
+    )
+    .unwrap();
+    let part = load("corpora/errors/merge/part_settotalmass.xml");
+    let err = base
+        .merge(&part, None, &MergeOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        err,
+        "corpora/errors/merge/part_settotalmass.xml:2:3: cannot merge: compiler settotalmass=\"2\" differs from the base's \"5\" and has no exact conversion"
+    );
 }

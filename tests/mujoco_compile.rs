@@ -2,7 +2,7 @@
 //!
 //! Expected sizes, names and arrays of `ARM` were taken from the Python bindings of the
 //! same library (PyPI mujoco==3.17.0, `mujoco.MjModel.from_xml_string`).
-#![cfg(feature = "mujoco")]
+#![cfg(mjcf_mujoco)]
 
 use std::path::Path;
 use std::sync::Arc;
@@ -231,7 +231,7 @@ fn compile_file_resolves_assets_next_to_the_file() {
         (s.nbody, s.njnt, s.ngeom, s.nmesh, s.nq, s.nv),
         (2, 1, 1, 1, 7, 6)
     );
-    assert_eq!(model.ffi().nmeshvert, 4);
+    assert_eq!(model.mesh_vertex_count(), 4);
     assert_eq!(model.names(ObjType::Mesh), ["tet"]);
     assert_eq!(model.body_pos()[3..], [0.0, 0.0, 1.0]);
 }
@@ -242,8 +242,8 @@ fn compile_str_resolves_assets_against_dir() {
     let cube = write_mesh_dir(CUBE_OBJ);
     let from_tet = compile_str(MESH_MODEL, tet.path()).unwrap();
     let from_cube = compile_str(MESH_MODEL, cube.path()).unwrap();
-    assert_eq!(from_tet.ffi().nmeshvert, 4);
-    assert_eq!(from_cube.ffi().nmeshvert, 8);
+    assert_eq!(from_tet.mesh_vertex_count(), 4);
+    assert_eq!(from_cube.mesh_vertex_count(), 8);
     // Nothing was written into the directory.
     let entries: Vec<_> = std::fs::read_dir(tet.path()).unwrap().collect();
     assert_eq!(entries.len(), 1);
@@ -401,5 +401,24 @@ fn eight_threads_compile_concurrently() {
         .collect();
     for handle in handles {
         handle.join().unwrap();
+    }
+}
+
+/// The build links the MuJoCo its feature selects: `castshadow` is a geom attribute from
+/// MuJoCo 4.0.0 on, which 3.17.0's schema rejects. (With `mujoco-c` and
+/// `MJCF_FORGE_MUJOCO_DIR` pointing at another MuJoCo, this test names the mismatch.)
+#[test]
+fn linked_mujoco_is_the_selected_version() {
+    let xml = r#"<mujoco><worldbody><geom size="1" castshadow="false"/></worldbody></mujoco>"#;
+    let got = compile_str(xml, here());
+    if cfg!(feature = "mujoco-c") {
+        let model = got.expect("MuJoCo 4.0.0 reads castshadow");
+        assert_eq!(model.sizes().ngeom, 1);
+    } else {
+        let err = got.expect_err("MuJoCo 3.17.0 has no castshadow");
+        assert!(
+            err.message.contains("unrecognized attribute: 'castshadow'"),
+            "{err}"
+        );
     }
 }

@@ -452,7 +452,7 @@ fn placed_objects_keep_their_physics() {
     );
 }
 
-#[cfg(feature = "mujoco")]
+#[cfg(mjcf_mujoco)]
 mod with_mujoco {
     use super::*;
     use mjcf_forge::mujoco::{ObjType, compile_file};

@@ -4,10 +4,10 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-#[cfg(feature = "mujoco")]
+#[cfg(mjcf_mujoco)]
 use std::io::Write as _;
 
-#[cfg(any(feature = "mujoco", test))]
+#[cfg(any(mjcf_mujoco, test))]
 use mjcf_forge::Document;
 
 #[derive(clap::Args)]
@@ -24,7 +24,7 @@ pub fn run(args: Args) -> ExitCode {
 }
 
 /// `compile IN [--json]`.
-#[cfg(feature = "mujoco")]
+#[cfg(mjcf_mujoco)]
 fn compile(input: &Path, json: bool) -> ExitCode {
     let doc = match Document::load(input) {
         Ok(doc) => doc,
@@ -70,7 +70,7 @@ fn compile(input: &Path, json: bool) -> ExitCode {
 }
 
 /// `compile` in a build without MuJoCo: says how to get one.
-#[cfg(not(feature = "mujoco"))]
+#[cfg(not(mjcf_mujoco))]
 fn compile(_input: &Path, _json: bool) -> ExitCode {
     eprintln!("mjcf-forge: compile: {}", super::NO_MUJOCO);
     ExitCode::from(super::USAGE)
@@ -84,7 +84,7 @@ fn compile(_input: &Path, _json: bool) -> ExitCode {
 /// sources: `robot.xml:12:7: Error: mesh 'nope' not found in geom 0` followed by the rest
 /// of MuJoCo's message (whose own `line N` counts lines of the generated XML) and by the
 /// include chain, as for load errors.
-#[cfg(feature = "mujoco")]
+#[cfg(mjcf_mujoco)]
 pub fn compile_document(doc: &Document) -> Result<mjcf_forge::mujoco::CompiledModel, String> {
     let xml = doc.to_pretty_string();
     mjcf_forge::mujoco::compile_str(&xml, doc.model_dir()).map_err(|err| {
@@ -116,7 +116,7 @@ pub fn compile_document(doc: &Document) -> Result<mjcf_forge::mujoco::CompiledMo
 /// line), because the writers escape `<` in attribute values and text; the only other
 /// markup they emit is closing tags and CDATA sections, which are skipped whole. (Counting
 /// lines that start with `<` would miscount inside mixed content and CDATA.)
-#[cfg(any(feature = "mujoco", test))]
+#[cfg(any(mjcf_mujoco, test))]
 fn element_starts(xml: &str) -> Vec<(u32, usize)> {
     let bytes = xml.as_bytes();
     let mut starts = Vec::new();
@@ -155,7 +155,7 @@ fn element_starts(xml: &str) -> Vec<(u32, usize)> {
 /// (the document's own rendering). When several share the line (mixed content), the one
 /// whose tag or name matches MuJoCo's `Element 'geom'` / `Element name 'g'` wins, else
 /// the first; when none starts there, the last one that starts before it.
-#[cfg(any(feature = "mujoco", test))]
+#[cfg(any(mjcf_mujoco, test))]
 fn element_at_line(
     doc: &Document,
     xml: &str,
@@ -191,7 +191,7 @@ fn element_at_line(
 }
 
 /// The text between `marker` and the next `'`.
-#[cfg(any(feature = "mujoco", test))]
+#[cfg(any(mjcf_mujoco, test))]
 fn quoted_after<'a>(text: &'a str, marker: &str) -> Option<&'a str> {
     let rest = &text[text.find(marker)? + marker.len()..];
     rest.find('\'').map(|end| &rest[..end])
@@ -199,7 +199,7 @@ fn quoted_after<'a>(text: &'a str, marker: &str) -> Option<&'a str> {
 
 /// The source position of `node`, or of its nearest ancestor that has one (elements made
 /// while loading, such as a section created on demand, have none: line 0).
-#[cfg(any(feature = "mujoco", test))]
+#[cfg(any(mjcf_mujoco, test))]
 fn source_location(doc: &Document, node: mjcf_forge::Node) -> Option<mjcf_forge::Location> {
     std::iter::successors(Some(node), |&n| doc.parent(n))
         .map(|n| doc.location(n))

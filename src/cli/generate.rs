@@ -304,14 +304,14 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
     Ok(summary)
 }
 
-#[cfg(feature = "mujoco")]
+#[cfg(mjcf_mujoco)]
 fn check(i: u64, params: &Params, xml: &str, dir: &Path) -> Result<Duration, String> {
     let t = Instant::now();
     mjcf_forge::scene::check_variant(i, params, xml, dir)?;
     Ok(t.elapsed())
 }
 
-#[cfg(not(feature = "mujoco"))]
+#[cfg(not(mjcf_mujoco))]
 fn check(_: u64, _: &Params, _: &str, _: &Path) -> Result<Duration, String> {
     Err(super::NO_MUJOCO.to_owned())
 }

@@ -92,7 +92,7 @@ pub fn refuse_validate_without_mujoco(validate: bool) -> Option<ExitCode> {
 
 /// `Ok` when this binary can compile with MuJoCo, else the reason it cannot.
 fn require_mujoco() -> Result<(), String> {
-    if cfg!(feature = "mujoco") {
+    if cfg!(mjcf_mujoco) {
         Ok(())
     } else {
         Err(NO_MUJOCO.to_owned())
@@ -104,11 +104,11 @@ fn require_mujoco() -> Result<(), String> {
 /// prefixed with the position of the element it names (see
 /// [`compile::compile_document`]).
 pub fn validate(doc: &Document) -> Result<(), String> {
-    #[cfg(feature = "mujoco")]
+    #[cfg(mjcf_mujoco)]
     {
         compile::compile_document(doc).map(drop)
     }
-    #[cfg(not(feature = "mujoco"))]
+    #[cfg(not(mjcf_mujoco))]
     {
         let _ = doc;
         Err(NO_MUJOCO.to_owned())

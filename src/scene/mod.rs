@@ -24,7 +24,7 @@
 //! The scene file is TOML; `corpora/scenes/demo/demo.toml` is a commented example and the
 //! README describes every key.
 
-#[cfg(feature = "mujoco")]
+#[cfg(mjcf_mujoco)]
 mod check;
 mod demo;
 mod load;
@@ -46,7 +46,7 @@ use crate::error::{Error, ErrorKind, Errors, Location};
 use crate::merge::MergePart;
 use crate::tree::Node;
 
-#[cfg(feature = "mujoco")]
+#[cfg(mjcf_mujoco)]
 pub use check::{PENETRATION_TOLERANCE, check_variant};
 pub use params::{Params, PlacedObject, RandomizedValue};
 pub use randomize::MUJOCO_DEFAULTS;

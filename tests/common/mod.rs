@@ -1,5 +1,5 @@
-//! Shared test helpers: the MuJoCo judge (tests/judge/judge.py in the setup's venv) and
-//! the wheel corpus listed by scripts/setup.sh.
+//! Shared test helpers: the MuJoCo judges (tests/judge/*.py, run under every MuJoCo version
+//! that scripts/setup.sh installs, one venv each, in parallel) and the wheel corpus it lists.
 
 #![allow(dead_code)]
 
@@ -11,27 +11,130 @@ pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// The venv's Python, which has the pinned `mujoco`. Missing setup is a failure, not a skip.
+/// The venv's Python, which has the pinned `mujoco` 3.17.0. Missing setup is a failure, not
+/// a skip.
 pub fn python() -> PathBuf {
-    let p = root().join(".cache/venv/bin/python");
-    assert!(
-        p.exists(),
-        "{} is missing: run scripts/setup.sh first",
-        p.display()
-    );
-    p
+    JUDGES[0].python()
 }
 
-/// Every MJCF file of the robosuite and dm-control wheels that MuJoCo compiles on its own.
-pub fn wheel_models() -> Vec<PathBuf> {
-    let list = root().join(".cache/corpus/models.txt");
-    let text = std::fs::read_to_string(&list)
-        .unwrap_or_else(|e| panic!("{}: {e}: run scripts/setup.sh first", list.display()));
-    let models: Vec<PathBuf> = text
-        .lines()
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| root().join(l))
+/// The Python whose MuJoCo is the one this test build links: 4.0.0's venv with the feature
+/// `mujoco-c` (its default library), else 3.17.0's.
+pub fn python_linked() -> PathBuf {
+    linked_judge().python()
+}
+
+/// The judge of the MuJoCo version this test build links (see [`python_linked`]).
+pub fn linked_judge() -> &'static Judge {
+    if cfg!(feature = "mujoco-c") {
+        &JUDGES[1]
+    } else {
+        &JUDGES[0]
+    }
+}
+
+/// One MuJoCo version that judges outputs: its venv (made by scripts/setup.sh) and the list
+/// of wheel models that compile under it.
+pub struct Judge {
+    /// The `mujoco` version installed in the venv.
+    pub version: &'static str,
+    venv: &'static str,
+    models_list: &'static str,
+}
+
+/// Every judging MuJoCo: what we write must compile under each to what its input compiles to
+/// under that same version.
+pub const JUDGES: [Judge; 2] = [
+    Judge {
+        version: "3.17.0",
+        venv: ".cache/venv",
+        models_list: "models.txt",
+    },
+    Judge {
+        version: "4.0.0",
+        venv: ".cache/venv-mj4",
+        models_list: "models-mj4.txt",
+    },
+];
+
+impl Judge {
+    /// The venv's Python. Missing setup is a failure, not a skip.
+    pub fn python(&self) -> PathBuf {
+        let p = root().join(self.venv).join("bin/python");
+        assert!(
+            p.exists(),
+            "{} is missing: run scripts/setup.sh first",
+            p.display()
+        );
+        p
+    }
+
+    /// The wheel models that this MuJoCo compiles on their own.
+    pub fn wheel_models(&self) -> Vec<PathBuf> {
+        let list = root().join(".cache/corpus").join(self.models_list);
+        let text = std::fs::read_to_string(&list)
+            .unwrap_or_else(|e| panic!("{}: {e}: run scripts/setup.sh first", list.display()));
+        text.lines()
+            .filter(|l| !l.trim().is_empty())
+            .map(|l| root().join(l))
+            .collect()
+    }
+
+    /// Whether this MuJoCo judges a pair whose input is `a`: every file of ours, and the
+    /// wheel models it compiles (a wheel model that only the other version compiles has no
+    /// reference here).
+    fn judges_input(&self, a: &Path, own_models: &[PathBuf]) -> bool {
+        !a.starts_with(root().join(".cache/corpus")) || own_models.iter().any(|m| m == a)
+    }
+}
+
+/// The one MuJoCo version that reads a case of ours, from its marker
+/// `mjcf-forge-judge: <version>-only` (a case about a difference between versions: the
+/// other versions must reject its input, which the judge checks, and judge nothing else).
+pub fn only_version(case: &Path) -> Option<String> {
+    const MARKER: &str = "mjcf-forge-judge: ";
+    let text = std::fs::read_to_string(case).ok()?;
+    let at = text.find(MARKER)? + MARKER.len();
+    let version = text[at..]
+        .split_whitespace()
+        .next()?
+        .strip_suffix("-only")?;
+    assert!(
+        JUDGES.iter().any(|j| j.version == version),
+        "{}: no judge for MuJoCo {version}",
+        case.display()
+    );
+    Some(version.to_string())
+}
+
+/// Runs `script args...` under every judging MuJoCo at once (one process each) and returns
+/// each judge with its output, in [`JUDGES`] order.
+pub fn run_each_judge(
+    args: impl Fn(&Judge) -> Vec<std::ffi::OsString>,
+) -> Vec<(&'static Judge, std::process::Output)> {
+    let children: Vec<_> = JUDGES
+        .iter()
+        .map(|j| {
+            let child = Command::new(j.python())
+                .args(args(j))
+                .stdout(std::process::Stdio::piped())
+                .stderr(std::process::Stdio::piped())
+                .spawn()
+                .unwrap_or_else(|e| panic!("run the MuJoCo {} judge: {e}", j.version));
+            (j, child)
+        })
         .collect();
+    children
+        .into_iter()
+        .map(|(j, child)| (j, child.wait_with_output().expect("wait for a judge")))
+        .collect()
+}
+
+/// Every MJCF file of the robosuite and dm-control wheels that MuJoCo compiles on its own,
+/// under any judging version.
+pub fn wheel_models() -> Vec<PathBuf> {
+    let mut models: Vec<PathBuf> = JUDGES.iter().flat_map(Judge::wheel_models).collect();
+    models.sort();
+    models.dedup();
     assert!(
         models.len() >= 100,
         "expected the full wheel corpus, found {} models",
@@ -56,35 +159,61 @@ pub struct Pair {
     pub prefix: String,
 }
 
-/// Runs the judge on all pairs in one process; returns the lines of failed pairs.
+/// Runs the judge under every judging MuJoCo (in parallel, all pairs in one process per
+/// version); returns the lines of failed pairs, each starting with `[MuJoCo <version>]`.
 pub fn judge(pairs: &[Pair], scratch_dir: &Path) -> Vec<String> {
-    let tsv = scratch_dir.join("pairs.tsv");
-    let body: String = pairs
-        .iter()
-        .map(|p| format!("{}\t{}\t{}\n", p.a.display(), p.b.display(), p.prefix))
-        .collect();
-    std::fs::write(&tsv, body).unwrap();
-    let out = Command::new(python())
-        .arg(root().join("tests/judge/judge.py"))
-        .arg("--pairs")
-        .arg(&tsv)
-        .arg("--verbose")
-        .output()
-        .expect("run the judge");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    let summary = stdout.lines().last().unwrap_or("").to_string();
-    let expected = format!("{} passed, 0 failed", pairs.len());
-    if out.status.success() && summary == expected {
-        return Vec::new();
+    let mut counts = Vec::new();
+    for j in &JUDGES {
+        let own = j.wheel_models();
+        let body: String = pairs
+            .iter()
+            .filter(|p| j.judges_input(&p.a, &own))
+            .map(|p| {
+                let mode = match only_version(&p.a) {
+                    Some(v) if v != j.version => "a-rejected",
+                    _ => "same",
+                };
+                format!(
+                    "{}\t{}\t{}\t{mode}\n",
+                    p.a.display(),
+                    p.b.display(),
+                    p.prefix
+                )
+            })
+            .collect();
+        counts.push(body.lines().count());
+        std::fs::write(scratch_dir.join(format!("pairs-{}.tsv", j.version)), body).unwrap();
     }
-    let mut failed: Vec<String> = stdout
-        .lines()
-        .filter(|l| !l.starts_with("ok "))
-        .map(str::to_string)
-        .collect();
-    if failed.is_empty() {
-        failed.push(format!("judge exited with {}: {stderr}", out.status));
+    let runs = run_each_judge(|j| {
+        vec![
+            root().join("tests/judge/judge.py").into(),
+            "--pairs".into(),
+            scratch_dir.join(format!("pairs-{}.tsv", j.version)).into(),
+            "--verbose".into(),
+        ]
+    });
+    let mut failed = Vec::new();
+    for ((j, out), count) in runs.into_iter().zip(counts) {
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        let summary = stdout.lines().last().unwrap_or("").to_string();
+        let expected = format!("{count} passed, 0 failed");
+        if out.status.success() && summary == expected {
+            continue;
+        }
+        let before = failed.len();
+        failed.extend(
+            stdout
+                .lines()
+                .filter(|l| !l.starts_with("ok "))
+                .map(|l| format!("[MuJoCo {}] {l}", j.version)),
+        );
+        if failed.len() == before {
+            failed.push(format!(
+                "[MuJoCo {}] judge exited with {}: {stderr}",
+                j.version, out.status
+            ));
+        }
     }
     failed
 }

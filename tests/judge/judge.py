@@ -24,9 +24,12 @@ Library:  compare(path_a, path_b, prefix="") -> list[str]   ([] = equivalent)
 CLI:      python tests/judge/judge.py A.xml B.xml [--prefix P]
           prints the differences, exits 1 if any (2 on bad usage).
 Batch:    python tests/judge/judge.py --pairs FILE.tsv [--json] [--verbose]
-          each non-blank line not starting with '#' is A<TAB>B[<TAB>PREFIX]
-          (paths relative to the current directory; prefix may be empty or
-          left out).  All pairs run in one process.  Prints one summary line per
+          each non-blank line not starting with '#' is A<TAB>B[<TAB>PREFIX
+          [<TAB>MODE]] (paths relative to the current directory; prefix may be
+          empty or left out). MODE "same" (the default) compares as above;
+          MODE "a-rejected" passes when this MuJoCo rejects A, and says so
+          otherwise: a case written for another MuJoCo version, whose input
+          has no meaning under this one, must really be rejected by it.  All pairs run in one process.  Prints one summary line per
           pair (with --json: one JSON object per line, keys a, b, prefix, ok,
           differences), then a final line "N passed, M failed"; exits 1 when
           any pair failed.
@@ -343,29 +346,50 @@ def compare(path_a: str | Path, path_b: str | Path, prefix: str = "",
 # ---------------------------------------------------------------------------
 # CLI
 # ---------------------------------------------------------------------------
-def _read_pairs(path: str) -> list[tuple[str, str, str]]:
+MODES = ("same", "a-rejected")
+
+
+def _read_pairs(path: str) -> list[tuple[str, str, str, str]]:
     pairs = []
     for lineno, line in enumerate(Path(path).read_text().splitlines(), 1):
         if not line.strip() or line.startswith("#"):
             continue
         cols = line.split("\t")
-        if len(cols) < 2 or len(cols) > 3 or not cols[0] or not cols[1]:
-            raise SystemExit(f"{path}:{lineno}: expected A<TAB>B[<TAB>PREFIX], got {line!r}")
-        pairs.append((cols[0], cols[1], cols[2] if len(cols) == 3 else ""))
+        if len(cols) < 2 or len(cols) > 4 or not cols[0] or not cols[1] \
+                or (len(cols) == 4 and cols[3] not in MODES):
+            raise SystemExit(f"{path}:{lineno}: expected A<TAB>B[<TAB>PREFIX[<TAB>MODE]] "
+                             f"with MODE one of {MODES}, got {line!r}")
+        cols += [""] * (3 - len(cols)) + (["same"] if len(cols) < 4 else [])
+        pairs.append((cols[0], cols[1], cols[2], cols[3]))
     return pairs
+
+
+def rejected(path_a: str | Path) -> list[str]:
+    """[] when this MuJoCo rejects A, else the difference to report."""
+    try:
+        load(path_a, True)
+    except CompileError:
+        return []
+    return [f"A ({path_a}) compiles under MuJoCo {mujoco.__version__}, "
+            "but the case says this version rejects it"]
 
 
 def _batch(pairs_file: str, as_json: bool, verbose: bool) -> int:
     passed = failed = 0
-    for a, b, prefix in _read_pairs(pairs_file):
-        diffs = compare(a, b, prefix, cache=True)  # an A often recurs across pairs
+    for a, b, prefix, mode in _read_pairs(pairs_file):
+        if mode == "a-rejected":
+            diffs = rejected(a)
+        else:
+            diffs = compare(a, b, prefix, cache=True)  # an A often recurs across pairs
         ok = not diffs
         passed += ok
         failed += not ok
         if as_json:
-            print(json.dumps({"a": a, "b": b, "prefix": prefix, "ok": ok, "differences": diffs}))
+            print(json.dumps({"a": a, "b": b, "prefix": prefix, "mode": mode, "ok": ok,
+                              "differences": diffs}))
         else:
-            what = f"{a} {b}" + (f" (prefix {prefix!r})" if prefix else "")
+            what = f"{a} {b}" + (f" (prefix {prefix!r})" if prefix else "") \
+                + (f" [{mode}]" if mode != "same" else "")
             if ok:
                 print(f"ok   {what}")
             else:

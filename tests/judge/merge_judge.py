@@ -233,7 +233,12 @@ def _trn(m: mujoco.MjModel, i: int):
     return TRN_KINDS.get(int(m.actuator_trntype[i]), (None, None))
 
 
+# MuJoCo 4.0.0 gives flexes one material per element (changelog 4.0.0, item 16):
+# flex_matid became (nflexelem x 1); before, it was (nflex x 1).
+MJ4 = tuple(int(x) for x in mujoco.__version__.split(".")[:2]) >= (4, 0)
+
 REFS: dict[str, Rule] = {
+    **({} if MJ4 else {"flex_matid": _k("material")}),
     "body_parentid": _k("body"), "body_rootid": _k("body"), "body_weldid": _k("body"),
     "body_jntadr": _k("joint"), "body_dofadr": _k("dof"), "body_geomadr": _k("geom"),
     "body_treeid": _k("tree"), "body_plugin": _k("plugin"),
@@ -246,7 +251,6 @@ REFS: dict[str, Rule] = {
     "site_bodyid": _k("body"), "site_dataid": _k("mesh"), "site_matid": _k("material"),
     "cam_bodyid": _k("body"), "cam_targetbodyid": _k("body"),
     "light_bodyid": _k("body"), "light_targetbodyid": _k("body"), "light_texid": _k("texture"),
-    "flex_matid": _k("material"),
     "skin_matid": _k("material"),
     "mat_texid": _k("texture"),
     "pair_geom1": _k("geom"), "pair_geom2": _k("geom"), "pair_signature": _k("bodypair"),
@@ -395,11 +399,20 @@ SLICES: dict[str, Slice] = {
     "flex_stiffness": Slice("flex", "flex_stiffnessadr", NEXT),
     "flex_bending": Slice("flex", "flex_bendingadr", NEXT),
     "flex_texcoord": Slice("flex", "flex_texcoordadr", _flex_texcoord_len),
+    **({
+        "flex_matid": Slice("flex", "flex_elemadr", "flex_elemnum", ref=lambda m, d: "material"),
+        # the interpolation cell of each vertex (an index inside its own flex)
+        "flex_vertcell": Slice("flex", "flex_vertadr", "flex_vertnum"),
+    } if MJ4 else {}),
 }
 
 # ---------------------------------------------------------------------------
 # Not compared, with the reason.  Everything else is.
 # ---------------------------------------------------------------------------
+# Arrays this MuJoCo no longer has (4.0.0 removed flexvert equalities: flex_vertmetric,
+# flex_vertedgenum, flex_vertedge, ...) are dropped from the tables.
+SLICES = {k: v for k, v in SLICES.items() if hasattr(mujoco.MjModel, k)}
+
 EXCLUDED: dict[str, str] = {
     "names_map": "hash table of names; the names themselves are matched",
     "dof_Madr": "address in the sparse mass matrix: a whole-model layout",

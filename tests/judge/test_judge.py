@@ -168,6 +168,24 @@ def test_cli_batch(tmp_path):
     assert lines[-1] == "2 passed, 1 failed"
 
 
+def test_cli_batch_a_rejected_mode(tmp_path):
+    """A case for another MuJoCo version passes only when this version rejects its input."""
+    bad = tmp_path / "bad.xml"
+    bad.write_text('<mujoco><worldbody><geom size="x"/></worldbody></mujoco>')
+    pairs = tmp_path / "pairs.tsv"
+    base = str(CORPUS / "base.xml")
+    pairs.write_text(f"{bad}\t{base}\t\ta-rejected\n{base}\t{base}\t\ta-rejected\n")
+    r = run_cli("--pairs", str(pairs))
+    lines = r.stdout.splitlines()
+    assert r.returncode == 1, r.stdout + r.stderr
+    assert lines[0].startswith("ok ") and "[a-rejected]" in lines[0]
+    assert lines[1].startswith("FAIL ") and "the case says this version rejects it" in lines[1]
+    assert lines[-1] == "1 passed, 1 failed"
+    pairs.write_text(f"{base}\t{base}\t\tnope\n")
+    r = run_cli("--pairs", str(pairs))
+    assert r.returncode != 0 and "MODE" in r.stderr
+
+
 def _real_models() -> list[str]:
     if not MODELS_TXT.exists():
         return []

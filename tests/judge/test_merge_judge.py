@@ -283,11 +283,30 @@ def test_derived_exclusions_are_needed():
     """
     experiments = [(load("merged.xml"), load("base.xml"),
                     [(load("gripper.xml"), "g_", "hand"), (load("tray.xml"), "", None)])]
+    # MuJoCo 4.0.0 rejects an unpinned flex under a body with joints (changelog 4.0.0,
+    # breaking change 14): the flex experiments into the moving "bracket"/"tip" exist under
+    # 3.17.0 only, and so does the check that every exclusion shows up somewhere.
+    skipped = []
+
+    def build(make):
+        try:
+            return make()
+        except ValueError as e:
+            if mj.MJ4 and "no flex vertices/nodes are pinned" in str(e):
+                skipped.append(str(e).splitlines()[0])
+                return None
+            raise
+
     for target in ("bracket", "tip", None):
-        experiments.append((_attach("probe_base.xml", "probe_part.xml", "p_", target),
-                            load("probe_base.xml"), [(load("probe_part.xml"), "p_", target)]))
-    experiments.append((load("probe_jelly_merged.xml"), load("probe_base.xml"),
-                        [(load("probe_jelly.xml"), "", "bracket")]))
+        merged = build(lambda: _attach("probe_base.xml", "probe_part.xml", "p_", target))
+        if merged is not None:
+            experiments.append((merged, load("probe_base.xml"),
+                                [(load("probe_part.xml"), "p_", target)]))
+    jelly = build(lambda: load("probe_jelly_merged.xml"))
+    if jelly is not None:
+        experiments.append((jelly, load("probe_base.xml"),
+                            [(load("probe_jelly.xml"), "", "bracket")]))
+    assert len(skipped) == (3 if mj.MJ4 else 0), skipped
     needed = set(mj.DERIVED) | set(mj.TARGET_BODY) | set(mj.TARGET_CHILD) | {"cam_intrinsic"}
     seen: set[str] = set()
     for merged, base, parts in experiments:
@@ -297,7 +316,8 @@ def test_derived_exclusions_are_needed():
         # compared everywhere, only the excluded arrays (and the trees) differ
         assert named <= needed | set(mj.PER_OBJECT_TREE), named
         seen |= named
-    assert needed - seen == set()
+    if not skipped:
+        assert needed - seen == set()
 
 
 def test_cam_intrinsic_follows_the_base_visual():

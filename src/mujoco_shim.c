@@ -1,0 +1,82 @@
+// The few MuJoCo entry points that src/mujoco.rs needs, for the cargo feature `mujoco-4`.
+//
+// Compiled by build.rs against the headers of the MuJoCo that the build links (the 4.0.0
+// wheel's `mujoco/include`), so the layout of mjModel, mjData and mjVFS comes from those
+// headers, never from a Rust copy of them. Fields are looked up by name through MuJoCo's own
+// X-macro tables (mjxmacro.h: MJMODEL_SIZES, MJMODEL_POINTERS), which MuJoCo keeps in step
+// with mjModel; Rust names the fields it reads and checks the element size it expects.
+#include <stdlib.h>
+#include <string.h>
+
+#include <mujoco/mujoco.h>
+
+int mjf_header_version(void) { return mjVERSION_HEADER; }
+
+// A size field of mjModel (MJMODEL_SIZES); -1 when `name` is not one.
+long long mjf_model_size(const mjModel* m, const char* name) {
+#define X(field) if (strcmp(name, #field) == 0) return (long long)m->field;
+  MJMODEL_SIZES
+#undef X
+  return -1;
+}
+
+// An array of mjModel (MJMODEL_POINTERS) and the size of its elements in bytes; NULL and
+// 0 when `name` is not one.
+const void* mjf_model_array(const mjModel* m, const char* name, size_t* elem_size) {
+#define X(type, field, nr, nc)                      \
+  if (strcmp(name, #field) == 0) {                  \
+    *elem_size = sizeof(type);                      \
+    return (const void*)m->field;                   \
+  }
+#define XNV X
+  MJMODEL_POINTERS
+#undef XNV
+#undef X
+  *elem_size = 0;
+  return NULL;
+}
+
+// A fresh VFS on the heap (mjVFS's size is the headers' business), or NULL.
+mjVFS* mjf_vfs_new(void) {
+  mjVFS* vfs = (mjVFS*)malloc(sizeof(mjVFS));
+  if (vfs) mj_defaultVFS(vfs);
+  return vfs;
+}
+
+void mjf_vfs_free(mjVFS* vfs) {
+  if (vfs) {
+    mj_deleteVFS(vfs);
+    free(vfs);
+  }
+}
+
+// mjtObj of an object kind named as in MJCF ("body", ..., "key"); -1 for others.
+int mjf_obj_type(const char* kind) {
+  static const struct { const char* name; int obj; } kinds[] = {
+    {"body", mjOBJ_BODY},         {"joint", mjOBJ_JOINT},       {"geom", mjOBJ_GEOM},
+    {"site", mjOBJ_SITE},         {"camera", mjOBJ_CAMERA},     {"light", mjOBJ_LIGHT},
+    {"mesh", mjOBJ_MESH},         {"material", mjOBJ_MATERIAL}, {"texture", mjOBJ_TEXTURE},
+    {"tendon", mjOBJ_TENDON},     {"actuator", mjOBJ_ACTUATOR}, {"sensor", mjOBJ_SENSOR},
+    {"equality", mjOBJ_EQUALITY}, {"key", mjOBJ_KEY},
+  };
+  for (size_t i = 0; i < sizeof(kinds) / sizeof(kinds[0]); i++) {
+    if (strcmp(kinds[i].name, kind) == 0) return kinds[i].obj;
+  }
+  return -1;
+}
+
+// The contacts at qpos0 (mj_forward on fresh data): writes up to `max` of them into
+// geom1/geom2/dist and returns how many there are (-1 when mjData cannot be made).
+int mjf_initial_contacts(const mjModel* m, int max, int* geom1, int* geom2, double* dist) {
+  mjData* d = mj_makeData(m);
+  if (!d) return -1;
+  mj_forward(m, d);
+  int n = d->ncon;
+  for (int i = 0; i < n && i < max; i++) {
+    geom1[i] = d->contact[i].geom[0];
+    geom2[i] = d->contact[i].geom[1];
+    dist[i] = d->contact[i].dist;
+  }
+  mj_deleteData(d);
+  return n;
+}
