@@ -137,8 +137,11 @@ impl Document {
         for skin in skins {
             let file = self.attr(skin, "file").unwrap_or_default().to_string();
             let bad = |reason: String| ErrorKind::Invalid(format!("skin file '{file}': {reason}"));
-            let bytes =
-                std::fs::read(&file).map_err(|e| self.error_at(skin, bad(e.to_string())))?;
+            let bytes = crate::limits::read_regular_file(
+                std::path::Path::new(&file),
+                self.limits.max_file_size,
+            )
+            .map_err(|e| self.error_at(skin, bad(e)))?;
             let skn = parse_skn(&bytes).map_err(|e| self.error_at(skin, bad(e)))?;
             self.remove_attr(skin, "file");
             self.set_attr(skin, "vertex", &f32_list(&skn.vertex));
