@@ -462,7 +462,7 @@ impl Resolver<'_> {
     fn resolve_element(
         &mut self,
         node: Node,
-        kind: Kind,
+        mut kind: Kind,
         slot: DefaultSlot,
         childclass: Option<usize>,
     ) {
@@ -488,6 +488,17 @@ impl Resolver<'_> {
                 Ok((_, out_tag, attrs)) => {
                     if self.doc.tag_sym(node) != Some(out_tag) {
                         self.doc.set_tag(node, out_tag);
+                        // Which attributes the element can carry is now the new tag's
+                        // business (`general` carries what `adhesion` cannot).
+                        if let Some(k) = self
+                            .doc
+                            .parent(node)
+                            .and_then(|p| self.doc.tag_sym(p))
+                            .and_then(|t| Kind::root().child(t))
+                            .and_then(|section| section.child(out_tag))
+                        {
+                            kind = k;
+                        }
                     }
                     merged.0 = attrs;
                 }
@@ -654,7 +665,15 @@ impl Resolver<'_> {
         for &(n, v) in &other_own {
             attrs.push((n, v));
         }
-        for &(n, v) in next.mech.0.iter().chain(control_out.0.iter()) {
+        // A name in both (a shortcut's table sets `ctrllimited`, which a class default may
+        // also hold among the mechanical rows) is written once, with the table's value: an
+        // attribute written twice makes the output unreadable.
+        let mech_only = next
+            .mech
+            .0
+            .iter()
+            .filter(|(n, _)| !control_out.0.iter().any(|(m, _)| m == n));
+        for &(n, v) in mech_only.chain(control_out.0.iter()) {
             let name = self.doc.sym_name(n);
             if out_tag == tag && forced.contains(&name) {
                 continue;
