@@ -213,23 +213,34 @@ impl Layout {
 
     /// MuJoCo numbers bodies depth first in document order; a body's joints (its own and
     /// those in its frames) come before the joints of its child bodies.
+    /// Explicit stacks rather than recursion: bodies and frames nest without bound.
     fn visit_body(&mut self, doc: &Document, body: Node) {
-        if doc.attr(body, "mocap").map(str::trim) == Some("true") {
-            self.mocap.push(body);
-        }
+        let mut bodies = vec![body];
         let mut children = Vec::new();
-        self.collect(doc, body, &mut children);
-        for c in children {
-            self.visit_body(doc, c);
+        while let Some(body) = bodies.pop() {
+            if doc.attr(body, "mocap").map(str::trim) == Some("true") {
+                self.mocap.push(body);
+            }
+            children.clear();
+            self.collect(doc, body, &mut children);
+            bodies.extend(children.iter().rev());
         }
     }
 
+    /// The joints of `node` and of its frames (into the layout), and its child bodies
+    /// (into `bodies`), in document order.
     fn collect(&mut self, doc: &Document, node: Node, bodies: &mut Vec<Node>) {
-        for k in doc.elements(node) {
+        let mut stack: Vec<Node> = doc.elements(node).collect();
+        stack.reverse();
+        while let Some(k) = stack.pop() {
             match doc.tag(k) {
                 "joint" | "freejoint" => self.joints.push(k),
                 "body" => bodies.push(k),
-                "frame" => self.collect(doc, k, bodies),
+                "frame" => {
+                    let at = stack.len();
+                    stack.extend(doc.elements(k));
+                    stack[at..].reverse();
+                }
                 t @ ("replicate" | "composite" | "flexcomp" | "attach")
                     if self.opaque.is_none() =>
                 {
@@ -561,7 +572,8 @@ impl Document {
 
     /// Copies a subtree of another document into this arena as the last child of
     /// `parent`, through `imp`. Nodes are created in place (no detached copy to re-link).
-    fn import(&mut self, other: &Document, node: Node, parent: Node, imp: &mut Import) -> Node {
+    /// Copies one node of `other` (without its children) under `parent` here.
+    fn import_one(&mut self, other: &Document, node: Node, parent: Node, imp: &mut Import) -> Node {
         let data = match *other.tree.data(node) {
             NodeData::Element { tag, attrs } => {
                 let tag = imp.sym(self, other, tag);
@@ -592,12 +604,25 @@ impl Document {
         if let Some(map) = imp.map.as_mut() {
             map.insert(node, new);
         }
-        let mut kid = other.tree.first_child(node);
-        while let Some(k) = kid {
-            self.import(other, k, new, imp);
-            kid = other.tree.next_sibling(k);
-        }
         new
+    }
+
+    /// Copies `node` of `other` and everything below it under `parent` here (in document
+    /// order, from a stack: parts nest without bound); returns the copy of `node`.
+    fn import(&mut self, other: &Document, node: Node, parent: Node, imp: &mut Import) -> Node {
+        let top = self.import_one(other, node, parent, imp);
+        let mut stack: Vec<(Node, Node)> = Vec::new();
+        let push_kids = |stack: &mut Vec<(Node, Node)>, node: Node, copy: Node| {
+            let at = stack.len();
+            stack.extend(other.children(node).map(|k| (k, copy)));
+            stack[at..].reverse();
+        };
+        push_kids(&mut stack, node, top);
+        while let Some((node, parent)) = stack.pop() {
+            let copy = self.import_one(other, node, parent, imp);
+            push_kids(&mut stack, node, copy);
+        }
+        top
     }
 }
 
@@ -938,23 +963,28 @@ impl Document {
     /// Whether two elements (here and in `other`) have the same tag, attributes (in any
     /// order) and children.
     fn same_subtree(&self, a: Node, other: &Document, b: Node) -> bool {
-        if self.tag(a) != other.tag(b) || self.text(a) != other.text(b) {
-            return false;
+        // Pairs still to compare, from a stack (no recursion on input depth).
+        let mut pairs = vec![(a, b)];
+        while let Some((a, b)) = pairs.pop() {
+            if self.tag(a) != other.tag(b) || self.text(a) != other.text(b) {
+                return false;
+            }
+            let mut x: Vec<(&str, &str)> = self.attrs(a).collect();
+            let mut y: Vec<(&str, &str)> = other.attrs(b).collect();
+            x.sort_unstable();
+            y.sort_unstable();
+            if x != y {
+                return false;
+            }
+            let at = pairs.len();
+            pairs.extend(self.children(a).zip(other.children(b)));
+            if pairs.len() - at != self.children(a).count()
+                || pairs.len() - at != other.children(b).count()
+            {
+                return false;
+            }
         }
-        let mut x: Vec<(&str, &str)> = self.attrs(a).collect();
-        let mut y: Vec<(&str, &str)> = other.attrs(b).collect();
-        x.sort_unstable();
-        y.sort_unstable();
-        if x != y {
-            return false;
-        }
-        let ka: Vec<Node> = self.children(a).collect();
-        let kb: Vec<Node> = other.children(b).collect();
-        ka.len() == kb.len()
-            && ka
-                .iter()
-                .zip(&kb)
-                .all(|(&p, &q)| self.same_subtree(p, other, q))
+        true
     }
 
     /// The name of an asset: its `name`, else the one MuJoCo derives from its file.
