@@ -252,6 +252,53 @@ impl Layout {
     }
 }
 
+/// A document's angle settings ([`Angles::of`]) where it must be used to convert angles:
+/// errors at the `<compiler>` at fault, quoting at most a little of a value; and an
+/// `eulerseq` with letters other than `xyzXYZ` refused when an `euler` attribute would be
+/// read under it, which MuJoCo refuses too (converting it would give a wrong rotation).
+fn angles_checked(doc: &Document) -> Result<Angles, Error> {
+    let mut angles = Angles::default();
+    let mut seq_at = None;
+    let invalid = |node: Node, msg: String| doc.error_at(node, ErrorKind::Invalid(msg));
+    for c in doc.elements(doc.root).filter(|&n| doc.tag(n) == "compiler") {
+        if let Some(a) = doc.attr(c, "angle") {
+            angles.degrees = match a.trim() {
+                "degree" => true,
+                "radian" => false,
+                other => {
+                    let other = crate::read::clip(other, 40);
+                    let msg = format!("compiler angle must be 'degree' or 'radian', not '{other}'");
+                    return Err(invalid(c, msg));
+                }
+            };
+        }
+        if let Some(seq) = doc.attr(c, "eulerseq") {
+            angles.seq = seq.as_bytes().try_into().map_err(|_| {
+                let seq = crate::read::clip(seq, 40);
+                invalid(
+                    c,
+                    format!("compiler eulerseq '{seq}' must have exactly 3 letters"),
+                )
+            })?;
+            seq_at = Some(c);
+        }
+    }
+    if let Some(c) = seq_at
+        && !angles.seq.iter().all(|l| b"xyzXYZ".contains(l))
+        && doc
+            .descendants(doc.root)
+            .any(|n| doc.attr(n, "euler").is_some())
+    {
+        let seq = String::from_utf8_lossy(&angles.seq);
+        let msg = format!(
+            "compiler eulerseq '{seq}' can only contain x, y, z, X, Y, Z (MuJoCo refuses \
+             the model's euler attributes)"
+        );
+        return Err(invalid(c, msg));
+    }
+    Ok(angles)
+}
+
 /// State for copying nodes of one document into another.
 struct Import {
     file_offset: u32,
@@ -736,10 +783,9 @@ impl Document {
                 part.remove(n);
             }
         }
-        let (base_angles, part_angles) = match (Angles::of(self), Angles::of(part)) {
+        let (base_angles, part_angles) = match (angles_checked(self), angles_checked(part)) {
             (Ok(b), Ok(p)) => (b, p),
-            (Err(e), _) => return errors.push(self.error_at(self.root, ErrorKind::Invalid(e))),
-            (_, Err(e)) => return errors.push(part.error_at(part.root, ErrorKind::Invalid(e))),
+            (b, p) => return errors.extend(b.err().into_iter().chain(p.err())),
         };
         if base_angles.seq != part_angles.seq {
             part.rewrite_euler_as_quat(&part_angles);
@@ -1252,7 +1298,7 @@ impl Document {
 
         // Where each item of the merged model comes from.
         let merged = Layout::of(self);
-        let angles = Angles::of(self).map_err(|e| located(self, self.root, e))?;
+        let angles = angles_checked(self)?;
         let mut from_part: AHashMap<Node, usize> = AHashMap::new();
         let mut from_base: AHashMap<Node, usize> = AHashMap::new();
         for items in [
