@@ -285,6 +285,7 @@ fn scan_start_tag(
     from: usize,
     spans: &mut Vec<AttrSpan>,
     at: &mut LineCursor,
+    max_attributes: usize,
 ) -> Option<StartTag> {
     spans.clear();
     let n = bytes.len();
@@ -337,6 +338,9 @@ fn scan_start_tag(
         let quote = *bytes.get(i)?;
         if quote != b'"' && quote != b'\'' {
             return None;
+        }
+        if spans.len() >= max_attributes {
+            return None; // `parse` reports it
         }
         let value_start = i + 1;
         let (len, unusual) = find_quote(&bytes[value_start..], quote)?;
@@ -456,7 +460,8 @@ fn first_forbidden_char(bytes: &[u8]) -> Option<(usize, String)> {
             0 => return Some((i, "NUL byte (not allowed in XML)".into())),
             0xEF => {
                 if let [0xBF, b @ (0xBE | 0xBF), ..] = bytes[i + 1..] {
-                    let c = 0xFF00 | u32::from(b);
+                    // EF BF BE is U+FFFE, EF BF BF is U+FFFF.
+                    let c = 0xFFFE + u32::from(b - 0xBE);
                     return Some((i, format!("character U+{c:04X} (not allowed in XML)")));
                 }
             }
@@ -892,7 +897,10 @@ impl Builder {
                                 if Some(host) == parent {
                                     inserted += 1;
                                 }
-                                self.include(&e, span, host, depth - 1, &reader, &lines, offset)?;
+                                // The include's attributes are read as any element's; the
+                                // element itself is dropped.
+                                let node = self.element(&e, span, &reader, &lines, offset)?;
+                                self.expand_include(node, span, host, depth - 1, false)?;
                                 None
                             }
                             Some(host) => {
@@ -1095,7 +1103,8 @@ impl Builder {
                 _ => {
                     let span = at.span(file, lt);
                     let mut spans = std::mem::take(&mut self.attr_spans);
-                    let tag = scan_start_tag(bytes, lt + 1, &mut spans, &mut at);
+                    let max = self.limits.max_attributes as usize;
+                    let tag = scan_start_tag(bytes, lt + 1, &mut spans, &mut at, max);
                     self.attr_spans = spans;
                     let StartTag {
                         gt,
@@ -1407,22 +1416,6 @@ impl Builder {
             Some(why) => Err(why),
             None => Ok(self.doc.names.intern(name)),
         }
-    }
-
-    fn include(
-        &mut self,
-        e: &BytesStart<'_>,
-        span: Span,
-        host: Node,
-        host_depth: u32,
-        reader: &Reader<&[u8]>,
-        lines: &Lines,
-        offset: usize,
-    ) -> Result<(), Errors> {
-        // Read the include's attributes through the common path, then drop the element.
-        let node = self.element(e, span, reader, lines, offset)?;
-        self.expand_include(node, span, host, host_depth, false)
-            .map(|_| ())
     }
 
     /// Reads the file an `<include>` (read into the detached `node`) names, in its place
