@@ -18,3 +18,5 @@ echo "== cargo test --features mujoco (with doctests)"
 cargo test --features mujoco
 echo "== judge self-tests"
 .cache/venv/bin/python -m pytest tests/judge -q -p no:cacheprovider
+echo "== fuzz smoke run (5 s per target; long campaigns: bash scripts/fuzz.sh SECONDS)"
+bash scripts/fuzz.sh 5
