@@ -38,6 +38,7 @@ mod names;
 mod paths;
 mod prefix;
 mod read;
+pub mod scene;
 mod schema;
 mod skin;
 mod tree;

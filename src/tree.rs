@@ -135,6 +135,12 @@ impl Tree {
         node.0.descendants(&self.arena).map(Node)
     }
 
+    /// The node's slot in the arena: nodes made later have larger slots, so a slot range
+    /// tells which merge brought a node in.
+    pub(crate) fn slot(node: Node) -> usize {
+        usize::from(node.0)
+    }
+
     pub(crate) fn count(&self) -> usize {
         self.arena.len()
     }

@@ -1,0 +1,354 @@
+//! The batch tier: a scene description in, any number of seeded variants out.
+//!
+//! A [`Scene`] is loaded once: every model file read once, the part that never changes
+//! (the base with its fixtures) assembled once into a template, the object pools prefixed
+//! lazily per slot and shared read-only by all threads. [`Scene::variant`] then clones the
+//! template (a few flat `Vec` copies), draws the objects of each group and places them,
+//! applies the randomizers and merges the objects in. Every random number of variant `i`
+//! comes from `(seed, i)` alone, so its bytes are the same for any thread count, any shard
+//! split and any order.
+//!
+//! ```
+//! use mjcf_forge::scene::Scene;
+//! let scene = Scene::demo()?;
+//! let a = scene.variant(3)?;
+//! let b = scene.variant(3)?;
+//! assert_eq!(a.xml(), b.xml());
+//! assert!(!a.params.objects.is_empty());
+//! // Every placed object is in the XML where the parameters say.
+//! let first = &a.params.objects[0];
+//! assert!(a.xml().contains(&format!(r#"<body name="{}""#, first.body)));
+//! # Ok::<(), mjcf_forge::Errors>(())
+//! ```
+//!
+//! The scene file is TOML; `corpora/scenes/demo/demo.toml` is a commented example and the
+//! README describes every key.
+
+mod demo;
+mod load;
+mod params;
+mod place;
+mod randomize;
+mod rng;
+mod spec;
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, OnceLock};
+
+use rayon::prelude::*;
+
+use crate::document::{Document, Section};
+use crate::error::{Error, ErrorKind, Errors, Location};
+use crate::merge::MergePart;
+use crate::tree::Node;
+
+pub use params::{Params, PlacedObject, RandomizedValue};
+
+use place::Placement;
+use randomize::Randomizer;
+use rng::Rng;
+
+/// A loaded scene description, ready to make variants. Cheap to share between threads
+/// (`Send + Sync`; everything is read-only after loading except per-slot instances, which
+/// are made once on first use).
+///
+/// ```
+/// use mjcf_forge::scene::Scene;
+/// use rayon::prelude::*;
+/// let scene = Scene::demo()?;
+/// assert_eq!(scene.seed(), 7);
+/// let variants: Vec<_> = scene.variants(0..4).collect::<Result<_, _>>()?;
+/// assert_eq!(variants.len(), 4);
+/// assert_eq!(variants[2].index, 2);
+/// # Ok::<(), mjcf_forge::Errors>(())
+/// ```
+#[derive(Debug)]
+pub struct Scene {
+    seed: u64,
+    /// The scene file (for messages) and its folder (model paths are relative to it).
+    file: Arc<Path>,
+    /// Base and fixtures, merged once.
+    template: Document,
+    /// Per randomizer, the template's elements it sets (node handles stay valid in clones).
+    template_targets: Vec<Vec<Target>>,
+    groups: Vec<Group>,
+    randomizers: Vec<Randomizer>,
+    /// Every model file the scene uses, as absolute paths (for exporting its assets).
+    model_files: Vec<PathBuf>,
+}
+
+/// One element a randomizer sets, with what the manifest says of it.
+#[derive(Clone, Debug)]
+pub(crate) struct Target {
+    node: Node,
+    /// The element's (full) name, if it has one.
+    name: Option<String>,
+    /// The part it belongs to: `base`, a fixture's prefix, an object group's name.
+    part: Arc<str>,
+    /// The prefix of that part's names (given to chosen names of objects).
+    prefix: Arc<str>,
+}
+
+/// A group of objects: its pool, count, prefix pattern and placement.
+#[derive(Debug)]
+struct Group {
+    name: String,
+    location: Location,
+    count: (u32, u32),
+    /// `{i}` replaced by the slot index.
+    prefix_pattern: String,
+    pool: Vec<PoolModel>,
+    weights: Vec<f64>,
+    placement: Placement,
+    /// Index of the earlier group to stack on.
+    on_top_of: Option<usize>,
+    /// Per slot and pool model (slot * pool.len() + model), made on first use.
+    instances: Vec<OnceLock<Result<Arc<Instance>, Errors>>>,
+    options: crate::model::XmlModelOptions,
+}
+
+/// A model of a pool, loaded once, before any prefix.
+#[derive(Debug)]
+struct PoolModel {
+    /// As written in the scene file.
+    file: String,
+    doc: Document,
+    /// Extent in the root body's frame.
+    bounds: crate::geometry::Bounds,
+}
+
+/// A pool model prefixed for one slot of its group.
+#[derive(Debug)]
+struct Instance {
+    doc: Document,
+    prefix: String,
+    root: Node,
+    root_name: String,
+    /// Per randomizer that applies to this group, the elements it sets.
+    targets: Vec<(usize, Vec<Target>)>,
+}
+
+/// One variant: its index, its document, and everything that was drawn for it.
+#[derive(Clone, Debug)]
+pub struct Variant {
+    /// The variant's index.
+    pub index: u64,
+    /// The scene, ready to write or compile.
+    pub document: Document,
+    /// What was drawn: the objects and their poses, every randomized value.
+    pub params: Params,
+}
+
+impl Variant {
+    /// The variant as compact XML.
+    pub fn xml(&self) -> String {
+        self.document.to_xml_string()
+    }
+
+    /// The parameters as one line of JSON (the manifest's line, without the file name).
+    pub fn params_json(&self) -> String {
+        self.params.to_json(self.index, None)
+    }
+}
+
+impl Scene {
+    /// Loads a scene file (TOML); model paths in it are relative to its folder.
+    ///
+    /// ```no_run
+    /// let scene = mjcf_forge::scene::Scene::load("corpora/scenes/demo/demo.toml")?;
+    /// # Ok::<(), mjcf_forge::Errors>(())
+    /// ```
+    pub fn load(path: impl AsRef<Path>) -> Result<Scene, Errors> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            Error::bare(ErrorKind::Io {
+                path: path.to_path_buf(),
+                reason: e.to_string(),
+            })
+        })?;
+        load::from_toml(&text, Arc::from(path), &load::Files)
+    }
+
+    /// A scene from TOML text; model paths are relative to `base_dir`.
+    ///
+    /// ```
+    /// let scene = mjcf_forge::scene::Scene::from_toml_str(
+    ///     "seed = 1\nbase = \"arena.xml\"\n",
+    ///     "corpora/scenes/demo",
+    /// )?;
+    /// assert_eq!(scene.seed(), 1);
+    /// # Ok::<(), mjcf_forge::Errors>(())
+    /// ```
+    pub fn from_toml_str(text: &str, base_dir: impl AsRef<Path>) -> Result<Scene, Errors> {
+        let label: Arc<Path> = Arc::from(base_dir.as_ref().join("<scene>").as_path());
+        load::from_toml(text, label, &load::Files)
+    }
+
+    /// A scene from the same description as JSON (what a Python dictionary dumps to);
+    /// model paths are relative to `base_dir`. Positions in messages are those of the
+    /// description written as TOML, whose line is quoted.
+    ///
+    /// ```
+    /// let scene = mjcf_forge::scene::Scene::from_json_str(
+    ///     r#"{"seed": 2, "base": "arena.xml"}"#,
+    ///     "corpora/scenes/demo",
+    /// )?;
+    /// assert_eq!(scene.seed(), 2);
+    /// # Ok::<(), mjcf_forge::Errors>(())
+    /// ```
+    pub fn from_json_str(json: &str, base_dir: impl AsRef<Path>) -> Result<Scene, Errors> {
+        let label: Arc<Path> = Arc::from(base_dir.as_ref().join("<scene dict>").as_path());
+        let value: serde_json::Value = serde_json::from_str(json).map_err(|e| {
+            Error::at(
+                Location::new(label.clone(), e.line() as u32, e.column() as u32),
+                ErrorKind::Invalid(format!("invalid JSON: {e}")),
+            )
+        })?;
+        let text = toml::to_string(&value).map_err(|e| {
+            Error::at(
+                Location::new(label.clone(), 1, 1),
+                ErrorKind::Invalid(format!("not a scene description: {e}")),
+            )
+        })?;
+        load::from_toml(&text, label, &load::Files)
+    }
+
+    /// The built-in demo scene: a table arena, a two-finger arm on a mount, and boxes,
+    /// cylinders and spheres with random poses, colours, frictions, masses and light. Its
+    /// models are ours and built into the library, so it needs no file.
+    pub fn demo() -> Result<Scene, Errors> {
+        load::from_toml(
+            demo::SCENE,
+            Arc::from(Path::new("<demo>/demo.toml")),
+            &demo::Embedded,
+        )
+    }
+
+    /// The seed (variant `i` draws from `(seed, i)`).
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// The same scene with another seed.
+    pub fn with_seed(mut self, seed: u64) -> Scene {
+        self.seed = seed;
+        self
+    }
+
+    /// The scene file (or label) this scene was read from.
+    pub fn file(&self) -> &Path {
+        &self.file
+    }
+
+    /// The template every variant starts from: the base with the fixtures merged in.
+    pub fn template(&self) -> &Document {
+        &self.template
+    }
+
+    /// The model files the scene uses (absolute; empty for the built-in demo).
+    pub fn model_files(&self) -> &[PathBuf] {
+        &self.model_files
+    }
+
+    /// Variant `index`: the same document and parameters for the same seed and index,
+    /// whatever else was made before, on whatever thread.
+    pub fn variant(&self, index: u64) -> Result<Variant, Errors> {
+        let mut doc = self.template.clone();
+        let mut params = Params::default();
+        let mut draws = randomize::Draws::new(self.seed, index, self.randomizers.len());
+        for (k, targets) in self.template_targets.iter().enumerate() {
+            self.randomizers[k].apply(&mut doc, targets, &mut draws, &mut params)?;
+        }
+        let mut rng = Rng::new(self.seed, index, 0);
+        let mut placed: Vec<place::Placed> = Vec::new();
+        let mut parts: Vec<(Document, String)> = Vec::new();
+        let mut group_members: Vec<Vec<usize>> = Vec::with_capacity(self.groups.len());
+        for group in &self.groups {
+            let count = rng.int_in(u64::from(group.count.0), u64::from(group.count.1)) as u32;
+            let mut members = Vec::with_capacity(count as usize);
+            for slot in 0..count {
+                let m = rng.weighted(&group.weights);
+                let inst = self.instance(group, slot, m)?;
+                let support = group.on_top_of.map(|g| &group_members[g]);
+                let pose = group
+                    .placement
+                    .sample(
+                        &mut rng,
+                        &group.pool[m].bounds,
+                        &placed,
+                        support.map(|s| s.as_slice()),
+                    )
+                    .map_err(|why| {
+                        Error::at(
+                            group.location.clone(),
+                            ErrorKind::Invalid(format!(
+                                "variant {index}: group '{}': no place for object {slot} ({}) {why}",
+                                group.name, group.pool[m].file
+                            )),
+                        )
+                    })?;
+                let mut doc = inst.doc.clone();
+                let (pos, quat) = place::write_pose(&mut doc, inst.root, &pose.pose);
+                for (k, targets) in &inst.targets {
+                    self.randomizers[*k].apply(&mut doc, targets, &mut draws, &mut params)?;
+                }
+                params.objects.push(PlacedObject {
+                    group: group.name.clone(),
+                    slot,
+                    model: group.pool[m].file.clone(),
+                    prefix: inst.prefix.clone(),
+                    body: inst.root_name.clone(),
+                    pos,
+                    quat,
+                });
+                members.push(placed.len());
+                placed.push(pose);
+                parts.push((doc, inst.prefix.clone()));
+            }
+            group_members.push(members);
+        }
+        if !parts.is_empty() {
+            let merge: Vec<MergePart<'_>> = parts
+                .iter()
+                .map(|(doc, prefix)| MergePart {
+                    doc,
+                    into: None,
+                    prefix,
+                })
+                .collect();
+            doc.merge_all(&merge, false)?;
+        }
+        Ok(Variant {
+            index,
+            document: doc,
+            params,
+        })
+    }
+
+    /// Variants `range`, made in parallel (rayon), in index order.
+    pub fn variants(
+        &self,
+        range: Range<u64>,
+    ) -> impl IndexedParallelIterator<Item = Result<Variant, Errors>> + '_ {
+        // rayon indexes ranges of usize; variant indices beyond it are not a concern on
+        // the 64-bit targets this runs on.
+        (range.start as usize..range.end as usize)
+            .into_par_iter()
+            .map(move |i| self.variant(i as u64))
+    }
+
+    fn instance(&self, group: &Group, slot: u32, m: usize) -> Result<Arc<Instance>, Errors> {
+        let at = slot as usize * group.pool.len() + m;
+        group.instances[at]
+            .get_or_init(|| load::make_instance(self, group, slot, m).map(Arc::new))
+            .clone()
+    }
+}
+
+impl Document {
+    /// The world body, if the document has one (no section is created).
+    pub(crate) fn worldbody(&self) -> Option<Node> {
+        self.find_section(Section::Worldbody)
+    }
+}
