@@ -16,7 +16,7 @@ seconds="${1:-60}"
 shift || true
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-  targets=(roundtrip readers prefix merge)
+  targets=(roundtrip readers prefix merge scene)
 fi
 
 if ! cargo fuzz --version >/dev/null 2>&1; then
@@ -27,7 +27,8 @@ cd fuzz
 for t in "${targets[@]}"; do cargo fuzz build -s none "$t"; done
 
 # Seeds: every model we wrote (as is for the readers; with a prefix, or as base and part,
-# for the others, in the input layouts the targets document).
+# for the others, in the input layouts the targets document); scene descriptions for
+# the scene target.
 seed() {
   local target="$1" dir="corpus/$1"
   mkdir -p "$dir"
@@ -40,8 +41,12 @@ seed() {
       roundtrip|readers) cp "$f" "$dir/seed-$i" ;;
       prefix) { printf 'p0_\0'; cat "$f"; } > "$dir/seed-$i" ;;
       merge) { cat "$f"; printf '\0'; cat "$f"; printf '\0p1_\0'; } > "$dir/seed-$i" ;;
+      scene) case "$f" in ../corpora/fuzz/scene/*) cp "$f" "$dir/seed-$i" ;; esac ;;
     esac
   done
+  if [ "$target" = scene ]; then
+    cp ../corpora/scenes/demo/*.toml "$dir/"
+  fi
 }
 
 mkdir -p logs

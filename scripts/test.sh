@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs every test of mjcf-forge (the README's test command; .ci/run calls it):
 # formatting, clippy, the Rust tests with and without the `mujoco` feature (real MuJoCo
-# judges every output), and the judge's own tests. Sets up first (idempotent).
+# judges every output), the judge's own tests and a short run of each fuzz target.
+# Sets up first (idempotent).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 

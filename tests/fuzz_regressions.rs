@@ -53,3 +53,8 @@ fn prefix_cases() {
 fn merge_cases() {
     replay("merge", targets::merge);
 }
+
+#[test]
+fn scene_cases() {
+    replay("scene", targets::scene);
+}

@@ -98,6 +98,43 @@ pub fn merge(data: &[u8]) {
     }
 }
 
+/// The scene description (TOML, or JSON when the input starts with `{`) and variant
+/// generation of the batch tier: a description is refused or gives a scene whose first
+/// variants are each refused or written well-formed, reload, and come out the same when
+/// made again (a variant depends on the seed and its index only).
+pub fn scene(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    // The demo scene's models, from the fuzz crate or from the root crate's tests.
+    let crate_dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut dir = crate_dir.join("corpora/scenes/demo");
+    if !dir.exists() {
+        dir = crate_dir.join("../corpora/scenes/demo");
+    }
+    let scene = if text.starts_with('{') {
+        mjcf_forge::scene::Scene::from_json_str(text, &dir)
+    } else {
+        mjcf_forge::scene::Scene::from_toml_str(text, &dir)
+    };
+    let Ok(scene) = scene else {
+        return;
+    };
+    for index in [0, 1, u64::MAX] {
+        let Ok(variant) = scene.variant(index) else {
+            continue;
+        };
+        let again = scene.variant(index).expect("the same variant again");
+        assert_eq!(
+            variant.xml(),
+            again.xml(),
+            "variant {index} differs when made again"
+        );
+        assert_eq!(variant.params_json(), again.params_json());
+        check_written(&variant.document, false);
+    }
+}
+
 /// Writes `doc` both ways and checks what every output must be: well-formed XML 1.0 to a
 /// strict parser, read back by us without error, and written again to the same bytes.
 ///

@@ -392,7 +392,13 @@ fn group(
                 .filter_map(|n| doc.attr(n, "name"))
                 .collect();
             let name = (0..)
-                .map(|k| if k == 0 { "root".to_string() } else { format!("root{k}") })
+                .map(|k| {
+                    if k == 0 {
+                        "root".to_string()
+                    } else {
+                        format!("root{k}")
+                    }
+                })
                 .find(|n| !taken.contains(&n.as_str()))
                 .expect("a free name exists");
             doc.set_attr(root, "name", &name);
