@@ -374,6 +374,27 @@ fn meshes_and_skins_naming_special_files_are_refused() {
 }
 
 #[test]
+fn scene_files_that_are_no_regular_files_are_refused() {
+    let dir = special_files();
+    for (file, why) in [
+        (
+            PathBuf::from("/dev/zero"),
+            "not a regular file (a character device)",
+        ),
+        (dir.path().join("fifo"), "not a regular file (a FIFO)"),
+    ] {
+        let shown = file.display().to_string();
+        let msg = on_both(move || {
+            mjcf_forge::scene::Scene::load(&file)
+                .map(|_| ())
+                .map_err(|e| e.to_string())
+        })
+        .unwrap_err();
+        assert_eq!(msg, format!("cannot read '{shown}': {why}"));
+    }
+}
+
+#[test]
 fn a_long_text_is_refused_by_the_size_limit() {
     let small = Limits {
         max_file_size: 100,
