@@ -155,7 +155,11 @@ fn nesting_up_to_the_limit_loads_prefixes_merges_validates_and_writes_on_a_small
         doc.validate().map_err(|e| e.to_string())?;
         let world = doc.section(mjcf_forge::Section::Worldbody);
         let bounds = mjcf_forge::geometry::subtree_bounds(&doc, world, |_, _| true)?;
-        assert_eq!(bounds.max[2], (bodies - 1) as f64, "the deepest geom's class size");
+        assert_eq!(
+            bounds.max[2],
+            (bodies - 1) as f64,
+            "the deepest geom's class size"
+        );
         doc.merge(&part, Some(&deepest), &MergeOptions::default())
             .map_err(|e| e.to_string())?;
         doc.validate().map_err(|e| e.to_string())?;
