@@ -82,7 +82,7 @@ pub fn merge(data: &[u8]) {
     }
     let before = base.to_xml_string();
     let options = MergeOptions {
-        fuse_keys: data.len() % 2 == 0,
+        fuse_keys: data.len().is_multiple_of(2),
         part_prefix: prefix.to_string(),
     };
     match base.merge(&part, into, &options) {
