@@ -252,6 +252,24 @@ impl Layout {
     }
 }
 
+impl Document {
+    /// The level of `node` (the root is level 1).
+    fn depth_of(&self, node: Node) -> usize {
+        std::iter::successors(Some(node), |&n| self.parent(n)).count()
+    }
+
+    /// How many levels the deepest element below `node` is under it (0 for a leaf).
+    fn depth_below(&self, node: Node) -> usize {
+        let mut deepest = 0;
+        let mut stack = vec![(node, 0)];
+        while let Some((n, d)) = stack.pop() {
+            deepest = deepest.max(d);
+            stack.extend(self.children(n).map(|k| (k, d + 1)));
+        }
+        deepest
+    }
+}
+
 /// A document's angle settings ([`Angles::of`]) where it must be used to convert angles:
 /// errors at the `<compiler>` at fault, quoting at most a little of a value; and an
 /// `eulerseq` with letters other than `xyzXYZ` refused when an `euler` attribute would be
@@ -514,6 +532,19 @@ impl Document {
             }
         }
         self.check_residual_defaults(part, &mut errors);
+        // What is merged must load again: a part nested into a deep body can pass the depth
+        // a load accepts (and MuJoCo's own, which is lower).
+        if let Some(world) = part.find_section(Section::Worldbody) {
+            let at = target.map_or(2, |t| self.depth_of(t));
+            let depth = at + part.depth_below(world);
+            if depth > self.limits.max_depth as usize {
+                let msg = format!(
+                    "merged here, the part would nest elements {depth} levels deep, more than {} (Limits::max_depth)",
+                    self.limits.max_depth
+                );
+                errors.push(part.error_at(world, ErrorKind::Invalid(msg)));
+            }
+        }
         if !errors.is_empty() {
             return Err(Errors(errors));
         }
