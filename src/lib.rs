@@ -35,6 +35,7 @@ mod model;
 #[cfg(feature = "mujoco")]
 pub mod mujoco;
 mod names;
+pub mod output;
 mod paths;
 mod prefix;
 mod read;
@@ -51,5 +52,5 @@ pub use error::{Error, ErrorKind, Errors, Location};
 pub use limits::Limits;
 pub use merge::{MergeOptions, MergePart, MergeReport};
 pub use model::{MujocoModel, Offsets, XmlModel, XmlModelOptions};
+pub use output::{AssetStore, OutputDir, TarWriter, write_atomic};
 pub use tree::Node;
-pub use write::write_atomic;

@@ -452,25 +452,43 @@ impl Document {
         // Every check runs before the document changes, except keyframe remapping: with
         // keys, or with several parts, work on a copy so that a failure changes nothing.
         let keys = !keys_of(self).is_empty() || parts.iter().any(|p| !keys_of(p.doc).is_empty());
-        let mut report = MergeReport::default();
-        let mut run = |doc: &mut Document| -> Result<(), Errors> {
-            for p in parts {
-                let options = MergeOptions {
-                    fuse_keys,
-                    part_prefix: p.prefix.to_string(),
-                };
-                let r = doc.merge_in_place(p.doc, p.into, &options)?;
-                report.warnings.extend(r.warnings);
-                report.shared_assets += r.shared_assets;
-            }
-            Ok(())
-        };
         if !keys && parts.len() == 1 {
-            run(self)?;
+            self.merge_unchecked(parts, fuse_keys)
         } else {
             let mut merged = self.clone();
-            run(&mut merged)?;
+            let report = merged.merge_unchecked(parts, fuse_keys)?;
             *self = merged;
+            Ok(report)
+        }
+    }
+
+    /// [`Document::merge_all`] without its two guards: no name check up front, and on error
+    /// the document is left half merged. For callers that checked the names themselves
+    /// and drop the document on error (the batch tier, which merges objects into a fresh
+    /// copy of its template for every variant).
+    pub(crate) fn merge_unchecked(
+        &mut self,
+        parts: &[MergePart<'_>],
+        fuse_keys: bool,
+    ) -> Result<MergeReport, Errors> {
+        // Room for every part at once: reserving per part would reallocate (and copy) the
+        // whole scene once per part.
+        let nodes: usize = parts.iter().map(|p| p.doc.node_count()).sum();
+        self.tree.reserve(nodes);
+        self.attrs
+            .reserve(parts.iter().map(|p| p.doc.attrs.len()).sum());
+        self.strings
+            .reserve(parts.iter().map(|p| p.doc.strings.len()).sum());
+        self.spans.reserve(nodes);
+        let mut report = MergeReport::default();
+        for p in parts {
+            let options = MergeOptions {
+                fuse_keys,
+                part_prefix: p.prefix.to_string(),
+            };
+            let r = self.merge_in_place(p.doc, p.into, &options)?;
+            report.warnings.extend(r.warnings);
+            report.shared_assets += r.shared_assets;
         }
         Ok(report)
     }
@@ -753,6 +771,41 @@ impl Document {
 
     /// The part brought to this document's compiler settings (`None`: it already is), or
     /// the reasons it cannot be.
+    /// `part` converted as [`Document::merge`] converts it, carrying this document's
+    /// `<compiler>` settings instead of its own, so that merging it here later converts
+    /// nothing more (the batch tier prepares each object once and merges it into every
+    /// variant). `None` when it needs no conversion.
+    pub(crate) fn prepared_part(
+        &self,
+        part: &Document,
+        errors: &mut Vec<Error>,
+    ) -> Option<Document> {
+        let mut conv = self.converted_part(part, errors)?;
+        let compiler = crate::names::sym("compiler");
+        let theirs: Vec<Node> = conv
+            .elements(conv.root)
+            .filter(|&n| conv.tag_sym(n) == Some(compiler))
+            .collect();
+        for n in theirs {
+            conv.remove(n);
+        }
+        let first = conv.tree.first_child(conv.root);
+        for c in self
+            .elements(self.root)
+            .filter(|&n| self.tag_sym(n) == Some(compiler))
+        {
+            let copy = conv.new_element(compiler, None);
+            for (name, value) in self.attrs(c) {
+                conv.set_attr(copy, name, value);
+            }
+            match first {
+                Some(f) => conv.tree.insert_before(f, copy),
+                None => conv.tree.append(conv.root, copy),
+            }
+        }
+        Some(conv)
+    }
+
     fn converted_part(&self, part: &Document, errors: &mut Vec<Error>) -> Option<Document> {
         let ours = compiler_settings(self);
         let theirs = compiler_settings(part);
@@ -1079,49 +1132,48 @@ impl Document {
         let Some(theirs) = part.find_section(Section::Asset) else {
             return Vec::new();
         };
-        let mut index: AHashMap<(Sym, &str), Node> = AHashMap::with_capacity(64);
-        if let Some(assets) = self.find_section(Section::Asset) {
+        // Index the part's assets (usually a handful) and look each base asset up in that,
+        // so a whole scene's assets are walked once per merge without building a map of them.
+        let mine: Vec<Node> = part.elements(theirs).collect();
+        let mut wanted: AHashMap<(Sym, &str), usize> = AHashMap::with_capacity(mine.len());
+        for (i, &a) in mine.iter().enumerate() {
+            if let (Some(tag), Some(name)) = (crate::names::known(part.tag(a)), part.asset_name(a))
+            {
+                wanted.entry((tag, name)).or_insert(i);
+            }
+        }
+        let mut same: Vec<Option<Node>> = vec![None; mine.len()];
+        if !wanted.is_empty()
+            && let Some(assets) = self.find_section(Section::Asset)
+        {
             for n in self.elements(assets) {
-                if let (Some(tag), Some(name)) = (self.tag_sym(n), self.asset_name(n)) {
-                    index.entry((tag, name)).or_insert(n);
+                if let (Some(tag), Some(name)) = (self.tag_sym(n), self.asset_name(n))
+                    && let Some(&i) = wanted.get(&(tag, name))
+                    && same[i].is_none()
+                {
+                    same[i] = Some(n);
                 }
             }
         }
-        part.elements(theirs)
-            .map(|a| match self.find_same_asset(&index, part, a) {
-                Some(Ok(_)) => true,
-                Some(Err(e)) => {
-                    errors.push(e);
+        mine.iter()
+            .zip(same)
+            .map(|(&a, found)| match found {
+                None => false,
+                Some(n) if self.same_subtree(n, part, a) => true,
+                Some(n) => {
+                    let tag = part.tag(a);
+                    let name = part.asset_name(a).unwrap_or_default();
+                    errors.push(part.error_at(
+                        a,
+                        ErrorKind::Invalid(format!(
+                            "asset <{tag}> '{name}' differs from the base's <{tag}> '{name}' at {}",
+                            self.location(n)
+                        )),
+                    ));
                     false
                 }
-                None => false,
             })
             .collect()
-    }
-
-    /// The base asset with the part asset's tag and name: `Ok` when the content is the same,
-    /// an error naming both when it is not, `None` when there is none.
-    fn find_same_asset(
-        &self,
-        index: &AHashMap<(Sym, &str), Node>,
-        part: &Document,
-        asset: Node,
-    ) -> Option<Result<Node, Error>> {
-        let tag = part.tag(asset);
-        let name = part.asset_name(asset)?;
-        let sym = crate::names::known(tag)?;
-        let same = *index.get(&(sym, name))?;
-        if self.same_subtree(same, part, asset) {
-            Some(Ok(same))
-        } else {
-            Some(Err(part.error_at(
-                asset,
-                ErrorKind::Invalid(format!(
-                    "asset <{tag}> '{name}' differs from the base's <{tag}> '{name}' at {}",
-                    self.location(same)
-                )),
-            )))
-        }
     }
 }
 

@@ -536,6 +536,17 @@ impl Sizes {
     }
 }
 
+/// A contact found by [`CompiledModel::initial_contacts`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Contact {
+    /// The first geom's id.
+    pub geom1: usize,
+    /// The second geom's id.
+    pub geom2: usize,
+    /// Signed distance: negative when the geoms interpenetrate.
+    pub dist: f64,
+}
+
 /// Defines read-only slice accessors for `mjModel` arrays: `name: type, |m| length`.
 macro_rules! model_arrays {
     ($($(#[$doc:meta])* $field:ident: $ty:ty, |$m:ident| $len:expr;)*) => {
@@ -568,6 +579,8 @@ model_arrays! {
     body_mass: f64, |m| n(m.nbody);
     /// Parent body ids (`nbody`; the world body is its own parent).
     body_parentid: i32, |m| n(m.nbody);
+    /// Per body, the id of its top-level ancestor (the body itself at the top).
+    body_rootid: i32, |m| n(m.nbody);
     /// Joint types (`mjtJoint`: 0 free, 1 ball, 2 slide, 3 hinge) (`njnt`).
     jnt_type: i32, |m| n(m.njnt);
     /// Joint axes in the body frame (`njnt x 3`).
@@ -616,6 +629,44 @@ unsafe fn slice_or_empty<'a, T>(ptr: *const T, len: usize) -> &'a [T] {
 }
 
 impl CompiledModel {
+    /// The contacts MuJoCo finds at the model's initial pose (`qpos0`): `mj_forward` on
+    /// fresh data, which is freed again. Geoms with a negative `dist` interpenetrate.
+    ///
+    /// ```
+    /// use mjcf_forge::mujoco::compile_str;
+    /// let xml = r#"<mujoco><worldbody><geom type="plane" size="1 1 1"/>
+    ///   <body pos="0 0 0.05"><freejoint/><geom type="sphere" size="0.1"/></body>
+    ///   </worldbody></mujoco>"#;
+    /// let model = compile_str(xml, std::path::Path::new(".")).unwrap();
+    /// let contacts = model.initial_contacts();
+    /// assert_eq!(contacts.len(), 1);
+    /// assert!((contacts[0].dist + 0.05).abs() < 1e-9);
+    /// ```
+    pub fn initial_contacts(&self) -> Vec<Contact> {
+        let m = std::ptr::from_ref(self.raw());
+        // SAFETY: `m` is a live compiled model; `mj_makeData` returns null or data sized
+        // for it, which `mj_forward` fills and we free before returning. `contact` holds
+        // `ncon` entries after `mj_forward`.
+        unsafe {
+            let d = ffi::mj_makeData(m);
+            if d.is_null() {
+                return Vec::new();
+            }
+            ffi::mj_forward(m, d);
+            let n = usize::try_from((*d).ncon).unwrap_or(0);
+            let contacts = slice_or_empty((*d).contact, n)
+                .iter()
+                .map(|c| Contact {
+                    geom1: usize::try_from(c.geom[0]).unwrap_or(usize::MAX),
+                    geom2: usize::try_from(c.geom[1]).unwrap_or(usize::MAX),
+                    dist: c.dist,
+                })
+                .collect();
+            ffi::mj_deleteData(d);
+            contacts
+        }
+    }
+
     fn raw(&self) -> &ffi::mjModel {
         // SAFETY: `ptr` is a live model owned by `self` (see `Drop`).
         unsafe { self.ptr.as_ref() }

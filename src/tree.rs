@@ -71,7 +71,8 @@ impl Tree {
         Node(self.arena.new_node(data))
     }
 
-    /// Dense index of a node, for side tables (0-based).
+    /// Dense index of a node, for side tables (0-based). Nodes made later have larger
+    /// indices, so an index range tells which merge brought a node in.
     #[inline]
     pub(crate) fn index(node: Node) -> usize {
         usize::from(node.0) - 1
@@ -133,12 +134,6 @@ impl Tree {
     /// The node and all its descendants in document order.
     pub(crate) fn descendants(&self, node: Node) -> impl Iterator<Item = Node> + '_ {
         node.0.descendants(&self.arena).map(Node)
-    }
-
-    /// The node's slot in the arena: nodes made later have larger slots, so a slot range
-    /// tells which merge brought a node in.
-    pub(crate) fn slot(node: Node) -> usize {
-        usize::from(node.0)
     }
 
     pub(crate) fn count(&self) -> usize {

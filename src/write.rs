@@ -1,10 +1,10 @@
 //! Writing: deterministic bytes, attribute values as read (escaped only where XML needs it).
 
-use std::io::Write as _;
 use std::path::Path;
 
 use crate::document::Document;
-use crate::error::{Error, ErrorKind};
+use crate::error::Error;
+use crate::output::write_atomic;
 use crate::tree::{Node, NodeData, StrRef};
 
 /// The bytes an attribute value cannot hold as they are: markup, the quote, and white
@@ -156,8 +156,8 @@ impl Document {
         out
     }
 
-    /// Writes the pretty form to `path` atomically: a temporary file in the same folder,
-    /// renamed over the target, so a failure never leaves a partial or clobbered file.
+    /// Writes the pretty form to `path` as [`crate::write_atomic`] does: a regular file is
+    /// replaced atomically, so a failure never leaves a partial or clobbered file.
     pub fn write_file(&self, path: impl AsRef<Path>) -> Result<(), Error> {
         write_atomic(path.as_ref(), self.to_pretty_string().as_bytes())
     }
@@ -280,75 +280,9 @@ fn push_indent(out: &mut String, level: usize) {
     }
 }
 
-/// Writes bytes to `path` through a temporary file in the same folder and a rename.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
-    let fail = |e: std::io::Error| {
-        Error::bare(ErrorKind::Write {
-            path: path.to_path_buf(),
-            reason: e.to_string(),
-        })
-    };
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(fail)?;
-    // A temporary file is private; the output gets the permissions of the file it replaces,
-    // or those of a newly created file (0666 less the umask).
-    let permissions = match std::fs::metadata(path) {
-        Ok(m) => m.permissions(),
-        Err(_) => new_file_permissions(dir).map_err(fail)?,
-    };
-    tmp.as_file().set_permissions(permissions).map_err(fail)?;
-    tmp.write_all(bytes).map_err(fail)?;
-    tmp.as_file().sync_all().map_err(fail)?;
-    tmp.persist(path).map_err(|e| fail(e.error))?;
-    Ok(())
-}
-
-/// The permissions a file newly created in `dir` gets (0666 less the umask), found by
-/// creating one: the standard library has no way to read the umask.
-fn new_file_permissions(dir: &Path) -> std::io::Result<std::fs::Permissions> {
-    let probe = tempfile::Builder::new()
-        .prefix(".mjcf-forge-probe")
-        .tempfile_in(dir)?;
-    let path = probe.path().to_path_buf();
-    drop(probe);
-    let file = std::fs::OpenOptions::new()
-        .write(true)
-        .create_new(true)
-        .open(&path)?;
-    let permissions = file.metadata()?.permissions();
-    drop(file);
-    std::fs::remove_file(&path)?;
-    Ok(permissions)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[cfg(unix)]
-    #[test]
-    fn outputs_are_not_private_files() {
-        use std::os::unix::fs::PermissionsExt;
-        let dir = tempfile::tempdir().unwrap();
-        let out = dir.path().join("out.xml");
-        write_atomic(&out, b"<mujoco/>").unwrap();
-        let mode = std::fs::metadata(&out).unwrap().permissions().mode() & 0o777;
-        let fresh = dir.path().join("fresh");
-        std::fs::write(&fresh, b"").unwrap();
-        assert_eq!(
-            mode,
-            std::fs::metadata(&fresh).unwrap().permissions().mode() & 0o777
-        );
-        std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o640)).unwrap();
-        write_atomic(&out, b"<mujoco/>").unwrap();
-        assert_eq!(
-            std::fs::metadata(&out).unwrap().permissions().mode() & 0o777,
-            0o640
-        );
-    }
 
     #[test]
     fn escapes_like_a_byte_loop() {

@@ -229,7 +229,7 @@ pub(crate) fn from_toml(
             }
             let nodes = template
                 .descendants(template.root())
-                .filter(|&n| (*start..*end).contains(&Tree::slot(n)));
+                .filter(|&n| (*start..*end).contains(&Tree::index(n)));
             match r.select(&template, nodes, prefix, label) {
                 Ok(t) => targets.extend(t),
                 Err(e) => errors.extend(e.0),
@@ -238,7 +238,9 @@ pub(crate) fn from_toml(
         selected[k] += targets.len();
         template_targets.push(targets);
     }
+    let prefixes_apart = prefixes_apart(&groups);
     let mut scene = Scene {
+        prefixes_apart,
         seed: spec.seed,
         file,
         template,
@@ -283,10 +285,22 @@ pub(crate) fn from_toml(
     Ok(scene)
 }
 
+/// Whether no prefix that an instance of any group can get begins another one (then two
+/// names with different prefixes always differ).
+fn prefixes_apart(groups: &[Group]) -> bool {
+    let mut all: Vec<String> = groups
+        .iter()
+        .flat_map(|g| (0..g.count.1).map(move |i| g.prefix_pattern.replace("{i}", &i.to_string())))
+        .collect();
+    all.sort();
+    // Sorted, a prefix of another string comes right before some string it begins.
+    all.windows(2).all(|w| !w[1].starts_with(w[0].as_str()))
+}
+
 /// One past the largest arena slot in use.
 fn slot_end(doc: &Document) -> usize {
     doc.descendants(doc.root())
-        .map(Tree::slot)
+        .map(Tree::index)
         .max()
         .unwrap_or(0)
         + 1
@@ -791,6 +805,7 @@ fn randomizer(
         shared: r.shared,
         location: src.location(r.kind.span()),
         index,
+        file: matches!(attr_spec.kind, AttrKind::File),
     })
 }
 
@@ -811,12 +826,20 @@ pub(crate) fn make_instance(
 ) -> Result<Instance, Errors> {
     let prefix = group.prefix_pattern.replace("{i}", &slot.to_string());
     let model = XmlModel::with_prefix(group.pool[m].doc.clone(), &prefix, group.options.clone())?;
-    let doc = model.into_document();
+    let mut doc = model.into_document();
+    // Brought to the template's compiler settings once, so merging a variant converts
+    // nothing; randomized angles are then written in the template's units.
+    let mut errors = Vec::new();
+    if let Some(converted) = scene.template.prepared_part(&doc, &mut errors) {
+        doc = converted;
+    }
+    if !errors.is_empty() {
+        return Err(Errors(errors));
+    }
     let root = root_body(&doc).expect("pool models have one root body");
     let root_name = doc.attr(root, "name").unwrap_or_default().to_string();
     let part: Arc<str> = Arc::from(group.name.as_str());
     let mut targets = Vec::new();
-    let mut errors = Vec::new();
     for r in &scene.randomizers {
         if !r.applies_to_part(&group.name) {
             continue;
@@ -827,6 +850,8 @@ pub(crate) fn make_instance(
             Err(e) => errors.extend(e.0),
         }
     }
+    // Instances are merged into copies of the template without a name check: check once.
+    errors.extend(scene.template.name_clashes(&[&doc]));
     if !errors.is_empty() {
         return Err(Errors(errors));
     }

@@ -24,6 +24,8 @@
 //! The scene file is TOML; `corpora/scenes/demo/demo.toml` is a commented example and the
 //! README describes every key.
 
+#[cfg(feature = "mujoco")]
+mod check;
 mod demo;
 mod load;
 mod params;
@@ -43,6 +45,8 @@ use crate::error::{Error, ErrorKind, Errors, Location};
 use crate::merge::MergePart;
 use crate::tree::Node;
 
+#[cfg(feature = "mujoco")]
+pub use check::{PENETRATION_TOLERANCE, check_variant};
 pub use params::{Params, PlacedObject, RandomizedValue};
 
 use place::Placement;
@@ -76,6 +80,8 @@ pub struct Scene {
     randomizers: Vec<Randomizer>,
     /// Every model file the scene uses, as absolute paths (for exporting its assets).
     model_files: Vec<PathBuf>,
+    /// No instance prefix begins another, so names of different instances never clash.
+    prefixes_apart: bool,
 }
 
 /// One element a randomizer sets, with what the manifest says of it.
@@ -259,6 +265,26 @@ impl Scene {
         &self.model_files
     }
 
+    /// Rewrites every file reference of the scene (template, object models, file choices
+    /// of randomizers) to the store's relocatable names, so that variants written into the
+    /// store's folder compile wherever the folder goes.
+    pub fn relocate_assets(&mut self, store: &crate::output::AssetStore) -> Result<(), Errors> {
+        store.relocate(&mut self.template)?;
+        for group in &mut self.groups {
+            for model in &mut group.pool {
+                store.relocate(&mut model.doc)?;
+            }
+            // Instances made before were made from the models as they were.
+            for slot in &mut group.instances {
+                *slot = OnceLock::new();
+            }
+        }
+        for r in &mut self.randomizers {
+            r.relocate_files(store)?;
+        }
+        Ok(())
+    }
+
     /// Variant `index`: the same document and parameters for the same seed and index,
     /// whatever else was made before, on whatever thread.
     pub fn variant(&self, index: u64) -> Result<Variant, Errors> {
@@ -325,7 +351,16 @@ impl Scene {
                     prefix,
                 })
                 .collect();
-            doc.merge_all(&merge, false)?;
+            // Each instance was checked against the template when it was made; instances
+            // cannot clash with each other when no prefix begins another.
+            if !self.prefixes_apart {
+                let docs: Vec<&Document> = parts.iter().map(|(d, _)| d).collect();
+                let clashes = doc.name_clashes(&docs);
+                if !clashes.is_empty() {
+                    return Err(Errors(clashes));
+                }
+            }
+            doc.merge_unchecked(&merge, false)?;
         }
         Ok(Variant {
             index,

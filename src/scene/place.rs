@@ -5,7 +5,6 @@
 
 use crate::document::Document;
 use crate::geometry::{Bounds, Pose};
-use crate::merge::fmt_num;
 use crate::tree::Node;
 
 use super::rng::Rng;
@@ -169,15 +168,31 @@ pub(crate) fn write_pose(doc: &mut Document, root: Node, pose: &Pose) -> (String
     (pos, quat)
 }
 
-/// Numbers as MJCF writes them: shortest round-trip text, space separated.
+/// Numbers as MJCF text: each the shortest text that reads back as the same `f64` (ryu,
+/// without a trailing `.0`), space separated. Every variant writes several of these per
+/// object, and the standard formatter costs several times more.
 pub(crate) fn join(values: &[f64]) -> String {
-    let mut out = String::new();
-    for (i, v) in values.iter().enumerate() {
+    let mut out = String::with_capacity(values.len() * 12);
+    let mut buf = ryu::Buffer::new();
+    for (i, &v) in values.iter().enumerate() {
         if i > 0 {
             out.push(' ');
         }
         // -0 reads back as 0 in MuJoCo; write it as 0 so equal poses give equal bytes.
-        out.push_str(&fmt_num(if *v == 0.0 { 0.0 } else { *v }));
+        if v == 0.0 || !v.is_finite() {
+            out.push_str(if v.is_nan() {
+                "nan"
+            } else if v == 0.0 {
+                "0"
+            } else if v > 0.0 {
+                "inf"
+            } else {
+                "-inf"
+            });
+            continue;
+        }
+        let text = buf.format_finite(v);
+        out.push_str(text.strip_suffix(".0").unwrap_or(text));
     }
     out
 }
@@ -231,6 +246,25 @@ mod tests {
             .sample(&mut rng, &cube(0.01), &placed, Some(&[0]))
             .unwrap();
         assert!((stacked.z_min - placed[0].z_max).abs() < 1e-12);
+    }
+
+    #[test]
+    fn numbers_read_back_exactly() {
+        let values = [
+            0.1,
+            -0.0,
+            1.0,
+            100.0,
+            0.8250000000000001,
+            1e-7,
+            -2.5e21,
+            1.0 / 3.0,
+        ];
+        let text = join(&values);
+        assert_eq!(text.split(' ').next(), Some("0.1"));
+        assert!(text.contains(" 0 1 100 "), "{text}");
+        let back: Vec<f64> = text.split(' ').map(|t| t.parse().unwrap()).collect();
+        assert_eq!(back, values.map(|v| if v == 0.0 { 0.0 } else { v }));
     }
 
     #[test]

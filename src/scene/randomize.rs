@@ -40,6 +40,8 @@ pub(crate) struct Randomizer {
     pub(crate) location: Location,
     /// The randomizer's index (its random stream).
     pub(crate) index: usize,
+    /// The attribute names a file (choices are absolute paths).
+    pub(crate) file: bool,
 }
 
 /// How values are drawn. Numeric bounds hold one value per drawn component (a single value
@@ -156,6 +158,25 @@ impl Draws {
 }
 
 impl Randomizer {
+    /// File choices rewritten to the store's relocatable names.
+    pub(crate) fn relocate_files(
+        &mut self,
+        store: &crate::output::AssetStore,
+    ) -> Result<(), Errors> {
+        if let Dist::Choice {
+            values,
+            prefixed: false,
+            ..
+        } = &mut self.dist
+            && self.file
+        {
+            for v in values.iter_mut() {
+                *v = store.relocate_file(std::path::Path::new(v.as_str()))?;
+            }
+        }
+        Ok(())
+    }
+
     /// Whether this randomizer can select elements of `part`.
     pub(crate) fn applies_to_part(&self, part: &str) -> bool {
         self.part.as_deref().is_none_or(|p| p == part)

@@ -1,0 +1,109 @@
+//! `export IN -o DIR`: one model as a relocatable folder, `DIR/<input file name>` and
+//! `DIR/assets/<hash>.<ext>` for every file it refers to (what dm_control's
+//! `export_with_assets` does), or with `--tar` the same as one tar stream.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use mjcf_forge::{AssetStore, Document, OutputDir, TarWriter};
+
+use super::{USAGE, WriteOptions, finish, refuse_validate_without_mujoco, render, write_stdout};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Input MJCF file.
+    input: PathBuf,
+    /// Output folder (created if missing); with `--tar`, the tar file (`-` for standard
+    /// output).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Write one tar stream (the folder's files as members, assets first) instead of a
+    /// folder.
+    #[arg(long)]
+    tar: bool,
+    /// Write compact XML instead of indented XML.
+    #[arg(long)]
+    compact: bool,
+    /// Compile the model with MuJoCo first; write nothing if it fails (needs the
+    /// `mujoco` feature).
+    #[arg(long)]
+    validate: bool,
+}
+
+pub fn run(args: Args) -> ExitCode {
+    if let Some(code) = refuse_validate_without_mujoco(args.validate) {
+        return code;
+    }
+    let Some(name) = args.input.file_name().and_then(|n| n.to_str()) else {
+        eprintln!("{}: not a UTF-8 file name", args.input.display());
+        return ExitCode::from(USAGE);
+    };
+    let options = WriteOptions {
+        compact: args.compact,
+        validate: args.validate,
+    };
+    let result = prepare(&args.input, options).and_then(|(store, text)| {
+        if args.tar {
+            export_tar(&store, name, &text, &args.output)
+        } else {
+            export_dir(&store, name, &text, &args.output)
+        }
+    });
+    finish(&[result])
+}
+
+/// Loads, validates (when asked, before anything moves: the model as it compiles from
+/// its own folder) and relocates the model; returns its assets and its XML.
+fn prepare(input: &Path, options: WriteOptions) -> Result<(AssetStore, String), String> {
+    let mut doc = Document::load(input).map_err(|e| e.to_string())?;
+    if options.validate {
+        super::validate(&doc)?;
+    }
+    let store = AssetStore::new();
+    store.relocate(&mut doc).map_err(|e| e.to_string())?;
+    let text = render(
+        &doc,
+        WriteOptions {
+            validate: false,
+            ..options
+        },
+    )?;
+    Ok((store, text))
+}
+
+/// Assets first, the model last, each file atomically: the model never names a file
+/// that is not there yet. A folder this run created is removed again on failure.
+fn export_dir(store: &AssetStore, name: &str, text: &str, dir: &Path) -> Result<(), String> {
+    let existed = std::fs::symlink_metadata(dir).is_ok();
+    let out = OutputDir::create(dir).map_err(|e| e.to_string())?;
+    let written = store
+        .write_to_dir(&out)
+        .and_then(|()| out.write(name, text.as_bytes()))
+        .and_then(|()| out.finish());
+    if written.is_err() && !existed {
+        let _ = std::fs::remove_dir_all(dir);
+    }
+    written.map_err(|e| e.to_string())
+}
+
+/// The tar stream is made in memory (one model's files) and then written as any single
+/// output is, so a failure never leaves a partial archive.
+fn export_tar(store: &AssetStore, name: &str, text: &str, output: &Path) -> Result<(), String> {
+    let to_stdout = output == Path::new("-");
+    let label = if to_stdout {
+        PathBuf::from("standard output")
+    } else {
+        output.to_path_buf()
+    };
+    let mut tar = TarWriter::new(Vec::new(), label);
+    store
+        .write_to_tar(&mut tar)
+        .and_then(|()| tar.append(name, text.as_bytes()))
+        .map_err(|e| e.to_string())?;
+    let bytes = tar.finish().map_err(|e| e.to_string())?;
+    if to_stdout {
+        write_stdout(&bytes)
+    } else {
+        mjcf_forge::write_atomic(output, &bytes).map_err(|e| e.to_string())
+    }
+}

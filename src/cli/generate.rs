@@ -1,0 +1,416 @@
+//! `generate [SCENE] -n N -o OUT`: seeded variants of a scene, in parallel, streamed to a
+//! folder (one XML per variant, `manifest*.jsonl`, `assets/`), a tar file or standard
+//! output (`-`: a WebDataset-style tar stream: `assets/...` first, then
+//! `NNNNNNNNN.xml` and `NNNNNNNNN.json` per variant).
+//!
+//! Variants are made in chunks, each chunk in parallel and written in index order, so
+//! memory stays bounded and the output is the same bytes for any thread count. With
+//! `--shard K/N` this process makes only its share of the indices; N processes given the
+//! same folder together write what one process writes (each its own manifest).
+
+use std::io::{IsTerminal as _, Write};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+use mjcf_forge::scene::{Scene, Variant};
+use mjcf_forge::{AssetStore, OutputDir, TarWriter};
+use rayon::prelude::*;
+
+use super::{USAGE, refuse_validate_without_mujoco};
+
+/// Variants made in parallel before their chunk is written: enough to keep every thread
+/// busy, few enough that memory stays small (a variant of a robot scene is ~50 KB).
+const CHUNK: u64 = 512;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Scene file (TOML); the built-in demo scene without it.
+    scene: Option<PathBuf>,
+    /// How many variants (indices START..START+N).
+    #[arg(short = 'n', long = "count", default_value_t = 10)]
+    count: u64,
+    /// A folder, a `.tar` file, or `-` for a tar stream on standard output.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Seed (overrides the scene file's).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// First index.
+    #[arg(long, default_value_t = 0)]
+    start: u64,
+    /// Worker threads (all cores without it).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// This process's share, K/N with K counted from 0 (as Slurm array task ids are).
+    #[arg(long)]
+    shard: Option<String>,
+    /// Compile every variant with MuJoCo and check that no placed object interpenetrates
+    /// another object or a fixture (needs the `mujoco` feature).
+    #[arg(long)]
+    validate: bool,
+    /// Print the summary as JSON on standard output (standard error when the variants go
+    /// to standard output).
+    #[arg(long)]
+    json: bool,
+    /// Indented XML instead of compact XML.
+    #[arg(long)]
+    pretty: bool,
+}
+
+/// Where the variants go.
+enum Sink {
+    Dir {
+        out: OutputDir,
+        manifest: tempfile::NamedTempFile,
+        manifest_name: String,
+    },
+    Tar {
+        tar: TarWriter<Box<dyn Write + Send + Sync>>,
+        /// The temporary file renamed over the target at the end (none for stdout).
+        file: Option<(tempfile::TempPath, PathBuf)>,
+        /// Assets written out for `--validate` (the stream itself is not on disk).
+        check_dir: Option<tempfile::TempDir>,
+    },
+}
+
+pub fn run(args: Args) -> ExitCode {
+    if let Some(code) = refuse_validate_without_mujoco(args.validate) {
+        return code;
+    }
+    let shard = match args.shard.as_deref().map(parse_shard).transpose() {
+        Ok(s) => s.unwrap_or((0, 1)),
+        Err(e) => {
+            eprintln!("mjcf-forge: --shard: {e}");
+            return ExitCode::from(USAGE);
+        }
+    };
+    let pool = match rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0))
+        .build()
+    {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("mjcf-forge: cannot start worker threads: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    match pool.install(|| generate(&args, shard)) {
+        Ok(summary) => {
+            let text = summary.text();
+            if args.json {
+                let json = summary.json();
+                if args.output == Path::new("-") {
+                    eprintln!("{json}");
+                } else {
+                    println!("{json}");
+                }
+            } else {
+                eprintln!("{text}");
+            }
+            for f in &summary.failures {
+                eprintln!("{f}");
+            }
+            if summary.failures.is_empty() {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::FAILURE
+            }
+        }
+        Err(e) => {
+            eprintln!("{e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// `K/N` with `K < N`.
+fn parse_shard(text: &str) -> Result<(u64, u64), String> {
+    let (k, n) = text
+        .split_once('/')
+        .ok_or_else(|| format!("expected K/N (such as 0/4), got '{text}'"))?;
+    let k: u64 = k
+        .trim()
+        .parse()
+        .map_err(|_| format!("K in '{text}' is not a number"))?;
+    let n: u64 = n
+        .trim()
+        .parse()
+        .map_err(|_| format!("N in '{text}' is not a number"))?;
+    if n == 0 || k >= n {
+        return Err(format!("need 0 <= K < N, got '{text}'"));
+    }
+    Ok((k, n))
+}
+
+/// What a run did.
+struct Summary {
+    variants: u64,
+    bytes: u64,
+    seconds: f64,
+    /// Time spent compiling with MuJoCo, summed over threads (with `--validate`).
+    compile: Option<Duration>,
+    failures: Vec<String>,
+    output: String,
+    range: (u64, u64),
+}
+
+impl Summary {
+    fn rate(&self) -> f64 {
+        self.variants as f64 / self.seconds.max(1e-9)
+    }
+
+    fn text(&self) -> String {
+        let mut s = format!(
+            "generated {} variants (indices {}..{}) in {:.2} s: {:.0} variants/s, {:.1} MB of XML -> {}",
+            self.variants,
+            self.range.0,
+            self.range.1,
+            self.seconds,
+            self.rate(),
+            self.bytes as f64 / 1e6,
+            self.output
+        );
+        if let Some(c) = self.compile {
+            s.push_str(&format!(
+                "; MuJoCo compile {:.2} ms per variant (summed over threads)",
+                c.as_secs_f64() * 1e3 / self.variants.max(1) as f64
+            ));
+        }
+        s.push_str(&format!("; {} failed", self.failures.len()));
+        s
+    }
+
+    fn json(&self) -> String {
+        serde_json::json!({
+            "variants": self.variants,
+            "start": self.range.0,
+            "end": self.range.1,
+            "seconds": self.seconds,
+            "variants_per_second": self.rate(),
+            "xml_bytes": self.bytes,
+            "compile_ms_per_variant": self.compile.map(|c| c.as_secs_f64() * 1e3 / self.variants.max(1) as f64),
+            "failures": self.failures,
+            "output": self.output,
+        })
+        .to_string()
+    }
+}
+
+fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
+    let started = Instant::now();
+    let mut scene = match &args.scene {
+        Some(path) => Scene::load(path),
+        None => Scene::demo(),
+    }
+    .map_err(|e| e.to_string())?;
+    if let Some(seed) = args.seed {
+        scene = scene.with_seed(seed);
+    }
+    let store = AssetStore::new();
+    scene.relocate_assets(&store).map_err(|e| e.to_string())?;
+    let lo = args.start + args.count * k / n;
+    let hi = args.start + args.count * (k + 1) / n;
+    let mut sink = open_sink(
+        &args.output,
+        &store,
+        args.validate,
+        (k, n),
+        args.shard.is_some(),
+    )?;
+    let check_dir: Option<PathBuf> = match &sink {
+        Sink::Dir { out, .. } => Some(out.path().to_path_buf()),
+        Sink::Tar { check_dir, .. } => check_dir.as_ref().map(|d| d.path().to_path_buf()),
+    };
+    let progress = std::io::stderr().is_terminal().then(|| {
+        let bar = indicatif::ProgressBar::new(hi - lo);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{bar:40} {pos}/{len} variants {per_sec} eta {eta}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar
+    });
+    let mut summary = Summary {
+        variants: 0,
+        bytes: 0,
+        seconds: 0.0,
+        compile: args.validate.then_some(Duration::ZERO),
+        failures: Vec::new(),
+        output: args.output.display().to_string(),
+        range: (lo, hi),
+    };
+    let mut at = lo;
+    while at < hi {
+        let end = (at + CHUNK).min(hi);
+        let made: Vec<Result<(u64, String, String, Duration), String>> = (at..end)
+            .into_par_iter()
+            .map(|i| {
+                let v = scene.variant(i).map_err(|e| e.to_string())?;
+                let xml = if args.pretty {
+                    v.document.to_pretty_string()
+                } else {
+                    v.xml()
+                };
+                let took = match (&check_dir, args.validate) {
+                    (Some(dir), true) => check(&v, &xml, dir)?,
+                    _ => Duration::ZERO,
+                };
+                let file = format!("{i:09}.xml");
+                let json = v.params.to_json(i, Some(&file));
+                if let Sink::Dir { out, .. } = &sink {
+                    out.write(&file, xml.as_bytes())
+                        .map_err(|e| e.to_string())?;
+                }
+                Ok((i, xml, json, took))
+            })
+            .collect();
+        for r in made {
+            match r {
+                Ok((i, xml, json, took)) => {
+                    summary.variants += 1;
+                    summary.bytes += xml.len() as u64;
+                    if let Some(c) = &mut summary.compile {
+                        *c += took;
+                    }
+                    write_variant(&mut sink, i, &xml, &json)?;
+                }
+                Err(e) => summary.failures.push(e),
+            }
+        }
+        if let Some(bar) = &progress {
+            bar.inc(end - at);
+        }
+        at = end;
+    }
+    if let Some(bar) = progress {
+        bar.finish_and_clear();
+    }
+    close_sink(sink)?;
+    summary.seconds = started.elapsed().as_secs_f64();
+    Ok(summary)
+}
+
+#[cfg(feature = "mujoco")]
+fn check(v: &Variant, xml: &str, dir: &Path) -> Result<Duration, String> {
+    let t = Instant::now();
+    mjcf_forge::scene::check_variant(v, xml, dir)?;
+    Ok(t.elapsed())
+}
+
+#[cfg(not(feature = "mujoco"))]
+fn check(_: &Variant, _: &str, _: &Path) -> Result<Duration, String> {
+    Err(super::NO_MUJOCO.to_owned())
+}
+
+fn open_sink(
+    output: &Path,
+    store: &AssetStore,
+    validate: bool,
+    (k, n): (u64, u64),
+    sharded: bool,
+) -> Result<Sink, String> {
+    let is_tar = output == Path::new("-") || output.extension().is_some_and(|e| e == "tar");
+    if !is_tar {
+        let out = OutputDir::create(output).map_err(|e| e.to_string())?;
+        store.write_to_dir(&out).map_err(|e| e.to_string())?;
+        let manifest = tempfile::Builder::new()
+            .prefix(".manifest")
+            .tempfile_in(out.path())
+            .map_err(|e| format!("cannot write in '{}': {e}", output.display()))?;
+        let manifest_name = if sharded {
+            format!("manifest-{k}-of-{n}.jsonl")
+        } else {
+            "manifest.jsonl".to_string()
+        };
+        return Ok(Sink::Dir {
+            out,
+            manifest,
+            manifest_name,
+        });
+    }
+    let check_dir = if validate {
+        let dir =
+            tempfile::tempdir().map_err(|e| format!("cannot make a folder for --validate: {e}"))?;
+        let out = OutputDir::create(dir.path()).map_err(|e| e.to_string())?;
+        store.write_to_dir(&out).map_err(|e| e.to_string())?;
+        out.finish().map_err(|e| e.to_string())?;
+        Some(dir)
+    } else {
+        None
+    };
+    let (writer, file, label): (Box<dyn Write + Send + Sync>, _, PathBuf) =
+        if output == Path::new("-") {
+            (
+                Box::new(std::io::BufWriter::with_capacity(
+                    1 << 20,
+                    std::io::stdout(),
+                )),
+                None,
+                PathBuf::from("standard output"),
+            )
+        } else {
+            let folder = match output.parent() {
+                Some(p) if !p.as_os_str().is_empty() => p,
+                _ => Path::new("."),
+            };
+            let tmp = tempfile::Builder::new()
+                .prefix(".mjcf-forge")
+                .tempfile_in(folder)
+                .map_err(|e| format!("cannot write '{}': {e}", output.display()))?;
+            let (f, path) = tmp.into_parts();
+            (
+                Box::new(std::io::BufWriter::with_capacity(1 << 20, f)),
+                Some((path, output.to_path_buf())),
+                output.to_path_buf(),
+            )
+        };
+    let mut tar = TarWriter::new(writer, label);
+    store.write_to_tar(&mut tar).map_err(|e| e.to_string())?;
+    Ok(Sink::Tar {
+        tar,
+        file,
+        check_dir,
+    })
+}
+
+fn write_variant(sink: &mut Sink, i: u64, xml: &str, json: &str) -> Result<(), String> {
+    match sink {
+        Sink::Dir { manifest, .. } => {
+            let f = manifest.as_file_mut();
+            f.write_all(json.as_bytes())
+                .and_then(|()| f.write_all(b"\n"))
+                .map_err(|e| format!("cannot write the manifest: {e}"))
+        }
+        Sink::Tar { tar, .. } => tar
+            .append(&format!("{i:09}.xml"), xml.as_bytes())
+            .and_then(|()| tar.append(&format!("{i:09}.json"), json.as_bytes()))
+            .map_err(|e| e.to_string()),
+    }
+}
+
+fn close_sink(sink: Sink) -> Result<(), String> {
+    match sink {
+        Sink::Dir {
+            out,
+            manifest,
+            manifest_name,
+        } => {
+            let target = out.path().join(&manifest_name);
+            manifest
+                .persist(&target)
+                .map_err(|e| format!("cannot write '{}': {}", target.display(), e.error))?;
+            out.finish().map_err(|e| e.to_string())
+        }
+        Sink::Tar { tar, file, .. } => {
+            let writer = tar.finish().map_err(|e| e.to_string())?;
+            drop(writer);
+            if let Some((tmp, target)) = file {
+                tmp.persist(&target)
+                    .map_err(|e| format!("cannot write '{}': {}", target.display(), e.error))?;
+            }
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,116 @@
+//! The subcommands, one file each (`Args` for clap and `run`), and what they share: how a
+//! finished document is written, how problems are reported, and `--validate`.
+
+pub mod compile;
+pub mod export;
+pub mod generate;
+pub mod info;
+pub mod inline;
+pub mod merge;
+pub mod prefix;
+
+use std::io::Write as _;
+use std::path::Path;
+use std::process::ExitCode;
+
+use mjcf_forge::Document;
+
+/// Exit code for a command line that cannot be carried out as asked.
+pub const USAGE: u8 = 2;
+
+/// What `compile` and `--validate` say in a build without MuJoCo.
+pub const NO_MUJOCO: &str = "built without the `mujoco` feature; rebuild with --features mujoco";
+
+/// How a command that writes a model writes it.
+#[derive(Clone, Copy)]
+pub struct WriteOptions {
+    /// Compact XML instead of indented XML.
+    pub compact: bool,
+    /// Compile with MuJoCo before writing anything.
+    pub validate: bool,
+}
+
+/// The text of a finished document, validated first when asked: what every command that
+/// writes a model writes, once everything that can fail has run.
+pub fn render(doc: &Document, options: WriteOptions) -> Result<String, String> {
+    if options.validate {
+        validate(doc)?;
+    }
+    Ok(if options.compact {
+        doc.to_xml_string()
+    } else {
+        doc.to_pretty_string()
+    })
+}
+
+/// Writes a finished document (validated first when asked) to a file or standard output.
+/// The output is written only when everything before it succeeded, and atomically, so a
+/// failure leaves the old file intact (see [`mjcf_forge::write_atomic`] for symlinks and
+/// special files).
+pub fn emit(doc: &Document, output: Option<&Path>, options: WriteOptions) -> Result<(), String> {
+    let text = render(doc, options)?;
+    match output {
+        Some(path) => mjcf_forge::write_atomic(path, text.as_bytes()).map_err(|e| e.to_string()),
+        None => write_stdout(text.as_bytes()),
+    }
+}
+
+/// `print!` would panic on a closed pipe; a failed write is an ordinary error here.
+pub fn write_stdout(bytes: &[u8]) -> Result<(), String> {
+    let mut out = std::io::stdout().lock();
+    out.write_all(bytes)
+        .and_then(|()| out.flush())
+        .map_err(|e| format!("cannot write to standard output: {e}"))
+}
+
+/// Prints the problems of all runs; success only when there were none.
+pub fn finish(results: &[Result<(), String>]) -> ExitCode {
+    let mut failed = false;
+    for problem in results.iter().filter_map(|r| r.as_ref().err()) {
+        eprintln!("{problem}");
+        failed = true;
+    }
+    if failed {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+/// With `--validate` in a build without MuJoCo: the usage error, said once before any model
+/// is loaded (rather than once per model).
+pub fn refuse_validate_without_mujoco(validate: bool) -> Option<ExitCode> {
+    if !validate {
+        return None;
+    }
+    let Err(e) = require_mujoco() else {
+        return None;
+    };
+    eprintln!("mjcf-forge: --validate: {e}");
+    Some(ExitCode::from(USAGE))
+}
+
+/// `Ok` when this binary can compile with MuJoCo, else the reason it cannot.
+fn require_mujoco() -> Result<(), String> {
+    if cfg!(feature = "mujoco") {
+        Ok(())
+    } else {
+        Err(NO_MUJOCO.to_owned())
+    }
+}
+
+/// Compiles `doc` with MuJoCo and forgets the model: the check behind `--validate`, for
+/// every subcommand that writes a model. The error is ready to print: MuJoCo's message,
+/// prefixed with the position of the element it names (see
+/// [`compile::compile_document`]).
+pub fn validate(doc: &Document) -> Result<(), String> {
+    #[cfg(feature = "mujoco")]
+    {
+        compile::compile_document(doc).map(drop)
+    }
+    #[cfg(not(feature = "mujoco"))]
+    {
+        let _ = doc;
+        Err(NO_MUJOCO.to_owned())
+    }
+}

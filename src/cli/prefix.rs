@@ -1,0 +1,43 @@
+//! `prefix IN --prefix P [-o OUT]`.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use mjcf_forge::Document;
+
+use super::{WriteOptions, emit, finish, refuse_validate_without_mujoco};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Input MJCF file.
+    input: PathBuf,
+    /// The prefix.
+    #[arg(long)]
+    prefix: String,
+    /// Output file; standard output without it.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Write compact XML instead of indented XML.
+    #[arg(long)]
+    compact: bool,
+    /// Compile the output with MuJoCo first (needs the `mujoco` feature).
+    #[arg(long)]
+    validate: bool,
+}
+
+pub fn run(args: Args) -> ExitCode {
+    if let Some(code) = refuse_validate_without_mujoco(args.validate) {
+        return code;
+    }
+    let options = WriteOptions {
+        compact: args.compact,
+        validate: args.validate,
+    };
+    let result = Document::load(&args.input)
+        .map_err(|e| e.to_string())
+        .and_then(|mut doc| {
+            doc.apply_prefix(&args.prefix).map_err(|e| e.to_string())?;
+            emit(&doc, args.output.as_deref(), options)
+        });
+    finish(&[result])
+}

@@ -1,0 +1,461 @@
+//! Relocatable asset files: every file a model refers to, copied once into `assets/`
+//! under a name derived from its content, and referred to relatively, so that the output
+//! folder can be moved or copied to another machine and still compile.
+//!
+//! Names are `assets/<hash>.<extension>`: the first 128 bits of the file's BLAKE3 hash in
+//! hex, and the source's extension (MuJoCo picks a mesh or texture decoder by it). BLAKE3
+//! is specified bit for bit and cryptographic, so the same file gets the same name on
+//! every machine, in every run and every shard, and two different files never share one
+//! (a fast non-cryptographic hash would let a crafted file stand in for another).
+//!
+//! MuJoCo resolves a relative file name against the folder of the model file it loads
+//! (checked with MuJoCo 3.17.0: `assets/a.stl` in `/m/x.xml`, loaded from another working
+//! folder, opens `/m/assets/a.stl`), but first prepends `compiler` `meshdir` /
+//! `texturedir` / `assetdir` when set (`meshdir="sub"` made it open `sub/assets/a.stl`).
+//! Loading left those settings in the document (every file was absolute, so they did not
+//! matter); relocation removes them.
+
+use std::collections::{BTreeMap, HashMap};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+use rayon::prelude::*;
+
+use super::{OutputDir, TarWriter};
+use crate::document::Document;
+use crate::error::{Error, ErrorKind, Errors};
+use crate::names::{Sym, sym};
+use crate::prefix::{file_stem, named_after_file};
+use crate::schema::Kind;
+use crate::tree::Node;
+use crate::vocab::AttrKind;
+
+/// The folder of the output that asset files go to.
+const ASSETS: &str = "assets";
+
+/// How many hex digits of the hash name a file (128 bits).
+const HASH_DIGITS: usize = 32;
+
+/// Gathers the asset files of many documents, each once, under content-derived names.
+///
+/// One store is shared by every thread of a batch (`&self` everywhere): its lock is held
+/// only to look up and record names, never while a file is read or hashed.
+///
+/// ```
+/// use mjcf_forge::{AssetStore, Document, OutputDir};
+/// let tmp = tempfile::tempdir()?;
+/// std::fs::write(tmp.path().join("grid.png"), b"not really a png")?;
+/// let mut doc = Document::from_str(
+///     r#"<mujoco><compiler texturedir="."/><asset><texture file="grid.png" type="2d"/></asset></mujoco>"#,
+///     tmp.path(),
+/// )?;
+/// let store = AssetStore::new();
+/// store.relocate(&mut doc)?;
+/// let xml = doc.to_xml_string();
+/// // Named after its file as MuJoCo would, now explicitly; the folder setting is gone.
+/// assert!(xml.contains(r#"<texture file="assets/"#) && xml.contains(r#"name="grid""#));
+/// assert!(!xml.contains("texturedir"));
+/// let out = OutputDir::create(tmp.path().join("out"))?;
+/// store.write_to_dir(&out)?;
+/// out.finish()?;
+/// assert_eq!(std::fs::read_dir(tmp.path().join("out/assets"))?.count(), 1);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug, Default)]
+pub struct AssetStore {
+    inner: Mutex<Inner>,
+}
+
+#[derive(Debug, Default)]
+struct Inner {
+    /// Source file -> its name in the output (`assets/<hash>.<ext>`).
+    by_source: HashMap<PathBuf, String>,
+    /// Name in the output -> where to copy it from and the hash it must still have. A
+    /// sorted map: the order files are written in (and a tar stream's bytes) must not
+    /// depend on which thread saw a file first.
+    by_name: BTreeMap<String, Source>,
+}
+
+#[derive(Clone, Debug)]
+struct Source {
+    path: PathBuf,
+    hash: blake3::Hash,
+}
+
+/// One file attribute found in a document.
+struct FileRef {
+    node: Node,
+    attr: Sym,
+    /// MuJoCo names this asset after this file (it has no `name`).
+    named_after_it: bool,
+}
+
+impl AssetStore {
+    /// An empty store.
+    pub fn new() -> AssetStore {
+        AssetStore::default()
+    }
+
+    /// How many distinct files the store holds.
+    pub fn len(&self) -> usize {
+        self.lock().by_name.len()
+    }
+
+    /// Whether the store holds no file.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Every file of the store: its name in the output (`assets/...`) and its source, in
+    /// name order.
+    pub fn files(&self) -> Vec<(String, PathBuf)> {
+        self.lock()
+            .by_name
+            .iter()
+            .map(|(name, s)| (name.clone(), s.path.clone()))
+            .collect()
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, Inner> {
+        // A panic elsewhere cannot leave the maps half-updated (each update is one insert),
+        // so a poisoned lock still holds good data.
+        self.inner.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// Rewrites every file reference of `doc` (meshes, height fields, skins, flexcomp
+    /// files, every texture file including cube faces) into `assets/<hash>.<ext>`,
+    /// relative to the folder the document will be written to, and records each source to
+    /// copy. Assets that MuJoCo names after their file get that name explicitly, and the
+    /// `compiler` folder settings (`meshdir`, `texturedir`, `assetdir`) are removed so they
+    /// cannot redirect the relative names.
+    ///
+    /// Every problem is reported, each at its element; on error the document is
+    /// unchanged. An `<asset><model file>` (a whole MJCF file to attach) is refused: its
+    /// own file references would break once it is copied alone.
+    pub fn relocate(&self, doc: &mut Document) -> Result<(), Errors> {
+        let refs = file_refs(doc);
+        let mut errors = Vec::new();
+        let mut names = Vec::with_capacity(refs.len());
+        for r in &refs {
+            let value = doc.attr_sym(r.node, r.attr).unwrap_or_default();
+            if doc.tag(r.node) == "model" {
+                errors.push(doc.error_at(
+                    r.node,
+                    ErrorKind::Invalid(format!(
+                        "cannot relocate the model asset '{value}': its own file references \
+                         would break (load it and merge it instead)"
+                    )),
+                ));
+                continue;
+            }
+            match self.relocate_file(Path::new(value)) {
+                Ok(name) => names.push(name),
+                Err(e) => errors.push(doc.error_at(r.node, e.kind)),
+            }
+        }
+        if !errors.is_empty() {
+            return Err(Errors(errors));
+        }
+        for (r, name) in refs.iter().zip(names) {
+            if r.named_after_it {
+                let old = doc.attr_sym(r.node, r.attr).unwrap_or_default();
+                if let Some(stem) = file_stem(old).map(str::to_owned) {
+                    doc.set_attr(r.node, "name", &stem);
+                }
+            }
+            let value = doc.push_str(&name);
+            doc.set_attr_ref(r.node, r.attr, value);
+        }
+        let compiler = Some(sym("compiler"));
+        let compilers: Vec<Node> = doc
+            .elements(doc.root())
+            .filter(|&n| doc.tag_sym(n) == compiler)
+            .collect();
+        for c in compilers {
+            for setting in ["meshdir", "texturedir", "assetdir"] {
+                doc.remove_attr(c, setting);
+            }
+        }
+        Ok(())
+    }
+
+    /// Records one file (for a randomizer that picks texture or mesh files) and returns
+    /// the name to write in the document: `assets/<hash>.<ext>`. The file is read and
+    /// hashed once per store, however often it is asked for.
+    ///
+    /// ```
+    /// let tmp = tempfile::tempdir()?;
+    /// let file = tmp.path().join("cube.obj");
+    /// std::fs::write(&file, b"v 0 0 0")?;
+    /// let store = mjcf_forge::AssetStore::new();
+    /// let name = store.relocate_file(&file)?;
+    /// assert_eq!(name, "assets/f992f1321acdd7fef55c54a953930d6b.obj");
+    /// assert_eq!(store.relocate_file(&file)?, name);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn relocate_file(&self, absolute: &Path) -> Result<String, Error> {
+        if let Some(name) = self.lock().by_source.get(absolute) {
+            return Ok(name.clone());
+        }
+        let hash = hash_file(absolute)?;
+        let mut name = format!("{ASSETS}/{}", &hash.to_hex()[..HASH_DIGITS]);
+        if let Some(ext) = absolute.extension() {
+            name.push('.');
+            name.push_str(&ext.to_string_lossy());
+        }
+        let mut inner = self.lock();
+        inner.by_source.insert(absolute.to_path_buf(), name.clone());
+        inner.by_name.entry(name.clone()).or_insert(Source {
+            path: absolute.to_path_buf(),
+            hash,
+        });
+        Ok(name)
+    }
+
+    /// Copies every file into `dir` (`dir/assets/...`), each once, in parallel. A file
+    /// already present under its content name is skipped (another shard, or an earlier
+    /// run, wrote those very bytes); the others are written atomically, so shards sharing
+    /// a folder never see a partial file nor clobber each other's.
+    pub fn write_to_dir(&self, dir: &OutputDir) -> Result<(), Error> {
+        let files: Vec<(String, Source)> = self
+            .lock()
+            .by_name
+            .iter()
+            .map(|(n, s)| (n.clone(), s.clone()))
+            .collect();
+        let results: Vec<Result<(), Error>> = files
+            .par_iter()
+            .map(|(name, source)| {
+                if dir.contains(name) {
+                    return Ok(());
+                }
+                dir.write(name, &source.read()?)
+            })
+            .collect();
+        // The first failure in name order, whatever thread met it first.
+        results.into_iter().collect()
+    }
+
+    /// Appends every file to a tar stream as `assets/<hash>.<ext>`, in name order (so the
+    /// same store gives the same bytes).
+    ///
+    /// ```
+    /// let tmp = tempfile::tempdir()?;
+    /// let file = tmp.path().join("cube.obj");
+    /// std::fs::write(&file, b"v 0 0 0")?;
+    /// let store = mjcf_forge::AssetStore::new();
+    /// store.relocate_file(&file)?;
+    /// let mut tar = mjcf_forge::TarWriter::new(Vec::new(), "shard.tar");
+    /// store.write_to_tar(&mut tar)?;
+    /// let bytes = tar.finish()?;
+    /// assert!(bytes.starts_with(b"assets/f992f1321acdd7fef55c54a953930d6b.obj\0"));
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn write_to_tar<W: Write>(&self, tar: &mut TarWriter<W>) -> Result<(), Error> {
+        let files: Vec<(String, Source)> = self
+            .lock()
+            .by_name
+            .iter()
+            .map(|(n, s)| (n.clone(), s.clone()))
+            .collect();
+        for (name, source) in files {
+            tar.append(&name, &source.read()?)?;
+        }
+        Ok(())
+    }
+}
+
+impl Source {
+    /// The bytes to copy, checked against the hash that named them: a file changed since
+    /// it was recorded would otherwise be written under another content's name.
+    fn read(&self) -> Result<Vec<u8>, Error> {
+        let bytes = read_regular_file(&self.path)?;
+        if blake3::hash(&bytes) != self.hash {
+            return Err(read_error(
+                &self.path,
+                "the file changed while the output was being written",
+            ));
+        }
+        Ok(bytes)
+    }
+}
+
+fn read_error(path: &Path, reason: impl Into<String>) -> Error {
+    Error::bare(ErrorKind::Io {
+        path: path.to_path_buf(),
+        reason: reason.into(),
+    })
+}
+
+/// Opens `path` if it is a regular file: a FIFO would block forever and a device such as
+/// `/dev/zero` never ends.
+fn open_regular_file(path: &Path) -> Result<std::fs::File, Error> {
+    let file = std::fs::File::open(path).map_err(|e| read_error(path, e.to_string()))?;
+    let meta = file
+        .metadata()
+        .map_err(|e| read_error(path, e.to_string()))?;
+    if !meta.is_file() {
+        return Err(read_error(path, "not a regular file"));
+    }
+    Ok(file)
+}
+
+fn read_regular_file(path: &Path) -> Result<Vec<u8>, Error> {
+    use std::io::Read as _;
+    let mut file = open_regular_file(path)?;
+    let mut bytes = Vec::new();
+    file.read_to_end(&mut bytes)
+        .map_err(|e| read_error(path, e.to_string()))?;
+    Ok(bytes)
+}
+
+fn hash_file(path: &Path) -> Result<blake3::Hash, Error> {
+    let file = open_regular_file(path)?;
+    let mut hasher = blake3::Hasher::new();
+    hasher
+        .update_reader(file)
+        .map_err(|e| read_error(path, e.to_string()))?;
+    Ok(hasher.finalize())
+}
+
+/// Every file attribute of the document, in document order. A walk with its own stack:
+/// nesting depth comes from the input and must not become recursion depth.
+fn file_refs(doc: &Document) -> Vec<FileRef> {
+    let file = sym("file");
+    let mut refs = Vec::new();
+    let mut stack: Vec<(Node, Kind)> = vec![(doc.root(), Kind::root())];
+    let mut kids = Vec::new();
+    while let Some((node, kind)) = stack.pop() {
+        if kind.has_file_attrs() {
+            let has_name = doc.attr_sym(node, sym("name")).is_some();
+            let file_named = named_after_file(kind).is_some() && !has_name;
+            for a in doc.attr_slice(node) {
+                let is_file = kind
+                    .attr(a.name)
+                    .is_some_and(|spec| spec.kind == AttrKind::File);
+                if is_file && !doc.str(a.value).trim().is_empty() {
+                    refs.push(FileRef {
+                        node,
+                        attr: a.name,
+                        named_after_it: file_named && a.name == file,
+                    });
+                }
+            }
+        }
+        kids.clear();
+        kids.extend(doc.elements(node).filter_map(|kid| {
+            let k = doc.tag_sym(kid).and_then(|t| kind.child(t))?;
+            // Sections like <sensor> or <actuator> cannot hold a file reference.
+            k.reaches_file_attrs().then_some((kid, k))
+        }));
+        // Reversed onto the stack, so they come off in document order.
+        stack.extend(kids.drain(..).rev());
+    }
+    refs
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_file_attribute_is_relocated_and_named_files_keep_their_names() {
+        let tmp = tempfile::tempdir().unwrap();
+        for (f, body) in [
+            ("a.obj", "v 1"),
+            ("b.png", "png"),
+            ("c.png", "png"),
+            ("h.bin", "h"),
+        ] {
+            std::fs::write(tmp.path().join(f), body).unwrap();
+        }
+        let xml = r#"<mujoco><compiler meshdir="." texturedir="." assetdir="."/>
+            <asset><mesh file="a.obj"/><mesh name="m2" file="a.obj"/>
+            <texture name="sky" type="skybox" fileright="b.png" fileleft="c.png" fileup="b.png"
+               filedown="b.png" filefront="b.png" fileback="b.png"/>
+            <texture type="2d" file="c.png"/><hfield file="h.bin"/></asset></mujoco>"#;
+        let mut doc = Document::from_str(xml, tmp.path()).unwrap();
+        let store = AssetStore::new();
+        store.relocate(&mut doc).unwrap();
+        // b.png and c.png have the same bytes: one file.
+        assert_eq!(store.len(), 3);
+        let out = doc.to_xml_string();
+        let name = |f: &str| store.relocate_file(&tmp.path().join(f)).unwrap();
+        assert!(
+            out.contains(&format!(r#"<mesh file="{}" name="a"/>"#, name("a.obj"))),
+            "{out}"
+        );
+        assert!(out.contains(&format!(r#"<mesh name="m2" file="{}"/>"#, name("a.obj"))));
+        assert!(out.contains(&format!(r#"fileleft="{}""#, name("b.png"))));
+        assert!(out.contains(&format!(r#"<hfield file="{}" name="h"/>"#, name("h.bin"))));
+        assert!(out.contains("<compiler/>"), "{out}");
+        assert!(!out.contains(&tmp.path().display().to_string()), "{out}");
+    }
+
+    #[test]
+    fn problems_are_reported_at_their_elements_and_leave_the_document_as_it_was() {
+        let tmp = tempfile::tempdir().unwrap();
+        let xml = "<mujoco><asset>\n<mesh file=\"missing.stl\"/>\n<model name=\"m\" file=\"x.xml\"/>\n\
+                   <texture type=\"2d\" file=\"/dev/null\"/></asset></mujoco>";
+        let mut doc = Document::from_str(xml, tmp.path()).unwrap();
+        let before = doc.to_xml_string();
+        let err = AssetStore::new()
+            .relocate(&mut doc)
+            .unwrap_err()
+            .to_string();
+        let missing = tmp.path().join("missing.stl");
+        assert_eq!(
+            err,
+            format!(
+                "<string>:2:1: cannot read '{}': No such file or directory (os error 2)\n\
+                 <string>:3:1: cannot relocate the model asset '{}': its own file references \
+                 would break (load it and merge it instead)\n\
+                 <string>:4:1: cannot read '/dev/null': not a regular file",
+                missing.display(),
+                tmp.path().join("x.xml").display()
+            )
+        );
+        assert_eq!(doc.to_xml_string(), before);
+    }
+
+    /// Names are standard BLAKE3 (the specification's vector for the empty input), so
+    /// any other implementation, on any machine, gives the same names.
+    #[test]
+    fn names_are_standard_blake3_with_the_source_extension() {
+        let tmp = tempfile::tempdir().unwrap();
+        let empty = tmp.path().join("empty.STL");
+        std::fs::write(&empty, "").unwrap();
+        let store = AssetStore::new();
+        assert_eq!(
+            store.relocate_file(&empty).unwrap(),
+            "assets/af1349b9f5f9a1a6a0404dea36dcc949.STL"
+        );
+        let bare = tmp.path().join("noext");
+        std::fs::write(&bare, "").unwrap();
+        assert_eq!(
+            store.relocate_file(&bare).unwrap(),
+            "assets/af1349b9f5f9a1a6a0404dea36dcc949"
+        );
+    }
+
+    #[test]
+    fn a_file_changed_after_it_was_named_is_not_copied() {
+        let tmp = tempfile::tempdir().unwrap();
+        let file = tmp.path().join("a.stl");
+        std::fs::write(&file, "one").unwrap();
+        let store = AssetStore::new();
+        store.relocate_file(&file).unwrap();
+        std::fs::write(&file, "two").unwrap();
+        let out = OutputDir::create(tmp.path().join("out")).unwrap();
+        let err = store.write_to_dir(&out).unwrap_err().to_string();
+        assert_eq!(
+            err,
+            format!(
+                "cannot read '{}': the file changed while the output was being written",
+                file.display()
+            )
+        );
+        assert!(!tmp.path().join("out/assets").exists());
+    }
+}

@@ -1,0 +1,592 @@
+//! Output files that are never partial or clobbered, at little more than the
+//! filesystem's own cost per file.
+//!
+//! Every output is written to a temporary file in the folder it ends up in and renamed over
+//! its final name, so a reader (or a crash) sees the old file or the new one, never a part
+//! of it. What costs time per file is kept out of the write path:
+//! - the temporary file is created with mode `0666` and the kernel applies the umask, so
+//!   it gets exactly the permissions of a newly created file without reading the umask
+//!   (which the standard library cannot do) or probing with a file per output;
+//! - [`OutputDir`] syncs once, in [`OutputDir::finish`], rather than once per file: a
+//!   crash before that may lose files written since the last sync, but (the rename being
+//!   the last step) never leaves a partial file under a final name;
+//! - nothing is canonicalized or checked per file; a subfolder (`assets/`) is created
+//!   the first time a write into it finds it missing.
+//!
+//! A single output ([`write_atomic`]) follows what users expect of `-o PATH`: a symlink is
+//! written through (the link stays a link), a FIFO or device (`-o /dev/null`,
+//! `-o /dev/stdout`) is written to directly and never replaced by a regular file, and a
+//! regular file is replaced atomically keeping its permissions.
+
+use std::fs::File;
+use std::io::Write as _;
+use std::path::{Component, Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use crate::error::{Error, ErrorKind};
+
+/// Prefix of temporary files, so that one left by a killed process is recognisable.
+const TEMP_PREFIX: &str = ".mjcf-forge-";
+
+/// How many symbolic links [`write_atomic`] follows before giving up (Linux's limit).
+const MAX_LINKS: usize = 40;
+
+fn write_error(path: &Path, e: &std::io::Error) -> Error {
+    Error::bare(ErrorKind::Write {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    })
+}
+
+/// A temporary file next to an output, removed on drop unless renamed into place: any
+/// error (or a panic) between its creation and [`TempFile::persist`] leaves nothing.
+///
+/// Written here rather than with `tempfile`, whose errors name the temporary file (users
+/// never asked for it; ours name the output) and whose names cost a random draw each: a
+/// name from the process id and a counter is unique among live processes, and one left
+/// by a dead process is stepped over.
+struct TempFile {
+    path: PathBuf,
+    file: File,
+    persisted: bool,
+}
+
+impl TempFile {
+    /// A new temporary file in `folder`, with the permissions a new file there gets.
+    fn create_in(folder: &Path) -> std::io::Result<TempFile> {
+        static COUNTER: AtomicU64 = AtomicU64::new(0);
+        let pid = std::process::id();
+        loop {
+            let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+            let path = folder.join(format!("{TEMP_PREFIX}{pid}-{n}"));
+            let mut options = std::fs::OpenOptions::new();
+            options.write(true).create_new(true);
+            #[cfg(unix)]
+            {
+                use std::os::unix::fs::OpenOptionsExt;
+                // The umask applies to the mode given at creation, as for any new file.
+                options.mode(0o666);
+            }
+            match options.open(&path) {
+                Ok(file) => {
+                    return Ok(TempFile {
+                        path,
+                        file,
+                        persisted: false,
+                    });
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+                Err(e) => return Err(e),
+            }
+        }
+    }
+
+    /// Renames the file over `target`.
+    fn persist(mut self, target: &Path) -> std::io::Result<()> {
+        std::fs::rename(&self.path, target)?;
+        self.persisted = true;
+        Ok(())
+    }
+}
+
+impl Drop for TempFile {
+    fn drop(&mut self) {
+        if !self.persisted {
+            let _ = std::fs::remove_file(&self.path);
+        }
+    }
+}
+
+/// The folder of `path` for a temporary file next to it.
+fn folder_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
+/// Writes `bytes` to the output `path` as users expect of `-o PATH`, never leaving a
+/// partial or clobbered file:
+/// - a regular file (or a new one) is replaced atomically: a temporary file in the same
+///   folder, synced, then renamed over it; a replaced file's permissions are kept;
+/// - a symbolic link is followed to its target, which is replaced (the link stays);
+/// - a FIFO, a device (`/dev/null`) or another special file is written to directly,
+///   never replaced; `/dev/stdout` and `/dev/stderr` (and their `/dev/fd`,
+///   `/proc/self/fd` names) are the process's own streams, whatever they are.
+///
+/// Errors name `path`, never the temporary file.
+///
+/// ```
+/// let dir = tempfile::tempdir()?;
+/// let out = dir.path().join("model.xml");
+/// mjcf_forge::write_atomic(&out, b"<mujoco/>")?;
+/// assert_eq!(std::fs::read(&out)?, b"<mujoco/>");
+/// mjcf_forge::write_atomic(std::path::Path::new("/dev/null"), b"<mujoco/>")?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+    let fail = |e: std::io::Error| write_error(path, &e);
+    let target = match follow_links(path).map_err(fail)? {
+        Target::Stream(stream) => return stream(bytes).map_err(fail),
+        Target::Path(target) => target,
+    };
+    let old_permissions = match std::fs::metadata(&target) {
+        Ok(m) if m.is_dir() => {
+            return Err(fail(std::io::Error::new(
+                std::io::ErrorKind::IsADirectory,
+                "is a folder",
+            )));
+        }
+        Ok(m) if !m.is_file() => {
+            // A FIFO or a device: its reader or driver takes the bytes as they come.
+            let mut file = std::fs::OpenOptions::new()
+                .write(true)
+                .open(&target)
+                .map_err(fail)?;
+            return file
+                .write_all(bytes)
+                .and_then(|()| file.flush())
+                .map_err(fail);
+        }
+        Ok(m) => Some(m.permissions()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
+        Err(e) => return Err(fail(e)),
+    };
+    let mut tmp = TempFile::create_in(folder_of(&target)).map_err(fail)?;
+    if let Some(permissions) = old_permissions {
+        tmp.file.set_permissions(permissions).map_err(fail)?;
+    }
+    tmp.file.write_all(bytes).map_err(fail)?;
+    // One output, one sync: the rename must not reach the disk before the data does.
+    tmp.file.sync_all().map_err(fail)?;
+    tmp.persist(&target).map_err(fail)?;
+    Ok(())
+}
+
+type StreamWriter = fn(&[u8]) -> std::io::Result<()>;
+
+/// What writing to a path changes.
+enum Target {
+    /// The process's own standard output or error.
+    Stream(StreamWriter),
+    /// This file (possibly missing, for a dangling link or a new output).
+    Path(PathBuf),
+}
+
+/// The process's own standard output or error when `path` names it. Opening
+/// `/dev/stdout` anew would start at offset 0 of a redirected file (overwriting what the
+/// shell wrote before it) or, followed to that file, replace it; writing to the inherited
+/// stream is what `-o /dev/stdout` means.
+fn standard_stream(path: &Path) -> Option<StreamWriter> {
+    fn stdout(bytes: &[u8]) -> std::io::Result<()> {
+        let mut out = std::io::stdout().lock();
+        out.write_all(bytes).and_then(|()| out.flush())
+    }
+    fn stderr(bytes: &[u8]) -> std::io::Result<()> {
+        let mut out = std::io::stderr().lock();
+        out.write_all(bytes).and_then(|()| out.flush())
+    }
+    match path.to_str()? {
+        "/dev/stdout" | "/dev/fd/1" | "/proc/self/fd/1" => Some(stdout),
+        "/dev/stderr" | "/dev/fd/2" | "/proc/self/fd/2" => Some(stderr),
+        _ => None,
+    }
+}
+
+/// `path` with symbolic links followed as far as they lead on disk. A link the kernel
+/// makes for an open pipe or socket (`/proc/self/fd/N` reads `pipe:[1234]`) is not a path:
+/// the link itself is returned, and opening it reaches the right object.
+fn follow_links(path: &Path) -> std::io::Result<Target> {
+    let mut current = path.to_path_buf();
+    for _ in 0..MAX_LINKS {
+        if let Some(stream) = standard_stream(&current) {
+            return Ok(Target::Stream(stream));
+        }
+        match std::fs::symlink_metadata(&current) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let link = std::fs::read_link(&current)?;
+                if !is_plain_path(&link) {
+                    return Ok(Target::Path(current));
+                }
+                // An absolute link replaces the folder; a relative one is read from it.
+                current = folder_of(&current).join(&link);
+            }
+            _ => return Ok(Target::Path(current)),
+        }
+    }
+    Err(std::io::Error::new(
+        std::io::ErrorKind::InvalidInput,
+        "too many levels of symbolic links",
+    ))
+}
+
+/// Whether a link's text looks like a file path (kernel-made links read `pipe:[N]`,
+/// `socket:[N]`, `anon_inode:[...]`).
+fn is_plain_path(link: &Path) -> bool {
+    let text = link.as_os_str().as_encoded_bytes();
+    !(text.ends_with(b"]") && text.contains(&b':') && !text.contains(&b'/'))
+}
+
+/// A folder that receives many output files, from many threads at once.
+///
+/// [`OutputDir::write`] takes `&self` and holds no lock: each file is its own temporary
+/// file and rename, so threads only meet in the kernel. Files get the permissions of a
+/// newly created file (an existing file of the same name is replaced, not written
+/// through). [`OutputDir::finish`] syncs the filesystem once at the end.
+///
+/// ```
+/// use mjcf_forge::OutputDir;
+/// use rayon::prelude::*;
+/// let tmp = tempfile::tempdir()?;
+/// let dir = OutputDir::create(tmp.path().join("variants"))?;
+/// (0..8).into_par_iter().try_for_each(|i| dir.write(&format!("{i:09}.xml"), b"<mujoco/>"))?;
+/// dir.write("assets/cube.stl", b"solid")?;
+/// dir.finish()?;
+/// assert!(tmp.path().join("variants/000000007.xml").is_file());
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug)]
+pub struct OutputDir {
+    path: PathBuf,
+    /// Held open for the one sync at the end (and, on Linux, to create files in).
+    handle: File,
+    /// Set once unnamed temporary files turn out not to work here.
+    #[cfg(target_os = "linux")]
+    no_unnamed_files: std::sync::atomic::AtomicBool,
+}
+
+impl OutputDir {
+    /// Creates the folder (and its parents) if missing and opens it.
+    ///
+    /// ```
+    /// let err = mjcf_forge::OutputDir::create("Cargo.toml/out").unwrap_err();
+    /// assert!(err.to_string().starts_with("Cargo.toml/out: cannot create folder: "));
+    /// ```
+    pub fn create(path: impl AsRef<Path>) -> Result<OutputDir, Error> {
+        let path = path.as_ref();
+        let fail = |e: std::io::Error| {
+            Error::bare(ErrorKind::Invalid(format!(
+                "{}: cannot create folder: {e}",
+                path.display()
+            )))
+        };
+        std::fs::create_dir_all(path).map_err(fail)?;
+        let handle = File::open(path).map_err(fail)?;
+        Ok(OutputDir {
+            path: path.to_path_buf(),
+            handle,
+            #[cfg(target_os = "linux")]
+            no_unnamed_files: std::sync::atomic::AtomicBool::new(false),
+        })
+    }
+
+    /// The folder.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The final path of `relative_name`, after checking it stays inside the folder.
+    fn final_path(&self, relative_name: &str) -> Result<PathBuf, Error> {
+        let relative = Path::new(relative_name);
+        let inside = !relative_name.is_empty()
+            && relative
+                .components()
+                .all(|c| matches!(c, Component::Normal(_)));
+        if !inside {
+            return Err(Error::bare(ErrorKind::Write {
+                path: self.path.join(relative),
+                reason: "not a file name inside the output folder".to_owned(),
+            }));
+        }
+        Ok(self.path.join(relative))
+    }
+
+    /// Writes `bytes` as the file `relative_name` (which may name a subfolder:
+    /// `assets/cube.stl`, created when missing), replacing it atomically. On any error
+    /// nothing is left behind and the error names the final file.
+    pub fn write(&self, relative_name: &str, bytes: &[u8]) -> Result<(), Error> {
+        let path = self.final_path(relative_name)?;
+        let fail = |e: std::io::Error| write_error(&path, &e);
+        #[cfg(target_os = "linux")]
+        if self.write_unnamed(relative_name, bytes).map_err(fail)? {
+            return Ok(());
+        }
+        let folder = folder_of(&path);
+        let mut tmp = match TempFile::create_in(folder) {
+            Ok(tmp) => tmp,
+            // The first file of a subfolder creates it; later ones find it.
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound && folder != self.path => {
+                std::fs::create_dir_all(folder).map_err(fail)?;
+                TempFile::create_in(folder).map_err(fail)?
+            }
+            Err(e) => return Err(fail(e)),
+        };
+        tmp.file.write_all(bytes).map_err(fail)?;
+        tmp.persist(&path).map_err(fail)?;
+        Ok(())
+    }
+
+    /// Linux: writes the file without a name (`O_TMPFILE`) and links it under its final
+    /// name once complete: one directory entry per file, as a plain write makes, instead
+    /// of a temporary one plus a rename; and a process killed mid-write leaves nothing at
+    /// all (an unnamed file vanishes with it). `Ok(false)` when this cannot be done here
+    /// (the name exists already, which a link cannot replace; a filesystem without
+    /// `O_TMPFILE`; no `/proc`): the caller then writes through a named temporary file.
+    #[cfg(target_os = "linux")]
+    fn write_unnamed(&self, relative_name: &str, bytes: &[u8]) -> std::io::Result<bool> {
+        use rustix::fs::{AtFlags, CWD, Mode, OFlags};
+        use rustix::io::Errno;
+        use std::os::fd::AsRawFd as _;
+        if self.no_unnamed_files.load(Ordering::Relaxed) {
+            return Ok(false);
+        }
+        let folder = match Path::new(relative_name).parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        let open = || {
+            rustix::fs::openat(
+                &self.handle,
+                folder,
+                OFlags::WRONLY | OFlags::TMPFILE | OFlags::CLOEXEC,
+                // The umask applies, as for any new file.
+                Mode::from_raw_mode(0o666),
+            )
+        };
+        let fd = match open() {
+            Ok(fd) => fd,
+            Err(Errno::NOENT) if folder != Path::new(".") => {
+                std::fs::create_dir_all(self.path.join(folder))?;
+                open()?
+            }
+            Err(Errno::OPNOTSUPP | Errno::ISDIR | Errno::INVAL) => {
+                self.no_unnamed_files.store(true, Ordering::Relaxed);
+                return Ok(false);
+            }
+            Err(e) => return Err(e.into()),
+        };
+        let mut file = File::from(fd);
+        file.write_all(bytes)?;
+        let fd_path = format!("/proc/self/fd/{}", file.as_raw_fd());
+        match rustix::fs::linkat(
+            CWD,
+            fd_path.as_str(),
+            &self.handle,
+            relative_name,
+            AtFlags::SYMLINK_FOLLOW,
+        ) {
+            Ok(()) => Ok(true),
+            Err(Errno::EXIST) => Ok(false),
+            Err(Errno::NOENT) => {
+                // No /proc to name the file by.
+                self.no_unnamed_files.store(true, Ordering::Relaxed);
+                Ok(false)
+            }
+            Err(e) => Err(e.into()),
+        }
+    }
+
+    /// Whether `relative_name` is already there (a file written by an earlier run, or by
+    /// another process sharing the folder).
+    pub fn contains(&self, relative_name: &str) -> bool {
+        self.final_path(relative_name)
+            .is_ok_and(|p| std::fs::symlink_metadata(p).is_ok())
+    }
+
+    /// Makes everything written durable: one sync of the folder's filesystem, instead of
+    /// one per file.
+    pub fn finish(self) -> Result<(), Error> {
+        sync_filesystem(&self.handle).map_err(|e| write_error(&self.path, &e))
+    }
+}
+
+#[cfg(target_os = "linux")]
+fn sync_filesystem(handle: &File) -> std::io::Result<()> {
+    rustix::fs::syncfs(handle).map_err(std::io::Error::from)
+}
+
+/// Elsewhere: syncing the folder at least makes its renames durable.
+#[cfg(not(target_os = "linux"))]
+fn sync_filesystem(handle: &File) -> std::io::Result<()> {
+    handle.sync_all()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn listing(dir: &Path) -> Vec<String> {
+        let mut names: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        names
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn outputs_get_a_new_files_permissions_or_keep_the_replaced_ones() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        let fresh = dir.path().join("fresh");
+        std::fs::write(&fresh, b"").unwrap();
+        let out = dir.path().join("out.xml");
+        write_atomic(&out, b"<mujoco/>").unwrap();
+        assert_eq!(mode(&out), mode(&fresh));
+        std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o640)).unwrap();
+        write_atomic(&out, b"<mujoco/>").unwrap();
+        assert_eq!(mode(&out), 0o640);
+
+        let outputs = OutputDir::create(dir.path().join("d")).unwrap();
+        outputs.write("a/b.xml", b"x").unwrap();
+        assert_eq!(mode(&dir.path().join("d/a/b.xml")), mode(&fresh));
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_symlink_is_written_through_and_stays_a_link() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("target.xml");
+        std::fs::write(&target, b"old").unwrap();
+        let link = dir.path().join("link.xml");
+        std::os::unix::fs::symlink("target.xml", &link).unwrap();
+        // A link to a link, and a dangling link whose target gets created.
+        let link2 = dir.path().join("link2.xml");
+        std::os::unix::fs::symlink(&link, &link2).unwrap();
+        write_atomic(&link2, b"new").unwrap();
+        assert!(std::fs::symlink_metadata(&link).unwrap().is_symlink());
+        assert!(std::fs::symlink_metadata(&link2).unwrap().is_symlink());
+        assert_eq!(std::fs::read(&target).unwrap(), b"new");
+        let dangling = dir.path().join("dangling.xml");
+        std::os::unix::fs::symlink("made.xml", &dangling).unwrap();
+        write_atomic(&dangling, b"made").unwrap();
+        assert_eq!(std::fs::read(dir.path().join("made.xml")).unwrap(), b"made");
+        assert!(std::fs::symlink_metadata(&dangling).unwrap().is_symlink());
+        assert_eq!(
+            listing(dir.path()),
+            [
+                "dangling.xml",
+                "link.xml",
+                "link2.xml",
+                "made.xml",
+                "target.xml"
+            ]
+        );
+        // A loop is an error naming the path asked for.
+        let a = dir.path().join("loop_a");
+        std::os::unix::fs::symlink("loop_b", &a).unwrap();
+        std::os::unix::fs::symlink("loop_a", dir.path().join("loop_b")).unwrap();
+        let err = write_atomic(&a, b"x").unwrap_err().to_string();
+        assert_eq!(
+            err,
+            format!(
+                "cannot write '{}': too many levels of symbolic links",
+                a.display()
+            )
+        );
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_device_is_written_to_not_replaced() {
+        write_atomic(Path::new("/dev/null"), b"<mujoco/>").unwrap();
+        let m = std::fs::metadata("/dev/null").unwrap();
+        assert!(!m.is_file(), "/dev/null became a regular file");
+        // A symlink to the device, as /dev/stdout is to a terminal.
+        let dir = tempfile::tempdir().unwrap();
+        let link = dir.path().join("null");
+        std::os::unix::fs::symlink("/dev/null", &link).unwrap();
+        write_atomic(&link, b"x").unwrap();
+        assert!(std::fs::symlink_metadata(&link).unwrap().is_symlink());
+        assert_eq!(listing(dir.path()), ["null"]);
+    }
+
+    #[test]
+    fn errors_name_the_final_file_and_leave_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let err = write_atomic(dir.path(), b"x").unwrap_err().to_string();
+        assert_eq!(
+            err,
+            format!("cannot write '{}': is a folder", dir.path().display())
+        );
+        let missing = dir.path().join("no/out.xml");
+        let err = write_atomic(&missing, b"x").unwrap_err().to_string();
+        assert_eq!(
+            err,
+            format!(
+                "cannot write '{}': No such file or directory (os error 2)",
+                missing.display()
+            )
+        );
+        let outputs = OutputDir::create(dir.path().join("d")).unwrap();
+        std::fs::create_dir(dir.path().join("d/taken")).unwrap();
+        let err = outputs.write("taken", b"x").unwrap_err().to_string();
+        assert!(
+            err.starts_with(&format!(
+                "cannot write '{}': ",
+                dir.path().join("d/taken").display()
+            )),
+            "{err}"
+        );
+        for bad in ["", "../x", "/etc/x", "a/../../x", "./"] {
+            let err = outputs.write(bad, b"x").unwrap_err().to_string();
+            assert!(
+                err.ends_with("not a file name inside the output folder"),
+                "{bad}: {err}"
+            );
+        }
+        assert_eq!(listing(&dir.path().join("d")), ["taken"]);
+        assert!(listing(&dir.path().join("d/taken")).is_empty());
+    }
+
+    /// A second run into the same folder replaces the first one's files (a link cannot
+    /// replace a name, so this takes the rename path) and leaves nothing else.
+    #[test]
+    fn a_rerun_replaces_files_atomically() {
+        let dir = tempfile::tempdir().unwrap();
+        for round in ["one", "two"] {
+            let outputs = OutputDir::create(dir.path()).unwrap();
+            outputs.write("a.xml", round.as_bytes()).unwrap();
+            outputs.write("assets/b.bin", round.as_bytes()).unwrap();
+            outputs.finish().unwrap();
+            assert_eq!(
+                std::fs::read(dir.path().join("a.xml")).unwrap(),
+                round.as_bytes()
+            );
+            assert_eq!(
+                std::fs::read(dir.path().join("assets/b.bin")).unwrap(),
+                round.as_bytes()
+            );
+        }
+        assert_eq!(listing(dir.path()), ["a.xml", "assets"]);
+        assert_eq!(listing(&dir.path().join("assets")), ["b.bin"]);
+    }
+
+    #[test]
+    fn many_threads_write_one_folder() {
+        use rayon::prelude::*;
+        let dir = tempfile::tempdir().unwrap();
+        let outputs = OutputDir::create(dir.path()).unwrap();
+        (0..200u32)
+            .into_par_iter()
+            .try_for_each(|i| {
+                let name = if i % 2 == 0 {
+                    format!("{i:09}.xml")
+                } else {
+                    format!("assets/{i:09}.bin")
+                };
+                outputs.write(&name, format!("{i}").as_bytes())
+            })
+            .unwrap();
+        assert!(outputs.contains("assets/000000199.bin"));
+        outputs.finish().unwrap();
+        assert_eq!(listing(dir.path()).len(), 101);
+        assert_eq!(listing(&dir.path().join("assets")).len(), 100);
+        assert_eq!(
+            std::fs::read_to_string(dir.path().join("000000198.xml")).unwrap(),
+            "198"
+        );
+    }
+}

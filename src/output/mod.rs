@@ -1,0 +1,12 @@
+//! Where outputs go: files that are never partial or clobbered ([`write_atomic`],
+//! [`OutputDir`]), asset files gathered under content-derived names so an output folder
+//! can be moved ([`AssetStore`]), and a tar stream of a whole output folder
+//! ([`TarWriter`]).
+
+mod assets;
+mod files;
+mod tar;
+
+pub use assets::AssetStore;
+pub use files::{OutputDir, write_atomic};
+pub use tar::TarWriter;
