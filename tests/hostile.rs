@@ -214,6 +214,34 @@ fn a_deep_include_chain_is_refused_before_the_stack_runs_out() {
 }
 
 #[test]
+fn a_raised_include_depth_limit_cannot_exhaust_the_stack() {
+    let dir = tempfile::tempdir().unwrap();
+    let n = 1000; // five times what 2 MiB of stack holds unoptimised
+    for i in 0..n {
+        let body = if i + 1 < n {
+            format!("<mujoco><include file=\"f{}.xml\"/></mujoco>", i + 1)
+        } else {
+            "<mujoco><worldbody><body name=\"last\"/></worldbody></mujoco>".to_string()
+        };
+        std::fs::write(dir.path().join(format!("f{i}.xml")), body).unwrap();
+    }
+    let main = dir.path().join("f0.xml");
+    let deep = Limits {
+        max_include_depth: 5000,
+        ..Limits::default()
+    };
+    let out = on_both(move || {
+        Document::load_with(&main, &deep)
+            .map(|d| d.to_xml_string())
+            .map_err(|e| e.to_string())
+    });
+    assert_eq!(
+        out.unwrap(),
+        "<mujoco><worldbody><body name=\"last\"/></worldbody></mujoco>"
+    );
+}
+
+#[test]
 fn deep_elements_inside_an_included_file_count_from_the_include() {
     let dir = tempfile::tempdir().unwrap();
     let inner = nested(("", ""), "<body>", "</body>", 600);
