@@ -901,3 +901,47 @@ fn the_command_line_refuses_a_prefix_with_white_space() {
     );
     assert_eq!(listing(&dir), ["ok.xml"]);
 }
+
+/// What the tricky cases above write is also read by Python's XML parser (expat, which
+/// checks names, characters and namespaces as XML 1.0 says).
+#[test]
+fn outputs_are_read_by_pythons_xml_parser() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut cases: Vec<String> = vec![
+        load_str(
+            "<mujoco><custom><text name=\"t\" data=\"&#9;&#xA;&#xD;&#x10FFFF;&lt;&amp;&quot;\u{E000}\"/></custom><worldbody><body>a&amp;b&#x85;<![CDATA[]]]]>]]></body></worldbody></mujoco>",
+        )
+        .unwrap(),
+        load_str(&std::fs::read_to_string(common::root().join("corpora/features/actuator_adhesion_general_default.xml")).unwrap()).unwrap(),
+    ];
+    let mut doc = Document::from_str(
+        "<mujoco><worldbody><body name=\"b\"><geom name=\"g\" size=\"1\"/></body></worldbody><contact><exclude body1=\"b\" body2=\"b\"/></contact></mujoco>",
+        ".",
+    )
+    .unwrap();
+    doc.apply_prefix("<&\"'>\u{e9}").unwrap();
+    cases.push(doc.to_pretty_string());
+    cases.push(doc.to_xml_string());
+    let mut files = Vec::new();
+    for (i, xml) in cases.iter().enumerate() {
+        assert_well_formed(xml);
+        let f = dir.path().join(format!("case{i}.xml"));
+        std::fs::write(&f, xml).unwrap();
+        files.push(f);
+    }
+    let out = std::process::Command::new(common::python())
+        .arg("-c")
+        .arg("import sys, xml.etree.ElementTree as ET\nfor f in sys.argv[1:]: ET.parse(f)\nprint(len(sys.argv) - 1)")
+        .args(&files)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout).trim(),
+        cases.len().to_string()
+    );
+}
