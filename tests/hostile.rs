@@ -449,6 +449,57 @@ fn scene_files_that_are_no_regular_files_are_refused() {
 }
 
 #[test]
+fn skin_and_mesh_headers_claiming_huge_counts_are_refused_without_reserving_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    let skin = dir.path().join("huge.skn");
+    let header: Vec<u8> = [0i32, 0, 0, i32::MAX]
+        .iter()
+        .flat_map(|n| n.to_le_bytes())
+        .collect();
+    std::fs::write(&skin, &header).unwrap();
+    let msh = dir.path().join("huge.msh");
+    let header: Vec<u8> = [i32::MAX, i32::MAX, i32::MAX, i32::MAX]
+        .iter()
+        .flat_map(|n| n.to_le_bytes())
+        .collect();
+    std::fs::write(&msh, &header).unwrap();
+    let stl = dir.path().join("huge.stl");
+    let mut bytes = vec![0u8; 84];
+    bytes[80..84].copy_from_slice(&u32::MAX.to_le_bytes());
+    std::fs::write(&stl, &bytes).unwrap();
+    let (s, m, t) = (
+        skin.display().to_string(),
+        msh.display().to_string(),
+        stl.display().to_string(),
+    );
+    let msgs = on_both(move || {
+        let xml = format!("<mujoco><asset><skin file=\"{s}\"/></asset></mujoco>");
+        let mut doc = Document::from_str(&xml, ".").unwrap();
+        let skin = doc.apply_prefix("p_").unwrap_err().to_string();
+        let mut meshes = Vec::new();
+        for f in [&m, &t] {
+            let xml = format!("<mujoco><asset><mesh name=\"m\" file=\"{f}\"/></asset></mujoco>");
+            let doc = Document::from_str(&xml, ".").unwrap();
+            let asset = doc.find_section(mjcf_forge::Section::Asset).unwrap();
+            let mesh = doc.elements(asset).next().unwrap();
+            meshes.push(mjcf_forge::geometry::mesh_vertices(&doc, mesh).unwrap_err());
+        }
+        (skin, meshes)
+    });
+    assert!(
+        msgs.0.ends_with("file is shorter than its header says"),
+        "{}",
+        msgs.0
+    );
+    assert!(
+        msgs.1[0].contains("MSH file has 16 bytes, its header says"),
+        "{}",
+        msgs.1[0]
+    );
+    assert!(msgs.1[1].contains("huge.stl"), "{}", msgs.1[1]);
+}
+
+#[test]
 fn a_long_text_is_refused_by_the_size_limit() {
     let small = Limits {
         max_file_size: 100,
