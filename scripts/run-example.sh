@@ -2,6 +2,7 @@
 # Sets up everything (Python venv with the pinned MuJoCo, the robosuite and dm-control
 # wheel corpora, a release build with MuJoCo compiled in) and runs the main jobs on built-in
 # examples, writing to out/:
+#   0. generate: 500 seeded variants of the built-in demo scene, validated by MuJoCo;
 #   1. inline: a feature model with includes, default classes and compiler dirs;
 #   2. merge: robosuite's Lift scene (table arena, Panda + gripper, a can), validated by
 #      compiling it with MuJoCo;
@@ -14,6 +15,11 @@ cargo build --release --features mujoco
 forge=target/release/mjcf-forge
 rs=.cache/corpus/robosuite-1.5.2/robosuite/models/assets
 mkdir -p out
+
+echo "== generate: 500 variants of the built-in demo scene, each compiled and checked by MuJoCo -> out/demo/"
+rm -rf out/demo
+"$forge" generate -n 500 -o out/demo --validate
+head -c 600 out/demo/manifest.jsonl; echo " ..."
 
 echo "== inline corpora/features/include_nested.xml -> out/include_nested.xml"
 "$forge" inline corpora/features/include_nested.xml -o out/include_nested.xml --validate

@@ -1128,7 +1128,7 @@ impl Document {
 
     /// For each asset of the part, in order: whether the base already has it (same tag,
     /// name and content); an asset with a base name but other content is an error naming both.
-    fn asset_decisions(&self, part: &Document, errors: &mut Vec<Error>) -> Vec<bool> {
+    pub(crate) fn asset_decisions(&self, part: &Document, errors: &mut Vec<Error>) -> Vec<bool> {
         let Some(theirs) = part.find_section(Section::Asset) else {
             return Vec::new();
         };

@@ -577,6 +577,8 @@ model_arrays! {
     body_quat: f64, |m| n(m.nbody) * 4;
     /// Body masses (`nbody`).
     body_mass: f64, |m| n(m.nbody);
+    /// Body principal moments of inertia (`nbody x 3`).
+    body_inertia: f64, |m| n(m.nbody) * 3;
     /// Parent body ids (`nbody`; the world body is its own parent).
     body_parentid: i32, |m| n(m.nbody);
     /// Per body, the id of its top-level ancestor (the body itself at the top).
@@ -595,6 +597,8 @@ model_arrays! {
     geom_size: f64, |m| n(m.ngeom) * 3;
     /// Geom positions relative to their body (`ngeom x 3`).
     geom_pos: f64, |m| n(m.ngeom) * 3;
+    /// Geom orientations relative to their body, `w x y z` (`ngeom x 4`).
+    geom_quat: f64, |m| n(m.ngeom) * 4;
     /// Geom friction: slide, spin, roll (`ngeom x 3`).
     geom_friction: f64, |m| n(m.ngeom) * 3;
     /// Geom colors when no material is set (`ngeom x 4`).

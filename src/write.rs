@@ -47,8 +47,8 @@ fn text_word_is_special(w: u64) -> bool {
     (bytes_equal(w, b'&') | bytes_equal(w | (LO * 0x02), b'>')) != 0
 }
 
-#[cfg(test)]
-fn escape_attr(out: &mut String, value: &str) {
+/// Appends `value` escaped for a double-quoted attribute.
+pub(crate) fn escape_attr(out: &mut String, value: &str) {
     if is_clean(value.as_bytes(), &ATTR_SPECIAL, attr_word_is_special) {
         out.push_str(value);
     } else {
@@ -165,7 +165,7 @@ impl Document {
     /// Writes `root` and everything below it. An explicit stack of steps, not recursion:
     /// documents nest as deep as [`crate::Limits::max_depth`] allows (and deeper once
     /// merged), and writing may run on a worker thread with a small stack.
-    fn write_node(&self, out: &mut String, root: Node, indent: Option<usize>) {
+    pub(crate) fn write_node(&self, out: &mut String, root: Node, indent: Option<usize>) {
         enum Step {
             /// Write a node at this indent; `newline` first when its siblings are indented.
             Enter {

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
-use mjcf_forge::scene::{Scene, Variant};
+use mjcf_forge::scene::{Params, Scene};
 use mjcf_forge::{AssetStore, OutputDir, TarWriter};
 use rayon::prelude::*;
 
@@ -30,7 +30,8 @@ pub struct Args {
     /// How many variants (indices START..START+N).
     #[arg(short = 'n', long = "count", default_value_t = 10)]
     count: u64,
-    /// A folder, a `.tar` file, or `-` for a tar stream on standard output.
+    /// A folder, a `.tar` file (with `--shard K/N`: `NAME-KKKKKK.tar`), or `-` for a tar
+    /// stream on standard output.
     #[arg(short, long)]
     output: PathBuf,
     /// Seed (overrides the scene file's).
@@ -211,6 +212,11 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
     scene.relocate_assets(&store).map_err(|e| e.to_string())?;
     let lo = args.start + args.count * k / n;
     let hi = args.start + args.count * (k + 1) / n;
+    // A scene that cannot make even its first variant (say, a region too small for its
+    // objects) is refused before anything is written.
+    if lo < hi {
+        scene.variant(lo).map_err(|e| e.to_string())?;
+    }
     let mut sink = open_sink(
         &args.output,
         &store,
@@ -247,18 +253,18 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
         let made: Vec<Result<(u64, String, String, Duration), String>> = (at..end)
             .into_par_iter()
             .map(|i| {
-                let v = scene.variant(i).map_err(|e| e.to_string())?;
-                let xml = if args.pretty {
-                    v.document.to_pretty_string()
+                let (xml, params) = if args.pretty {
+                    let v = scene.variant(i).map_err(|e| e.to_string())?;
+                    (v.document.to_pretty_string(), v.params)
                 } else {
-                    v.xml()
+                    scene.variant_xml(i).map_err(|e| e.to_string())?
                 };
                 let took = match (&check_dir, args.validate) {
-                    (Some(dir), true) => check(&v, &xml, dir)?,
+                    (Some(dir), true) => check(i, &params, &xml, dir)?,
                     _ => Duration::ZERO,
                 };
                 let file = format!("{i:09}.xml");
-                let json = v.params.to_json(i, Some(&file));
+                let json = params.to_json(i, Some(&file));
                 if let Sink::Dir { out, .. } = &sink {
                     out.write(&file, xml.as_bytes())
                         .map_err(|e| e.to_string())?;
@@ -293,14 +299,14 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
 }
 
 #[cfg(feature = "mujoco")]
-fn check(v: &Variant, xml: &str, dir: &Path) -> Result<Duration, String> {
+fn check(i: u64, params: &Params, xml: &str, dir: &Path) -> Result<Duration, String> {
     let t = Instant::now();
-    mjcf_forge::scene::check_variant(v, xml, dir)?;
+    mjcf_forge::scene::check_variant(i, params, xml, dir)?;
     Ok(t.elapsed())
 }
 
 #[cfg(not(feature = "mujoco"))]
-fn check(_: &Variant, _: &str, _: &Path) -> Result<Duration, String> {
+fn check(_: u64, _: &Params, _: &str, _: &Path) -> Result<Duration, String> {
     Err(super::NO_MUJOCO.to_owned())
 }
 
@@ -339,6 +345,15 @@ fn open_sink(
         Some(dir)
     } else {
         None
+    };
+    // Shards writing tar files each write their own, named as WebDataset shards are.
+    let sharded_name;
+    let output = if sharded && output != Path::new("-") {
+        let stem = output.file_stem().unwrap_or_default().to_string_lossy();
+        sharded_name = output.with_file_name(format!("{stem}-{k:06}.tar"));
+        sharded_name.as_path()
+    } else {
+        output
     };
     let (writer, file, label): (Box<dyn Write + Send + Sync>, _, PathBuf) =
         if output == Path::new("-") {

@@ -5,26 +5,30 @@ use std::path::Path;
 
 use crate::mujoco::{CompiledModel, ObjType, compile_str};
 
-use super::Variant;
+use super::Params;
 
 /// Penetration MuJoCo may report for objects resting exactly on a surface (rounding).
 pub const PENETRATION_TOLERANCE: f64 = 1e-6;
 
-/// Compiles `xml` (variant `variant`'s text, its relative file names resolved against
-/// `dir`) and checks its placed objects: `Err` with MuJoCo's message, or the first pair of
-/// interpenetrating geoms that involves a placed object.
+/// Compiles `xml` (the text of variant `index`, drawn with `params`; relative file names
+/// resolved against `dir`) and checks its placed objects: `Err` with MuJoCo's message, or
+/// the first pair of interpenetrating geoms that involves a placed object.
 ///
 /// ```
 /// let scene = mjcf_forge::scene::Scene::demo()?;
-/// let v = scene.variant(0)?;
-/// mjcf_forge::scene::check_variant(&v, &v.xml(), std::path::Path::new(".")).unwrap();
+/// let (xml, params) = scene.variant_xml(0)?;
+/// mjcf_forge::scene::check_variant(0, &params, &xml, std::path::Path::new(".")).unwrap();
 /// # Ok::<(), mjcf_forge::Errors>(())
 /// ```
-pub fn check_variant(variant: &Variant, xml: &str, dir: &Path) -> Result<CompiledModel, String> {
-    let model = compile_str(xml, dir).map_err(|e| format!("variant {}: {e}", variant.index))?;
+pub fn check_variant(
+    index: u64,
+    params: &Params,
+    xml: &str,
+    dir: &Path,
+) -> Result<CompiledModel, String> {
+    let model = compile_str(xml, dir).map_err(|e| format!("variant {index}: {e}"))?;
     let bodies = model.names(ObjType::Body);
-    let placed: Vec<usize> = variant
-        .params
+    let placed: Vec<usize> = params
         .objects
         .iter()
         .filter_map(|o| bodies.iter().position(|b| *b == o.body))
@@ -48,8 +52,7 @@ pub fn check_variant(variant: &Variant, xml: &str, dir: &Path) -> Result<Compile
                 )
             };
             return Err(format!(
-                "variant {}: {} interpenetrates {} by {:.3} mm at the initial pose",
-                variant.index,
+                "variant {index}: {} interpenetrates {} by {:.3} mm at the initial pose",
                 label(c.geom1, a),
                 label(c.geom2, b),
                 -c.dist * 1e3

@@ -17,7 +17,7 @@ use crate::vocab::{self, AttrKind};
 use super::place::{self, Placement, Rotation};
 use super::randomize::{self, Dist, Randomizer};
 use super::spec::{self, SceneSpec};
-use super::{Group, Instance, PoolModel, Scene};
+use super::{Group, Instance, PoolModel, Scene, splice};
 
 /// The largest count a group may ask for (each slot keeps its prefixed instances).
 const MAX_COUNT: u32 = 10_000;
@@ -75,12 +75,23 @@ impl Source<'_> {
     }
 }
 
-/// Builds a scene from TOML text named `file` (its folder holds the models).
+/// Builds a scene from TOML text named `file` (its folder holds the models). Problems in
+/// the scene file come in the order of their positions.
 pub(crate) fn from_toml(
     text: &str,
     file: Arc<Path>,
     models: &dyn ModelSource,
 ) -> Result<Scene, Errors> {
+    build(text, file.clone(), models).map_err(|mut e| {
+        e.0.sort_by_key(|e| match &e.location {
+            Some(l) if l.file == file => (0, l.line, l.col),
+            _ => (1, 0, 0),
+        });
+        e
+    })
+}
+
+fn build(text: &str, file: Arc<Path>, models: &dyn ModelSource) -> Result<Scene, Errors> {
     let src = Source {
         text,
         file: file.clone(),
@@ -239,7 +250,9 @@ pub(crate) fn from_toml(
         template_targets.push(targets);
     }
     let prefixes_apart = prefixes_apart(&groups);
+    let splice = splice::Template::build(&template, &template_targets, &randomizers);
     let mut scene = Scene {
+        splice,
         prefixes_apart,
         seed: spec.seed,
         file,
@@ -258,7 +271,7 @@ pub(crate) fn from_toml(
                     for (k, t) in &inst.targets {
                         selected[*k] += t.len();
                     }
-                    let _ = group.instances[m].set(Ok(Arc::new(inst)));
+                    let _ = group.instances[m].set(Ok(inst));
                 }
                 Err(e) => errors.extend(e.0),
             }
@@ -421,7 +434,18 @@ fn group(
             .elements(root)
             .any(|k| matches!(doc.tag(k), "joint" | "freejoint"));
         if g.free_joint && !has_joint {
-            doc.append_element(root, "freejoint", &[("name", "joint0")]);
+            // Named joint0 as robosuite names an object's first joint, or the first free
+            // jointN when the model already uses that name.
+            let taken: Vec<&str> = doc
+                .descendants(doc.root())
+                .filter(|&n| matches!(doc.tag(n), "joint" | "freejoint"))
+                .filter_map(|n| doc.attr(n, "name"))
+                .collect();
+            let name = (0..)
+                .map(|k| format!("joint{k}"))
+                .find(|n| !taken.contains(&n.as_str()))
+                .expect("a free name exists");
+            doc.append_element(root, "freejoint", &[("name", &name)]);
         }
         let bounds = match geometry::subtree_bounds(&doc, root, |_, _| true) {
             Ok(b) if b.min.iter().chain(&b.max).all(|x| x.is_finite()) => b,
@@ -855,11 +879,15 @@ pub(crate) fn make_instance(
     if !errors.is_empty() {
         return Err(Errors(errors));
     }
+    let fragments = scene.splice.as_ref().and_then(|t| {
+        splice::Fragments::build(&doc, root, &targets, &scene.randomizers, &scene.template, t)
+    });
     Ok(Instance {
         doc,
         prefix,
         root,
         root_name,
         targets,
+        fragments,
     })
 }

@@ -33,6 +33,7 @@ mod place;
 mod randomize;
 mod rng;
 mod spec;
+mod splice;
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -48,9 +49,10 @@ use crate::tree::Node;
 #[cfg(feature = "mujoco")]
 pub use check::{PENETRATION_TOLERANCE, check_variant};
 pub use params::{Params, PlacedObject, RandomizedValue};
+pub use randomize::MUJOCO_DEFAULTS;
 
 use place::Placement;
-use randomize::Randomizer;
+use randomize::{AttrTarget, Overlay, Randomizer};
 use rng::Rng;
 
 /// A loaded scene description, ready to make variants. Cheap to share between threads
@@ -82,6 +84,9 @@ pub struct Scene {
     model_files: Vec<PathBuf>,
     /// No instance prefix begins another, so names of different instances never clash.
     prefixes_apart: bool,
+    /// The template's text with holes and insertion points, when variants can be written
+    /// by splicing (see `splice`).
+    splice: Option<splice::Template>,
 }
 
 /// One element a randomizer sets, with what the manifest says of it.
@@ -110,7 +115,7 @@ struct Group {
     /// Index of the earlier group to stack on.
     on_top_of: Option<usize>,
     /// Per slot and pool model (slot * pool.len() + model), made on first use.
-    instances: Vec<OnceLock<Result<Arc<Instance>, Errors>>>,
+    instances: Vec<OnceLock<Result<Instance, Errors>>>,
     options: crate::model::XmlModelOptions,
 }
 
@@ -133,6 +138,17 @@ struct Instance {
     root_name: String,
     /// Per randomizer that applies to this group, the elements it sets.
     targets: Vec<(usize, Vec<Target>)>,
+    /// The instance's text to splice into the template's, when it can be.
+    fragments: Option<splice::Fragments>,
+}
+
+/// Everything drawn for one variant, before it is written.
+pub(crate) struct Drawn<'s> {
+    /// Values of the template's randomized attributes.
+    template: Overlay<'s>,
+    /// Each placed object: its instance and its values (root pose first).
+    placed: Vec<(&'s Instance, Overlay<'s>)>,
+    params: Params,
 }
 
 /// One variant: its index, its document, and everything that was drawn for it.
@@ -288,15 +304,162 @@ impl Scene {
     /// Variant `index`: the same document and parameters for the same seed and index,
     /// whatever else was made before, on whatever thread.
     pub fn variant(&self, index: u64) -> Result<Variant, Errors> {
+        let drawn = self.draw(index)?;
         let mut doc = self.template.clone();
+        drawn.template.apply_to(&mut doc);
+        let parts: Vec<(Document, &str)> = drawn
+            .placed
+            .iter()
+            .map(|(inst, overlay)| {
+                let mut part = inst.doc.clone();
+                place::clear_orientation(&mut part, inst.root);
+                overlay.apply_to(&mut part);
+                (part, inst.prefix.as_str())
+            })
+            .collect();
+        if !parts.is_empty() {
+            let merge: Vec<MergePart<'_>> = parts
+                .iter()
+                .map(|(doc, prefix)| MergePart {
+                    doc,
+                    into: None,
+                    prefix,
+                })
+                .collect();
+            // Each instance was checked against the template when it was made; instances
+            // cannot clash with each other when no prefix begins another.
+            if !self.prefixes_apart {
+                let docs: Vec<&Document> = parts.iter().map(|(d, _)| d).collect();
+                let clashes = doc.name_clashes(&docs);
+                if !clashes.is_empty() {
+                    return Err(Errors(clashes));
+                }
+            }
+            doc.merge_unchecked(&merge, false)?;
+        }
+        Ok(Variant {
+            index,
+            document: doc,
+            params: drawn.params,
+        })
+    }
+
+    /// Variant `index` as compact XML with its parameters: the same bytes as
+    /// `variant(index)?.xml()`, made without building the document where the scene
+    /// allows (the template's text is copied with the variant's values and objects
+    /// spliced in; see `splice`).
+    ///
+    /// ```
+    /// let scene = mjcf_forge::scene::Scene::demo()?;
+    /// let (xml, params) = scene.variant_xml(5)?;
+    /// let v = scene.variant(5)?;
+    /// assert_eq!(xml, v.xml());
+    /// assert_eq!(params, v.params);
+    /// # Ok::<(), mjcf_forge::Errors>(())
+    /// ```
+    pub fn variant_xml(&self, index: u64) -> Result<(String, Params), Errors> {
+        if let Some(splice) = &self.splice {
+            let drawn = self.draw(index)?;
+            if let Some(xml) = splice.write(&drawn) {
+                return Ok((xml, drawn.params));
+            }
+        }
+        let v = self.variant(index)?;
+        Ok((v.xml(), v.params))
+    }
+
+    /// Makes variants `range` as XML in parallel, in chunks of `chunk`, and hands each to
+    /// `sink` in index order, so memory stays bounded however long the range. A variant
+    /// that fails is handed over as its error; `sink` stops everything by returning an
+    /// error.
+    ///
+    /// ```
+    /// let scene = mjcf_forge::scene::Scene::demo()?;
+    /// let mut seen = Vec::new();
+    /// scene.stream(10..20, 4, |i, made| {
+    ///     let (xml, _params) = made?;
+    ///     seen.push((i, xml.len()));
+    ///     Ok::<(), mjcf_forge::Errors>(())
+    /// })?;
+    /// assert_eq!(seen.iter().map(|s| s.0).collect::<Vec<_>>(), (10..20).collect::<Vec<_>>());
+    /// # Ok::<(), mjcf_forge::Errors>(())
+    /// ```
+    pub fn stream<E>(
+        &self,
+        range: Range<u64>,
+        chunk: u64,
+        mut sink: impl FnMut(u64, Result<(String, Params), Errors>) -> Result<(), E>,
+    ) -> Result<(), E> {
+        let chunk = chunk.max(1);
+        let mut at = range.start;
+        while at < range.end {
+            let end = (at + chunk).min(range.end);
+            let made: Vec<_> = (at as usize..end as usize)
+                .into_par_iter()
+                .map(|i| self.variant_xml(i as u64))
+                .collect();
+            for (i, m) in (at..end).zip(made) {
+                sink(i, m)?;
+            }
+            at = end;
+        }
+        Ok(())
+    }
+
+    /// Writes variants `range` to `out` as a tar stream in the layout of `generate -o -`
+    /// (the variants' XML with file references as the scene has them: absolute unless
+    /// [`Scene::relocate_assets`] was called, whose store then writes the `assets/`
+    /// members first with [`crate::AssetStore::write_to_tar`]).
+    ///
+    /// ```
+    /// let scene = mjcf_forge::scene::Scene::demo()?;
+    /// let mut tar = mjcf_forge::TarWriter::new(Vec::new(), "memory");
+    /// scene.write_tar(0..3, &mut tar)?;
+    /// let bytes = tar.finish()?;
+    /// assert!(bytes.len() > 3 * 2 * 512);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn write_tar<W: std::io::Write>(
+        &self,
+        range: Range<u64>,
+        tar: &mut crate::output::TarWriter<W>,
+    ) -> Result<(), Errors> {
+        self.stream(range, 512, |i, made| {
+            let (xml, params) = made?;
+            let file = format!("{i:09}.xml");
+            tar.append(&file, xml.as_bytes())?;
+            tar.append(
+                &format!("{i:09}.json"),
+                params.to_json(i, Some(&file)).as_bytes(),
+            )?;
+            Ok(())
+        })
+    }
+
+    /// Whether [`Scene::variant_xml`] writes by splicing text (rather than building each
+    /// variant's document) for every object instance made so far.
+    pub fn splices(&self) -> bool {
+        self.splice.is_some()
+            && self.groups.iter().all(|g| {
+                g.instances
+                    .iter()
+                    .filter_map(OnceLock::get)
+                    .all(|i| i.as_ref().is_ok_and(|i| i.fragments.is_some()))
+            })
+    }
+
+    /// Everything drawn for variant `index`: the template's values, each placed
+    /// instance with its values (pose included), and the parameters.
+    fn draw(&self, index: u64) -> Result<Drawn<'_>, Errors> {
         let mut params = Params::default();
         let mut draws = randomize::Draws::new(self.seed, index, self.randomizers.len());
+        let mut template = Overlay::new(&self.template);
         for (k, targets) in self.template_targets.iter().enumerate() {
-            self.randomizers[k].apply(&mut doc, targets, &mut draws, &mut params)?;
+            self.randomizers[k].apply(&mut template, targets, &mut draws, &mut params)?;
         }
         let mut rng = Rng::new(self.seed, index, 0);
         let mut placed: Vec<place::Placed> = Vec::new();
-        let mut parts: Vec<(Document, String)> = Vec::new();
+        let mut instances: Vec<(&Instance, Overlay<'_>)> = Vec::new();
         let mut group_members: Vec<Vec<usize>> = Vec::with_capacity(self.groups.len());
         for group in &self.groups {
             let count = rng.int_in(u64::from(group.count.0), u64::from(group.count.1)) as u32;
@@ -322,10 +485,12 @@ impl Scene {
                             )),
                         )
                     })?;
-                let mut doc = inst.doc.clone();
-                let (pos, quat) = place::write_pose(&mut doc, inst.root, &pose.pose);
+                let mut overlay = Overlay::new(&inst.doc);
+                let (pos, quat) = place::pose_text(&pose.pose);
+                overlay.set(inst.root, "pos", pos.clone());
+                overlay.set(inst.root, "quat", quat.clone());
                 for (k, targets) in &inst.targets {
-                    self.randomizers[*k].apply(&mut doc, targets, &mut draws, &mut params)?;
+                    self.randomizers[*k].apply(&mut overlay, targets, &mut draws, &mut params)?;
                 }
                 params.objects.push(PlacedObject {
                     group: group.name.clone(),
@@ -338,33 +503,13 @@ impl Scene {
                 });
                 members.push(placed.len());
                 placed.push(pose);
-                parts.push((doc, inst.prefix.clone()));
+                instances.push((inst, overlay));
             }
             group_members.push(members);
         }
-        if !parts.is_empty() {
-            let merge: Vec<MergePart<'_>> = parts
-                .iter()
-                .map(|(doc, prefix)| MergePart {
-                    doc,
-                    into: None,
-                    prefix,
-                })
-                .collect();
-            // Each instance was checked against the template when it was made; instances
-            // cannot clash with each other when no prefix begins another.
-            if !self.prefixes_apart {
-                let docs: Vec<&Document> = parts.iter().map(|(d, _)| d).collect();
-                let clashes = doc.name_clashes(&docs);
-                if !clashes.is_empty() {
-                    return Err(Errors(clashes));
-                }
-            }
-            doc.merge_unchecked(&merge, false)?;
-        }
-        Ok(Variant {
-            index,
-            document: doc,
+        Ok(Drawn {
+            template,
+            placed: instances,
             params,
         })
     }
@@ -381,11 +526,18 @@ impl Scene {
             .map(move |i| self.variant(i as u64))
     }
 
-    fn instance(&self, group: &Group, slot: u32, m: usize) -> Result<Arc<Instance>, Errors> {
+    /// Pool model `m` of `group` prefixed for `slot`, made on first use and kept.
+    fn instance<'s>(
+        &'s self,
+        group: &'s Group,
+        slot: u32,
+        m: usize,
+    ) -> Result<&'s Instance, Errors> {
         let at = slot as usize * group.pool.len() + m;
         group.instances[at]
-            .get_or_init(|| load::make_instance(self, group, slot, m).map(Arc::new))
-            .clone()
+            .get_or_init(|| load::make_instance(self, group, slot, m))
+            .as_ref()
+            .map_err(Clone::clone)
     }
 }
 

@@ -155,14 +155,23 @@ fn extent(bounds: &Bounds, q: [f64; 4], axis: [f64; 3]) -> (f64, f64, f64) {
     (lo, hi, r)
 }
 
-/// Writes `pose` as the root body's `pos` and `quat` (any other orientation attribute
-/// dropped) and returns both as written.
-pub(crate) fn write_pose(doc: &mut Document, root: Node, pose: &Pose) -> (String, String) {
-    let pos = join(&pose.pos);
-    let quat = join(&pose.quat);
+/// A pose as the root body's `pos` and `quat` texts.
+pub(crate) fn pose_text(pose: &Pose) -> (String, String) {
+    (join(&pose.pos), join(&pose.quat))
+}
+
+/// Drops the orientation attributes that a written `quat` replaces.
+pub(crate) fn clear_orientation(doc: &mut Document, root: Node) {
     for attr in ["euler", "axisangle", "xyaxes", "zaxis"] {
         doc.remove_attr(root, attr);
     }
+}
+
+/// Writes `pose` as the root body's `pos` and `quat` (any other orientation attribute
+/// dropped) and returns both as written.
+pub(crate) fn write_pose(doc: &mut Document, root: Node, pose: &Pose) -> (String, String) {
+    let (pos, quat) = pose_text(pose);
+    clear_orientation(doc, root);
     doc.set_attr(root, "pos", &pos);
     doc.set_attr(root, "quat", &quat);
     (pos, quat)

@@ -71,9 +71,9 @@ pub(crate) enum Dist {
 }
 
 /// MuJoCo's value of an attribute an element does not write (checked against `mjSpec`'s
-/// defaults by `tests/scene_judge.rs`), for scaling or keeping components of a value
-/// that is not written.
-pub(crate) const MUJOCO_DEFAULTS: &[(&str, &str, &str)] = &[
+/// defaults by `tests/scene_batch.rs`), for scaling or keeping components of a value
+/// that is not written: `(element, attribute, value)`.
+pub const MUJOCO_DEFAULTS: &[(&str, &str, &str)] = &[
     ("geom", "friction", "1 0.005 0.0001"),
     ("geom", "rgba", "0.5 0.5 0.5 1"),
     ("geom", "solref", "0.02 1"),
@@ -122,6 +122,69 @@ pub(crate) fn angle_components(kind: &str, attribute: &str) -> Option<&'static [
         (_, "axisangle") => Some(&[3]),
         ("joint", "range" | "ref" | "springref") => Some(&[0, 1]),
         _ => None,
+    }
+}
+
+/// Where a variant's values go: straight into a document, or into an [`Overlay`] of
+/// values over a document that stays as it is (the holes of pre-rendered text).
+pub(crate) trait AttrTarget {
+    /// The attribute's current value (as set in this variant, else as in the document).
+    fn get(&self, node: Node, attr: &str) -> Option<&str>;
+    /// Sets the attribute.
+    fn set(&mut self, node: Node, attr: &str, value: String);
+    /// The document the nodes belong to (for messages and element facts).
+    fn doc(&self) -> &Document;
+}
+
+impl AttrTarget for Document {
+    fn get(&self, node: Node, attr: &str) -> Option<&str> {
+        self.attr(node, attr)
+    }
+    fn set(&mut self, node: Node, attr: &str, value: String) {
+        self.set_attr(node, attr, &value);
+    }
+    fn doc(&self) -> &Document {
+        self
+    }
+}
+
+/// Values set over a document that is not changed: `(node, attribute, value)` in the order
+/// set (a later value of the same attribute wins).
+pub(crate) struct Overlay<'a> {
+    pub(crate) doc: &'a Document,
+    pub(crate) values: Vec<(Node, String, String)>,
+}
+
+impl<'a> Overlay<'a> {
+    pub(crate) fn new(doc: &'a Document) -> Overlay<'a> {
+        Overlay {
+            doc,
+            values: Vec::new(),
+        }
+    }
+
+    /// Sets every value on `doc` (a copy of the overlaid document), in order.
+    pub(crate) fn apply_to(&self, doc: &mut Document) {
+        for (node, attr, value) in &self.values {
+            doc.set_attr(*node, attr, value);
+        }
+    }
+}
+
+impl AttrTarget for Overlay<'_> {
+    fn get(&self, node: Node, attr: &str) -> Option<&str> {
+        self.values
+            .iter()
+            .rev()
+            .find(|(n, a, _)| *n == node && a == attr)
+            .map(|(_, _, v)| v.as_str())
+            .or_else(|| self.doc.attr(node, attr))
+    }
+    fn set(&mut self, node: Node, attr: &str, value: String) {
+        self.values.push((node, attr.to_string(), value));
+    }
+    fn doc(&self) -> &Document {
+        self.doc
     }
 }
 
@@ -280,7 +343,7 @@ impl Randomizer {
     /// Sets the attribute on every target, recording each value.
     pub(crate) fn apply(
         &self,
-        doc: &mut Document,
+        out: &mut impl AttrTarget,
         targets: &[Target],
         draws: &mut Draws,
         params: &mut Params,
@@ -301,21 +364,35 @@ impl Randomizer {
                         values[i].clone()
                     }
                 }
-                Drawn::Numbers(x) => self.numbers(doc, t.node, &x)?,
+                Drawn::Numbers(x) => self.numbers(out, t.node, &x)?,
             };
             if self.kind == "body" && self.attribute == "mass" {
-                scale_inertia(doc, t.node, &value, &self.location)?;
+                scale_inertia(out, t.node, &value, &self.location)?;
             }
-            doc.set_attr(t.node, &self.attribute, &value);
             params.randomized.push(RandomizedValue {
                 kind: self.kind.clone(),
                 name: t.name.clone(),
                 part: t.part.to_string(),
                 attribute: self.attribute.clone(),
-                value,
+                value: value.clone(),
             });
+            out.set(t.node, &self.attribute, value);
         }
         Ok(())
+    }
+
+    /// The attributes this randomizer sets on `node`, in the order it sets them.
+    pub(crate) fn attributes_set(&self, doc: &Document, node: Node) -> Vec<&str> {
+        let mut out = Vec::new();
+        if self.kind == "body" && self.attribute == "mass" {
+            for a in ["diaginertia", "fullinertia"] {
+                if doc.attr(node, a).is_some() {
+                    out.push(a);
+                }
+            }
+        }
+        out.push(self.attribute.as_str());
+        out
     }
 
     fn draw(&self, draws: &mut Draws) -> Drawn {
@@ -372,9 +449,10 @@ impl Randomizer {
     }
 
     /// The new text of the attribute of `node` from the drawn numbers.
-    fn numbers(&self, doc: &Document, node: Node, drawn: &[f64]) -> Result<String, Errors> {
-        let current_text = doc
-            .attr(node, &self.attribute)
+    fn numbers(&self, out: &impl AttrTarget, node: Node, drawn: &[f64]) -> Result<String, Errors> {
+        let doc = out.doc();
+        let current_text = out
+            .get(node, &self.attribute)
             .or_else(|| mujoco_default(self.attr_tag(), &self.attribute));
         let mut current: Vec<f64> = match current_text {
             Some(t) => parse_numbers(t).ok_or_else(|| {
@@ -421,18 +499,19 @@ impl Randomizer {
 
 /// After a body's mass changed to `value`, its inertia scaled by new/old mass.
 fn scale_inertia(
-    doc: &mut Document,
+    out: &mut impl AttrTarget,
     inertial: Node,
     value: &str,
     at: &Location,
 ) -> Result<(), Errors> {
-    let old: f64 = doc
-        .attr(inertial, "mass")
+    let old: f64 = out
+        .get(inertial, "mass")
         .and_then(|m| m.trim().parse().ok())
         .unwrap_or(0.0);
     let new: f64 = value.trim().parse().unwrap_or(0.0);
     if old <= 0.0 {
-        return Err(doc
+        return Err(out
+            .doc()
             .error_at(
                 inertial,
                 ErrorKind::Invalid(format!(
@@ -443,9 +522,9 @@ fn scale_inertia(
     }
     let factor = new / old;
     for attr in ["diaginertia", "fullinertia"] {
-        if let Some(v) = doc.attr(inertial, attr).and_then(parse_numbers) {
+        if let Some(v) = out.get(inertial, attr).and_then(parse_numbers) {
             let scaled: Vec<f64> = v.iter().map(|x| x * factor).collect();
-            doc.set_attr(inertial, attr, &join(&scaled));
+            out.set(inertial, attr, join(&scaled));
         }
     }
     Ok(())
