@@ -996,3 +996,51 @@ fn outputs_are_read_by_pythons_xml_parser() {
         cases.len().to_string()
     );
 }
+
+/// Memory stays bounded: the command line, run with 1 GB of address space, refuses each
+/// input that used to grow memory without bound (or reserve it from a file's header) with
+/// its message, instead of aborting.
+#[test]
+fn the_command_line_refuses_memory_hungry_inputs_within_a_memory_limit() {
+    let dir = special_files();
+    let d = dir.path();
+    let skin = d.join("huge.skn");
+    let header: Vec<u8> = [0i32, 0, 0, i32::MAX]
+        .iter()
+        .flat_map(|n| n.to_le_bytes())
+        .collect();
+    std::fs::write(&skin, &header).unwrap();
+    let mut cases = Vec::new();
+    for (name, body) in [
+        ("zero", "<include file=\"/dev/zero\"/>".to_string()),
+        ("urandom", "<include file=\"/dev/urandom\"/>".to_string()),
+        ("huge", "<include file=\"huge\"/>".to_string()),
+        (
+            "skin",
+            format!("<asset><skin file=\"{}\"/></asset>", skin.display()),
+        ),
+    ] {
+        let f = d.join(format!("{name}.xml"));
+        std::fs::write(&f, format!("<mujoco>{body}</mujoco>")).unwrap();
+        cases.push((name, f));
+    }
+    for (name, file) in cases {
+        let out = within(QUICK, move || {
+            std::process::Command::new("sh")
+                .arg("-c")
+                .arg("ulimit -v 1000000 && exec \"$0\" prefix \"$1\" --prefix p_")
+                .arg(env!("CARGO_BIN_EXE_mjcf-forge"))
+                .arg(&file)
+                .output()
+                .unwrap()
+        });
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{name}: {err}");
+        assert!(
+            err.contains("not a regular file")
+                || err.contains("(Limits::max_file_size)")
+                || err.contains("shorter than its header says"),
+            "{name}: {err}"
+        );
+    }
+}
