@@ -447,30 +447,38 @@ fn maybe_forbidden(b: u8) -> bool {
 /// Every byte of every file passes here: blocks of 32 bytes with no suspect are passed
 /// over with one branch.
 fn first_forbidden_char(bytes: &[u8]) -> Option<(usize, String)> {
-    let mut block_start = 0;
-    for block in bytes.chunks(32) {
-        if block.iter().fold(false, |any, &b| any | maybe_forbidden(b)) {
-            for (k, &b) in block.iter().enumerate() {
-                let i = block_start + k;
-                match b {
-                    0 => return Some((i, "NUL byte (not allowed in XML)".into())),
-                    0xEF => {
-                        if let [0xBF, b @ (0xBE | 0xBF), ..] = bytes[i + 1..] {
-                            // EF BF BE is U+FFFE, EF BF BF is U+FFFF.
-                            let c = 0xFFFE + u32::from(b - 0xBE);
-                            let what = format!("character U+{c:04X} (not allowed in XML)");
-                            return Some((i, what));
-                        }
+    let blocks = bytes.chunks_exact(32);
+    let tail = blocks.remainder();
+    let suspect_at = blocks
+        .enumerate()
+        // A byte-wide OR over a fixed-size block vectorises; a fold over `bool` does not.
+        .filter(|(_, block)| {
+            block
+                .iter()
+                .fold(0u8, |any, &b| any | u8::from(maybe_forbidden(b)))
+                != 0
+        })
+        .map(|(i, _)| i * 32)
+        .chain((!tail.is_empty()).then_some(bytes.len() - tail.len()));
+    for start in suspect_at {
+        let end = (start + 32).min(bytes.len());
+        for (i, &b) in bytes.iter().enumerate().take(end).skip(start) {
+            match b {
+                0 => return Some((i, "NUL byte (not allowed in XML)".into())),
+                0xEF => {
+                    if let [0xBF, b @ (0xBE | 0xBF), ..] = bytes[i + 1..] {
+                        // EF BF BE is U+FFFE, EF BF BF is U+FFFF.
+                        let c = 0xFFFE + u32::from(b - 0xBE);
+                        return Some((i, format!("character U+{c:04X} (not allowed in XML)")));
                     }
-                    b if maybe_forbidden(b) => {
-                        let what = format!("control character U+{b:04X} (not allowed in XML)");
-                        return Some((i, what));
-                    }
-                    _ => {}
                 }
+                b if maybe_forbidden(b) => {
+                    let what = format!("control character U+{b:04X} (not allowed in XML)");
+                    return Some((i, what));
+                }
+                _ => {}
             }
         }
-        block_start += block.len();
     }
     None
 }
@@ -1413,10 +1421,17 @@ impl Builder {
 
     /// The symbol of an element or attribute name read from the source; a name met for the
     /// first time must be one we can write back (see [`name_problem`]).
+    #[inline]
     fn name_sym(&mut self, name: &str) -> Result<Sym, String> {
-        if let Some(sym) = self.doc.names.get(name) {
-            return Ok(sym);
+        match self.doc.names.get(name) {
+            Some(sym) => Ok(sym),
+            None => self.new_name_sym(name),
         }
+    }
+
+    /// [`Builder::name_sym`] for a name not seen before (rare: most are vocabulary).
+    #[cold]
+    fn new_name_sym(&mut self, name: &str) -> Result<Sym, String> {
         match name_problem(name, &self.limits) {
             Some(why) => Err(why),
             None => Ok(self.doc.names.intern(name)),
