@@ -35,3 +35,6 @@ echo "== compile --json out/lift.xml"
 "$forge" compile out/lift.xml --json
 echo "== info --json (the can as one instance)"
 "$forge" info "$rs/objects/can.xml" --prefix can0_ --json
+
+echo "== python: a Gymnasium environment drawing a new scene variant per reset (the built-in demo scene)"
+.cache/venv/bin/python python/examples/gym_env.py --episodes 3

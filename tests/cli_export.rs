@@ -8,13 +8,17 @@ use std::process::Command;
 
 use common::{Pair, forge, judge, path_arg, python, root, scratch, stderr};
 
-/// Real models with meshes, textures (cube faces too), height fields, skins and compiler
-/// folder settings (`assetdir`, `texturedir`, `meshdir`).
-const MODELS: [&str; 6] = [
+/// Real models with meshes (STL, OBJ, MSH), textures (cube faces too), height fields,
+/// skins, assets named after their files, one file used as a texture and a height field,
+/// and compiler folder settings (`assetdir`, `texturedir`, `meshdir`).
+const MODELS: [&str; 9] = [
     ".cache/corpus/robosuite-1.5.2/robosuite/models/assets/robots/panda/robot.xml",
     ".cache/corpus/robosuite-1.5.2/robosuite/models/assets/arenas/table_arena.xml",
     ".cache/corpus/robosuite-1.5.2/robosuite/models/assets/arenas/bins_arena.xml",
     ".cache/corpus/dm_control-1.0.50/dm_control/mjcf/test_assets/model_with_assetdir.xml",
+    ".cache/corpus/dm_control-1.0.50/dm_control/mjcf/test_assets/model_with_assets.xml",
+    ".cache/corpus/dm_control-1.0.50/dm_control/mjcf/test_assets/model_with_nameless_assets.xml",
+    ".cache/corpus/dm_control-1.0.50/dm_control/mjcf/test_assets/model_with_separators.xml",
     ".cache/corpus/dm_control-1.0.50/dm_control/suite/dog.xml",
     ".cache/corpus/dm_control-1.0.50/dm_control/locomotion/walkers/assets/fruitfly_v2/fruitfly.xml",
 ];

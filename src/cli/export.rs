@@ -5,9 +5,10 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use mjcf_forge::output::AtomicFile;
 use mjcf_forge::{AssetStore, Document, OutputDir, TarWriter};
 
-use super::{USAGE, WriteOptions, finish, refuse_validate_without_mujoco, render, write_stdout};
+use super::{USAGE, WriteOptions, finish, refuse_validate_without_mujoco, render};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -92,24 +93,24 @@ fn export_dir(store: &AssetStore, name: &str, text: &str, dir: &Path) -> Result<
     written.map_err(|e| e.to_string())
 }
 
-/// The tar stream is made in memory (one model's files) and then written as any single
-/// output is, so a failure never leaves a partial archive.
+/// The tar stream goes straight to its output as it is made (assets first, the model
+/// last); a regular file appears whole, under its name, only once the stream is complete.
 fn export_tar(store: &AssetStore, name: &str, text: &str, output: &Path) -> Result<(), String> {
-    let to_stdout = output == Path::new("-");
-    let label = if to_stdout {
-        PathBuf::from("standard output")
+    let (path, label) = if output == Path::new("-") {
+        (Path::new("/dev/stdout"), PathBuf::from("standard output"))
     } else {
-        output.to_path_buf()
+        (output, output.to_path_buf())
     };
-    let mut tar = TarWriter::new(Vec::new(), label);
+    let file = AtomicFile::create(path).map_err(|e| e.to_string())?;
+    let mut tar = TarWriter::new(std::io::BufWriter::with_capacity(1 << 20, file), label);
     store
         .write_to_tar(&mut tar)
         .and_then(|()| tar.append(name, text.as_bytes()))
         .map_err(|e| e.to_string())?;
-    let bytes = tar.finish().map_err(|e| e.to_string())?;
-    if to_stdout {
-        write_stdout(&bytes)
-    } else {
-        mjcf_forge::write_atomic(output, &bytes).map_err(|e| e.to_string())
-    }
+    let buffered = tar.finish().map_err(|e| e.to_string())?;
+    // `finish` flushed the buffer, so taking the file out of it cannot fail.
+    let file = buffered
+        .into_inner()
+        .map_err(|e| format!("cannot write '{}': {}", output.display(), e.error()))?;
+    file.commit().map_err(|e| e.to_string())
 }

@@ -8,11 +8,12 @@
 //! `--shard K/N` this process makes only its share of the indices; N processes given the
 //! same folder together write what one process writes (each its own manifest).
 
-use std::io::{IsTerminal as _, Write};
+use std::io::{BufWriter, IsTerminal as _, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
+use mjcf_forge::output::AtomicFile;
 use mjcf_forge::scene::{Params, Scene};
 use mjcf_forge::{AssetStore, OutputDir, TarWriter};
 use rayon::prelude::*;
@@ -63,13 +64,10 @@ pub struct Args {
 enum Sink {
     Dir {
         out: OutputDir,
-        manifest: tempfile::NamedTempFile,
-        manifest_name: String,
+        manifest: BufWriter<AtomicFile>,
     },
     Tar {
-        tar: TarWriter<Box<dyn Write + Send + Sync>>,
-        /// The temporary file renamed over the target at the end (none for stdout).
-        file: Option<(tempfile::TempPath, PathBuf)>,
+        tar: TarWriter<BufWriter<AtomicFile>>,
         /// Assets written out for `--validate` (the stream itself is not on disk).
         check_dir: Option<tempfile::TempDir>,
     },
@@ -321,19 +319,15 @@ fn open_sink(
     if !is_tar {
         let out = OutputDir::create(output).map_err(|e| e.to_string())?;
         store.write_to_dir(&out).map_err(|e| e.to_string())?;
-        let manifest = tempfile::Builder::new()
-            .prefix(".manifest")
-            .tempfile_in(out.path())
-            .map_err(|e| format!("cannot write in '{}': {e}", output.display()))?;
-        let manifest_name = if sharded {
+        let name = if sharded {
             format!("manifest-{k}-of-{n}.jsonl")
         } else {
             "manifest.jsonl".to_string()
         };
+        let manifest = out.create_file(&name).map_err(|e| e.to_string())?;
         return Ok(Sink::Dir {
             out,
-            manifest,
-            manifest_name,
+            manifest: BufWriter::with_capacity(1 << 16, manifest),
         });
     }
     let check_dir = if validate {
@@ -347,57 +341,31 @@ fn open_sink(
         None
     };
     // Shards writing tar files each write their own, named as WebDataset shards are.
-    let sharded_name;
-    let output = if sharded && output != Path::new("-") {
+    let path = if output == Path::new("-") {
+        PathBuf::from("/dev/stdout")
+    } else if sharded {
         let stem = output.file_stem().unwrap_or_default().to_string_lossy();
-        sharded_name = output.with_file_name(format!("{stem}-{k:06}.tar"));
-        sharded_name.as_path()
+        output.with_file_name(format!("{stem}-{k:06}.tar"))
     } else {
-        output
+        output.to_path_buf()
     };
-    let (writer, file, label): (Box<dyn Write + Send + Sync>, _, PathBuf) =
-        if output == Path::new("-") {
-            (
-                Box::new(std::io::BufWriter::with_capacity(
-                    1 << 20,
-                    std::io::stdout(),
-                )),
-                None,
-                PathBuf::from("standard output"),
-            )
-        } else {
-            let folder = match output.parent() {
-                Some(p) if !p.as_os_str().is_empty() => p,
-                _ => Path::new("."),
-            };
-            let tmp = tempfile::Builder::new()
-                .prefix(".mjcf-forge")
-                .tempfile_in(folder)
-                .map_err(|e| format!("cannot write '{}': {e}", output.display()))?;
-            let (f, path) = tmp.into_parts();
-            (
-                Box::new(std::io::BufWriter::with_capacity(1 << 20, f)),
-                Some((path, output.to_path_buf())),
-                output.to_path_buf(),
-            )
-        };
-    let mut tar = TarWriter::new(writer, label);
+    let file = AtomicFile::create(&path).map_err(|e| e.to_string())?;
+    let label = if output == Path::new("-") {
+        PathBuf::from("standard output")
+    } else {
+        path
+    };
+    let mut tar = TarWriter::new(BufWriter::with_capacity(1 << 20, file), label);
     store.write_to_tar(&mut tar).map_err(|e| e.to_string())?;
-    Ok(Sink::Tar {
-        tar,
-        file,
-        check_dir,
-    })
+    Ok(Sink::Tar { tar, check_dir })
 }
 
 fn write_variant(sink: &mut Sink, i: u64, xml: &str, json: &str) -> Result<(), String> {
     match sink {
-        Sink::Dir { manifest, .. } => {
-            let f = manifest.as_file_mut();
-            f.write_all(json.as_bytes())
-                .and_then(|()| f.write_all(b"\n"))
-                .map_err(|e| format!("cannot write the manifest: {e}"))
-        }
+        Sink::Dir { manifest, .. } => manifest
+            .write_all(json.as_bytes())
+            .and_then(|()| manifest.write_all(b"\n"))
+            .map_err(|e| format!("cannot write the manifest: {e}")),
         Sink::Tar { tar, .. } => tar
             .append(&format!("{i:09}.xml"), xml.as_bytes())
             .and_then(|()| tar.append(&format!("{i:09}.json"), json.as_bytes()))
@@ -405,27 +373,19 @@ fn write_variant(sink: &mut Sink, i: u64, xml: &str, json: &str) -> Result<(), S
     }
 }
 
+/// Puts the outputs in place: the manifest (or the tar file) appears whole, only now.
 fn close_sink(sink: Sink) -> Result<(), String> {
+    let commit = |w: BufWriter<AtomicFile>| -> Result<(), String> {
+        let file = w
+            .into_inner()
+            .map_err(|e| format!("cannot write the output: {}", e.error()))?;
+        file.commit().map_err(|e| e.to_string())
+    };
     match sink {
-        Sink::Dir {
-            out,
-            manifest,
-            manifest_name,
-        } => {
-            let target = out.path().join(&manifest_name);
-            manifest
-                .persist(&target)
-                .map_err(|e| format!("cannot write '{}': {}", target.display(), e.error))?;
+        Sink::Dir { out, manifest } => {
+            commit(manifest)?;
             out.finish().map_err(|e| e.to_string())
         }
-        Sink::Tar { tar, file, .. } => {
-            let writer = tar.finish().map_err(|e| e.to_string())?;
-            drop(writer);
-            if let Some((tmp, target)) = file {
-                tmp.persist(&target)
-                    .map_err(|e| format!("cannot write '{}': {}", target.display(), e.error))?;
-            }
-            Ok(())
-        }
+        Sink::Tar { tar, .. } => commit(tar.finish().map_err(|e| e.to_string())?),
     }
 }

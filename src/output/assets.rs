@@ -230,7 +230,10 @@ impl AssetStore {
                 if dir.contains(name) {
                     return Ok(());
                 }
-                dir.write(name, &source.read()?)
+                let mut file = dir.create_file(name)?;
+                let path = file.path().to_path_buf();
+                source.copy_to(&mut file, &path)?;
+                file.commit()
             })
             .collect();
         // The first failure in name order, whatever thread met it first.
@@ -260,24 +263,50 @@ impl AssetStore {
             .map(|(n, s)| (n.clone(), s.clone()))
             .collect();
         for (name, source) in files {
-            tar.append(&name, &source.read()?)?;
+            let size = std::fs::metadata(&source.path)
+                .map_err(|e| read_error(&source.path, e.to_string()))?
+                .len();
+            let tar_name = tar.name().to_path_buf();
+            tar.append_with(&name, size, |out| source.copy_to(out, &tar_name))?;
         }
         Ok(())
     }
 }
 
 impl Source {
-    /// The bytes to copy, checked against the hash that named them: a file changed since
-    /// it was recorded would otherwise be written under another content's name.
-    fn read(&self) -> Result<Vec<u8>, Error> {
-        let bytes = read_regular_file(&self.path)?;
-        if blake3::hash(&bytes) != self.hash {
+    /// Copies the file into `out` block by block (an asset is never whole in memory) and
+    /// checks it against the hash that named it: a file changed since it was recorded
+    /// would otherwise be written under another content's name. Returns the byte count.
+    /// `out_name` is what a write error names.
+    fn copy_to(&self, out: &mut dyn Write, out_name: &Path) -> Result<u64, Error> {
+        use std::io::Read as _;
+        let mut file = open_regular_file(&self.path)?;
+        let mut hasher = blake3::Hasher::new();
+        let mut buf = vec![0u8; 1 << 16];
+        let mut total = 0u64;
+        loop {
+            let n = match file.read(&mut buf) {
+                Ok(0) => break,
+                Ok(n) => n,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                Err(e) => return Err(read_error(&self.path, e.to_string())),
+            };
+            hasher.update(&buf[..n]);
+            out.write_all(&buf[..n]).map_err(|e| {
+                Error::bare(ErrorKind::Write {
+                    path: out_name.to_path_buf(),
+                    reason: e.to_string(),
+                })
+            })?;
+            total += n as u64;
+        }
+        if hasher.finalize() != self.hash {
             return Err(read_error(
                 &self.path,
                 "the file changed while the output was being written",
             ));
         }
-        Ok(bytes)
+        Ok(total)
     }
 }
 
@@ -289,9 +318,20 @@ fn read_error(path: &Path, reason: impl Into<String>) -> Error {
 }
 
 /// Opens `path` if it is a regular file: a FIFO would block forever and a device such as
-/// `/dev/zero` never ends.
+/// `/dev/zero` never ends. Opened without blocking (a FIFO without a writer would block
+/// the open itself), then checked on the open file, so nothing can swap it in between.
 fn open_regular_file(path: &Path) -> Result<std::fs::File, Error> {
-    let file = std::fs::File::open(path).map_err(|e| read_error(path, e.to_string()))?;
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        // No effect on the regular files that pass the check below.
+        options.custom_flags(rustix::fs::OFlags::NONBLOCK.bits() as i32);
+    }
+    let file = options
+        .open(path)
+        .map_err(|e| read_error(path, e.to_string()))?;
     let meta = file
         .metadata()
         .map_err(|e| read_error(path, e.to_string()))?;
@@ -299,15 +339,6 @@ fn open_regular_file(path: &Path) -> Result<std::fs::File, Error> {
         return Err(read_error(path, "not a regular file"));
     }
     Ok(file)
-}
-
-fn read_regular_file(path: &Path) -> Result<Vec<u8>, Error> {
-    use std::io::Read as _;
-    let mut file = open_regular_file(path)?;
-    let mut bytes = Vec::new();
-    file.read_to_end(&mut bytes)
-        .map_err(|e| read_error(path, e.to_string()))?;
-    Ok(bytes)
 }
 
 fn hash_file(path: &Path) -> Result<blake3::Hash, Error> {
@@ -439,6 +470,24 @@ mod tests {
         );
     }
 
+    /// A FIFO without a writer would block a plain open forever.
+    #[cfg(unix)]
+    #[test]
+    fn a_fifo_is_refused_at_once() {
+        let tmp = tempfile::tempdir().unwrap();
+        let fifo = tmp.path().join("mesh.stl");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap();
+        assert!(made.success());
+        let err = AssetStore::new().relocate_file(&fifo).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            format!("cannot read '{}': not a regular file", fifo.display())
+        );
+    }
+
     #[test]
     fn a_file_changed_after_it_was_named_is_not_copied() {
         let tmp = tempfile::tempdir().unwrap();
@@ -449,13 +498,21 @@ mod tests {
         std::fs::write(&file, "two").unwrap();
         let out = OutputDir::create(tmp.path().join("out")).unwrap();
         let err = store.write_to_dir(&out).unwrap_err().to_string();
-        assert_eq!(
-            err,
-            format!(
-                "cannot read '{}': the file changed while the output was being written",
-                file.display()
-            )
+        let expected = format!(
+            "cannot read '{}': the file changed while the output was being written",
+            file.display()
         );
-        assert!(!tmp.path().join("out/assets").exists());
+        assert_eq!(err, expected);
+        // Nothing under the content name, and no temporary file either.
+        let left: Vec<_> = std::fs::read_dir(tmp.path().join("out/assets"))
+            .map(|d| d.map(|e| e.unwrap().file_name()).collect())
+            .unwrap_or_default();
+        assert!(left.is_empty(), "{left:?}");
+        // The same for a tar stream.
+        let mut tar = TarWriter::new(Vec::new(), "t.tar");
+        assert_eq!(
+            store.write_to_tar(&mut tar).unwrap_err().to_string(),
+            expected
+        );
     }
 }

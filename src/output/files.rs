@@ -19,7 +19,7 @@
 //! regular file is replaced atomically keeping its permissions.
 
 use std::fs::File;
-use std::io::Write as _;
+use std::io::Write;
 use std::path::{Component, Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -45,6 +45,7 @@ fn write_error(path: &Path, e: &std::io::Error) -> Error {
 /// never asked for it; ours name the output) and whose names cost a random draw each: a
 /// name from the process id and a counter is unique among live processes, and one left
 /// by a dead process is stepped over.
+#[derive(Debug)]
 struct TempFile {
     path: PathBuf,
     file: File,
@@ -125,50 +126,172 @@ fn folder_of(path: &Path) -> &Path {
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
-    let fail = |e: std::io::Error| write_error(path, &e);
-    let target = match follow_links(path).map_err(fail)? {
-        Target::Stream(stream) => return stream(bytes).map_err(fail),
-        Target::Path(target) => target,
-    };
-    let old_permissions = match std::fs::metadata(&target) {
-        Ok(m) if m.is_dir() => {
-            return Err(fail(std::io::Error::new(
-                std::io::ErrorKind::IsADirectory,
-                "is a folder",
-            )));
-        }
-        Ok(m) if !m.is_file() => {
-            // A FIFO or a device: its reader or driver takes the bytes as they come.
-            let mut file = std::fs::OpenOptions::new()
-                .write(true)
-                .open(&target)
-                .map_err(fail)?;
-            return file
-                .write_all(bytes)
-                .and_then(|()| file.flush())
-                .map_err(fail);
-        }
-        Ok(m) => Some(m.permissions()),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
-        Err(e) => return Err(fail(e)),
-    };
-    let mut tmp = TempFile::create_in(folder_of(&target)).map_err(fail)?;
-    if let Some(permissions) = old_permissions {
-        tmp.file.set_permissions(permissions).map_err(fail)?;
-    }
-    tmp.file.write_all(bytes).map_err(fail)?;
-    // One output, one sync: the rename must not reach the disk before the data does.
-    tmp.file.sync_all().map_err(fail)?;
-    tmp.persist(&target).map_err(fail)?;
-    Ok(())
+    let mut file = AtomicFile::create(path)?;
+    file.write_all(bytes).map_err(|e| write_error(path, &e))?;
+    file.commit()
 }
 
-type StreamWriter = fn(&[u8]) -> std::io::Result<()>;
+/// An output written as a stream (a tar archive, a manifest) under the rules of
+/// [`write_atomic`]: a regular file appears under its name, whole, only at
+/// [`AtomicFile::commit`]; dropped without it (any error, a panic), nothing is left and
+/// an old file stays as it was. Symlinks are written through; FIFOs, devices and
+/// standard streams are written to as the bytes come.
+///
+/// ```
+/// use std::io::Write as _;
+/// let dir = tempfile::tempdir()?;
+/// let path = dir.path().join("shard.tar");
+/// let mut file = mjcf_forge::output::AtomicFile::create(&path)?;
+/// file.write_all(b"first part, ")?;
+/// assert!(!path.exists(), "not there before commit");
+/// file.write_all(b"second part")?;
+/// file.commit()?;
+/// assert_eq!(std::fs::read(&path)?, b"first part, second part");
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug)]
+pub struct AtomicFile {
+    /// The name asked for: what messages say.
+    path: PathBuf,
+    sink: Sink,
+}
+
+#[derive(Debug)]
+enum Sink {
+    Std(StdStream),
+    /// A FIFO or a device.
+    Direct(File),
+    Temp {
+        tmp: TempFile,
+        /// The file the rename replaces (the path with symlinks followed).
+        target: PathBuf,
+        /// Sync before the rename: a single output, not one of an [`OutputDir`] (which
+        /// syncs once for all in [`OutputDir::finish`]).
+        sync: bool,
+    },
+}
+
+impl AtomicFile {
+    /// Opens the output `path` (see [`write_atomic`] for what each kind of path means).
+    pub fn create(path: impl AsRef<Path>) -> Result<AtomicFile, Error> {
+        let path = path.as_ref();
+        let fail = |e: std::io::Error| write_error(path, &e);
+        let target = match follow_links(path).map_err(fail)? {
+            Target::Stream(stream) => {
+                return Ok(AtomicFile {
+                    path: path.to_path_buf(),
+                    sink: Sink::Std(stream),
+                });
+            }
+            Target::Path(target) => target,
+        };
+        let old_permissions = match std::fs::metadata(&target) {
+            Ok(m) if m.is_dir() => {
+                return Err(fail(std::io::Error::new(
+                    std::io::ErrorKind::IsADirectory,
+                    "is a folder",
+                )));
+            }
+            Ok(m) if !m.is_file() => {
+                // A FIFO or a device: its reader or driver takes the bytes as they come.
+                let file = std::fs::OpenOptions::new()
+                    .write(true)
+                    .open(&target)
+                    .map_err(fail)?;
+                return Ok(AtomicFile {
+                    path: path.to_path_buf(),
+                    sink: Sink::Direct(file),
+                });
+            }
+            Ok(m) => Some(m.permissions()),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
+            Err(e) => return Err(fail(e)),
+        };
+        let tmp = TempFile::create_in(folder_of(&target)).map_err(fail)?;
+        if let Some(permissions) = old_permissions {
+            tmp.file.set_permissions(permissions).map_err(fail)?;
+        }
+        Ok(AtomicFile {
+            path: path.to_path_buf(),
+            sink: Sink::Temp {
+                tmp,
+                target,
+                sync: true,
+            },
+        })
+    }
+
+    /// The output's name, as asked for.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Flushes the output and, for a regular file, puts it in place.
+    pub fn commit(self) -> Result<(), Error> {
+        let fail = |e: std::io::Error| write_error(&self.path, &e);
+        match self.sink {
+            Sink::Std(stream) => stream.flush().map_err(fail),
+            Sink::Direct(mut file) => file.flush().map_err(fail),
+            Sink::Temp { tmp, target, sync } => {
+                if sync {
+                    // The rename must not reach the disk before the data does.
+                    tmp.file.sync_all().map_err(fail)?;
+                }
+                tmp.persist(&target).map_err(fail)
+            }
+        }
+    }
+}
+
+impl Write for AtomicFile {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        match &mut self.sink {
+            Sink::Std(StdStream::Out) => std::io::stdout().write(buf),
+            Sink::Std(StdStream::Err) => std::io::stderr().write(buf),
+            Sink::Direct(file) => file.write(buf),
+            Sink::Temp { tmp, .. } => tmp.file.write(buf),
+        }
+    }
+
+    fn write_all(&mut self, buf: &[u8]) -> std::io::Result<()> {
+        match &mut self.sink {
+            // One lock for the whole buffer, so lines of other threads cannot cut into it.
+            Sink::Std(StdStream::Out) => std::io::stdout().lock().write_all(buf),
+            Sink::Std(StdStream::Err) => std::io::stderr().lock().write_all(buf),
+            Sink::Direct(file) => file.write_all(buf),
+            Sink::Temp { tmp, .. } => tmp.file.write_all(buf),
+        }
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        match &mut self.sink {
+            Sink::Std(stream) => stream.flush(),
+            Sink::Direct(file) => file.flush(),
+            Sink::Temp { tmp, .. } => tmp.file.flush(),
+        }
+    }
+}
+
+/// The process's standard output or error.
+#[derive(Clone, Copy, Debug)]
+enum StdStream {
+    Out,
+    Err,
+}
+
+impl StdStream {
+    fn flush(self) -> std::io::Result<()> {
+        match self {
+            StdStream::Out => std::io::stdout().flush(),
+            StdStream::Err => std::io::stderr().flush(),
+        }
+    }
+}
 
 /// What writing to a path changes.
 enum Target {
     /// The process's own standard output or error.
-    Stream(StreamWriter),
+    Stream(StdStream),
     /// This file (possibly missing, for a dangling link or a new output).
     Path(PathBuf),
 }
@@ -177,18 +300,10 @@ enum Target {
 /// `/dev/stdout` anew would start at offset 0 of a redirected file (overwriting what the
 /// shell wrote before it) or, followed to that file, replace it; writing to the inherited
 /// stream is what `-o /dev/stdout` means.
-fn standard_stream(path: &Path) -> Option<StreamWriter> {
-    fn stdout(bytes: &[u8]) -> std::io::Result<()> {
-        let mut out = std::io::stdout().lock();
-        out.write_all(bytes).and_then(|()| out.flush())
-    }
-    fn stderr(bytes: &[u8]) -> std::io::Result<()> {
-        let mut out = std::io::stderr().lock();
-        out.write_all(bytes).and_then(|()| out.flush())
-    }
+fn standard_stream(path: &Path) -> Option<StdStream> {
     match path.to_str()? {
-        "/dev/stdout" | "/dev/fd/1" | "/proc/self/fd/1" => Some(stdout),
-        "/dev/stderr" | "/dev/fd/2" | "/proc/self/fd/2" => Some(stderr),
+        "/dev/stdout" | "/dev/fd/1" | "/proc/self/fd/1" => Some(StdStream::Out),
+        "/dev/stderr" | "/dev/fd/2" | "/proc/self/fd/2" => Some(StdStream::Err),
         _ => None,
     }
 }
@@ -386,6 +501,43 @@ impl OutputDir {
         }
     }
 
+    /// Opens `relative_name` for writing as a stream (a manifest written line by line),
+    /// put in place whole by [`AtomicFile::commit`]; synced with the rest by
+    /// [`OutputDir::finish`].
+    ///
+    /// ```
+    /// use std::io::Write as _;
+    /// let tmp = tempfile::tempdir()?;
+    /// let dir = mjcf_forge::OutputDir::create(tmp.path())?;
+    /// let mut manifest = dir.create_file("manifest.jsonl")?;
+    /// writeln!(manifest, "{{\"index\": 0}}")?;
+    /// manifest.commit()?;
+    /// dir.finish()?;
+    /// assert_eq!(std::fs::read_to_string(tmp.path().join("manifest.jsonl"))?, "{\"index\": 0}\n");
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn create_file(&self, relative_name: &str) -> Result<AtomicFile, Error> {
+        let path = self.final_path(relative_name)?;
+        let fail = |e: std::io::Error| write_error(&path, &e);
+        let folder = folder_of(&path);
+        let tmp = match TempFile::create_in(folder) {
+            Ok(tmp) => tmp,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound && folder != self.path => {
+                std::fs::create_dir_all(folder).map_err(fail)?;
+                TempFile::create_in(folder).map_err(fail)?
+            }
+            Err(e) => return Err(fail(e)),
+        };
+        Ok(AtomicFile {
+            path: path.clone(),
+            sink: Sink::Temp {
+                tmp,
+                target: path,
+                sync: false,
+            },
+        })
+    }
+
     /// Whether `relative_name` is already there (a file written by an earlier run, or by
     /// another process sharing the folder).
     pub fn contains(&self, relative_name: &str) -> bool {
@@ -562,6 +714,30 @@ mod tests {
         }
         assert_eq!(listing(dir.path()), ["a.xml", "assets"]);
         assert_eq!(listing(&dir.path().join("assets")), ["b.bin"]);
+    }
+
+    /// A stream dropped before its commit (an error half way through a tar archive)
+    /// leaves the old file as it was and no temporary file.
+    #[test]
+    fn an_uncommitted_stream_leaves_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("shard.tar");
+        std::fs::write(&path, b"old").unwrap();
+        let mut file = AtomicFile::create(&path).unwrap();
+        file.write_all(b"half").unwrap();
+        drop(file);
+        assert_eq!(std::fs::read(&path).unwrap(), b"old");
+        let outputs = OutputDir::create(dir.path()).unwrap();
+        let mut manifest = outputs.create_file("sub/manifest.jsonl").unwrap();
+        manifest.write_all(b"{}").unwrap();
+        drop(manifest);
+        assert_eq!(listing(dir.path()), ["shard.tar", "sub"]);
+        assert!(listing(&dir.path().join("sub")).is_empty());
+        let mut manifest = outputs.create_file("sub/manifest.jsonl").unwrap();
+        manifest.write_all(b"{}\n").unwrap();
+        assert_eq!(manifest.path(), dir.path().join("sub/manifest.jsonl"));
+        manifest.commit().unwrap();
+        assert_eq!(listing(&dir.path().join("sub")), ["manifest.jsonl"]);
     }
 
     #[test]

@@ -8,5 +8,5 @@ mod files;
 mod tar;
 
 pub use assets::AssetStore;
-pub use files::{OutputDir, write_atomic};
+pub use files::{AtomicFile, OutputDir, write_atomic};
 pub use tar::TarWriter;

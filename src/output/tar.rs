@@ -66,6 +66,47 @@ impl<W: Write> TarWriter<W> {
             .map_err(|e| self.fail(format!("{name}: {e}")))
     }
 
+    /// Appends a regular file `name` of `size` bytes that `write` streams into the archive
+    /// (an asset copied block by block, never whole in memory); `write` returns how many
+    /// bytes it wrote, which must be `size`.
+    ///
+    /// ```
+    /// use std::io::Write as _;
+    /// let mut tar = mjcf_forge::TarWriter::new(Vec::new(), "t.tar");
+    /// tar.append_with("a.txt", 5, |out| {
+    ///     out.write_all(b"hello").unwrap();
+    ///     Ok(5)
+    /// })?;
+    /// assert_eq!(&tar.finish()?[512..517], b"hello");
+    /// # Ok::<(), mjcf_forge::Error>(())
+    /// ```
+    pub fn append_with(
+        &mut self,
+        name: &str,
+        size: u64,
+        write: impl FnOnce(&mut dyn Write) -> Result<u64, Error>,
+    ) -> Result<(), Error> {
+        let header = self.header(name, size)?;
+        self.out
+            .write_all(&header)
+            .map_err(|e| self.fail(format!("{name}: {e}")))?;
+        let written = write(&mut self.out)?;
+        if written != size {
+            return Err(self.fail(format!(
+                "{name}: {written} bytes written where its header says {size}"
+            )));
+        }
+        let padding = (BLOCK - (size % BLOCK as u64) as usize) % BLOCK;
+        self.out
+            .write_all(&[0; BLOCK][..padding])
+            .map_err(|e| self.fail(format!("{name}: {e}")))
+    }
+
+    /// What error messages call the stream.
+    pub fn name(&self) -> &Path {
+        &self.name
+    }
+
     /// Ends the stream with its two zero blocks, flushes it and gives the writer back.
     pub fn finish(mut self) -> Result<W, Error> {
         self.out
@@ -168,6 +209,21 @@ mod tests {
             .sum();
         assert_eq!(stored, sum);
         assert!(bytes[bytes.len() - 2 * BLOCK..].iter().all(|&b| b == 0));
+    }
+
+    #[test]
+    fn a_member_shorter_than_its_header_is_an_error() {
+        let mut tar = TarWriter::new(Vec::new(), "t.tar");
+        let err = tar
+            .append_with("a", 10, |out| {
+                out.write_all(b"abc").unwrap();
+                Ok(3)
+            })
+            .unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "cannot write 't.tar': a: 3 bytes written where its header says 10"
+        );
     }
 
     #[test]

@@ -1,0 +1,35 @@
+"""mjcf_forge: MuJoCo MJCF models loaded exactly as MuJoCo reads them, in Rust.
+
+- :class:`Document`: a model with its includes expanded, default classes inlined and
+  asset paths absolute; prefix, merge, validate, edit elements, write.
+- :class:`Model`: one instance of a model with its own name prefix and robosuite's
+  vocabulary (``bodies``, ``joints``, ``contact_geoms``, ``bottom_offset``, ...).
+- :class:`Scene`: a randomized scene description; ``scene.variant(i)`` is variant ``i``
+  (the same bytes for the same seed and index, whatever the thread count), and
+  ``scene.variants(indices, threads=...)`` generates many on Rust threads.
+- :class:`MjcfError`: the one exception type (a ``ValueError``), with ``.errors``.
+"""
+
+from ._mjcf_forge import (
+    Document,
+    Element,
+    MergeReport,
+    MjcfError,
+    Model,
+    Scene,
+    Variant,
+    VariantIterator,
+    __version__,
+)
+
+__all__ = [
+    "Document",
+    "Element",
+    "MergeReport",
+    "MjcfError",
+    "Model",
+    "Scene",
+    "Variant",
+    "VariantIterator",
+    "__version__",
+]

@@ -1,0 +1,44 @@
+//! The `mjcf_forge` Python module: thin wrappers around the mjcf-forge library.
+//!
+//! Each Python type converts its arguments at the edge, does the work in Rust with the GIL
+//! released (see `errors::run`), and turns `Errors` and panics into `MjcfError`. The
+//! library crate knows nothing of Python.
+#![forbid(unsafe_code)]
+
+mod document;
+mod errors;
+mod model;
+mod scene;
+
+use pyo3::prelude::*;
+
+/// Panics on purpose inside the edge where every call runs, with the GIL released
+/// (`detached=True`) or held: the tests' proof that a panic reaches Python as an
+/// `MjcfError`, never as PyO3's `PanicException`. Not part of the API.
+#[pyfunction]
+#[pyo3(signature = (detached = true))]
+fn _panic_for_tests(py: Python<'_>, detached: bool) -> PyResult<()> {
+    let work = || -> Result<(), errors::Failure> { panic!("deliberate panic for the tests") };
+    if detached {
+        errors::run(py, work)
+    } else {
+        Ok(errors::catch(work)?)
+    }
+}
+
+/// MuJoCo MJCF models loaded exactly as MuJoCo reads them, prefixed, merged into scenes,
+/// and written back; randomized scene variants generated in Rust threads.
+#[pymodule]
+fn _mjcf_forge(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("MjcfError", m.py().get_type::<errors::MjcfError>())?;
+    m.add_class::<document::PyDocument>()?;
+    m.add_class::<document::PyElement>()?;
+    m.add_class::<document::PyMergeReport>()?;
+    m.add_class::<model::PyModel>()?;
+    m.add_class::<scene::PyScene>()?;
+    m.add_class::<scene::PyVariant>()?;
+    m.add_class::<scene::PyVariantIter>()?;
+    m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

@@ -1,0 +1,45 @@
+"""Shared paths and helpers of the Python package's tests.
+
+Run: .cache/venv/bin/python -m pytest python/tests   (after scripts/setup.sh, which builds
+and installs the package into .cache/venv and downloads the wheel corpora).
+"""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+CORPUS = ROOT / ".cache" / "corpus"
+MODELS_TXT = CORPUS / "models.txt"
+RS_ASSETS = CORPUS / "robosuite-1.5.2" / "robosuite" / "models" / "assets"
+
+# The MuJoCo judges (tests/judge) and MuJoCo's bounds (scripts/bounds.py).
+sys.path.insert(0, str(ROOT / "tests" / "judge"))
+sys.path.insert(0, str(ROOT / "scripts"))
+# The examples are imported as modules by their tests.
+sys.path.insert(0, str(ROOT / "python" / "examples"))
+
+
+def corpus_models() -> list[Path]:
+    """The wheel models MuJoCo compiles on their own (made by scripts/setup.sh)."""
+    if not MODELS_TXT.is_file():
+        pytest.fail(f"{MODELS_TXT} missing: run scripts/setup.sh")
+    return [ROOT / line for line in MODELS_TXT.read_text().split()]
+
+
+@pytest.fixture(scope="session")
+def forge_cli() -> Path:
+    """The mjcf-forge command line of this checkout (built when missing)."""
+    given = os.environ.get("MJCF_FORGE_BIN")
+    if given:
+        return Path(given)
+    binary = ROOT / "target" / "debug" / "mjcf-forge"
+    # cargo decides whether anything changed; a no-op build takes well under a second.
+    subprocess.run(
+        ["cargo", "build", "--quiet", "--bin", "mjcf-forge"], cwd=ROOT, check=True
+    )
+    return binary

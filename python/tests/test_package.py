@@ -1,0 +1,101 @@
+"""The package as users meet it: stubs that match the module, docstrings on everything
+public, ``help()`` that reads well, one exception type."""
+from __future__ import annotations
+
+import ast
+import inspect
+import pydoc
+from pathlib import Path
+
+import mjcf_forge
+
+STUB = Path(mjcf_forge.__file__).with_name("_mjcf_forge.pyi")
+PUBLIC_CLASSES = ["Document", "Element", "MergeReport", "Model", "Scene", "Variant", "VariantIterator"]
+
+
+def stub_members() -> dict[str, set[str]]:
+    tree = ast.parse(STUB.read_text())
+    out: dict[str, set[str]] = {}
+    for node in tree.body:
+        if isinstance(node, ast.ClassDef):
+            out[node.name] = {
+                n.name if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef)) else n.target.id
+                for n in node.body
+                if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef, ast.AnnAssign))
+            }
+    return out
+
+
+def runtime_members(cls) -> set[str]:
+    return {
+        name
+        for name in vars(cls)
+        if not name.startswith("_") or name in {"__init__", "__next__", "__iter__"}
+    }
+
+
+def test_installed_package_has_stubs_and_py_typed():
+    assert STUB.is_file()
+    assert Path(mjcf_forge.__file__).with_name("py.typed").is_file()
+    assert set(mjcf_forge.__all__) >= set(PUBLIC_CLASSES) | {"MjcfError"}
+
+
+def test_stubs_name_exactly_the_public_methods_and_properties():
+    stubs = stub_members()
+    for name in PUBLIC_CLASSES:
+        cls = getattr(mjcf_forge, name)
+        in_stub = {m for m in stubs[name] if not m.startswith("_") or m in {"__next__", "__iter__"}}
+        at_runtime = {m for m in runtime_members(cls) if m != "__init__"}
+        assert at_runtime == in_stub, (name, at_runtime ^ in_stub)
+    assert "errors" in stubs["MjcfError"]
+
+
+def test_every_public_member_has_a_docstring():
+    missing = []
+    for name in PUBLIC_CLASSES:
+        cls = getattr(mjcf_forge, name)
+        if not (cls.__doc__ or "").strip():
+            missing.append(name)
+        for member in runtime_members(cls):
+            if member.startswith("_"):
+                continue
+            doc = inspect.getdoc(getattr(cls, member))
+            if not doc or not doc.strip():
+                missing.append(f"{name}.{member}")
+    assert not missing, missing
+    assert "file:line:col" in mjcf_forge.MjcfError.__doc__
+
+
+def test_help_of_scene_reads_well():
+    text = pydoc.render_doc(mjcf_forge.Scene, renderer=pydoc.plaintext)
+    for expected in ["variant(self, /, index)", "variants(self, /, indices, threads=None, window=None)",
+                     "from_dict(description, base_dir=None)", "(seed, i)", "GIL"]:
+        assert expected in text, expected
+
+
+def test_help_shows_real_defaults():
+    # A Rust-side default that Python cannot show appears as "Ellipsis" in help().
+    for name in PUBLIC_CLASSES:
+        text = pydoc.render_doc(getattr(mjcf_forge, name), renderer=pydoc.plaintext)
+        assert "Ellipsis" not in text, name
+    assert "contact_geom_rgba=(0.0, 0.5, 0.0, 1.0)" in pydoc.render_doc(mjcf_forge.Model)
+
+
+def test_one_exception_type_derives_from_value_error():
+    assert issubclass(mjcf_forge.MjcfError, ValueError)
+    assert mjcf_forge.MjcfError.__module__ == "mjcf_forge"
+
+
+def test_a_rust_panic_reaches_python_as_mjcf_error():
+    import pytest
+
+    from mjcf_forge import _mjcf_forge
+
+    for detached in (True, False):
+        with pytest.raises(mjcf_forge.MjcfError) as err:
+            _mjcf_forge._panic_for_tests(detached=detached)
+        assert err.value.errors == [
+            "internal error in mjcf-forge (please report it): deliberate panic for the tests"
+        ]
+    # The module still works afterwards.
+    assert mjcf_forge.Document.from_string("<mujoco/>").to_xml() == "<mujoco/>"
