@@ -452,7 +452,9 @@ impl Document {
         // Every check runs before the document changes, except keyframe remapping: with
         // keys, or with several parts, work on a copy so that a failure changes nothing.
         let keys = !keys_of(self).is_empty() || parts.iter().any(|p| !keys_of(p.doc).is_empty());
-        if !keys && parts.len() == 1 {
+        // A base smaller than its part may adopt the part's angle unit before the checks
+        // (`adopt_angle_unit_if_smaller`): then it too works on a copy (a small one).
+        if !keys && parts.len() == 1 && self.node_count() >= parts[0].doc.node_count() {
             self.merge_unchecked(parts, fuse_keys)
         } else {
             let mut merged = self.clone();
