@@ -2,8 +2,9 @@
 # Runs every test of mjcf-forge (the README's test command; .ci/run calls it):
 # formatting, clippy, the Rust tests with and without the `mujoco` feature (real MuJoCo
 # 3.17.0 and 4.0.0 judge every output), the `mujoco-c` build against MuJoCo 4.0.0, the
-# judge's own tests under both versions, and the Python package's tests (setup has built and
-# installed it into .cache/venv). Sets up first (idempotent).
+# judge's own tests under both versions, the Python package's tests (setup has built and
+# installed it into .cache/venv) and a short run of each fuzz target. Sets up first
+# (idempotent).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
@@ -30,3 +31,5 @@ echo "== judge self-tests (MuJoCo 3.17.0 and 4.0.0)"
 .cache/venv-mj4/bin/python -m pytest tests/judge -q -p no:cacheprovider
 echo "== python package (pytest: API, errors, threads, MuJoCo judge, Gymnasium, Ray)"
 .cache/venv/bin/python -m pytest python/tests -q -p no:cacheprovider
+echo "== fuzz smoke run (5 s per target; long campaigns: bash scripts/fuzz.sh SECONDS)"
+bash scripts/fuzz.sh 5

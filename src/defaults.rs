@@ -283,8 +283,45 @@ impl Resolver<'_> {
 
     /// Reads one `<default>` element into class `class`: its own elements first, in order,
     /// then its nested classes (each a copy of this class as it is then), as MuJoCo does.
+    /// Nested classes are read depth first from a stack of their own, not by recursion:
+    /// nesting is bounded only by [`crate::Limits::max_depth`], and this may run on a
+    /// worker thread with a small stack.
     fn read_class(&mut self, section: Node, class: usize) {
-        let kids: Vec<Node> = self.doc.elements(section).collect();
+        let nested = self.read_class_rows(section, class);
+        let mut stack: Vec<(usize, std::vec::IntoIter<Node>)> = vec![(class, nested.into_iter())];
+        while let Some((class, nested)) = stack.last_mut() {
+            let class = *class;
+            let Some(el) = nested.next() else {
+                stack.pop();
+                continue;
+            };
+            let Some(name) = self.doc.attr_sym(el, self.syms.class).map(str::to_string) else {
+                let e = self.doc.error_at(
+                    el,
+                    ErrorKind::Invalid("nested <default> needs a 'class'".into()),
+                );
+                self.errors.push(e);
+                continue;
+            };
+            if self.by_name.contains_key(&name) {
+                let e = self.doc.error_at(el, ErrorKind::RepeatedClass(name));
+                self.errors.push(e);
+                continue;
+            }
+            let mut child = self.classes[class].clone();
+            child.parent = Some(class);
+            let index = self.classes.len();
+            self.classes.push(child);
+            self.by_name.insert(name, index);
+            let nested = self.read_class_rows(el, index);
+            stack.push((index, nested.into_iter()));
+        }
+    }
+
+    /// Reads the elements of one `<default>` (not its nested classes) into class `class`;
+    /// returns the nested `<default>` elements, in order.
+    fn read_class_rows(&mut self, section: Node, class: usize) -> Vec<Node> {
+        let mut kids: Vec<Node> = self.doc.elements(section).collect();
         for &el in &kids {
             if self.doc.tag_sym(el) == Some(self.syms.default) {
                 continue;
@@ -316,30 +353,8 @@ impl Resolver<'_> {
                 }
             }
         }
-        for &el in &kids {
-            if self.doc.tag_sym(el) != Some(self.syms.default) {
-                continue;
-            }
-            let Some(name) = self.doc.attr_sym(el, self.syms.class).map(str::to_string) else {
-                let e = self.doc.error_at(
-                    el,
-                    ErrorKind::Invalid("nested <default> needs a 'class'".into()),
-                );
-                self.errors.push(e);
-                continue;
-            };
-            if self.by_name.contains_key(&name) {
-                let e = self.doc.error_at(el, ErrorKind::RepeatedClass(name));
-                self.errors.push(e);
-                continue;
-            }
-            let mut child = self.classes[class].clone();
-            child.parent = Some(class);
-            let index = self.classes.len();
-            self.classes.push(child);
-            self.by_name.insert(name, index);
-            self.read_class(el, index);
-        }
+        kids.retain(|&el| self.doc.tag_sym(el) == Some(self.syms.default));
+        kids
     }
 
     /// The attributes an element writes itself (its `class` left out).
@@ -410,8 +425,8 @@ impl Resolver<'_> {
         r
     }
 
-    /// Walks the model below `node` (of kind `kind`), resolving each element.
-    fn resolve(&mut self, node: Node, kind: Kind, childclass: Option<usize>) {
+    /// Resolves one element (of kind `kind`); returns the class its children default to.
+    fn resolve(&mut self, node: Node, kind: Kind, childclass: Option<usize>) -> Option<usize> {
         let mut active = childclass;
         if let Some(cc) = self.doc.attr_sym(node, self.syms.childclass) {
             match self.by_name.get(cc) {
@@ -428,18 +443,28 @@ impl Resolver<'_> {
         if let Some(slot) = kind.spec().default_slot {
             self.resolve_element(node, kind, slot, active);
         }
-        self.resolve_children(node, kind, active);
+        active
     }
 
-    /// Resolves the child elements MJCF knows under `node` (of kind `kind`). Resolving
-    /// changes attributes and tags only, never the tree, so siblings can be walked in place.
+    /// Resolves the elements MJCF knows below `node` (of kind `kind`), in document order.
+    /// Resolving changes attributes and tags only, never the tree. An explicit stack, not
+    /// recursion: a deep body tree must not exhaust a worker thread's stack.
     fn resolve_children(&mut self, node: Node, kind: Kind, childclass: Option<usize>) {
-        let mut next = self.doc.tree.first_child(node);
-        while let Some(kid) = next {
-            next = self.doc.tree.next_sibling(kid);
-            if let Some(kkind) = self.doc.tag_sym(kid).and_then(|t| kind.child(t)) {
-                self.resolve(kid, kkind, childclass);
+        let mut stack: Vec<(Node, Kind, Option<usize>)> = Vec::new();
+        let push_kids = |doc: &Document, stack: &mut Vec<_>, node, kind: Kind, class| {
+            let at = stack.len();
+            for kid in doc.children(node) {
+                if let Some(kkind) = doc.tag_sym(kid).and_then(|t| kind.child(t)) {
+                    stack.push((kid, kkind, class));
+                }
             }
+            // Popped first to last.
+            stack[at..].reverse();
+        };
+        push_kids(self.doc, &mut stack, node, kind, childclass);
+        while let Some((node, kind, class)) = stack.pop() {
+            let active = self.resolve(node, kind, class);
+            push_kids(self.doc, &mut stack, node, kind, active);
         }
     }
 
@@ -462,7 +487,7 @@ impl Resolver<'_> {
     fn resolve_element(
         &mut self,
         node: Node,
-        kind: Kind,
+        mut kind: Kind,
         slot: DefaultSlot,
         childclass: Option<usize>,
     ) {
@@ -488,6 +513,17 @@ impl Resolver<'_> {
                 Ok((_, out_tag, attrs)) => {
                     if self.doc.tag_sym(node) != Some(out_tag) {
                         self.doc.set_tag(node, out_tag);
+                        // Which attributes the element can carry is now the new tag's
+                        // business (`general` carries what `adhesion` cannot).
+                        if let Some(k) = self
+                            .doc
+                            .parent(node)
+                            .and_then(|p| self.doc.tag_sym(p))
+                            .and_then(|t| Kind::root().child(t))
+                            .and_then(|section| section.child(out_tag))
+                        {
+                            kind = k;
+                        }
                     }
                     merged.0 = attrs;
                 }
@@ -691,7 +727,15 @@ impl Resolver<'_> {
         for &(n, v) in &other_own {
             attrs.push((n, v));
         }
-        for &(n, v) in next.mech.0.iter().chain(control_out.0.iter()) {
+        // A name in both (a shortcut's table sets `ctrllimited`, which a class default may
+        // also hold among the mechanical rows) is written once, with the table's value: an
+        // attribute written twice makes the output unreadable.
+        let mech_only = next
+            .mech
+            .0
+            .iter()
+            .filter(|(n, _)| !control_out.0.iter().any(|(m, _)| m == n));
+        for &(n, v) in mech_only.chain(control_out.0.iter()) {
             let name = self.doc.sym_name(n);
             if out_tag == tag && forced.contains(&name) {
                 continue;

@@ -4,6 +4,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use crate::error::{Error, ErrorKind, Errors, Location};
+use crate::limits::Limits;
 use crate::names::{Names, Sym};
 use crate::tree::{Attr, AttrRange, Node, NodeData, StrRef, Tree};
 
@@ -122,6 +123,8 @@ pub struct Document {
     pub(crate) names: Names,
     /// The folder of the main file: MuJoCo resolves includes and asset paths from here.
     pub(crate) model_dir: Arc<Path>,
+    /// The bounds it was loaded with; files read later (meshes, skins) keep to them too.
+    pub(crate) limits: Limits,
 }
 
 impl Document {
@@ -133,7 +136,23 @@ impl Document {
     /// # Ok::<(), mjcf_forge::Errors>(())
     /// ```
     pub fn load(path: impl AsRef<Path>) -> Result<Document, Errors> {
-        let mut doc = crate::read::read_file(path.as_ref())?;
+        Document::load_with(path, &Limits::default())
+    }
+
+    /// [`Document::load`] within other [`Limits`] than the default ones.
+    ///
+    /// ```
+    /// use mjcf_forge::{Document, Limits};
+    /// let path = std::env::temp_dir().join("mjcf_forge_load_with_doc.xml");
+    /// std::fs::write(&path, "<mujoco><worldbody/></mujoco>").unwrap();
+    /// let tiny = Limits { max_file_size: 10, ..Limits::default() };
+    /// let err = Document::load_with(&path, &tiny).unwrap_err().to_string();
+    /// assert!(err.ends_with("29 bytes, more than the limit of 10 (Limits::max_file_size)"), "{err}");
+    /// assert!(Document::load_with(&path, &Limits::default()).is_ok());
+    /// # std::fs::remove_file(&path).unwrap();
+    /// ```
+    pub fn load_with(path: impl AsRef<Path>, limits: &Limits) -> Result<Document, Errors> {
+        let mut doc = crate::read::read_file(path.as_ref(), limits)?;
         doc.finish_load()?;
         Ok(doc)
     }
@@ -148,9 +167,34 @@ impl Document {
     /// ```
     #[allow(clippy::should_implement_trait)]
     pub fn from_str(xml: &str, base_dir: impl AsRef<Path>) -> Result<Document, Errors> {
-        let mut doc = crate::read::read_str(xml, base_dir.as_ref())?;
+        Document::from_str_with(xml, base_dir, &Limits::default())
+    }
+
+    /// [`Document::from_str`] within other [`Limits`] than the default ones.
+    ///
+    /// ```
+    /// use mjcf_forge::{Document, Limits};
+    /// let few = Limits { max_attributes: 2, ..Limits::default() };
+    /// let xml = r#"<mujoco><worldbody><geom size="1" rgba="1 0 0 1" name="g"/></worldbody></mujoco>"#;
+    /// let err = Document::from_str_with(xml, ".", &few).unwrap_err();
+    /// assert_eq!(
+    ///     err.to_string(),
+    ///     "<string>:1:50: more than 2 attributes on one element (Limits::max_attributes)"
+    /// );
+    /// ```
+    pub fn from_str_with(
+        xml: &str,
+        base_dir: impl AsRef<Path>,
+        limits: &Limits,
+    ) -> Result<Document, Errors> {
+        let mut doc = crate::read::read_str(xml, base_dir.as_ref(), limits)?;
         doc.finish_load()?;
         Ok(doc)
+    }
+
+    /// The bounds this document was loaded with (files it reads later keep to them).
+    pub fn limits(&self) -> &Limits {
+        &self.limits
     }
 
     pub(crate) fn finish_load(&mut self) -> Result<(), Errors> {

@@ -26,7 +26,10 @@
 mod defaults;
 mod document;
 mod error;
+#[doc(hidden)]
+pub mod fuzzing;
 pub mod geometry;
+mod limits;
 mod merge;
 mod model;
 #[cfg(mjcf_mujoco)]
@@ -46,6 +49,7 @@ mod write;
 
 pub use document::{Document, Section};
 pub use error::{Error, ErrorKind, Errors, Location};
+pub use limits::Limits;
 pub use merge::{MergeOptions, MergePart, MergeReport};
 pub use model::{MujocoModel, Offsets, XmlModel, XmlModelOptions};
 pub use output::{AssetStore, OutputDir, TarWriter, write_atomic};

@@ -223,23 +223,34 @@ impl Layout {
 
     /// MuJoCo numbers bodies depth first in document order; a body's joints (its own and
     /// those in its frames) come before the joints of its child bodies.
+    /// Explicit stacks rather than recursion: bodies and frames nest without bound.
     fn visit_body(&mut self, doc: &Document, body: Node) {
-        if doc.attr(body, "mocap").map(str::trim) == Some("true") {
-            self.mocap.push(body);
-        }
+        let mut bodies = vec![body];
         let mut children = Vec::new();
-        self.collect(doc, body, &mut children);
-        for c in children {
-            self.visit_body(doc, c);
+        while let Some(body) = bodies.pop() {
+            if doc.attr(body, "mocap").map(str::trim) == Some("true") {
+                self.mocap.push(body);
+            }
+            children.clear();
+            self.collect(doc, body, &mut children);
+            bodies.extend(children.iter().rev());
         }
     }
 
+    /// The joints of `node` and of its frames (into the layout), and its child bodies
+    /// (into `bodies`), in document order.
     fn collect(&mut self, doc: &Document, node: Node, bodies: &mut Vec<Node>) {
-        for k in doc.elements(node) {
+        let mut stack: Vec<Node> = doc.elements(node).collect();
+        stack.reverse();
+        while let Some(k) = stack.pop() {
             match doc.tag(k) {
                 "joint" | "freejoint" => self.joints.push(k),
                 "body" => bodies.push(k),
-                "frame" => self.collect(doc, k, bodies),
+                "frame" => {
+                    let at = stack.len();
+                    stack.extend(doc.elements(k));
+                    stack[at..].reverse();
+                }
                 t @ ("replicate" | "composite" | "flexcomp" | "attach")
                     if self.opaque.is_none() =>
                 {
@@ -249,6 +260,71 @@ impl Layout {
             }
         }
     }
+}
+
+impl Document {
+    /// The level of `node` (the root is level 1).
+    fn depth_of(&self, node: Node) -> usize {
+        std::iter::successors(Some(node), |&n| self.parent(n)).count()
+    }
+
+    /// How many levels the deepest element below `node` is under it (0 for a leaf).
+    fn depth_below(&self, node: Node) -> usize {
+        let mut deepest = 0;
+        let mut stack = vec![(node, 0)];
+        while let Some((n, d)) = stack.pop() {
+            deepest = deepest.max(d);
+            stack.extend(self.children(n).map(|k| (k, d + 1)));
+        }
+        deepest
+    }
+}
+
+/// A document's angle settings ([`Angles::of`]) where it must be used to convert angles:
+/// errors at the `<compiler>` at fault, quoting at most a little of a value; and an
+/// `eulerseq` with letters other than `xyzXYZ` refused when an `euler` attribute would be
+/// read under it, which MuJoCo refuses too (converting it would give a wrong rotation).
+fn angles_checked(doc: &Document) -> Result<Angles, Error> {
+    let mut angles = Angles::default();
+    let mut seq_at = None;
+    let invalid = |node: Node, msg: String| doc.error_at(node, ErrorKind::Invalid(msg));
+    for c in doc.elements(doc.root).filter(|&n| doc.tag(n) == "compiler") {
+        if let Some(a) = doc.attr(c, "angle") {
+            angles.degrees = match a.trim() {
+                "degree" => true,
+                "radian" => false,
+                other => {
+                    let other = crate::read::clip(other, 40);
+                    let msg = format!("compiler angle must be 'degree' or 'radian', not '{other}'");
+                    return Err(invalid(c, msg));
+                }
+            };
+        }
+        if let Some(seq) = doc.attr(c, "eulerseq") {
+            angles.seq = seq.as_bytes().try_into().map_err(|_| {
+                let seq = crate::read::clip(seq, 40);
+                invalid(
+                    c,
+                    format!("compiler eulerseq '{seq}' must have exactly 3 letters"),
+                )
+            })?;
+            seq_at = Some(c);
+        }
+    }
+    if let Some(c) = seq_at
+        && !angles.seq.iter().all(|l| b"xyzXYZ".contains(l))
+        && doc
+            .descendants(doc.root)
+            .any(|n| doc.attr(n, "euler").is_some())
+    {
+        let seq = String::from_utf8_lossy(&angles.seq);
+        let msg = format!(
+            "compiler eulerseq '{seq}' can only contain x, y, z, X, Y, Z (MuJoCo refuses \
+             the model's euler attributes)"
+        );
+        return Err(invalid(c, msg));
+    }
+    Ok(angles)
 }
 
 /// State for copying nodes of one document into another.
@@ -386,7 +462,9 @@ impl Document {
         // Every check runs before the document changes, except keyframe remapping: with
         // keys, or with several parts, work on a copy so that a failure changes nothing.
         let keys = !keys_of(self).is_empty() || parts.iter().any(|p| !keys_of(p.doc).is_empty());
-        if !keys && parts.len() == 1 {
+        // A base smaller than its part may adopt the part's angle unit before the checks
+        // (`adopt_angle_unit_if_smaller`): then it too works on a copy (a small one).
+        if !keys && parts.len() == 1 && self.node_count() >= parts[0].doc.node_count() {
             self.merge_unchecked(parts, fuse_keys)
         } else {
             let mut merged = self.clone();
@@ -484,6 +562,19 @@ impl Document {
             }
         }
         self.check_residual_defaults(part, &mut errors);
+        // What is merged must load again: a part nested into a deep body can pass the depth
+        // a load accepts (and MuJoCo's own, which is lower).
+        if let Some(world) = part.find_section(Section::Worldbody) {
+            let at = target.map_or(2, |t| self.depth_of(t));
+            let depth = at + part.depth_below(world);
+            if depth > self.limits.max_depth as usize {
+                let msg = format!(
+                    "merged here, the part would nest elements {depth} levels deep, more than {} (Limits::max_depth)",
+                    self.limits.max_depth
+                );
+                errors.push(part.error_at(world, ErrorKind::Invalid(msg)));
+            }
+        }
         if !errors.is_empty() {
             return Err(Errors(errors));
         }
@@ -589,7 +680,8 @@ impl Document {
 
     /// Copies a subtree of another document into this arena as the last child of
     /// `parent`, through `imp`. Nodes are created in place (no detached copy to re-link).
-    fn import(&mut self, other: &Document, node: Node, parent: Node, imp: &mut Import) -> Node {
+    /// Copies one node of `other` (without its children) under `parent` here.
+    fn import_one(&mut self, other: &Document, node: Node, parent: Node, imp: &mut Import) -> Node {
         let data = match *other.tree.data(node) {
             NodeData::Element { tag, attrs } => {
                 let tag = imp.sym(self, other, tag);
@@ -620,12 +712,25 @@ impl Document {
         if let Some(map) = imp.map.as_mut() {
             map.insert(node, new);
         }
-        let mut kid = other.tree.first_child(node);
-        while let Some(k) = kid {
-            self.import(other, k, new, imp);
-            kid = other.tree.next_sibling(k);
-        }
         new
+    }
+
+    /// Copies `node` of `other` and everything below it under `parent` here (in document
+    /// order, from a stack: parts nest without bound); returns the copy of `node`.
+    fn import(&mut self, other: &Document, node: Node, parent: Node, imp: &mut Import) -> Node {
+        let top = self.import_one(other, node, parent, imp);
+        let mut stack: Vec<(Node, Node)> = Vec::new();
+        let push_kids = |stack: &mut Vec<(Node, Node)>, node: Node, copy: Node| {
+            let at = stack.len();
+            stack.extend(other.children(node).map(|k| (k, copy)));
+            stack[at..].reverse();
+        };
+        push_kids(&mut stack, node, top);
+        while let Some((node, parent)) = stack.pop() {
+            let copy = self.import_one(other, node, parent, imp);
+            push_kids(&mut stack, node, copy);
+        }
+        top
     }
 }
 
@@ -843,10 +948,9 @@ impl Document {
                 part.remove(n);
             }
         }
-        let (base_angles, part_angles) = match (Angles::of(self), Angles::of(part)) {
+        let (base_angles, part_angles) = match (angles_checked(self), angles_checked(part)) {
             (Ok(b), Ok(p)) => (b, p),
-            (Err(e), _) => return errors.push(self.error_at(self.root, ErrorKind::Invalid(e))),
-            (_, Err(e)) => return errors.push(part.error_at(part.root, ErrorKind::Invalid(e))),
+            (b, p) => return errors.extend(b.err().into_iter().chain(p.err())),
         };
         if base_angles.seq != part_angles.seq {
             part.rewrite_euler_as_quat(&part_angles);
@@ -1092,23 +1196,28 @@ impl Document {
     /// Whether two elements (here and in `other`) have the same tag, attributes (in any
     /// order) and children.
     fn same_subtree(&self, a: Node, other: &Document, b: Node) -> bool {
-        if self.tag(a) != other.tag(b) || self.text(a) != other.text(b) {
-            return false;
+        // Pairs still to compare, from a stack (no recursion on input depth).
+        let mut pairs = vec![(a, b)];
+        while let Some((a, b)) = pairs.pop() {
+            if self.tag(a) != other.tag(b) || self.text(a) != other.text(b) {
+                return false;
+            }
+            let mut x: Vec<(&str, &str)> = self.attrs(a).collect();
+            let mut y: Vec<(&str, &str)> = other.attrs(b).collect();
+            x.sort_unstable();
+            y.sort_unstable();
+            if x != y {
+                return false;
+            }
+            let at = pairs.len();
+            pairs.extend(self.children(a).zip(other.children(b)));
+            if pairs.len() - at != self.children(a).count()
+                || pairs.len() - at != other.children(b).count()
+            {
+                return false;
+            }
         }
-        let mut x: Vec<(&str, &str)> = self.attrs(a).collect();
-        let mut y: Vec<(&str, &str)> = other.attrs(b).collect();
-        x.sort_unstable();
-        y.sort_unstable();
-        if x != y {
-            return false;
-        }
-        let ka: Vec<Node> = self.children(a).collect();
-        let kb: Vec<Node> = other.children(b).collect();
-        ka.len() == kb.len()
-            && ka
-                .iter()
-                .zip(&kb)
-                .all(|(&p, &q)| self.same_subtree(p, other, q))
+        true
     }
 
     /// The name of an asset: its `name`, else the one MuJoCo derives from its file.
@@ -1389,7 +1498,7 @@ impl Document {
 
         // Where each item of the merged model comes from.
         let merged = Layout::of(self);
-        let angles = Angles::of(self).map_err(|e| located(self, self.root, e))?;
+        let angles = angles_checked(self)?;
         let mut from_part: AHashMap<Node, usize> = AHashMap::new();
         let mut from_base: AHashMap<Node, usize> = AHashMap::new();
         for items in [

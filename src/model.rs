@@ -474,10 +474,17 @@ impl Document {
     /// The bodies whose parent is the world body (directly or through frames).
     pub(crate) fn top_level_bodies(&self, world: Node) -> Vec<Node> {
         let mut out = Vec::new();
-        for k in self.elements(world) {
+        // Document order through nested frames, from a stack (frames nest without bound).
+        let mut stack: Vec<Node> = self.elements(world).collect();
+        stack.reverse();
+        while let Some(k) = stack.pop() {
             match self.tag(k) {
                 "body" => out.push(k),
-                "frame" => out.extend(self.top_level_bodies(k)),
+                "frame" => {
+                    let at = stack.len();
+                    stack.extend(self.elements(k));
+                    stack[at..].reverse();
+                }
                 _ => {}
             }
         }

@@ -53,7 +53,21 @@ pub(crate) fn absolutize_paths(doc: &mut Document) -> Result<(), Errors> {
     }
     let model_dir = doc.model_dir.clone();
     let mut found = Found::default();
-    collect(doc, root, Kind::root(), &dirs, &model_dir, &mut found);
+    // Depth first in document order from an explicit stack (no recursion on input depth).
+    let mut stack = vec![(root, Kind::root())];
+    while let Some((node, kind)) = stack.pop() {
+        collect(doc, node, kind, &dirs, &model_dir, &mut found);
+        let at = stack.len();
+        for kid in doc.children(node) {
+            if let Some(kkind) = doc.tag_sym(kid).and_then(|t| kind.child(t)) {
+                // Sections like <sensor> or <actuator> cannot hold a file reference.
+                if kkind.reaches_file_attrs() {
+                    stack.push((kid, kkind));
+                }
+            }
+        }
+        stack[at..].reverse();
+    }
     for &(node, name, start, end) in &found.edits {
         let value = doc.push_str(&found.text[start as usize..end as usize]);
         doc.set_attr_ref(node, name, value);
@@ -109,16 +123,6 @@ fn collect(
                 found
                     .edits
                     .push((node, a.name, start, found.text.len() as u32));
-            }
-        }
-    }
-    let mut next = doc.tree.first_child(node);
-    while let Some(kid) = next {
-        next = doc.tree.next_sibling(kid);
-        if let Some(kkind) = doc.tag_sym(kid).and_then(|t| kind.child(t)) {
-            // Sections like <sensor> or <actuator> cannot hold a file reference.
-            if kkind.reaches_file_attrs() {
-                collect(doc, kid, kkind, dirs, model_dir, found);
             }
         }
     }

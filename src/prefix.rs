@@ -101,6 +101,44 @@ fn trimmed(text: &str, r: StrRef) -> StrRef {
     }
 }
 
+/// Refuses a prefix that would make names MuJoCo reads differently, or output no XML 1.0
+/// parser reads: white space splits the name lists some attributes hold (a flex's `body`),
+/// and control characters are not XML characters.
+///
+/// ```
+/// let mut doc = mjcf_forge::Document::from_str("<mujoco/>", ".")?;
+/// let err = doc.apply_prefix("robot 0_").unwrap_err();
+/// assert_eq!(
+///     err.to_string(),
+///     "prefix 'robot 0_' holds white space (U+0020), which would split name lists"
+/// );
+/// # Ok::<(), mjcf_forge::Errors>(())
+/// ```
+pub(crate) fn check_prefix(prefix: &str) -> Result<(), Error> {
+    let shown = crate::read::clip(prefix, 60);
+    let refuse = |why: String| {
+        Err(Error::bare(crate::error::ErrorKind::Invalid(format!(
+            "prefix '{shown}' {why}"
+        ))))
+    };
+    for c in prefix.chars() {
+        if c.is_whitespace() {
+            return refuse(format!(
+                "holds white space (U+{:04X}), which would split name lists",
+                c as u32
+            ));
+        }
+        if c.is_control() || matches!(c, '\u{FFFE}' | '\u{FFFF}') {
+            let what = format!(
+                "holds U+{:04X}, which is not a character XML allows",
+                c as u32
+            );
+            return refuse(what);
+        }
+    }
+    Ok(())
+}
+
 impl Document {
     /// Gives every name in the document the prefix `prefix`: identifiers and every
     /// reference to them, in every section. References to the world body (`world`) stay.
@@ -136,6 +174,7 @@ impl Document {
         if prefix.is_empty() {
             return Ok(());
         }
+        check_prefix(prefix)?;
         self.inline_skin_files()?;
         // First find what to rename (no allocation per name), then write every new value
         // straight into the string buffer.

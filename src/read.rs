@@ -16,7 +16,8 @@ use quick_xml::events::{BytesStart, Event};
 
 use crate::document::{Document, SourceFile, Span};
 use crate::error::{Error, ErrorKind, Errors, Location};
-use crate::names::Names;
+use crate::limits::{Limits, read_regular_file};
+use crate::names::{Names, Sym};
 use crate::tree::{Node, NodeData, Tree};
 
 /// Turns byte offsets of one source text into 1-based line:col. The reader asks for
@@ -284,6 +285,7 @@ fn scan_start_tag(
     from: usize,
     spans: &mut Vec<AttrSpan>,
     at: &mut LineCursor,
+    max_attributes: usize,
 ) -> Option<StartTag> {
     spans.clear();
     let n = bytes.len();
@@ -336,6 +338,9 @@ fn scan_start_tag(
         let quote = *bytes.get(i)?;
         if quote != b'"' && quote != b'\'' {
             return None;
+        }
+        if spans.len() >= max_attributes {
+            return None; // `parse` reports it
         }
         let value_start = i + 1;
         let (len, unusual) = find_quote(&bytes[value_start..], quote)?;
@@ -427,6 +432,182 @@ fn scan_attrs(content: &[u8], from: usize, out: &mut Vec<AttrSpan>) -> bool {
     }
 }
 
+/// Whether `b` may start a character XML 1.0 does not allow (its `Char` production): C0
+/// controls other than tab, newline and carriage return, and 0xEF, the lead byte of U+FFFE
+/// and U+FFFF (checked further in [`first_forbidden_char`]). Arithmetic, not a table, so
+/// that a block of bytes is tested with vector instructions.
+#[inline]
+fn maybe_forbidden(b: u8) -> bool {
+    (b < 0x20) & (b != b'\t') & (b != b'\n') & (b != b'\r') | (b == 0xEF)
+}
+
+/// The offset and description of the first character of `bytes` that XML 1.0 forbids.
+/// Copied through, such a character makes the output unreadable to every XML 1.0 parser, so
+/// it is refused where it stands (surrogates cannot occur: the text is UTF-8 or refused).
+/// Every byte of every file passes here: blocks of 32 bytes with no suspect are passed
+/// over with one branch.
+fn first_forbidden_char(bytes: &[u8]) -> Option<(usize, String)> {
+    let blocks = bytes.chunks_exact(32);
+    let tail = blocks.remainder();
+    let suspect_at = blocks
+        .enumerate()
+        // A byte-wide OR over a fixed-size block vectorises; a fold over `bool` does not.
+        .filter(|(_, block)| {
+            block
+                .iter()
+                .fold(0u8, |any, &b| any | u8::from(maybe_forbidden(b)))
+                != 0
+        })
+        .map(|(i, _)| i * 32)
+        .chain((!tail.is_empty()).then_some(bytes.len() - tail.len()));
+    for start in suspect_at {
+        let end = (start + 32).min(bytes.len());
+        for (i, &b) in bytes.iter().enumerate().take(end).skip(start) {
+            match b {
+                0 => return Some((i, "NUL byte (not allowed in XML)".into())),
+                0xEF => {
+                    if let [0xBF, b @ (0xBE | 0xBF), ..] = bytes[i + 1..] {
+                        // EF BF BE is U+FFFE, EF BF BF is U+FFFF.
+                        let c = 0xFFFE + u32::from(b - 0xBE);
+                        return Some((i, format!("character U+{c:04X} (not allowed in XML)")));
+                    }
+                }
+                b if maybe_forbidden(b) => {
+                    let what = format!("control character U+{b:04X} (not allowed in XML)");
+                    return Some((i, what));
+                }
+                _ => {}
+            }
+        }
+    }
+    None
+}
+
+/// XML 1.0's `Char` production.
+fn is_xml_char(c: char) -> bool {
+    matches!(c, '\t' | '\n' | '\r' | ' '..='\u{D7FF}' | '\u{E000}'..='\u{FFFD}' | '\u{10000}'..)
+}
+
+/// XML 1.0's `NameStartChar` production, without `:` (see [`name_problem`]).
+fn is_name_start(c: char) -> bool {
+    matches!(c,
+        'A'..='Z' | '_' | 'a'..='z' | '\u{C0}'..='\u{D6}' | '\u{D8}'..='\u{F6}'
+        | '\u{F8}'..='\u{2FF}' | '\u{370}'..='\u{37D}' | '\u{37F}'..='\u{1FFF}'
+        | '\u{200C}'..='\u{200D}' | '\u{2070}'..='\u{218F}' | '\u{2C00}'..='\u{2FEF}'
+        | '\u{3001}'..='\u{D7FF}' | '\u{F900}'..='\u{FDCF}' | '\u{FDF0}'..='\u{FFFD}'
+        | '\u{10000}'..='\u{EFFFF}')
+}
+
+/// XML 1.0's `NameChar` production, without `:`.
+fn is_name_char(c: char) -> bool {
+    is_name_start(c)
+        || matches!(c, '-' | '.' | '0'..='9' | '\u{B7}' | '\u{300}'..='\u{36F}' | '\u{203F}'..='\u{2040}')
+}
+
+/// Why `name` cannot be an element or attribute name we write back, if it cannot: it must
+/// be an XML name, within the length limit. A `:` is refused too: it would need a namespace
+/// declaration that namespace-aware parsers (Python's, for one) check, and no MJCF name
+/// has one.
+fn name_problem(name: &str, limits: &Limits) -> Option<String> {
+    if name.len() > limits.max_name_len as usize {
+        return Some(format!(
+            "name of {} bytes, longer than {} (Limits::max_name_len)",
+            name.len(),
+            limits.max_name_len
+        ));
+    }
+    let mut chars = name.chars();
+    match chars.next() {
+        None => Some("a tag without a name".into()),
+        Some(c) if !is_name_start(c) || !chars.all(is_name_char) => {
+            Some(format!("'{}' is not an XML name", clip(name, 40)))
+        }
+        Some(_) => None,
+    }
+}
+
+/// `text` cut to at most about `max` bytes (on a character boundary), marked when cut: for
+/// quoting input in messages without echoing a huge value.
+pub(crate) fn clip(text: &str, max: usize) -> std::borrow::Cow<'_, str> {
+    if text.len() <= max {
+        return text.into();
+    }
+    let mut end = max;
+    while !text.is_char_boundary(end) {
+        end -= 1;
+    }
+    format!("{}... ({} bytes)", &text[..end], text.len()).into()
+}
+
+/// Expands the entity and character references of `raw` (an attribute value), checking
+/// that each character a reference yields is allowed in XML 1.0. On failure: the offset in
+/// `raw` of the reference at fault and what is wrong with it. Linear: the end of each
+/// reference is looked for only up to the next `&`.
+fn expand_refs(raw: &str) -> Result<std::borrow::Cow<'_, str>, (usize, String)> {
+    let Some(first) = raw.find('&') else {
+        return Ok(raw.into());
+    };
+    let mut out = String::with_capacity(raw.len());
+    out.push_str(&raw[..first]);
+    let mut i = first;
+    while i < raw.len() {
+        let rest = &raw[i + 1..];
+        let end = rest
+            .find([';', '&'])
+            .filter(|&j| rest.as_bytes()[j] == b';');
+        let Some(end) = end else {
+            return Err((i, "'&' without its ';' (write '&amp;' for '&')".into()));
+        };
+        let reference = &raw[i..i + 1 + end + 1];
+        let shown = clip(reference, 40);
+        match quick_xml::escape::unescape(reference) {
+            Ok(v) => {
+                if let Some(c) = v.chars().find(|&c| !is_xml_char(c)) {
+                    return Err((
+                        i,
+                        format!(
+                            "'{shown}' stands for U+{:04X}, which XML 1.0 does not allow",
+                            c as u32
+                        ),
+                    ));
+                }
+                out.push_str(&v);
+            }
+            Err(quick_xml::escape::EscapeError::InvalidCharRef(_)) => {
+                return Err((i, format!("invalid character reference '{shown}'")));
+            }
+            Err(_) => return Err((i, format!("unknown entity '{shown}'"))),
+        }
+        i += 1 + end + 1;
+        let next = raw[i..].find('&').map_or(raw.len(), |j| i + j);
+        out.push_str(&raw[i..next]);
+        i = next;
+    }
+    Ok(out.into())
+}
+
+/// The offset of `part` in `whole`, when it is a slice of it.
+fn offset_in(whole: &[u8], part: &[u8]) -> Option<usize> {
+    let start = (part.as_ptr() as usize).checked_sub(whole.as_ptr() as usize)?;
+    (start + part.len() <= whole.len()).then_some(start)
+}
+
+/// A UTF-16 text (by its byte order mark, or by the zero bytes around the first `<`): MJCF
+/// is read as UTF-8, and without this the first zero byte would be all the message says.
+fn is_utf16(bytes: &[u8]) -> bool {
+    matches!(
+        bytes,
+        [0xFF, 0xFE, ..] | [0xFE, 0xFF, ..] | [b'<', 0, ..] | [0, b'<', ..]
+    )
+}
+
+/// How many files deep includes are read on one stack (see [`Builder::expand_include`]):
+/// each level takes about 2.5 KiB of stack in a release build and 11 KiB unoptimised.
+const INCLUDES_PER_STACK: u32 = 32;
+
+/// The stack of a thread that reads the next [`INCLUDES_PER_STACK`] levels of includes.
+const INCLUDE_STACK: usize = 4 << 20;
+
 struct Builder {
     doc: Document,
     files: Vec<SourceFile>,
@@ -434,8 +615,6 @@ struct Builder {
     chain: Vec<PathBuf>,
     /// The same files as the user would name them.
     chain_display: Vec<PathBuf>,
-    /// Canonical paths of every file read so far (MuJoCo includes a file at most once).
-    seen: Vec<PathBuf>,
     /// The main file's folder as the user named it: included files are shown under it.
     display_dir: PathBuf,
     /// The main file's absolute path until its canonical path is needed: that takes a
@@ -447,13 +626,22 @@ struct Builder {
     attr_spans: Vec<AttrSpan>,
     /// For `parse_fast`: the open elements' name ranges in their source (reused buffer).
     open_names: Vec<(u32, u32)>,
+    /// Canonical paths of every file read so far (MuJoCo includes a file at most once),
+    /// hashed: thousands of sibling includes stay linear.
+    seen_set: ahash::AHashSet<PathBuf>,
+    limits: Limits,
+    /// The depth of the element the file being read inserts its elements under (0 for the
+    /// main file, whose root element is level 1).
+    depth_base: u32,
+    /// How many includes deep the file being read is (0: the main file).
+    include_depth: u32,
 }
 
-pub(crate) fn read_file(path: &Path) -> Result<Document, Errors> {
-    let bytes = std::fs::read(path).map_err(|e| {
+pub(crate) fn read_file(path: &Path, limits: &Limits) -> Result<Document, Errors> {
+    let bytes = read_regular_file(path, limits.max_file_size).map_err(|reason| {
         Error::bare(ErrorKind::Io {
             path: path.to_path_buf(),
-            reason: e.to_string(),
+            reason,
         })
     })?;
     let abs = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
@@ -465,18 +653,25 @@ pub(crate) fn read_file(path: &Path) -> Result<Document, Errors> {
         dir,
         display_dir,
         Main::File { abs: abs.clone() },
+        limits,
     )
 }
 
-pub(crate) fn read_str(xml: &str, base_dir: &Path) -> Result<Document, Errors> {
+pub(crate) fn read_str(xml: &str, base_dir: &Path, limits: &Limits) -> Result<Document, Errors> {
+    let name: Arc<Path> = Arc::from(Path::new("<string>"));
+    if xml.len() as u64 > limits.max_file_size {
+        return Err(Error::at(
+            Location::new(name, 1, 1),
+            ErrorKind::Invalid(format!(
+                "text of {} bytes, more than the limit of {} (Limits::max_file_size)",
+                xml.len(),
+                limits.max_file_size
+            )),
+        )
+        .into());
+    }
     let dir = std::path::absolute(base_dir).unwrap_or_else(|_| base_dir.to_path_buf());
-    read_bytes(
-        xml.as_bytes(),
-        Arc::from(Path::new("<string>")),
-        &dir,
-        base_dir,
-        Main::Text,
-    )
+    read_bytes(xml.as_bytes(), name, &dir, base_dir, Main::Text, limits)
 }
 
 /// Where the main text came from: a file (which takes part in include cycles) or a string.
@@ -491,8 +686,9 @@ fn read_bytes(
     dir: &Path,
     display_dir: &Path,
     main: Main,
+    limits: &Limits,
 ) -> Result<Document, Errors> {
-    read_bytes_with(bytes, name, dir, display_dir, main, true)
+    read_bytes_with(bytes, name, dir, display_dir, main, limits, true)
 }
 
 fn read_bytes_with(
@@ -501,18 +697,19 @@ fn read_bytes_with(
     dir: &Path,
     display_dir: &Path,
     main: Main,
+    limits: &Limits,
     try_fast: bool,
 ) -> Result<Document, Errors> {
     let model_dir: Arc<Path> = Arc::from(dir);
     // Models are read by `Builder::parse_fast` when it can; anything outside what it handles
     // (and every error) sends the whole load, includes and all, through quick-xml.
     if let Some(src) = std::str::from_utf8(bytes).ok().filter(|_| try_fast) {
-        let mut b = Builder::new(bytes.len(), &name, &model_dir, display_dir, &main);
+        let mut b = Builder::new(bytes.len(), &name, &model_dir, display_dir, &main, limits);
         if b.parse_fast(src, 0, None).is_some() {
             return b.finish();
         }
     }
-    let mut b = Builder::new(bytes.len(), &name, &model_dir, display_dir, &main);
+    let mut b = Builder::new(bytes.len(), &name, &model_dir, display_dir, &main, limits);
     b.parse(bytes, 0, None)?;
     b.finish()
 }
@@ -524,6 +721,7 @@ impl Builder {
         model_dir: &Arc<Path>,
         display_dir: &Path,
         main: &Main,
+        limits: &Limits,
     ) -> Builder {
         // Sized from the robosuite and dm_control models (about 100 bytes of XML per node,
         // 15 per attribute once defaults are inlined, 0.55 bytes of values per byte), so
@@ -545,6 +743,7 @@ impl Builder {
                 files: Arc::new(Vec::new()),
                 names: Names::default(),
                 model_dir: model_dir.clone(),
+                limits: *limits,
             },
             files: vec![SourceFile {
                 path: name.clone(),
@@ -557,7 +756,6 @@ impl Builder {
                 Main::File { .. } => vec![name.to_path_buf()],
                 Main::Text => Vec::new(),
             },
-            seen: Vec::new(),
             display_dir: display_dir.to_path_buf(),
             main_to_canonicalize: match main {
                 Main::File { abs } => Some(abs.clone()),
@@ -566,6 +764,10 @@ impl Builder {
             pending_text: String::new(),
             attr_spans: Vec::new(),
             open_names: Vec::new(),
+            seen_set: ahash::AHashSet::new(),
+            limits: *limits,
+            depth_base: 0,
+            include_depth: 0,
         }
     }
 
@@ -600,14 +802,19 @@ impl Builder {
     /// is dropped, its children inserted in the include's place). Returns how many elements
     /// were inserted under `parent`.
     fn parse(&mut self, bytes: &[u8], file: u32, parent: Option<Node>) -> Result<usize, Errors> {
-        // XML has no NUL character; copied through, it would make the output unreadable.
-        if let Some(at) = bytes.iter().position(|&b| b == 0) {
-            let (line, col) = Lines::new(bytes).line_col(at);
+        if is_utf16(bytes) {
             return Err(Error::at(
-                self.loc(file, line, col),
-                ErrorKind::Syntax("NUL byte (not allowed in XML)".into()),
+                self.loc(file, 1, 1),
+                ErrorKind::Syntax(
+                    "the file is UTF-16; MJCF is read as UTF-8 (convert it, e.g. with iconv)"
+                        .into(),
+                ),
             )
             .into());
+        }
+        if let Some((at, what)) = first_forbidden_char(bytes) {
+            let (line, col) = Lines::new(bytes).line_col(at);
+            return Err(Error::at(self.loc(file, line, col), ErrorKind::Syntax(what)).into());
         }
         let mut lines = Lines::new(bytes);
         // Checked once here, the text lets tags, attribute values and character data be
@@ -645,6 +852,17 @@ impl Builder {
                 Event::Start(e) | Event::Empty(e) => {
                     let (line, col) = lines.advance(offset);
                     let span = Span { file, line, col };
+                    let depth = self.depth_base + stack.len() as u32 + u32::from(parent.is_none());
+                    if depth > self.limits.max_depth {
+                        return Err(Error::at(
+                            self.loc(file, line, col),
+                            ErrorKind::Invalid(format!(
+                                "element nesting deeper than {} levels (Limits::max_depth)",
+                                self.limits.max_depth
+                            )),
+                        )
+                        .into());
+                    }
                     let current = stack.last().copied();
                     let node = if stack.is_empty() {
                         if seen_root {
@@ -692,7 +910,10 @@ impl Builder {
                                 if Some(host) == parent {
                                     inserted += 1;
                                 }
-                                self.include(&e, span, host, &reader, &lines, offset)?;
+                                // The include's attributes are read as any element's; the
+                                // element itself is dropped.
+                                let node = self.element(&e, span, &reader, &lines, offset)?;
+                                self.expand_include(node, span, host, depth - 1, false)?;
                                 None
                             }
                             Some(host) => {
@@ -743,11 +964,8 @@ impl Builder {
                                         ErrorKind::Syntax(e.to_string()),
                                     )
                                 })?;
-                                let text = quick_xml::escape::unescape(&raw).map_err(|e| {
-                                    Error::at(
-                                        self.loc(file, line, col),
-                                        ErrorKind::Syntax(e.to_string()),
-                                    )
+                                let text = expand_refs(&raw).map_err(|(_, why)| {
+                                    Error::at(self.loc(file, line, col), ErrorKind::Syntax(why))
                                 })?;
                                 self.pending_text.push_str(&text);
                             }
@@ -759,8 +977,8 @@ impl Builder {
                         let (line, col) = lines.advance(offset);
                         let name = r.decode().unwrap_or_default();
                         let entity = format!("&{name};");
-                        let text = quick_xml::escape::unescape(&entity).map_err(|e| {
-                            Error::at(self.loc(file, line, col), ErrorKind::Syntax(e.to_string()))
+                        let text = expand_refs(&entity).map_err(|(_, why)| {
+                            Error::at(self.loc(file, line, col), ErrorKind::Syntax(why))
                         })?;
                         pending.get_or_insert((*host, Span { file, line, col }));
                         self.pending_text.push_str(&text);
@@ -809,7 +1027,7 @@ impl Builder {
     /// [`Builder::parse`], which handles everything and words the errors.
     fn parse_fast(&mut self, src: &str, file: u32, parent: Option<Node>) -> Option<usize> {
         let bytes = src.as_bytes();
-        if bytes.contains(&0) {
+        if first_forbidden_char(bytes).is_some() {
             return None; // `parse` reports it
         }
         if bytes.starts_with(b"\xEF\xBB\xBF") {
@@ -898,7 +1116,8 @@ impl Builder {
                 _ => {
                     let span = at.span(file, lt);
                     let mut spans = std::mem::take(&mut self.attr_spans);
-                    let tag = scan_start_tag(bytes, lt + 1, &mut spans, &mut at);
+                    let max = self.limits.max_attributes as usize;
+                    let tag = scan_start_tag(bytes, lt + 1, &mut spans, &mut at, max);
                     self.attr_spans = spans;
                     let StartTag {
                         gt,
@@ -907,6 +1126,10 @@ impl Builder {
                         is_empty,
                     } = tag?;
                     let content = src.get(lt + 1..content_end)?;
+                    let depth = self.depth_base + stack.len() as u32 + u32::from(parent.is_none());
+                    if depth > self.limits.max_depth {
+                        break None;
+                    }
                     let current = stack.last().copied();
                     let node = if stack.is_empty() {
                         match parent {
@@ -933,8 +1156,10 @@ impl Builder {
                                     inserted += 1;
                                 }
                                 let node = self.commit_scanned(content, name_len, span, None)?;
-                                if !matches!(self.expand_include(node, span, host, true), Ok(true))
-                                {
+                                if !matches!(
+                                    self.expand_include(node, span, host, depth - 1, true),
+                                    Ok(true)
+                                ) {
                                     break None;
                                 }
                                 None
@@ -1028,8 +1253,14 @@ impl Builder {
         span: Span,
         host: Option<Node>,
     ) -> Option<Node> {
-        let tag = self.doc.names.intern(content.get(..name_len)?);
+        if spans.len() > self.limits.max_attributes as usize {
+            return None;
+        }
+        let tag = self.name_sym(content.get(..name_len)?).ok()?;
         let (attrs_at, strings_at) = (self.doc.attrs.len(), self.doc.strings.len());
+        // Few attributes are compared pairwise as they come; many are sorted once below, so
+        // that a tag with thousands stays linear-logarithmic.
+        let few = spans.len() <= 16;
         let undo = |doc: &mut Document| {
             doc.attrs.truncate(attrs_at);
             doc.strings.truncate(strings_at);
@@ -1042,13 +1273,15 @@ impl Builder {
             ) else {
                 return undo(&mut self.doc);
             };
-            let name = self.doc.names.intern(key);
+            let Ok(name) = self.name_sym(key) else {
+                return undo(&mut self.doc);
+            };
             let doc = &mut self.doc;
-            if doc.attrs[attrs_at..].iter().any(|a| a.name == name) {
+            if few && doc.attrs[attrs_at..].iter().any(|a| a.name == name) {
                 return undo(doc);
             }
             let value = if a.has_ref {
-                match quick_xml::escape::unescape(raw) {
+                match expand_refs(raw) {
                     Ok(v) => doc.push_str(&v),
                     Err(_) => return undo(doc),
                 }
@@ -1056,6 +1289,13 @@ impl Builder {
                 doc.push_str(raw)
             };
             doc.attrs.push(crate::tree::Attr { name, value });
+        }
+        if !few {
+            let mut names: Vec<Sym> = self.doc.attrs[attrs_at..].iter().map(|a| a.name).collect();
+            names.sort_unstable();
+            if names.windows(2).any(|w| w[0] == w[1]) {
+                return undo(&mut self.doc);
+            }
         }
         let doc = &mut self.doc;
         let attrs = crate::tree::AttrRange {
@@ -1079,21 +1319,30 @@ impl Builder {
         lines: &Lines,
         offset: usize,
     ) -> Result<Node, Errors> {
+        let syntax =
+            |loc: Location, msg: String| Errors::from(Error::at(loc, ErrorKind::Syntax(msg)));
         let tag_bytes = e.name();
         let tag = std::str::from_utf8(tag_bytes.as_ref()).map_err(|err| {
-            Error::at(
-                self.loc(span.file, span.line, span.col),
-                ErrorKind::Syntax(err.to_string()),
+            syntax(
+                self.loc_in(span, lines, tag_bytes.as_ref(), 0),
+                err.to_string(),
             )
         })?;
-        let tag = self.doc.names.intern(tag);
+        let tag = self
+            .name_sym(tag)
+            .map_err(|why| syntax(self.loc_in(span, lines, tag_bytes.as_ref(), 0), why))?;
         let node = self.doc.tree.new_node(NodeData::Element {
             tag,
             attrs: crate::tree::AttrRange::default(),
         });
         self.doc.set_span(node, span);
         let start = self.doc.attrs.len() as u32;
-        for attr in e.attributes() {
+        // quick-xml's own duplicate check compares each attribute with all before it; ours
+        // below is a hash set (and words the error at the repeated attribute).
+        let mut keys = ahash::AHashSet::new();
+        let mut attributes = e.attributes();
+        attributes.with_checks(false);
+        for (count, attr) in attributes.enumerate() {
             let attr = attr.map_err(|err| {
                 use quick_xml::events::attributes::AttrError;
                 // quick-xml counts attribute offsets from the byte after '<'.
@@ -1113,23 +1362,41 @@ impl Builder {
                     }
                 };
                 let (line, col) = lines.line_col(offset + 1 + at);
-                Error::at(self.loc(span.file, line, col), ErrorKind::Syntax(msg))
+                syntax(self.loc(span.file, line, col), msg)
             })?;
-            let key = std::str::from_utf8(attr.key.as_ref()).map_err(|err| {
-                Error::at(
-                    self.loc(span.file, span.line, span.col),
-                    ErrorKind::Syntax(err.to_string()),
+            let key_bytes = attr.key.as_ref();
+            if count >= self.limits.max_attributes as usize {
+                let msg = format!(
+                    "more than {} attributes on one element (Limits::max_attributes)",
+                    self.limits.max_attributes
+                );
+                return Err(Error::at(
+                    self.loc_in(span, lines, key_bytes, 0),
+                    ErrorKind::Invalid(msg),
+                )
+                .into());
+            }
+            let key = std::str::from_utf8(key_bytes)
+                .map_err(|err| syntax(self.loc_in(span, lines, key_bytes, 0), err.to_string()))?;
+            let name = self.name_sym(key).map_err(|why| {
+                syntax(
+                    self.loc_in(span, lines, key_bytes, 0),
+                    format!("attribute name: {why}"),
                 )
             })?;
-            let value = attr
-                .decode_and_unescape_value(reader.decoder())
-                .map_err(|err| {
-                    Error::at(
-                        self.loc(span.file, span.line, span.col),
-                        ErrorKind::Syntax(err.to_string()),
-                    )
-                })?;
-            let name = self.doc.names.intern(key);
+            if !keys.insert(name) {
+                return Err(syntax(
+                    self.loc_in(span, lines, key_bytes, 0),
+                    format!("attribute '{}' is already defined", clip(key, 40)),
+                ));
+            }
+            let raw = &attr.value;
+            let text = reader
+                .decoder()
+                .decode(raw)
+                .map_err(|err| syntax(self.loc_in(span, lines, raw, 0), err.to_string()))?;
+            let value = expand_refs(&text)
+                .map_err(|(at, why)| syntax(self.loc_in(span, lines, raw, at), why))?;
             let value = self.doc.push_str(&value);
             self.doc.attrs.push(crate::tree::Attr { name, value });
         }
@@ -1140,40 +1407,70 @@ impl Builder {
         Ok(node)
     }
 
-    fn include(
-        &mut self,
-        e: &BytesStart<'_>,
-        span: Span,
-        host: Node,
-        reader: &Reader<&[u8]>,
-        lines: &Lines,
-        offset: usize,
-    ) -> Result<(), Errors> {
-        // Read the include's attributes through the common path, then drop the element.
-        let node = self.element(e, span, reader, lines, offset)?;
-        self.expand_include(node, span, host, false).map(|_| ())
+    /// Where `part` (plus `extra` bytes) is in the file, when it is a slice of the source;
+    /// else the position of the tag it belongs to, `span`.
+    fn loc_in(&self, span: Span, lines: &Lines, part: &[u8], extra: usize) -> Location {
+        match offset_in(lines.text, part) {
+            Some(at) => {
+                let (line, col) = lines.line_col(at + extra);
+                self.loc(span.file, line, col)
+            }
+            None => self.loc(span.file, span.line, span.col),
+        }
+    }
+
+    /// The symbol of an element or attribute name read from the source; a name met for the
+    /// first time must be one we can write back (see [`name_problem`]).
+    #[inline]
+    fn name_sym(&mut self, name: &str) -> Result<Sym, String> {
+        match self.doc.names.get(name) {
+            Some(sym) => Ok(sym),
+            None => self.new_name_sym(name),
+        }
+    }
+
+    /// [`Builder::name_sym`] for a name not seen before (rare: most are vocabulary).
+    #[cold]
+    fn new_name_sym(&mut self, name: &str) -> Result<Sym, String> {
+        match name_problem(name, &self.limits) {
+            Some(why) => Err(why),
+            None => Ok(self.doc.names.intern(name)),
+        }
     }
 
     /// Reads the file an `<include>` (read into the detached `node`) names, in its place
     /// under `host`. With `fast`, the file is read by [`Builder::parse_fast`], and `Ok(false)`
     /// means it was not in that reader's reach (the load then starts over with quick-xml).
+    /// `host_depth` is the depth of `host` (see [`Limits::max_depth`]).
+    ///
+    /// Reading an included file recurses (on include depth only), so that depth is checked
+    /// before anything else: a chain of includes cannot exhaust the stack.
     fn expand_include(
         &mut self,
         node: Node,
         span: Span,
         host: Node,
+        host_depth: u32,
         fast: bool,
     ) -> Result<bool, Errors> {
-        let here = self.loc(span.file, span.line, span.col);
+        // Built only for a message: it walks the include chain.
+        let here = |b: &Builder| b.loc(span.file, span.line, span.col);
+        if self.include_depth >= self.limits.max_include_depth {
+            let msg = format!(
+                "includes nested deeper than {} files (Limits::max_include_depth)",
+                self.limits.max_include_depth
+            );
+            return Err(Error::at(here(self), ErrorKind::Invalid(msg)).into());
+        }
         let Some(file) = self.doc.attr(node, "file").map(str::to_owned) else {
-            return Err(Error::at(here, ErrorKind::IncludeWithoutFile).into());
+            return Err(Error::at(here(self), ErrorKind::IncludeWithoutFile).into());
         };
         // MuJoCo resolves every include against the main file's folder, not the including one.
         let full = self.doc.model_dir.join(&file);
         let path = self.display_dir.join(&file);
         let canonical = std::fs::canonicalize(&full).map_err(|err| {
             Error::at(
-                here.clone(),
+                here(self),
                 ErrorKind::Io {
                     path: path.clone(),
                     reason: err.to_string(),
@@ -1185,22 +1482,24 @@ impl Builder {
             // include is met).
             let main = std::fs::canonicalize(&*self.files[0].path).unwrap_or(abs);
             self.chain.insert(0, main.clone());
-            self.seen.insert(0, main);
+            self.seen_set.insert(main);
         }
-        if let Some(i) = self.chain.iter().position(|p| *p == canonical) {
-            let mut chain = self.chain_display[i..].to_vec();
-            chain.push(path);
-            return Err(Error::at(here, ErrorKind::IncludeCycle { chain }).into());
+        // A file in the chain has been seen: the chain is searched only then (it is as long
+        // as the includes are deep, and a lookup per include would make chains quadratic).
+        if self.seen_set.contains(&canonical) {
+            if let Some(i) = self.chain.iter().position(|p| *p == canonical) {
+                let mut chain = self.chain_display[i..].to_vec();
+                chain.push(path);
+                return Err(Error::at(here(self), ErrorKind::IncludeCycle { chain }).into());
+            }
+            return Err(Error::at(here(self), ErrorKind::IncludedTwice(path)).into());
         }
-        if self.seen.contains(&canonical) {
-            return Err(Error::at(here, ErrorKind::IncludedTwice(path)).into());
-        }
-        let bytes = std::fs::read(&full).map_err(|err| {
+        let bytes = read_regular_file(&full, self.limits.max_file_size).map_err(|reason| {
             Error::at(
-                here.clone(),
+                here(self),
                 ErrorKind::Io {
                     path: path.clone(),
-                    reason: err.to_string(),
+                    reason,
                 },
             )
         })?;
@@ -1211,24 +1510,75 @@ impl Builder {
         });
         self.chain.push(canonical.clone());
         self.chain_display.push(path.clone());
-        self.seen.push(canonical);
-        let inserted = if fast {
-            match std::str::from_utf8(&bytes)
-                .ok()
-                .and_then(|src| self.parse_fast(src, index, Some(host)))
-            {
-                Some(n) => n,
-                None => return Ok(false),
-            }
+        self.seen_set.insert(canonical);
+        let saved_base = std::mem::replace(&mut self.depth_base, host_depth);
+        self.include_depth += 1;
+        let read = |b: &mut Builder| -> Result<Option<usize>, Errors> {
+            Ok(if fast {
+                std::str::from_utf8(&bytes)
+                    .ok()
+                    .and_then(|src| b.parse_fast(src, index, Some(host)))
+            } else {
+                Some(b.parse(&bytes, index, Some(host))?)
+            })
+        };
+        // Reading an included file recurses. Every `INCLUDES_PER_STACK` files deep, the
+        // rest of the chain is read on a thread of its own with a stack of known size, so
+        // that no `max_include_depth` can make the caller's stack (a rayon worker's, say)
+        // the real bound.
+        let inserted = if self.include_depth.is_multiple_of(INCLUDES_PER_STACK) {
+            let at = here(self);
+            std::thread::scope(|scope| {
+                match std::thread::Builder::new()
+                    .stack_size(INCLUDE_STACK)
+                    .spawn_scoped(scope, || read(self))
+                {
+                    Ok(reader) => reader
+                        .join()
+                        .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
+                    Err(e) => {
+                        let why = format!("cannot start a thread to read deeper includes: {e}");
+                        Err(Error::at(at, ErrorKind::Invalid(why)).into())
+                    }
+                }
+            })?
         } else {
-            self.parse(&bytes, index, Some(host))?
+            read(self)?
+        };
+        // (After an error the builder is dropped: nothing to restore on that path.)
+        self.include_depth -= 1;
+        self.depth_base = saved_base;
+        let Some(inserted) = inserted else {
+            return Ok(false);
         };
         self.chain.pop();
         self.chain_display.pop();
         if inserted == 0 {
-            return Err(Error::at(here, ErrorKind::EmptyInclude(path)).into());
+            return Err(Error::at(here(self), ErrorKind::EmptyInclude(path)).into());
         }
         Ok(true)
+    }
+}
+
+/// What a load of `bytes` (as `<string>`, from `dir`) gives, as text: the document (compact,
+/// pretty, every node's position) or the errors. With `fast`, the fast reader is tried
+/// first (as every load does); without, only quick-xml's path is used. The tests and the
+/// `readers` fuzz target hold the two to the same outcome.
+pub(crate) fn describe_load(bytes: &[u8], dir: &Path, fast: bool) -> String {
+    let name = Arc::from(Path::new("<string>"));
+    let limits = Limits::default();
+    match read_bytes_with(bytes, name, dir, dir, Main::Text, &limits, fast)
+        .and_then(|mut d| d.finish_load().map(|()| d))
+    {
+        Ok(d) => {
+            let mut out = format!("{}\n{}", d.to_xml_string(), d.to_pretty_string());
+            for n in d.descendants(d.root()) {
+                let l = d.location(n);
+                out.push_str(&format!(" {}:{}", l.line, l.col));
+            }
+            out
+        }
+        Err(e) => format!("error: {e}"),
     }
 }
 
@@ -1236,24 +1586,9 @@ impl Builder {
 mod tests {
     use super::*;
 
-    /// What a load gives, as text: the document (compact, pretty, every node's position)
-    /// or the errors.
     fn outcome(xml: &str, fast: bool) -> String {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("corpora/features");
-        let name = Arc::from(Path::new("<string>"));
-        match read_bytes_with(xml.as_bytes(), name, &dir, &dir, Main::Text, fast)
-            .and_then(|mut d| d.finish_load().map(|()| d))
-        {
-            Ok(d) => {
-                let mut out = format!("{}\n{}", d.to_xml_string(), d.to_pretty_string());
-                for n in d.descendants(d.root()) {
-                    let l = d.location(n);
-                    out.push_str(&format!(" {}:{}", l.line, l.col));
-                }
-                out
-            }
-            Err(e) => format!("error: {e}"),
-        }
+        describe_load(xml.as_bytes(), &dir, fast)
     }
 
     #[test]
@@ -1337,6 +1672,32 @@ mod tests {
                     String::from_utf8_lossy(s)
                 );
             }
+        }
+    }
+
+    #[test]
+    fn forbidden_characters_are_found_like_a_char_loop() {
+        let mut samples: Vec<String> = vec![String::new(), "\u{FFFD}\u{FFFE}".into()];
+        for c in [
+            '\u{0}', '\u{1}', '\u{1F}', '\u{FFFE}', '\u{FFFF}', '\u{F000}', '\t', 'x',
+        ] {
+            for at in [0, 1, 31, 32, 33, 70] {
+                let mut s: String = "\u{e9}a\n\r".repeat(at).chars().take(at).collect();
+                s.push(c);
+                s.push_str("tail");
+                samples.push(s);
+            }
+        }
+        for s in &samples {
+            let naive = s
+                .char_indices()
+                .find(|&(_, c)| !is_xml_char(c))
+                .map(|(i, _)| i);
+            assert_eq!(
+                first_forbidden_char(s.as_bytes()).map(|f| f.0),
+                naive,
+                "{s:?}"
+            );
         }
     }
 

@@ -71,7 +71,9 @@ fn parse_skn(bytes: &[u8]) -> Result<Skn, String> {
     let vertex = c.f32s(3 * nvert)?;
     let texcoord = c.f32s(2 * ntex)?;
     let face = c.i32s(3 * nface)?;
-    let mut bones = Vec::with_capacity(nbone);
+    // The count is the file's word: reserve no more than its remaining bytes can hold (a
+    // bone takes at least 72), or a hostile header reserves gigabytes.
+    let mut bones = Vec::with_capacity(nbone.min((bytes.len() - c.at) / 72));
     for _ in 0..nbone {
         let raw = c.take(40)?;
         let end = raw.iter().position(|&b| b == 0).unwrap_or(raw.len());
@@ -137,8 +139,11 @@ impl Document {
         for skin in skins {
             let file = self.attr(skin, "file").unwrap_or_default().to_string();
             let bad = |reason: String| ErrorKind::Invalid(format!("skin file '{file}': {reason}"));
-            let bytes =
-                std::fs::read(&file).map_err(|e| self.error_at(skin, bad(e.to_string())))?;
+            let bytes = crate::limits::read_regular_file(
+                std::path::Path::new(&file),
+                self.limits.max_file_size,
+            )
+            .map_err(|e| self.error_at(skin, bad(e)))?;
             let skn = parse_skn(&bytes).map_err(|e| self.error_at(skin, bad(e)))?;
             self.remove_attr(skin, "file");
             self.set_attr(skin, "vertex", &f32_list(&skn.vertex));

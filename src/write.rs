@@ -162,69 +162,112 @@ impl Document {
         write_atomic(path.as_ref(), self.to_pretty_string().as_bytes())
     }
 
-    pub(crate) fn write_node(&self, out: &mut String, node: Node, indent: Option<usize>) {
-        match *self.tree.data(node) {
-            NodeData::Text { text, cdata } => {
-                let text = self.str(text);
-                if cdata {
-                    out.push_str("<![CDATA[");
-                    out.push_str(&text.replace("]]>", "]]]]><![CDATA[>"));
-                    out.push_str("]]>");
-                } else {
-                    escape_text(out, text);
-                }
-            }
-            NodeData::Element { tag, .. } => {
-                // Vocabulary names come pre-rendered (` name="`, `<tag`, `</tag>`).
-                let markup = self.names.markup(tag);
-                match &markup {
-                    Some(m) => out.push_str(m.open),
-                    None => {
-                        out.push('<');
-                        out.push_str(self.names.resolve(tag));
-                    }
-                }
-                for a in self.attr_slice(node) {
-                    match self.names.markup(a.name) {
-                        Some(m) => out.push_str(m.attr),
-                        None => {
-                            out.push(' ');
-                            out.push_str(self.names.resolve(a.name));
-                            out.push_str("=\"");
-                        }
-                    }
-                    escape_attr_in(out, &self.strings, a.value);
-                    out.push('"');
-                }
-                let Some(first) = self.tree.first_child(node) else {
-                    out.push_str("/>");
-                    return;
-                };
-                out.push('>');
-                // Mixed content (text inside) is written inline to keep the text exact.
-                let child_indent = indent
-                    .filter(|_| self.tree.children(node).all(|k| self.is_element(k)))
-                    .map(|i| i + 1);
-                let mut next = Some(first);
-                while let Some(kid) = next {
-                    next = self.tree.next_sibling(kid);
-                    if let Some(i) = child_indent {
+    /// Writes `root` and everything below it. An explicit stack of steps, not recursion:
+    /// documents nest as deep as [`crate::Limits::max_depth`] allows (and deeper once
+    /// merged), and writing may run on a worker thread with a small stack.
+    pub(crate) fn write_node(&self, out: &mut String, root: Node, indent: Option<usize>) {
+        enum Step {
+            /// Write a node at this indent; `newline` first when its siblings are indented.
+            Enter {
+                node: Node,
+                indent: Option<usize>,
+                newline: bool,
+            },
+            /// Close an element whose children are written; `lined`: they were indented.
+            Leave {
+                tag: crate::names::Sym,
+                indent: Option<usize>,
+                lined: bool,
+            },
+        }
+        let mut stack = vec![Step::Enter {
+            node: root,
+            indent,
+            newline: false,
+        }];
+        while let Some(step) = stack.pop() {
+            let (node, indent) = match step {
+                Step::Leave { tag, indent, lined } => {
+                    if let (Some(i), true) = (indent, lined) {
                         out.push('\n');
                         push_indent(out, i);
                     }
-                    self.write_node(out, kid, child_indent);
-                }
-                if let (Some(i), Some(_)) = (indent, child_indent) {
-                    out.push('\n');
-                    push_indent(out, i);
-                }
-                match &markup {
-                    Some(m) => out.push_str(m.close),
-                    None => {
-                        out.push_str("</");
-                        out.push_str(self.names.resolve(tag));
-                        out.push('>');
+                    match self.names.markup(tag) {
+                        Some(m) => out.push_str(m.close),
+                        None => {
+                            out.push_str("</");
+                            out.push_str(self.names.resolve(tag));
+                            out.push('>');
+                        }
                     }
+                    continue;
+                }
+                Step::Enter {
+                    node,
+                    indent,
+                    newline,
+                } => {
+                    if let (Some(i), true) = (indent, newline) {
+                        out.push('\n');
+                        push_indent(out, i);
+                    }
+                    (node, indent)
+                }
+            };
+            match *self.tree.data(node) {
+                NodeData::Text { text, cdata } => {
+                    let text = self.str(text);
+                    if cdata {
+                        out.push_str("<![CDATA[");
+                        out.push_str(&text.replace("]]>", "]]]]><![CDATA[>"));
+                        out.push_str("]]>");
+                    } else {
+                        escape_text(out, text);
+                    }
+                }
+                NodeData::Element { tag, .. } => {
+                    // Vocabulary names come pre-rendered (` name="`, `<tag`, `</tag>`).
+                    match self.names.markup(tag) {
+                        Some(m) => out.push_str(m.open),
+                        None => {
+                            out.push('<');
+                            out.push_str(self.names.resolve(tag));
+                        }
+                    }
+                    for a in self.attr_slice(node) {
+                        match self.names.markup(a.name) {
+                            Some(m) => out.push_str(m.attr),
+                            None => {
+                                out.push(' ');
+                                out.push_str(self.names.resolve(a.name));
+                                out.push_str("=\"");
+                            }
+                        }
+                        escape_attr_in(out, &self.strings, a.value);
+                        out.push('"');
+                    }
+                    if self.tree.first_child(node).is_none() {
+                        out.push_str("/>");
+                        continue;
+                    }
+                    out.push('>');
+                    // Mixed content (text inside) is written inline to keep the text exact.
+                    let child_indent = indent
+                        .filter(|_| self.tree.children(node).all(|k| self.is_element(k)))
+                        .map(|i| i + 1);
+                    stack.push(Step::Leave {
+                        tag,
+                        indent,
+                        lined: child_indent.is_some(),
+                    });
+                    let at = stack.len();
+                    stack.extend(self.tree.children(node).map(|kid| Step::Enter {
+                        node: kid,
+                        indent: child_indent,
+                        newline: child_indent.is_some(),
+                    }));
+                    // Taken from the end: first child first.
+                    stack[at..].reverse();
                 }
             }
         }

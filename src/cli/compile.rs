@@ -12,6 +12,8 @@ use mjcf_forge::Document;
 
 #[derive(clap::Args)]
 pub struct Args {
+    #[command(flatten)]
+    limits: super::LimitArgs,
     /// Input MJCF file.
     input: PathBuf,
     /// Print the sizes as one JSON object.
@@ -20,13 +22,13 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> ExitCode {
-    compile(&args.input, args.json)
+    compile(&args.input, args.json, &args.limits.limits())
 }
 
 /// `compile IN [--json]`.
 #[cfg(mjcf_mujoco)]
-fn compile(input: &Path, json: bool) -> ExitCode {
-    let doc = match Document::load(input) {
+fn compile(input: &Path, json: bool, limits: &mjcf_forge::Limits) -> ExitCode {
+    let doc = match Document::load_with(input, limits) {
         Ok(doc) => doc,
         Err(e) => {
             eprintln!("{e}");
@@ -71,7 +73,7 @@ fn compile(input: &Path, json: bool) -> ExitCode {
 
 /// `compile` in a build without MuJoCo: says how to get one.
 #[cfg(not(mjcf_mujoco))]
-fn compile(_input: &Path, _json: bool) -> ExitCode {
+fn compile(_input: &Path, _json: bool, _limits: &mjcf_forge::Limits) -> ExitCode {
     eprintln!("mjcf-forge: compile: {}", super::NO_MUJOCO);
     ExitCode::from(super::USAGE)
 }

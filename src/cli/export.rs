@@ -12,6 +12,8 @@ use super::{USAGE, WriteOptions, finish, refuse_validate_without_mujoco, render}
 
 #[derive(clap::Args)]
 pub struct Args {
+    #[command(flatten)]
+    limits: super::LimitArgs,
     /// Input MJCF file.
     input: PathBuf,
     /// Output folder (created if missing); with `--tar`, the tar file (`-` for standard
@@ -43,7 +45,7 @@ pub fn run(args: Args) -> ExitCode {
         compact: args.compact,
         validate: args.validate,
     };
-    let result = prepare(&args.input, options).and_then(|(store, text)| {
+    let result = prepare(&args.input, options, &args.limits.limits()).and_then(|(store, text)| {
         if args.tar {
             export_tar(&store, name, &text, &args.output)
         } else {
@@ -55,8 +57,12 @@ pub fn run(args: Args) -> ExitCode {
 
 /// Loads, validates (when asked, before anything moves: the model as it compiles from
 /// its own folder) and relocates the model; returns its assets and its XML.
-fn prepare(input: &Path, options: WriteOptions) -> Result<(AssetStore, String), String> {
-    let mut doc = Document::load(input).map_err(|e| e.to_string())?;
+fn prepare(
+    input: &Path,
+    options: WriteOptions,
+    limits: &mjcf_forge::Limits,
+) -> Result<(AssetStore, String), String> {
+    let mut doc = Document::load_with(input, limits).map_err(|e| e.to_string())?;
     if options.validate {
         super::validate(&doc)?;
     }

@@ -9,6 +9,8 @@ use super::{USAGE, finish};
 
 #[derive(clap::Args)]
 pub struct Args {
+    #[command(flatten)]
+    limits: super::LimitArgs,
     /// Input MJCF file (exactly one top-level body).
     input: PathBuf,
     /// Naming prefix of the instance (none by default).
@@ -24,7 +26,8 @@ pub fn run(args: Args) -> ExitCode {
         eprintln!("mjcf-forge: info prints JSON only: add --json");
         return ExitCode::from(USAGE);
     }
-    let result = Document::load(&args.input)
+    let limits = args.limits.limits();
+    let result = Document::load_with(&args.input, &limits)
         .map_err(|e| e.to_string())
         .and_then(|doc| {
             let options = XmlModelOptions {

@@ -12,6 +12,8 @@ use super::{USAGE, WriteOptions, emit, finish, refuse_validate_without_mujoco, r
 
 #[derive(clap::Args)]
 pub struct Args {
+    #[command(flatten)]
+    limits: super::LimitArgs,
     /// Input MJCF files.
     #[arg(required = true)]
     inputs: Vec<PathBuf>,
@@ -39,25 +41,36 @@ pub fn run(args: Args) -> ExitCode {
         compact: args.compact,
         validate: args.validate,
     };
+    let limits = args.limits.limits();
     match args.out_dir {
-        Some(dir) => inline_to_dir(&args.inputs, &dir, options),
-        None => inline_one_input(&args.inputs, args.output.as_deref(), options),
+        Some(dir) => inline_to_dir(&args.inputs, &dir, options, &limits),
+        None => inline_one_input(&args.inputs, args.output.as_deref(), options, &limits),
     }
 }
 
-fn inline_one_input(inputs: &[PathBuf], output: Option<&Path>, options: WriteOptions) -> ExitCode {
+fn inline_one_input(
+    inputs: &[PathBuf],
+    output: Option<&Path>,
+    options: WriteOptions,
+    limits: &mjcf_forge::Limits,
+) -> ExitCode {
     if inputs.len() > 1 {
         eprintln!("mjcf-forge: several inputs need --out-dir DIR");
         return ExitCode::from(USAGE);
     }
-    finish(&[inline_model(&inputs[0], output, options)])
+    finish(&[inline_model(&inputs[0], output, options, limits)])
 }
 
 /// `inline --out-dir`: plans every output before writing any, so that a clash between two
 /// inputs is reported without touching the folder; then runs the models in parallel,
 /// writing each into one [`OutputDir`] (no lock, no sync per file; one sync at the end),
 /// and reports their problems in input order (never in thread order).
-fn inline_to_dir(inputs: &[PathBuf], dir: &Path, options: WriteOptions) -> ExitCode {
+fn inline_to_dir(
+    inputs: &[PathBuf],
+    dir: &Path,
+    options: WriteOptions,
+    limits: &mjcf_forge::Limits,
+) -> ExitCode {
     let jobs = match plan_outputs(inputs, dir) {
         Ok(jobs) => jobs,
         Err(problems) => {
@@ -77,7 +90,7 @@ fn inline_to_dir(inputs: &[PathBuf], dir: &Path, options: WriteOptions) -> ExitC
     let mut results: Vec<Result<(), String>> = jobs
         .par_iter()
         .map(|job| {
-            let doc = Document::load(job.input).map_err(|e| e.to_string())?;
+            let doc = Document::load_with(job.input, limits).map_err(|e| e.to_string())?;
             let text = render(&doc, options)?;
             out.write(job.output, text.as_bytes())
                 .map_err(|e| e.to_string())
@@ -155,8 +168,13 @@ impl FileIdentity {
 }
 
 /// Loads, optionally validates, and writes one model (standard output without `output`).
-fn inline_model(input: &Path, output: Option<&Path>, options: WriteOptions) -> Result<(), String> {
-    let doc = Document::load(input).map_err(|e| e.to_string())?;
+fn inline_model(
+    input: &Path,
+    output: Option<&Path>,
+    options: WriteOptions,
+    limits: &mjcf_forge::Limits,
+) -> Result<(), String> {
+    let doc = Document::load_with(input, limits).map_err(|e| e.to_string())?;
     emit(&doc, output, options)
 }
 

@@ -10,6 +10,8 @@ use super::{USAGE, WriteOptions, emit, finish, refuse_validate_without_mujoco};
 
 #[derive(clap::Args)]
 pub struct Args {
+    #[command(flatten)]
+    limits: super::LimitArgs,
     /// The base model.
     base: PathBuf,
     /// A part: FILE, FILE:PREFIX or FILE:PREFIX:BODY (in order of merging).
@@ -50,6 +52,7 @@ pub fn run(args: Args) -> ExitCode {
         args.fuse_keys,
         args.output.as_deref(),
         options,
+        &args.limits.limits(),
     )])
 }
 
@@ -84,13 +87,14 @@ fn merge(
     fuse_keys: bool,
     output: Option<&Path>,
     options: WriteOptions,
+    limits: &mjcf_forge::Limits,
 ) -> Result<(), String> {
-    let mut scene = Document::load(base).map_err(|e| e.to_string())?;
+    let mut scene = Document::load_with(base, limits).map_err(|e| e.to_string())?;
     // Parts load in parallel; they merge in the order given.
     let loaded: Vec<Result<Document, String>> = parts
         .par_iter()
         .map(|p| {
-            let mut doc = Document::load(&p.file).map_err(|e| e.to_string())?;
+            let mut doc = Document::load_with(&p.file, limits).map_err(|e| e.to_string())?;
             doc.apply_prefix(&p.prefix).map_err(|e| e.to_string())?;
             Ok(doc)
         })

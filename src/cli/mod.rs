@@ -114,3 +114,38 @@ pub fn validate(doc: &Document) -> Result<(), String> {
         Err(NO_MUJOCO.to_owned())
     }
 }
+
+/// Bounds on the input, for every subcommand that loads models (see
+/// `mjcf_forge::Limits`, whose defaults are far above any real model's needs).
+#[derive(clap::Args, Clone, Copy, Debug, Default)]
+pub struct LimitArgs {
+    /// Deepest element nesting accepted, includes expanded [default: 1000].
+    #[arg(long, value_name = "LEVELS")]
+    max_depth: Option<u32>,
+    /// Longest chain of files including each other [default: 100].
+    #[arg(long, value_name = "FILES")]
+    max_include_depth: Option<u32>,
+    /// Largest file read (models, includes, meshes, skins) [default: 1073741824].
+    #[arg(long, value_name = "BYTES")]
+    max_file_size: Option<u64>,
+    /// Most attributes on one element [default: 1000].
+    #[arg(long, value_name = "N")]
+    max_attributes: Option<u32>,
+    /// Longest element or attribute name, in bytes [default: 1000].
+    #[arg(long, value_name = "BYTES")]
+    max_name_len: Option<u32>,
+}
+
+impl LimitArgs {
+    /// The limits: the defaults, with what was given on the command line.
+    pub fn limits(&self) -> mjcf_forge::Limits {
+        let d = mjcf_forge::Limits::default();
+        mjcf_forge::Limits {
+            max_depth: self.max_depth.unwrap_or(d.max_depth),
+            max_include_depth: self.max_include_depth.unwrap_or(d.max_include_depth),
+            max_file_size: self.max_file_size.unwrap_or(d.max_file_size),
+            max_attributes: self.max_attributes.unwrap_or(d.max_attributes),
+            max_name_len: self.max_name_len.unwrap_or(d.max_name_len),
+        }
+    }
+}

@@ -9,6 +9,8 @@ use super::{WriteOptions, emit, finish, refuse_validate_without_mujoco};
 
 #[derive(clap::Args)]
 pub struct Args {
+    #[command(flatten)]
+    limits: super::LimitArgs,
     /// Input MJCF file.
     input: PathBuf,
     /// The prefix.
@@ -33,7 +35,8 @@ pub fn run(args: Args) -> ExitCode {
         compact: args.compact,
         validate: args.validate,
     };
-    let result = Document::load(&args.input)
+    let limits = args.limits.limits();
+    let result = Document::load_with(&args.input, &limits)
         .map_err(|e| e.to_string())
         .and_then(|mut doc| {
             doc.apply_prefix(&args.prefix).map_err(|e| e.to_string())?;

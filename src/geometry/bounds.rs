@@ -124,13 +124,23 @@ struct Walk<'a, F> {
 }
 
 impl<F: Fn(&Document, Node) -> bool> Walk<'_, F> {
+    /// Measures every geom below `node`, in document order, from an explicit stack (bodies
+    /// nest without bound; this may run on a worker thread with a small stack).
     fn subtree(&mut self, node: Node, pose: &Pose) -> Result<(), String> {
         let doc = self.doc;
-        for child in doc.elements(node) {
+        let mut stack: Vec<(Node, Pose)> = Vec::new();
+        let push_kids = |stack: &mut Vec<(Node, Pose)>, node: Node, pose: &Pose| {
+            let at = stack.len();
+            stack.extend(doc.elements(node).map(|k| (k, *pose)));
+            stack[at..].reverse();
+        };
+        push_kids(&mut stack, node, pose);
+        while let Some((child, pose)) = stack.pop() {
+            let pose = &pose;
             match doc.tag(child) {
                 "body" | "frame" => {
                     let inner = pose.compose(&element_pose(doc, child, &self.angles)?);
-                    self.subtree(child, &inner)?;
+                    push_kids(&mut stack, child, &inner);
                 }
                 "geom" if (self.filter)(doc, child) => {
                     if let Some(b) = self.geom(child, pose)? {

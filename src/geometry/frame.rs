@@ -53,10 +53,10 @@ impl Angles {
     /// # Ok::<(), String>(())
     /// ```
     pub fn new(degrees: bool, seq: &str) -> Result<Angles, String> {
-        let bytes: [u8; 3] = seq
-            .as_bytes()
-            .try_into()
-            .map_err(|_| format!("eulerseq '{seq}' must have exactly 3 letters"))?;
+        let bytes: [u8; 3] = seq.as_bytes().try_into().map_err(|_| {
+            let seq = crate::read::clip(seq, 40);
+            format!("eulerseq '{seq}' must have exactly 3 letters")
+        })?;
         if !bytes.iter().all(|c| b"xyzXYZ".contains(c)) {
             return Err(format!(
                 "eulerseq '{seq}' can only contain x, y, z, X, Y, Z"
@@ -92,7 +92,10 @@ impl Angles {
                         return Err(err_at(
                             doc,
                             c,
-                            format_args!("angle must be 'degree' or 'radian', not '{other}'"),
+                            format_args!(
+                                "angle must be 'degree' or 'radian', not '{}'",
+                                crate::read::clip(other, 40)
+                            ),
                         ));
                     }
                 };
@@ -104,7 +107,10 @@ impl Angles {
                     err_at(
                         doc,
                         c,
-                        format_args!("eulerseq '{s}' must have exactly 3 letters"),
+                        format_args!(
+                            "eulerseq '{}' must have exactly 3 letters",
+                            crate::read::clip(s, 40)
+                        ),
                     )
                 })?;
             }

@@ -79,7 +79,9 @@ pub fn mesh_vertices(doc: &Document, mesh: Node) -> Result<Vec<[f64; 3]>, String
                 .map(|e| e.to_string_lossy().to_ascii_lowercase())
                 .unwrap_or_default(),
         };
-        let bytes = std::fs::read(file)
+        // Only a regular file within the size limit: a mesh naming a FIFO or a device must
+        // not hang or fill memory.
+        let bytes = crate::limits::read_regular_file(Path::new(file), doc.limits.max_file_size)
             .map_err(|e| err_at(doc, mesh, format_args!("cannot read '{file}': {e}")))?;
         let parsed = match kind.as_str() {
             "stl" => read_stl(&bytes),

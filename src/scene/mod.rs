@@ -183,7 +183,15 @@ impl Scene {
     /// ```
     pub fn load(path: impl AsRef<Path>) -> Result<Scene, Errors> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| {
+        // Only a regular file within the size limit (a FIFO would block, a device never end).
+        let max = crate::Limits::default().max_file_size;
+        let bytes = crate::limits::read_regular_file(path, max).map_err(|reason| {
+            Error::bare(ErrorKind::Io {
+                path: path.to_path_buf(),
+                reason,
+            })
+        })?;
+        let text = String::from_utf8(bytes).map_err(|e| {
             Error::bare(ErrorKind::Io {
                 path: path.to_path_buf(),
                 reason: e.to_string(),

@@ -1,0 +1,14 @@
+//! Entry points for the fuzz targets in `fuzz/`: internals they compare, not a supported API.
+
+use std::path::Path;
+
+/// The outcome of loading `bytes` through the fast reader (falling back as every load does)
+/// and through quick-xml's path alone, each as text (see `read::describe_load`): equal for
+/// every input, or one of the readers is wrong.
+pub fn read_both_ways(bytes: &[u8], base_dir: &str) -> (String, String) {
+    let dir = Path::new(base_dir);
+    (
+        crate::read::describe_load(bytes, dir, true),
+        crate::read::describe_load(bytes, dir, false),
+    )
+}
