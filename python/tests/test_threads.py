@@ -92,6 +92,9 @@ def test_long_calls_release_the_gil():
         "validate": (lambda d: lambda: d.validate())(Document.from_string(xml)),
     }
     for name, call in calls.items():
-        took, longest = _longest_pause_while(call)
-        assert took > 0.04, (name, took)  # long enough to tell
-        assert longest < took / 2, (name, took, longest)
+        # A call that held the GIL would stop the ticks for its whole length every time;
+        # a busy machine can also stop them (the scheduler), but not three times running,
+        # so the best of three attempts decides.
+        attempts = [_longest_pause_while(call) for _ in range(3)]
+        assert all(took > 0.04 for took, _ in attempts), (name, attempts)  # long enough to tell
+        assert any(longest < took / 2 for took, longest in attempts), (name, attempts)
