@@ -319,6 +319,38 @@ uniform = [[0, 0, 0], [1, 1, 1]]
 }
 
 #[test]
+fn prefixes_that_can_clash_are_checked_on_the_spliced_path_too() {
+    // With prefix "o{i}", slot 1's "o1" + "1_g" and slot 11's "o11" + "_g" are one name:
+    // such scenes check names per variant, and the text path must refuse what the document
+    // path refuses rather than write a model with a name twice.
+    let dir = scratch("scene_prefix_clash");
+    let demo = root().join("corpora/scenes/demo");
+    std::fs::copy(demo.join("arena.xml"), dir.join("arena.xml")).unwrap();
+    std::fs::write(
+        dir.join("pebble.xml"),
+        r#"<mujoco><worldbody><body name="b"><geom name="1_g" size="0.005"/><geom name="_g" size="0.005" pos="0 0 0.01"/></body></worldbody></mujoco>"#,
+    )
+    .unwrap();
+    let text = r#"
+base = "arena.xml"
+[[objects]]
+name = "o"
+pool = ["pebble.xml"]
+count = 12
+prefix = "o{i}"
+[objects.placement]
+on = "table_top"
+x = [-0.4, 0.4]
+y = [-0.5, 0.5]
+"#;
+    let scene = Scene::from_toml_str(text, &dir).unwrap();
+    let a = scene.variant_xml(0).map(|(x, _)| x).map_err(|e| e.to_string());
+    let b = scene.variant(0).map(|v| v.xml()).map_err(|e| e.to_string());
+    assert!(b.as_ref().is_err_and(|e| e.contains("duplicate geom name 'o11_g'")), "{b:?}");
+    assert_eq!(a, b);
+}
+
+#[test]
 fn scene_from_json_is_the_scene_from_toml() {
     let dir = root().join("corpora/scenes/demo");
     let toml_text = std::fs::read_to_string(dir.join("demo.toml")).unwrap();

@@ -374,7 +374,8 @@ impl Scene {
     /// # Ok::<(), mjcf_forge::Errors>(())
     /// ```
     pub fn variant_xml_into(&self, index: u64, out: &mut String) -> Result<Params, Errors> {
-        if let Some(splice) = &self.splice {
+        // Splicing checks no names: only where instances cannot clash (see `variant`).
+        if let Some(splice) = self.splice.as_ref().filter(|_| self.prefixes_apart) {
             let drawn = self.draw(index)?;
             if splice.write(&drawn, out) {
                 return Ok(drawn.params);
