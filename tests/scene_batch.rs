@@ -344,9 +344,16 @@ x = [-0.4, 0.4]
 y = [-0.5, 0.5]
 "#;
     let scene = Scene::from_toml_str(text, &dir).unwrap();
-    let a = scene.variant_xml(0).map(|(x, _)| x).map_err(|e| e.to_string());
+    let a = scene
+        .variant_xml(0)
+        .map(|(x, _)| x)
+        .map_err(|e| e.to_string());
     let b = scene.variant(0).map(|v| v.xml()).map_err(|e| e.to_string());
-    assert!(b.as_ref().is_err_and(|e| e.contains("duplicate geom name 'o11_g'")), "{b:?}");
+    assert!(
+        b.as_ref()
+            .is_err_and(|e| e.contains("duplicate geom name 'o11_g'")),
+        "{b:?}"
+    );
     assert_eq!(a, b);
 }
 
