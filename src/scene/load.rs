@@ -760,6 +760,20 @@ fn randomizer(
                 && entries.iter().any(|e| e.weight() > 0.0),
             "choice needs a non-empty list with weights >= 0, one of them positive",
         )?;
+        // Chosen strings are written into the XML as they are: refuse what XML 1.0 cannot
+        // carry (a TOML escape such as \e gives one).
+        if let Some(bad) = entries
+            .iter()
+            .find_map(|e| e.value().chars().find(|&ch| !is_xml_char(ch)))
+        {
+            return Err(Error::at(
+                src.location(c.span()),
+                ErrorKind::Invalid(format!(
+                    "choice holds the character U+{:04X}, which XML cannot carry",
+                    bad as u32
+                )),
+            ));
+        }
         let file = matches!(attr_spec.kind, AttrKind::File);
         let values = entries
             .iter()
@@ -831,6 +845,11 @@ fn randomizer(
         index,
         file: matches!(attr_spec.kind, AttrKind::File),
     })
+}
+
+/// Whether XML 1.0 allows `c` in text (its `Char` production).
+fn is_xml_char(c: char) -> bool {
+    matches!(c, '\t' | '\n' | '\r' | '\u{20}'..='\u{D7FF}' | '\u{E000}'..='\u{FFFD}' | '\u{10000}'..)
 }
 
 /// Lists of bounds of one length (or a single value), each pair satisfying `ok`.
