@@ -24,27 +24,19 @@ pub struct Args {
     /// folder.
     #[arg(long)]
     tar: bool,
-    /// Write compact XML instead of indented XML.
-    #[arg(long)]
-    compact: bool,
-    /// Compile the model with MuJoCo first; write nothing if it fails (needs the
-    /// `mujoco` feature).
-    #[arg(long)]
-    validate: bool,
+    #[command(flatten)]
+    write: WriteOptions,
 }
 
 pub fn run(args: Args) -> ExitCode {
-    if let Some(code) = refuse_validate_without_mujoco(args.validate) {
+    if let Some(code) = refuse_validate_without_mujoco(args.write.validate) {
         return code;
     }
     let Some(name) = args.input.file_name().and_then(|n| n.to_str()) else {
         eprintln!("{}: not a UTF-8 file name", args.input.display());
         return ExitCode::from(USAGE);
     };
-    let options = WriteOptions {
-        compact: args.compact,
-        validate: args.validate,
-    };
+    let options = args.write;
     let result = prepare(&args.input, options, &args.limits.limits()).and_then(|(store, text)| {
         if args.tar {
             export_tar(&store, name, &text, &args.output)

@@ -23,24 +23,16 @@ pub struct Args {
     /// Output folder: one file per input, named after it.
     #[arg(long)]
     out_dir: Option<PathBuf>,
-    /// Write compact XML instead of indented XML.
-    #[arg(long)]
-    compact: bool,
-    /// Compile each output with MuJoCo first; write nothing for a model that fails
-    /// (needs the `mujoco` feature).
-    #[arg(long)]
-    validate: bool,
+    #[command(flatten)]
+    write: WriteOptions,
 }
 
 pub fn run(args: Args) -> ExitCode {
     // Without MuJoCo, fail before loading anything rather than once per model.
-    if let Some(code) = refuse_validate_without_mujoco(args.validate) {
+    if let Some(code) = refuse_validate_without_mujoco(args.write.validate) {
         return code;
     }
-    let options = WriteOptions {
-        compact: args.compact,
-        validate: args.validate,
-    };
+    let options = args.write;
     let limits = args.limits.limits();
     match args.out_dir {
         Some(dir) => inline_to_dir(&args.inputs, &dir, options, &limits),

@@ -23,16 +23,12 @@ pub struct Args {
     /// Output file; standard output without it.
     #[arg(short, long)]
     output: Option<PathBuf>,
-    /// Write compact XML instead of indented XML.
-    #[arg(long)]
-    compact: bool,
-    /// Compile the output with MuJoCo first (needs the `mujoco` feature).
-    #[arg(long)]
-    validate: bool,
+    #[command(flatten)]
+    write: WriteOptions,
 }
 
 pub fn run(args: Args) -> ExitCode {
-    if let Some(code) = refuse_validate_without_mujoco(args.validate) {
+    if let Some(code) = refuse_validate_without_mujoco(args.write.validate) {
         return code;
     }
     let specs: Vec<PartSpec> = match args.parts.iter().map(|p| PartSpec::parse(p)).collect() {
@@ -42,10 +38,7 @@ pub fn run(args: Args) -> ExitCode {
             return ExitCode::from(USAGE);
         }
     };
-    let options = WriteOptions {
-        compact: args.compact,
-        validate: args.validate,
-    };
+    let options = args.write;
     finish(&[merge(
         &args.base,
         &specs,

@@ -21,12 +21,16 @@ pub const USAGE: u8 = 2;
 /// What `compile` and `--validate` say in a build without MuJoCo.
 pub const NO_MUJOCO: &str = "built without the `mujoco` feature; rebuild with --features mujoco";
 
-/// How a command that writes a model writes it.
-#[derive(Clone, Copy)]
+/// How a command that writes a model writes it: the `--compact` and `--validate` flags
+/// every such command takes.
+#[derive(Clone, Copy, clap::Args)]
 pub struct WriteOptions {
-    /// Compact XML instead of indented XML.
+    /// Write compact XML instead of indented XML.
+    #[arg(long)]
     pub compact: bool,
-    /// Compile with MuJoCo before writing anything.
+    /// Compile with MuJoCo first; write nothing for a model that fails (needs the
+    /// `mujoco` feature).
+    #[arg(long)]
     pub validate: bool,
 }
 

@@ -19,22 +19,15 @@ pub struct Args {
     /// Output file; standard output without it.
     #[arg(short, long)]
     output: Option<PathBuf>,
-    /// Write compact XML instead of indented XML.
-    #[arg(long)]
-    compact: bool,
-    /// Compile the output with MuJoCo first (needs the `mujoco` feature).
-    #[arg(long)]
-    validate: bool,
+    #[command(flatten)]
+    write: WriteOptions,
 }
 
 pub fn run(args: Args) -> ExitCode {
-    if let Some(code) = refuse_validate_without_mujoco(args.validate) {
+    if let Some(code) = refuse_validate_without_mujoco(args.write.validate) {
         return code;
     }
-    let options = WriteOptions {
-        compact: args.compact,
-        validate: args.validate,
-    };
+    let options = args.write;
     let limits = args.limits.limits();
     let result = Document::load_with(&args.input, &limits)
         .map_err(|e| e.to_string())
