@@ -11,10 +11,10 @@ use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::sync::{Arc, Mutex, OnceLock};
 
 use mjcf_forge::Document;
-use mjcf_forge::scene::Scene;
+use mjcf_forge::scene::{PatchEntry, PatchValue, Scene, VariantPatch};
 use pyo3::exceptions::{PyImportError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyTuple};
+use pyo3::types::{PyDict, PyList, PyTuple};
 use rayon::prelude::*;
 
 use crate::document::PyDocument;
@@ -165,6 +165,14 @@ impl PyScene {
     #[getter]
     fn model_files(&self) -> Vec<PathBuf> {
         self.scene.model_files().to_vec()
+    }
+
+    /// The ``<statistic>`` attributes the scene's model sets itself (``extent``,
+    /// ``center``...), which MuJoCo keeps over what it computes: a patched model keeps
+    /// them too.
+    #[getter]
+    fn fixed_statistics(&self) -> Vec<&'static str> {
+        self.scene.fixed_statistics()
     }
 
     /// A copy of the template every variant starts from: the base with the fixtures.
@@ -355,6 +363,8 @@ pub(crate) struct PyVariant {
     document: OnceLock<Document>,
     /// The `str` made once on first access (the XML of a scene is tens of kilobytes).
     xml_str: OnceLock<Py<pyo3::types::PyString>>,
+    /// Structure key and patch, drawn again on first use (or shipped by pickling).
+    patch: OnceLock<VariantPatch>,
 }
 
 /// How a variant's document is made on demand.
@@ -375,7 +385,24 @@ impl PyVariant {
             origin,
             document: OnceLock::new(),
             xml_str: OnceLock::new(),
+            patch: OnceLock::new(),
         }
+    }
+
+    /// The structure key and patch, made on first call (GIL released by the caller).
+    fn drawn_patch(&self) -> Result<&VariantPatch, Failure> {
+        if let Some(p) = self.patch.get() {
+            return Ok(p);
+        }
+        let p = match &self.origin {
+            Origin::Scene(scene) => catch(|| Ok(scene.patch(self.index)?))?,
+            Origin::Text(_) => {
+                return Err(Failure::from(
+                    "this variant was unpickled without its patch".to_string(),
+                ));
+            }
+        };
+        Ok(self.patch.get_or_init(|| p))
     }
 
     /// The document, built on first call (GIL released by the caller).
@@ -434,7 +461,27 @@ impl PyVariant {
         &self.params_json
     }
 
-    /// A copy of the variant's :class:`Document` (to edit before writing or compiling).
+    /// The variant's structure: equal for two variants of a scene exactly when their
+    /// compiled models differ only in the values of :attr:`patch` (and what MuJoCo's
+    /// ``mj_setConst`` derives from them). 32 hex digits.
+    #[getter]
+    fn structure_key(&self, py: Python<'_>) -> PyResult<String> {
+        run(py, || Ok(self.drawn_patch()?.structure_key.clone()))
+    }
+
+    /// The values that turn a compiled model of this variant's structure into its own:
+    /// a list of ``(object, name, field, value)``, meaning
+    /// ``model.<object>(name).<field> = value`` with MuJoCo's named accessors
+    /// (``("geom", "object0_g0_vis", "rgba", (r, g, b, a))``,
+    /// ``("joint", "object0_joint0", "qpos0", (x, y, z, qw, qx, qy, qz))``). ``value`` is
+    /// a tuple of floats (a ``float`` field's already rounded as MuJoCo rounds it), or
+    /// for ``matid`` the material's name. See :class:`ModelCache`.
+    #[getter]
+    fn patch<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let p = run(py, || Ok(self.drawn_patch()?.clone()))?;
+        patch_list(py, &p.entries)
+    }
+
     #[getter]
     fn document(&self, py: Python<'_>) -> PyResult<PyDocument> {
         run(py, || Ok(self.doc()?.clone())).map(PyDocument::new)
@@ -468,16 +515,19 @@ impl PyVariant {
         )
     }
 
-    /// Pickling (Ray, multiprocessing) ships the index, the XML and the parameters; the
-    /// copy reads its document back from the XML (paths in it are absolute).
+    /// Pickling (Ray, multiprocessing) ships the index, the XML, the parameters and the
+    /// patch; the copy reads its document back from the XML (paths in it are absolute).
     fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
         let restore = py.get_type::<PyVariant>().getattr("_restore")?;
+        let patch = run(py, || Ok(self.drawn_patch()?.clone()))?;
         let args = (
             self.index,
             self.xml(py),
             self.params_json.as_str(),
             self.objects,
             self.model_dir(),
+            patch.structure_key.clone(),
+            patch_list(py, &patch.entries)?,
         )
             .into_pyobject(py)?;
         PyTuple::new(py, [restore, args.into_any()])
@@ -492,6 +542,8 @@ impl PyVariant {
         params_json: String,
         objects: usize,
         model_dir: PathBuf,
+        structure_key: String,
+        patch: Vec<(String, String, String, Bound<'_, PyAny>)>,
     ) -> PyResult<PyVariant> {
         let made = Made {
             index,
@@ -500,9 +552,72 @@ impl PyVariant {
             objects,
         };
         let variant = PyVariant::new(made, Origin::Text(model_dir));
+        let entries = patch
+            .into_iter()
+            .map(|(object, name, field, value)| patch_entry(object, name, field, &value))
+            .collect::<PyResult<Vec<_>>>()?;
+        let _ = variant.patch.set(VariantPatch {
+            index,
+            structure_key,
+            entries,
+        });
         // Read the document now: a pickled variant that does not read back is an error
         // at unpickling, not later.
         run(py, || variant.doc().map(|_| ()))?;
         Ok(variant)
     }
+}
+
+/// A patch as Python tuples (see `Variant.patch`).
+fn patch_list<'py>(py: Python<'py>, entries: &[PatchEntry]) -> PyResult<Bound<'py, PyList>> {
+    let items = entries
+        .iter()
+        .map(|e| {
+            let value = match &e.value {
+                PatchValue::Numbers(v) => PyTuple::new(py, v)?.into_any(),
+                PatchValue::Id { name, .. } => name.as_str().into_pyobject(py)?.into_any(),
+            };
+            (e.object, e.name.as_str(), e.field, value).into_pyobject(py)
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    PyList::new(py, items)
+}
+
+/// A patch entry back from its Python tuple (an unpickled variant's): the object and
+/// field names are the library's own, matched against its table.
+fn patch_entry(
+    object: String,
+    name: String,
+    field: String,
+    value: &Bound<'_, PyAny>,
+) -> PyResult<PatchEntry> {
+    const OBJECTS: [&str; 7] = [
+        "body", "joint", "geom", "site", "camera", "light", "material",
+    ];
+    let unknown =
+        || PyValueError::new_err(format!("not a patch entry: ({object}, {name}, {field})"));
+    let object = *OBJECTS.iter().find(|o| **o == object).ok_or_else(unknown)?;
+    let field = if field == "matid" {
+        "matid"
+    } else {
+        mjcf_forge::scene::PATCHABLE
+            .iter()
+            .map(|p| p.2)
+            .chain(["qpos0", "qpos_spring"])
+            .find(|f| *f == field)
+            .ok_or_else(unknown)?
+    };
+    let value = match value.extract::<String>() {
+        Ok(target) => PatchValue::Id {
+            object: "material",
+            name: target,
+        },
+        Err(_) => PatchValue::Numbers(value.extract::<Vec<f64>>()?),
+    };
+    Ok(PatchEntry {
+        object,
+        name,
+        field,
+        value,
+    })
 }

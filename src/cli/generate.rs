@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 
 use mjcf_forge::output::AtomicFile;
 use mjcf_forge::scene::{Params, Scene};
-use mjcf_forge::{AssetStore, OutputDir, TarWriter};
+use mjcf_forge::{AssetStore, OutputDir, TarWriter, frame_text_member};
 use rayon::prelude::*;
 
 use super::{USAGE, refuse_validate_without_mujoco};
@@ -63,6 +63,13 @@ pub struct Args {
 }
 
 /// Where the variants go.
+/// A chunk position's reused buffer: the variant's XML, or for a tar stream its two
+/// members (XML and JSON) framed.
+#[derive(Default)]
+struct Slot {
+    framed: String,
+}
+
 enum Sink {
     Dir {
         out: OutputDir,
@@ -247,46 +254,72 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
         output: args.output.display().to_string(),
         range: (lo, hi),
     };
-    // One text buffer per variant of a chunk, reused chunk after chunk: a variant's text
-    // is written into memory the last chunk left, not into fresh pages.
-    let mut texts: Vec<String> = vec![String::new(); CHUNK as usize];
+    // One text buffer per variant of a chunk, reused chunk after chunk: a variant is
+    // written into memory the last chunk left, not into fresh pages. Everything but the
+    // ordered writes happens on the workers (a tar stream's members are framed there), so
+    // the writing thread does one write per variant.
+    let is_tar = matches!(sink, Sink::Tar { .. });
+    let mut slots: Vec<Slot> = (0..CHUNK).map(|_| Slot::default()).collect();
     let mut at = lo;
     while at < hi {
         let end = (at + CHUNK).min(hi);
-        let made: Vec<Result<(String, Duration), String>> = texts[..(end - at) as usize]
+        let made: Vec<Result<(String, Duration, u64), String>> = slots[..(end - at) as usize]
             .par_iter_mut()
             .enumerate()
-            .map(|(k, xml)| {
+            .map(|(k, slot)| {
                 let i = at + k as u64;
-                let params = if args.pretty {
-                    let v = scene.variant(i).map_err(|e| e.to_string())?;
-                    *xml = v.document.to_pretty_string();
-                    v.params
+                let file = format!("{i:09}.xml");
+                let make = |buf: &mut String| -> Result<Params, String> {
+                    if args.pretty {
+                        let v = scene.variant(i).map_err(|e| e.to_string())?;
+                        buf.push_str(&v.document.to_pretty_string());
+                        Ok(v.params)
+                    } else {
+                        scene.variant_xml_append(i, buf).map_err(|e| e.to_string())
+                    }
+                };
+                // For a tar stream the XML is written straight into its member.
+                let (params, xml) = if is_tar {
+                    slot.framed.clear();
+                    let (params, range) = frame_text_member(&mut slot.framed, &file, |buf| {
+                        let start = buf.len();
+                        make(buf).map(|p| (p, start..buf.len()))
+                    })
+                    .map_err(|e| e.to_string())??;
+                    (params, &slot.framed[range])
                 } else {
-                    scene.variant_xml_into(i, xml).map_err(|e| e.to_string())?
+                    slot.framed.clear();
+                    (make(&mut slot.framed)?, slot.framed.as_str())
                 };
                 let took = match (&check_dir, args.validate) {
                     (Some(dir), true) => check(i, &params, xml, dir)?,
                     _ => Duration::ZERO,
                 };
-                let file = format!("{i:09}.xml");
                 let json = params.to_json(i, Some(&file));
                 if let Sink::Dir { out, .. } = &sink {
                     out.write(&file, xml.as_bytes())
                         .map_err(|e| e.to_string())?;
                 }
-                Ok((json, took))
+                let bytes = xml.len() as u64;
+                if is_tar {
+                    frame_text_member(&mut slot.framed, &format!("{i:09}.json"), |m| {
+                        m.push_str(&json);
+                        Ok::<(), String>(())
+                    })
+                    .map_err(|e| e.to_string())??;
+                }
+                Ok((json, took, bytes))
             })
             .collect();
-        for ((r, xml), i) in made.into_iter().zip(texts.iter()).zip(at..end) {
+        for (r, slot) in made.into_iter().zip(&slots) {
             match r {
-                Ok((json, took)) => {
+                Ok((json, took, bytes)) => {
                     summary.variants += 1;
-                    summary.bytes += xml.len() as u64;
+                    summary.bytes += bytes;
                     if let Some(c) = &mut summary.compile {
                         *c += took;
                     }
-                    write_variant(&mut sink, i, xml, &json)?;
+                    write_variant(&mut sink, &json, slot.framed.as_bytes())?;
                 }
                 Err(e) => summary.failures.push(e),
             }
@@ -368,16 +401,15 @@ fn open_sink(
     Ok(Sink::Tar { tar, check_dir })
 }
 
-fn write_variant(sink: &mut Sink, i: u64, xml: &str, json: &str) -> Result<(), String> {
+/// Writes a made variant in order: its manifest line to a folder (whose XML file a worker
+/// wrote), or its framed tar members to the stream.
+fn write_variant(sink: &mut Sink, json: &str, framed: &[u8]) -> Result<(), String> {
     match sink {
         Sink::Dir { manifest, .. } => manifest
             .write_all(json.as_bytes())
             .and_then(|()| manifest.write_all(b"\n"))
             .map_err(|e| format!("cannot write the manifest: {e}")),
-        Sink::Tar { tar, .. } => tar
-            .append(&format!("{i:09}.xml"), xml.as_bytes())
-            .and_then(|()| tar.append(&format!("{i:09}.json"), json.as_bytes()))
-            .map_err(|e| e.to_string()),
+        Sink::Tar { tar, .. } => tar.append_framed(framed).map_err(|e| e.to_string()),
     }
 }
 

@@ -135,23 +135,31 @@ impl AssetStore {
     /// own file references would break once it is copied alone.
     pub fn relocate(&self, doc: &mut Document) -> Result<(), Errors> {
         let refs = file_refs(doc);
+        // Files are read and hashed in parallel (a robot's meshes are tens of megabytes);
+        // a file two references share may be hashed twice, to the same name.
+        let results: Vec<Result<String, Error>> = refs
+            .par_iter()
+            .map(|r| {
+                let value = doc.attr_sym(r.node, r.attr).unwrap_or_default();
+                if doc.tag(r.node) == "model" {
+                    return Err(doc.error_at(
+                        r.node,
+                        ErrorKind::Invalid(format!(
+                            "cannot relocate the model asset '{value}': its own file \
+                             references would break (load it and merge it instead)"
+                        )),
+                    ));
+                }
+                self.relocate_file(Path::new(value))
+                    .map_err(|e| doc.error_at(r.node, e.kind))
+            })
+            .collect();
         let mut errors = Vec::new();
         let mut names = Vec::with_capacity(refs.len());
-        for r in &refs {
-            let value = doc.attr_sym(r.node, r.attr).unwrap_or_default();
-            if doc.tag(r.node) == "model" {
-                errors.push(doc.error_at(
-                    r.node,
-                    ErrorKind::Invalid(format!(
-                        "cannot relocate the model asset '{value}': its own file references \
-                         would break (load it and merge it instead)"
-                    )),
-                ));
-                continue;
-            }
-            match self.relocate_file(Path::new(value)) {
+        for r in results {
+            match r {
                 Ok(name) => names.push(name),
-                Err(e) => errors.push(doc.error_at(r.node, e.kind)),
+                Err(e) => errors.push(e),
             }
         }
         if !errors.is_empty() {

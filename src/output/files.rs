@@ -158,8 +158,7 @@ pub struct AtomicFile {
 
 #[derive(Debug)]
 enum Sink {
-    Std(StdStream),
-    /// A FIFO or a device.
+    /// A FIFO, a device, or the process's own standard output or error.
     Direct(File),
     Temp {
         tmp: TempFile,
@@ -180,7 +179,7 @@ impl AtomicFile {
             Target::Stream(stream) => {
                 return Ok(AtomicFile {
                     path: path.to_path_buf(),
-                    sink: Sink::Std(stream),
+                    sink: Sink::Direct(stream.unbuffered().map_err(fail)?),
                 });
             }
             Target::Path(target) => target,
@@ -230,7 +229,6 @@ impl AtomicFile {
     pub fn commit(self) -> Result<(), Error> {
         let fail = |e: std::io::Error| write_error(&self.path, &e);
         match self.sink {
-            Sink::Std(stream) => stream.flush().map_err(fail),
             Sink::Direct(mut file) => file.flush().map_err(fail),
             Sink::Temp { tmp, target, sync } => {
                 if sync {
@@ -246,8 +244,6 @@ impl AtomicFile {
 impl Write for AtomicFile {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
         match &mut self.sink {
-            Sink::Std(StdStream::Out) => std::io::stdout().write(buf),
-            Sink::Std(StdStream::Err) => std::io::stderr().write(buf),
             Sink::Direct(file) => file.write(buf),
             Sink::Temp { tmp, .. } => tmp.file.write(buf),
         }
@@ -255,9 +251,6 @@ impl Write for AtomicFile {
 
     fn write_all(&mut self, buf: &[u8]) -> std::io::Result<()> {
         match &mut self.sink {
-            // One lock for the whole buffer, so lines of other threads cannot cut into it.
-            Sink::Std(StdStream::Out) => std::io::stdout().lock().write_all(buf),
-            Sink::Std(StdStream::Err) => std::io::stderr().lock().write_all(buf),
             Sink::Direct(file) => file.write_all(buf),
             Sink::Temp { tmp, .. } => tmp.file.write_all(buf),
         }
@@ -265,7 +258,6 @@ impl Write for AtomicFile {
 
     fn flush(&mut self) -> std::io::Result<()> {
         match &mut self.sink {
-            Sink::Std(stream) => stream.flush(),
             Sink::Direct(file) => file.flush(),
             Sink::Temp { tmp, .. } => tmp.file.flush(),
         }
@@ -280,11 +272,20 @@ enum StdStream {
 }
 
 impl StdStream {
-    fn flush(self) -> std::io::Result<()> {
-        match self {
-            StdStream::Out => std::io::stdout().flush(),
-            StdStream::Err => std::io::stderr().flush(),
-        }
+    /// The stream's own file description, without the standard library's buffer (a line
+    /// buffer for standard output, which scans every block written for its last newline):
+    /// whatever that buffer holds is flushed first, and the output goes on where it ends.
+    fn unbuffered(self) -> std::io::Result<File> {
+        use std::os::fd::AsFd as _;
+        let fd = match self {
+            StdStream::Out => {
+                let out = std::io::stdout();
+                out.lock().flush()?;
+                out.as_fd().try_clone_to_owned()?
+            }
+            StdStream::Err => std::io::stderr().as_fd().try_clone_to_owned()?,
+        };
+        Ok(File::from(fd))
     }
 }
 

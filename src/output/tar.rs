@@ -7,7 +7,7 @@
 //! the stream's length. Hand-written rather than the `tar` crate: the format needed here
 //! is one header layout and two padding rules, and owning it keeps the bytes pinned.
 
-use std::io::Write;
+use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, ErrorKind};
@@ -118,39 +118,132 @@ impl<W: Write> TarWriter<W> {
 
     /// The ustar header of a regular file.
     fn header(&self, name: &str, size: u64) -> Result<[u8; BLOCK], Error> {
-        let (prefix, base) = split_name(name).ok_or_else(|| {
-            self.fail(format!(
-                "member name '{name}' does not fit a tar header (a relative path of at most \
-                 255 bytes, its last 100 after a '/')"
-            ))
-        })?;
-        if size > MAX_SIZE {
-            return Err(self.fail(format!("member '{name}' is larger than 8 GiB")));
-        }
-        let mut h = [0u8; BLOCK];
-        h[..base.len()].copy_from_slice(base.as_bytes());
-        octal(&mut h[100..108], 0o644);
-        octal(&mut h[108..116], 0); // uid
-        octal(&mut h[116..124], 0); // gid
-        octal(&mut h[124..136], size);
-        octal(&mut h[136..148], 0); // mtime: the same bytes on every run
-        h[156] = b'0'; // regular file
-        h[257..263].copy_from_slice(b"ustar\0");
-        h[263..265].copy_from_slice(b"00");
-        h[345..345 + prefix.len()].copy_from_slice(prefix.as_bytes());
-        // The checksum is summed with its own field read as spaces.
-        h[148..156].fill(b' ');
-        let sum: u32 = h.iter().map(|&b| u32::from(b)).sum();
-        octal(&mut h[148..155], u64::from(sum));
-        Ok(h)
+        header(name, size).map_err(|e| self.fail(e))
     }
 }
 
+impl<W: Write> TarWriter<BufWriter<W>> {
+    /// Appends whole members that [`frame_text_member`] laid out (in parallel, say), written
+    /// past the buffer in one call after flushing what the buffer holds: no copy of a large
+    /// member through it.
+    ///
+    /// ```
+    /// use mjcf_forge::{TarWriter, frame_text_member};
+    /// let mut framed = String::new();
+    /// frame_text_member(&mut framed, "000000000.xml", |m| {
+    ///     m.push_str("<mujoco/>");
+    ///     Ok::<(), std::fmt::Error>(())
+    /// })?
+    /// .unwrap();
+    /// let mut tar = TarWriter::new(std::io::BufWriter::new(Vec::new()), "t.tar");
+    /// tar.append_framed(framed.as_bytes())?;
+    /// let mut same = TarWriter::new(Vec::new(), "t.tar");
+    /// same.append("000000000.xml", b"<mujoco/>")?;
+    /// assert_eq!(tar.finish()?.into_inner().unwrap(), same.finish()?);
+    /// # Ok::<(), mjcf_forge::Error>(())
+    /// ```
+    pub fn append_framed(&mut self, framed: &[u8]) -> Result<(), Error> {
+        if framed.len() % BLOCK != 0 {
+            return Err(self.fail(format!(
+                "{} bytes of framed members, not whole 512-byte blocks",
+                framed.len()
+            )));
+        }
+        self.out
+            .flush()
+            .and_then(|()| self.out.get_mut().write_all(framed))
+            .map_err(|e| self.fail(e.to_string()))
+    }
+}
+
+/// Appends one whole tar member named `name` to `out`, its bytes the text `fill` appends
+/// (written straight into place: a variant's XML is never copied into its member), then
+/// the header [`TarWriter::append`] writes for them before, and the padding to a whole
+/// block after. A header is ASCII and NUL bytes, so the member stays a `String`. For
+/// laying out members on worker threads, then writing them in order with
+/// [`TarWriter::append_framed`]. Gives what `fill` gives, or the header's error (a name
+/// that does not fit); if either fails, `out` is as it was.
+///
+/// ```
+/// let mut out = String::new();
+/// mjcf_forge::frame_text_member(&mut out, "a.json", |m| {
+///     m.push_str("{}");
+///     Ok::<(), std::fmt::Error>(())
+/// })?
+/// .unwrap();
+/// assert_eq!(out.len(), 1024);
+/// assert_eq!(&out[512..514], "{}");
+/// # Ok::<(), mjcf_forge::Error>(())
+/// ```
+pub fn frame_text_member<T, E>(
+    out: &mut String,
+    name: &str,
+    fill: impl FnOnce(&mut String) -> Result<T, E>,
+) -> Result<Result<T, E>, Error> {
+    let at = out.len();
+    out.extend(std::iter::repeat_n('\0', BLOCK));
+    let made = match fill(out) {
+        Ok(made) => made,
+        Err(e) => {
+            out.truncate(at);
+            return Ok(Err(e));
+        }
+    };
+    let size = out.len() - at - BLOCK;
+    let header = match header(name, size as u64) {
+        Ok(h) => h,
+        Err(reason) => {
+            out.truncate(at);
+            return Err(Error::bare(ErrorKind::Write {
+                path: PathBuf::from(name),
+                reason,
+            }));
+        }
+    };
+    // The header's bytes are the name's (UTF-8), ASCII digits and NULs.
+    let header = std::str::from_utf8(&header).expect("a tar header of a UTF-8 name is UTF-8");
+    out.replace_range(at..at + BLOCK, header);
+    let padding = (BLOCK - size % BLOCK) % BLOCK;
+    out.extend(std::iter::repeat_n('\0', padding));
+    Ok(Ok(made))
+}
+
+/// The ustar header of a regular file `name` of `size` bytes, or why it cannot be stored.
+fn header(name: &str, size: u64) -> Result<[u8; BLOCK], String> {
+    let (prefix, base) = split_name(name).ok_or_else(|| {
+        format!(
+            "member name '{name}' does not fit a tar header (a relative path of at most \
+             255 bytes, its last 100 after a '/')"
+        )
+    })?;
+    if size > MAX_SIZE {
+        return Err(format!("member '{name}' is larger than 8 GiB"));
+    }
+    let mut h = [0u8; BLOCK];
+    h[..base.len()].copy_from_slice(base.as_bytes());
+    octal(&mut h[100..108], 0o644);
+    octal(&mut h[108..116], 0); // uid
+    octal(&mut h[116..124], 0); // gid
+    octal(&mut h[124..136], size);
+    octal(&mut h[136..148], 0); // mtime: the same bytes on every run
+    h[156] = b'0'; // regular file
+    h[257..263].copy_from_slice(b"ustar\0");
+    h[263..265].copy_from_slice(b"00");
+    h[345..345 + prefix.len()].copy_from_slice(prefix.as_bytes());
+    // The checksum is summed with its own field read as spaces.
+    h[148..156].fill(b' ');
+    let sum: u32 = h.iter().map(|&b| u32::from(b)).sum();
+    octal(&mut h[148..155], u64::from(sum));
+    Ok(h)
+}
+
 /// Writes `value` as zero-padded octal digits filling `field` but its last byte (NUL).
-fn octal(field: &mut [u8], value: u64) {
+fn octal(field: &mut [u8], mut value: u64) {
     let digits = field.len() - 1;
-    let text = format!("{value:0digits$o}");
-    field[..digits].copy_from_slice(text.as_bytes());
+    for d in field[..digits].iter_mut().rev() {
+        *d = b'0' + (value & 7) as u8;
+        value >>= 3;
+    }
     field[digits] = 0;
 }
 

@@ -253,6 +253,7 @@ fn build(text: &str, file: Arc<Path>, models: &dyn ModelSource) -> Result<Scene,
     let splice = splice::Template::build(&template, &template_targets, &randomizers);
     let mut scene = Scene {
         splice,
+        structure: OnceLock::new(),
         prefixes_apart,
         seed: spec.seed,
         file,

@@ -29,6 +29,7 @@ mod check;
 mod demo;
 mod load;
 mod params;
+mod patch;
 mod place;
 mod randomize;
 mod rng;
@@ -49,6 +50,7 @@ use crate::tree::Node;
 #[cfg(mjcf_mujoco)]
 pub use check::{PENETRATION_TOLERANCE, check_variant};
 pub use params::{Params, PlacedObject, RandomizedValue};
+pub use patch::{PATCHABLE, PatchEntry, PatchValue, VariantPatch};
 pub use randomize::MUJOCO_DEFAULTS;
 
 use place::Placement;
@@ -87,6 +89,9 @@ pub struct Scene {
     /// The template's text with holes and insertion points, when variants can be written
     /// by splicing (see `splice`).
     splice: Option<splice::Template>,
+    /// What the scene's settings let a patch carry, and what its structure keys start
+    /// from (a hash of the template and every pool model), made on first use.
+    structure: OnceLock<(patch::Rules, [u8; 32])>,
 }
 
 /// One element a randomizer sets, with what the manifest says of it.
@@ -374,6 +379,22 @@ impl Scene {
     /// # Ok::<(), mjcf_forge::Errors>(())
     /// ```
     pub fn variant_xml_into(&self, index: u64, out: &mut String) -> Result<Params, Errors> {
+        out.clear();
+        self.variant_xml_append(index, out)
+    }
+
+    /// [`Scene::variant_xml`] appended to `out` (what it holds stays): for writing a
+    /// variant straight into a larger buffer, such as its tar member after the header.
+    ///
+    /// ```
+    /// let scene = mjcf_forge::scene::Scene::demo()?;
+    /// let mut out = String::from("<!-- 3 -->");
+    /// let params = scene.variant_xml_append(3, &mut out)?;
+    /// assert_eq!(out, format!("<!-- 3 -->{}", scene.variant_xml(3)?.0));
+    /// assert_eq!(params, scene.variant_xml(3)?.1);
+    /// # Ok::<(), mjcf_forge::Errors>(())
+    /// ```
+    pub fn variant_xml_append(&self, index: u64, out: &mut String) -> Result<Params, Errors> {
         // Splicing checks no names: only where instances cannot clash (see `variant`).
         if let Some(splice) = self.splice.as_ref().filter(|_| self.prefixes_apart) {
             let drawn = self.draw(index)?;
@@ -382,7 +403,6 @@ impl Scene {
             }
         }
         let v = self.variant(index)?;
-        out.clear();
         out.push_str(&v.xml());
         Ok(v.params)
     }
@@ -531,6 +551,58 @@ impl Scene {
             placed: instances,
             params,
         })
+    }
+
+    /// Variant `index` as a structure key and a patch: variants with the same key compile
+    /// to models that differ only in the patch's values (and what MuJoCo's `mj_setConst`
+    /// derives from them), so one compiled model of the structure, patched, is exactly
+    /// the variant's. What cannot be patched exactly (an attribute without a rule in
+    /// [`PATCHABLE`], an unnamed element) is part of the key.
+    ///
+    /// ```
+    /// let scene = mjcf_forge::scene::Scene::demo()?;
+    /// let p = scene.patch(3)?;
+    /// assert_eq!(p.structure_key.len(), 32);
+    /// // Placed objects' free joints are patched: their qpos0 is where they were placed.
+    /// assert!(p.entries.iter().any(|e| e.object == "joint" && e.field == "qpos0"));
+    /// assert_eq!(scene.patch(3)?, p);
+    /// # Ok::<(), mjcf_forge::Errors>(())
+    /// ```
+    pub fn patch(&self, index: u64) -> Result<VariantPatch, Errors> {
+        let drawn = self.draw(index)?;
+        let (rules, fingerprint) = self.structure.get_or_init(|| {
+            let parts: Vec<&Document> = self
+                .groups
+                .iter()
+                .flat_map(|g| g.pool.iter().map(|m| &m.doc))
+                .collect();
+            let mut h = blake3::Hasher::new();
+            for d in std::iter::once(&self.template).chain(parts.iter().copied()) {
+                let text = d.to_xml_string();
+                h.update(&(text.len() as u64).to_le_bytes());
+                h.update(text.as_bytes());
+            }
+            (
+                patch::Rules::new(&self.template, &parts),
+                *h.finalize().as_bytes(),
+            )
+        });
+        Ok(patch::split(fingerprint, rules, index, &drawn))
+    }
+
+    /// The `<statistic>` values the scene's model sets itself (`extent`, `center`...):
+    /// MuJoCo keeps them over what it computes, so a patched model must too.
+    ///
+    /// ```
+    /// let scene = mjcf_forge::scene::Scene::demo()?;
+    /// assert!(scene.fixed_statistics().is_empty());
+    /// # Ok::<(), mjcf_forge::Errors>(())
+    /// ```
+    pub fn fixed_statistics(&self) -> Vec<&'static str> {
+        ["meaninertia", "meanmass", "meansize", "extent", "center"]
+            .into_iter()
+            .filter(|a| patch::setting(&self.template, "statistic", a).is_some())
+            .collect()
     }
 
     /// Variants `range`, made in parallel (rayon), in index order.

@@ -175,8 +175,12 @@ impl Template {
     /// (with `out` unspecified) when one of its objects cannot be spliced or a hole has no
     /// value.
     pub(crate) fn write(&self, drawn: &Drawn<'_>, out: &mut String) -> bool {
-        out.clear();
-        self.write_into(drawn, out).is_some()
+        let start = out.len();
+        let ok = self.write_into(drawn, out).is_some();
+        if !ok {
+            out.truncate(start);
+        }
+        ok
     }
 
     fn write_into(&self, drawn: &Drawn<'_>, out: &mut String) -> Option<()> {

@@ -1,0 +1,333 @@
+//! A variant as a *structure* and a *patch*: what decides the compiled model's sizes,
+//! topology and asset contents (which object is placed in which slot, every value that
+//! cannot be written into a compiled model exactly), and the values that can (a placed
+//! object's pose, colours, frictions, masses...). Variants with the same structure key
+//! compile to models that differ only in the patched values and what MuJoCo's
+//! `mj_setConst` derives from them, so one compiled model per structure serves them all.
+//!
+//! Each rule below says which compiled field an attribute lands in, unchanged but for the
+//! compiler's own arithmetic (a quaternion normalized, a number read as `float`); an
+//! attribute without a rule, or an element the rule cannot name, goes into the structure
+//! key instead, so its variants are compiled, never approximated. `PATCHABLE` lists the
+//! rules; `tests/scene_patch.rs` and `python/tests/test_model_cache.py` hold each against
+//! MuJoCo compiling the variant's XML.
+
+use crate::document::{Document, Section};
+use crate::tree::Node;
+
+use super::Drawn;
+
+/// One compiled value a variant sets: `model.<object>(name).<field> = value` in MuJoCo's
+/// Python bindings (the named accessors), or the rows of `<object>_<field>` (`geom_rgba`,
+/// `dof_damping` for a joint's `damping`...) for the element's id.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PatchEntry {
+    /// The element's type, as MuJoCo's named accessors call it: `body`, `joint`, `geom`,
+    /// `site`, `camera`, `light`, `material`.
+    pub object: &'static str,
+    /// The element's name in the compiled model.
+    pub name: String,
+    /// The field, as the accessor calls it (`rgba`, `friction`, `mass`, `qpos0`...).
+    pub field: &'static str,
+    /// The value.
+    pub value: PatchValue,
+}
+
+/// A patched value.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PatchValue {
+    /// Numbers exactly as the compiled model holds them (a `float` field's values are
+    /// already rounded to `f32`).
+    Numbers(Vec<f64>),
+    /// The id of the element of type `object` named `name` (a material chosen for a geom).
+    Id {
+        /// The referenced element's type.
+        object: &'static str,
+        /// Its name.
+        name: String,
+    },
+}
+
+/// Variant `index` as a structure key and a patch (see [`super::Scene::patch`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct VariantPatch {
+    /// The variant's index.
+    pub index: u64,
+    /// Equal for two variants of one scene exactly when their compiled models differ only
+    /// in the patched fields (and what `mj_setConst` derives from them): 32 hex digits.
+    pub structure_key: String,
+    /// The values that turn a compiled model of this structure into this variant's.
+    pub entries: Vec<PatchEntry>,
+}
+
+/// `(element, attribute, compiled field, components, float)`: the attributes a patch can
+/// carry. `float`: the compiled field is `float` (the text is read as `f32`, as MuJoCo's
+/// parser reads it). Anything else a randomizer sets is structure.
+pub const PATCHABLE: &[(&str, &str, &str, usize, bool)] = &[
+    ("geom", "rgba", "rgba", 4, true),
+    ("geom", "friction", "friction", 3, false),
+    ("geom", "solref", "solref", 2, false),
+    ("geom", "solimp", "solimp", 5, false),
+    ("geom", "margin", "margin", 1, false),
+    ("geom", "gap", "gap", 1, false),
+    ("site", "rgba", "rgba", 4, true),
+    ("material", "rgba", "rgba", 4, true),
+    ("material", "specular", "specular", 1, true),
+    ("material", "shininess", "shininess", 1, true),
+    ("material", "reflectance", "reflectance", 1, true),
+    ("material", "emission", "emission", 1, true),
+    ("light", "diffuse", "diffuse", 3, true),
+    ("light", "specular", "specular", 3, true),
+    ("light", "ambient", "ambient", 3, true),
+    ("light", "attenuation", "attenuation", 3, true),
+    ("joint", "damping", "damping", 1, false),
+    ("joint", "armature", "armature", 1, false),
+    ("joint", "frictionloss", "frictionloss", 1, false),
+    ("joint", "stiffness", "stiffness", 1, false),
+    ("camera", "fovy", "fovy", 1, false),
+    ("inertial", "mass", "mass", 1, false),
+    ("inertial", "diaginertia", "inertia", 3, false),
+    ("body", "pos", "pos", 3, false),
+    ("body", "quat", "quat", 4, false),
+];
+
+/// What holds for the whole scene, decided once: which rules its compiler settings and
+/// sections allow.
+#[derive(Debug)]
+pub(crate) struct Rules {
+    /// Masses and inertias land unchanged (no `settotalmass`, bounds, balancing, or
+    /// inertia from geoms over `<inertial>`).
+    mass: bool,
+    /// Body frames land unchanged (no keyframes, whose rows would follow a placed free
+    /// joint; no static bodies fused away).
+    poses: bool,
+}
+
+impl Rules {
+    pub(crate) fn new(template: &Document, parts: &[&Document]) -> Rules {
+        let setting = |name: &str| setting(template, "compiler", name);
+        let mass = setting("settotalmass").is_none_or(|v| v.trim().parse() == Ok(-1.0))
+            && setting("boundmass").is_none_or(|v| v.trim().parse() == Ok(0.0))
+            && setting("boundinertia").is_none_or(|v| v.trim().parse() == Ok(0.0))
+            && setting("balanceinertia").is_none_or(|v| v.trim() == "false")
+            && setting("inertiafromgeom").is_none_or(|v| v.trim() != "true");
+        let has_keys = |d: &Document| {
+            d.find_section(Section::Keyframe)
+                .is_some_and(|k| d.elements(k).next().is_some())
+        };
+        let poses = setting("fusestatic").is_none_or(|v| v.trim() == "false")
+            && !has_keys(template)
+            && !parts.iter().any(|d| has_keys(d));
+        Rules { mass, poses }
+    }
+}
+
+/// The value of `attr` on the root's `tag` elements (`compiler`, `statistic`), the last
+/// one that sets it winning, as MuJoCo reads repeated elements.
+pub(crate) fn setting<'d>(doc: &'d Document, tag: &str, attr: &str) -> Option<&'d str> {
+    doc.elements(doc.root())
+        .filter(|&n| doc.tag(n) == tag)
+        .filter_map(|n| doc.attr(n, attr))
+        .last()
+}
+
+/// Splits a drawn variant into its structure key and its patch.
+pub(crate) fn split(
+    fingerprint: &[u8; 32],
+    rules: &Rules,
+    index: u64,
+    drawn: &Drawn<'_>,
+) -> VariantPatch {
+    let mut key = blake3::Hasher::new();
+    key.update(fingerprint);
+    let mut entries = Vec::new();
+    for o in &drawn.params.objects {
+        for s in [o.group.as_str(), &o.slot.to_string(), &o.model] {
+            key.update(&(s.len() as u64).to_le_bytes());
+            key.update(s.as_bytes());
+        }
+    }
+    let overlays = std::iter::once((&drawn.template, None))
+        .chain(drawn.placed.iter().map(|(inst, o)| (o, Some(inst.root))));
+    for (part, (overlay, root)) in overlays.enumerate() {
+        let doc = overlay.doc;
+        let mut bodies: Vec<Node> = Vec::new();
+        for (node, attr, value) in &overlay.values {
+            match entry(doc, *node, attr, value, rules, root == Some(*node)) {
+                Some(e) => {
+                    if e.object == "body" && !bodies.contains(node) {
+                        bodies.push(*node);
+                    }
+                    entries.push(e);
+                }
+                None => {
+                    key.update(&(part as u64).to_le_bytes());
+                    key.update(&(crate::tree::Tree::index(*node) as u64).to_le_bytes());
+                    for s in [attr.as_str(), value.as_str()] {
+                        key.update(&(s.len() as u64).to_le_bytes());
+                        key.update(s.as_bytes());
+                    }
+                }
+            }
+        }
+        // A free joint's qpos0 (and qpos_spring) is its body's frame.
+        for body in bodies {
+            let get = |a: &str| {
+                overlay
+                    .values
+                    .iter()
+                    .rev()
+                    .find(|(n, at, _)| *n == body && at == a)
+                    .map(|(_, _, v)| v.as_str())
+                    .or_else(|| doc.attr(body, a))
+            };
+            let Some(joint) = free_joint(doc, body) else {
+                continue;
+            };
+            let pos = numbers(get("pos").unwrap_or("0 0 0"), 3, false);
+            let quat = numbers(get("quat").unwrap_or("1 0 0 0"), 4, false).map(normalized);
+            // A frame the rules could not read stayed structure (its body entry too).
+            let (Some(pos), Some(quat)) = (pos, quat) else {
+                continue;
+            };
+            let qpos: Vec<f64> = pos.into_iter().chain(quat).collect();
+            for field in ["qpos0", "qpos_spring"] {
+                entries.push(PatchEntry {
+                    object: "joint",
+                    name: joint.to_string(),
+                    field,
+                    value: PatchValue::Numbers(qpos.clone()),
+                });
+            }
+        }
+    }
+    let hash = key.finalize();
+    VariantPatch {
+        index,
+        structure_key: hash.to_hex()[..32].to_string(),
+        entries,
+    }
+}
+
+/// The patch entry for `attr = value` on `node`, or `None` when it is structure.
+/// `placed_root`: the node is a placed object's root body, whose written orientation is
+/// its `quat` alone (placement clears the others).
+fn entry(
+    doc: &Document,
+    node: Node,
+    attr: &str,
+    value: &str,
+    rules: &Rules,
+    placed_root: bool,
+) -> Option<PatchEntry> {
+    let tag = doc.tag(node);
+    if tag == "geom" && attr == "material" {
+        return Some(PatchEntry {
+            object: "geom",
+            name: doc.attr(node, "name")?.to_string(),
+            field: "matid",
+            value: PatchValue::Id {
+                object: "material",
+                name: value.to_string(),
+            },
+        });
+    }
+    let &(_, _, field, n, float) = PATCHABLE
+        .iter()
+        .find(|(k, a, ..)| *k == tag && *a == attr)?;
+    let (object, name) = match tag {
+        "inertial" => {
+            if !rules.mass || doc.attr(node, "fullinertia").is_some() {
+                return None;
+            }
+            let body = doc.parent(node)?;
+            ("body", doc.attr(body, "name")?)
+        }
+        "body" => {
+            // A frame relative to the world or a parent body, on a body that exists.
+            let parent = doc.parent(node)?;
+            if !rules.poses
+                || !matches!(doc.tag(parent), "body" | "worldbody")
+                || (!placed_root
+                    && ["euler", "axisangle", "xyaxes", "zaxis"]
+                        .iter()
+                        .any(|a| doc.attr(node, a).is_some()))
+            {
+                return None;
+            }
+            ("body", doc.attr(node, "name")?)
+        }
+        // A spring-damper's stiffness and damping are derived from its own attributes.
+        "joint" if doc.attr(node, "springdamper").is_some() => return None,
+        "camera" if doc.attr(node, "sensorsize").is_some() => return None,
+        _ => (object_of(tag), doc.attr(node, "name")?),
+    };
+    if name.is_empty() {
+        return None;
+    }
+    let mut v = numbers(value, n, float)?;
+    if attr == "quat" {
+        v = normalized(v);
+    }
+    Some(PatchEntry {
+        object,
+        name: name.to_string(),
+        field,
+        value: PatchValue::Numbers(v),
+    })
+}
+
+fn object_of(tag: &str) -> &'static str {
+    match tag {
+        "geom" => "geom",
+        "site" => "site",
+        "material" => "material",
+        "light" => "light",
+        "joint" => "joint",
+        "camera" => "camera",
+        _ => "body",
+    }
+}
+
+/// The body's free joint's name, when its only joint is a named free joint.
+fn free_joint(doc: &Document, body: Node) -> Option<&str> {
+    let mut joints = doc
+        .elements(body)
+        .filter(|&k| matches!(doc.tag(k), "joint" | "freejoint"));
+    let j = joints.next()?;
+    let free = doc.tag(j) == "freejoint" || doc.attr(j, "type").map(str::trim) == Some("free");
+    (free && joints.next().is_none())
+        .then(|| doc.attr(j, "name"))
+        .flatten()
+}
+
+/// Exactly `n` numbers, each as MuJoCo reads it (`f32` for a `float` field).
+fn numbers(text: &str, n: usize, float: bool) -> Option<Vec<f64>> {
+    let v: Vec<f64> = text
+        .split_ascii_whitespace()
+        .map(|t| {
+            if float {
+                t.parse::<f32>().ok().map(f64::from)
+            } else {
+                t.parse::<f64>().ok()
+            }
+        })
+        .collect::<Option<_>>()?;
+    (v.len() == n && v.iter().all(|x| x.is_finite())).then_some(v)
+}
+
+/// A quaternion normalized as MuJoCo's compiler does (`mjuu_normvec`, `mjEPS` = 1e-14):
+/// left alone when its norm is within 1e-14 of 1 (3.17.0 and 4.0.0 both keep
+/// `quat="1.0000000000000002 0 0 0"` as written).
+fn normalized(q: Vec<f64>) -> Vec<f64> {
+    const EPS: f64 = 1e-14;
+    let squares = q.iter().fold(0.0, |acc, x| acc + x * x);
+    if squares < EPS {
+        return q;
+    }
+    let norm = squares.sqrt();
+    if (norm - 1.0).abs() <= EPS {
+        return q;
+    }
+    q.iter().map(|x| x / norm).collect()
+}
