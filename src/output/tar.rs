@@ -143,7 +143,7 @@ impl<W: Write> TarWriter<BufWriter<W>> {
     /// # Ok::<(), mjcf_forge::Error>(())
     /// ```
     pub fn append_framed(&mut self, framed: &[u8]) -> Result<(), Error> {
-        if framed.len() % BLOCK != 0 {
+        if !framed.len().is_multiple_of(BLOCK) {
             return Err(self.fail(format!(
                 "{} bytes of framed members, not whole 512-byte blocks",
                 framed.len()
