@@ -7,6 +7,8 @@
 - :class:`Scene`: a randomized scene description; ``scene.variant(i)`` is variant ``i``
   (the same bytes for the same seed and index, whatever the thread count), and
   ``scene.variants(indices, threads=...)`` generates many on Rust threads.
+- :class:`ModelCache`: compiled models of a scene's variants at patch cost: one compile
+  per structure (``variant.structure_key``), then ``variant.patch`` written into it.
 - :class:`MjcfError`: the one exception type (a ``ValueError``), with ``.errors``.
 """
 
@@ -21,6 +23,7 @@ from ._mjcf_forge import (
     VariantIterator,
     __version__,
 )
+from ._cache import ModelCache
 
 __all__ = [
     "Document",
@@ -28,6 +31,7 @@ __all__ = [
     "MergeReport",
     "MjcfError",
     "Model",
+    "ModelCache",
     "Scene",
     "Variant",
     "VariantIterator",

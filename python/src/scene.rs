@@ -471,7 +471,8 @@ impl PyVariant {
 
     /// The values that turn a compiled model of this variant's structure into its own:
     /// a list of ``(object, name, field, value)``, meaning
-    /// ``model.<object>(name).<field> = value`` with MuJoCo's named accessors
+    /// ``model.<object>(name).<field> = value`` with MuJoCo's named accessors (``name``
+    /// is an ``int``, the element's id, for an unnamed element of the scene's template)
     /// (``("geom", "object0_g0_vis", "rgba", (r, g, b, a))``,
     /// ``("joint", "object0_joint0", "qpos0", (x, y, z, qw, qx, qy, qz))``). ``value`` is
     /// a tuple of floats (a ``float`` field's already rounded as MuJoCo rounds it), or
@@ -543,7 +544,7 @@ impl PyVariant {
         objects: usize,
         model_dir: PathBuf,
         structure_key: String,
-        patch: Vec<(String, String, String, Bound<'_, PyAny>)>,
+        patch: Vec<(String, Bound<'_, PyAny>, String, Bound<'_, PyAny>)>,
     ) -> PyResult<PyVariant> {
         let made = Made {
             index,
@@ -554,7 +555,7 @@ impl PyVariant {
         let variant = PyVariant::new(made, Origin::Text(model_dir));
         let entries = patch
             .into_iter()
-            .map(|(object, name, field, value)| patch_entry(object, name, field, &value))
+            .map(|(object, name, field, value)| patch_entry(object, &name, field, &value))
             .collect::<PyResult<Vec<_>>>()?;
         let _ = variant.patch.set(VariantPatch {
             index,
@@ -577,7 +578,11 @@ fn patch_list<'py>(py: Python<'py>, entries: &[PatchEntry]) -> PyResult<Bound<'p
                 PatchValue::Numbers(v) => PyTuple::new(py, v)?.into_any(),
                 PatchValue::Id { name, .. } => name.as_str().into_pyobject(py)?.into_any(),
             };
-            (e.object, e.name.as_str(), e.field, value).into_pyobject(py)
+            let name = match e.id {
+                Some(id) => id.into_pyobject(py)?.into_any(),
+                None => e.name.as_str().into_pyobject(py)?.into_any(),
+            };
+            (e.object, name, e.field, value).into_pyobject(py)
         })
         .collect::<PyResult<Vec<_>>>()?;
     PyList::new(py, items)
@@ -587,10 +592,14 @@ fn patch_list<'py>(py: Python<'py>, entries: &[PatchEntry]) -> PyResult<Bound<'p
 /// field names are the library's own, matched against its table.
 fn patch_entry(
     object: String,
-    name: String,
+    name: &Bound<'_, PyAny>,
     field: String,
     value: &Bound<'_, PyAny>,
 ) -> PyResult<PatchEntry> {
+    let (name, id) = match name.extract::<usize>() {
+        Ok(id) => (String::new(), Some(id)),
+        Err(_) => (name.extract::<String>()?, None),
+    };
     const OBJECTS: [&str; 7] = [
         "body", "joint", "geom", "site", "camera", "light", "material",
     ];
@@ -603,7 +612,7 @@ fn patch_entry(
         mjcf_forge::scene::PATCHABLE
             .iter()
             .map(|p| p.2)
-            .chain(["qpos0", "qpos_spring"])
+            .chain(["qpos0", "qpos_spring", "ipos", "iquat"])
             .find(|f| *f == field)
             .ok_or_else(unknown)?
     };
@@ -617,6 +626,7 @@ fn patch_entry(
     Ok(PatchEntry {
         object,
         name,
+        id,
         field,
         value,
     })

@@ -25,8 +25,11 @@ pub struct PatchEntry {
     /// The element's type, as MuJoCo's named accessors call it: `body`, `joint`, `geom`,
     /// `site`, `camera`, `light`, `material`.
     pub object: &'static str,
-    /// The element's name in the compiled model.
+    /// The element's name in the compiled model; empty for an unnamed element, which
+    /// `id` then identifies.
     pub name: String,
+    /// The element's id (index among its type) in the compiled model, for an unnamed one.
+    pub id: Option<usize>,
     /// The field, as the accessor calls it (`rgba`, `friction`, `mass`, `qpos0`...).
     pub field: &'static str,
     /// The value.
@@ -101,6 +104,9 @@ pub(crate) struct Rules {
     /// Body frames land unchanged (no keyframes, whose rows would follow a placed free
     /// joint; no static bodies fused away).
     poses: bool,
+    /// Compiled ids of the template's elements that can be patched unnamed, when nothing
+    /// reorders them (see [`template_ids`]).
+    ids: Option<ahash::AHashMap<Node, usize>>,
 }
 
 impl Rules {
@@ -118,8 +124,73 @@ impl Rules {
         let poses = setting("fusestatic").is_none_or(|v| v.trim() == "false")
             && !has_keys(template)
             && !parts.iter().any(|d| has_keys(d));
-        Rules { mass, poses }
+        // A dampratio actuator's damping is derived from the masses at compile time.
+        let dampratio = std::iter::once(template)
+            .chain(parts.iter().copied())
+            .any(|d| {
+                d.descendants(d.root())
+                    .any(|n| d.attr(n, "dampratio").is_some())
+            });
+        // Objects merged in bring only bodies to the world (their elements come after the
+        // template's), unless a part has world-level elements of its own.
+        let world_level = parts.iter().any(|d| {
+            d.worldbody().is_some_and(|w| {
+                d.descendants(w)
+                    .any(|n| ID_KINDS.contains(&d.tag(n)) && owner(d, n) == Some(w))
+            })
+        });
+        Rules {
+            mass: mass && !dampratio,
+            poses,
+            ids: (!world_level).then(|| template_ids(template)).flatten(),
+        }
     }
+}
+
+/// The element types an unnamed element of the template can be patched by id.
+const ID_KINDS: [&str; 6] = ["geom", "site", "camera", "light", "joint", "freejoint"];
+
+/// The body an element belongs to: its nearest body or world body, through frames.
+fn owner(doc: &Document, node: Node) -> Option<Node> {
+    let mut at = doc.parent(node)?;
+    while doc.tag(at) == "frame" {
+        at = doc.parent(at)?;
+    }
+    matches!(doc.tag(at), "body" | "worldbody").then_some(at)
+}
+
+/// Compiled ids of the template's geoms, sites, cameras, lights and joints: MuJoCo
+/// numbers bodies depth first in document order and each body's elements (through frames)
+/// in document order, body after body. `None` when the template has what changes that
+/// order (`replicate`, `attach`, an `include` left unexpanded).
+fn template_ids(template: &Document) -> Option<ahash::AHashMap<Node, usize>> {
+    let world = template.worldbody()?;
+    let mut order = ahash::AHashMap::new();
+    order.insert(world, 0usize);
+    let mut elements: Vec<(usize, usize, Node)> = Vec::new();
+    for n in template.descendants(world) {
+        let tag = template.tag(n);
+        if matches!(tag, "replicate" | "attach" | "include") {
+            return None;
+        }
+        if tag == "body" {
+            let next = order.len();
+            order.insert(n, next);
+        } else if let Some(kind) = ID_KINDS.iter().position(|k| *k == tag) {
+            let body = owner(template, n)?;
+            // joint and freejoint share one numbering.
+            elements.push((*order.get(&body)?, kind.min(4), n));
+        }
+    }
+    // Stable: within a body, document order.
+    elements.sort_by_key(|&(body, _, _)| body);
+    let mut ids = ahash::AHashMap::new();
+    let mut next = [0usize; 5];
+    for (_, kind, n) in elements {
+        ids.insert(n, next[kind]);
+        next[kind] += 1;
+    }
+    Some(ids)
 }
 
 /// The value of `attr` on the root's `tag` elements (`compiler`, `statistic`), the last
@@ -151,9 +222,11 @@ pub(crate) fn split(
         .chain(drawn.placed.iter().map(|(inst, o)| (o, Some(inst.root))));
     for (part, (overlay, root)) in overlays.enumerate() {
         let doc = overlay.doc;
+        // Unnamed elements are known by id in the template only.
+        let ids = if part == 0 { rules.ids.as_ref() } else { None };
         let mut bodies: Vec<Node> = Vec::new();
         for (node, attr, value) in &overlay.values {
-            match entry(doc, *node, attr, value, rules, root == Some(*node)) {
+            match entry(doc, *node, attr, value, rules, ids, root == Some(*node)) {
                 Some(e) => {
                     if e.object == "body" && !bodies.contains(node) {
                         bodies.push(*node);
@@ -181,13 +254,31 @@ pub(crate) fn split(
                     .map(|(_, _, v)| v.as_str())
                     .or_else(|| doc.attr(body, a))
             };
-            let Some(joint) = free_joint(doc, body) else {
-                continue;
-            };
             let pos = numbers(get("pos").unwrap_or("0 0 0"), 3, false);
             let quat = numbers(get("quat").unwrap_or("1 0 0 0"), 4, false).map(normalized);
             // A frame the rules could not read stayed structure (its body entry too).
             let (Some(pos), Some(quat)) = (pos, quat) else {
+                continue;
+            };
+            // A body with neither <inertial> nor geoms has no mass, and MuJoCo gives it
+            // its own frame as inertial frame (seen in 3.17.0 and 4.0.0).
+            let massless = !doc.descendants(body).any(|n| {
+                n != body
+                    && matches!(doc.tag(n), "inertial" | "geom")
+                    && owner(doc, n) == Some(body)
+            });
+            if massless && let Some(name) = doc.attr(body, "name") {
+                for (field, v) in [("ipos", &pos), ("iquat", &quat)] {
+                    entries.push(PatchEntry {
+                        object: "body",
+                        name: name.to_string(),
+                        id: None,
+                        field,
+                        value: PatchValue::Numbers(v.clone()),
+                    });
+                }
+            }
+            let Some(joint) = free_joint(doc, body) else {
                 continue;
             };
             let qpos: Vec<f64> = pos.into_iter().chain(quat).collect();
@@ -195,6 +286,7 @@ pub(crate) fn split(
                 entries.push(PatchEntry {
                     object: "joint",
                     name: joint.to_string(),
+                    id: None,
                     field,
                     value: PatchValue::Numbers(qpos.clone()),
                 });
@@ -218,13 +310,23 @@ fn entry(
     attr: &str,
     value: &str,
     rules: &Rules,
+    ids: Option<&ahash::AHashMap<Node, usize>>,
     placed_root: bool,
 ) -> Option<PatchEntry> {
     let tag = doc.tag(node);
+    // The element's name, or for an unnamed one its compiled id.
+    let named = |n: Node| -> Option<(String, Option<usize>)> {
+        match doc.attr(n, "name").filter(|s| !s.is_empty()) {
+            Some(name) => Some((name.to_string(), None)),
+            None => Some((String::new(), Some(*ids?.get(&n)?))),
+        }
+    };
     if tag == "geom" && attr == "material" {
+        let (name, id) = named(node)?;
         return Some(PatchEntry {
             object: "geom",
-            name: doc.attr(node, "name")?.to_string(),
+            name,
+            id,
             field: "matid",
             value: PatchValue::Id {
                 object: "material",
@@ -235,13 +337,13 @@ fn entry(
     let &(_, _, field, n, float) = PATCHABLE
         .iter()
         .find(|(k, a, ..)| *k == tag && *a == attr)?;
-    let (object, name) = match tag {
+    let (object, (name, id)) = match tag {
         "inertial" => {
             if !rules.mass || doc.attr(node, "fullinertia").is_some() {
                 return None;
             }
             let body = doc.parent(node)?;
-            ("body", doc.attr(body, "name")?)
+            ("body", (doc.attr(body, "name")?.to_string(), None))
         }
         "body" => {
             // A frame relative to the world or a parent body, on a body that exists.
@@ -255,14 +357,15 @@ fn entry(
             {
                 return None;
             }
-            ("body", doc.attr(node, "name")?)
+            ("body", (doc.attr(node, "name")?.to_string(), None))
         }
         // A spring-damper's stiffness and damping are derived from its own attributes.
         "joint" if doc.attr(node, "springdamper").is_some() => return None,
         "camera" if doc.attr(node, "sensorsize").is_some() => return None,
-        _ => (object_of(tag), doc.attr(node, "name")?),
+        "material" => ("material", (doc.attr(node, "name")?.to_string(), None)),
+        _ => (object_of(tag), named(node)?),
     };
-    if name.is_empty() {
+    if name.is_empty() && id.is_none() {
         return None;
     }
     let mut v = numbers(value, n, float)?;
@@ -271,7 +374,8 @@ fn entry(
     }
     Some(PatchEntry {
         object,
-        name: name.to_string(),
+        name,
+        id,
         field,
         value: PatchValue::Numbers(v),
     })
