@@ -527,8 +527,7 @@ impl PyVariant {
             self.params_json.as_str(),
             self.objects,
             self.model_dir(),
-            patch.structure_key.clone(),
-            patch_list(py, &patch.entries)?,
+            (patch.structure_key.clone(), patch_list(py, &patch.entries)?),
         )
             .into_pyobject(py)?;
         PyTuple::new(py, [restore, args.into_any()])
@@ -543,8 +542,7 @@ impl PyVariant {
         params_json: String,
         objects: usize,
         model_dir: PathBuf,
-        structure_key: String,
-        patch: Vec<(String, Bound<'_, PyAny>, String, Bound<'_, PyAny>)>,
+        (structure_key, patch): (String, Vec<PatchTuple<'_>>),
     ) -> PyResult<PyVariant> {
         let made = Made {
             index,
@@ -568,6 +566,9 @@ impl PyVariant {
         Ok(variant)
     }
 }
+
+/// A patch entry as Python holds it: `(object, name or id, field, value)`.
+type PatchTuple<'py> = (String, Bound<'py, PyAny>, String, Bound<'py, PyAny>);
 
 /// A patch as Python tuples (see `Variant.patch`).
 fn patch_list<'py>(py: Python<'py>, entries: &[PatchEntry]) -> PyResult<Bound<'py, PyList>> {
