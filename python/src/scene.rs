@@ -542,8 +542,9 @@ impl PyVariant {
         params_json: String,
         objects: usize,
         model_dir: PathBuf,
-        (structure_key, patch): (String, Vec<PatchTuple<'_>>),
+        patched: (String, Vec<PatchTuple<'_>>),
     ) -> PyResult<PyVariant> {
+        let (structure_key, patch) = patched;
         let made = Made {
             index,
             xml,
