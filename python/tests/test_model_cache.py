@@ -1,0 +1,173 @@
+"""ModelCache and the structure/patch split, judged by the MuJoCo this venv has.
+
+Every patched model is compared with MuJoCo compiling the variant's XML: the judge's
+whole-model comparison (every array, size, name and statistic), and then bit for bit on
+every float array and statistic (the patch writes the compiler's own values and redoes its
+arithmetic in its order, so nothing is left to tolerance).
+"""
+from __future__ import annotations
+
+import collections
+import copy
+import pickle
+
+import mujoco
+import numpy as np
+import pytest
+
+import judge
+import mjcf_forge
+from conftest import ROOT, RS_ASSETS
+
+PATCH = ROOT / "corpora" / "scenes" / "patch"
+LIFT5_FIXED = ROOT / "benches" / "scenes" / "lift5_fixed.toml"
+LIFT5 = ROOT / "benches" / "scenes" / "lift5.toml"
+
+
+def not_bit_identical(a: mujoco.MjModel, b: mujoco.MjModel) -> list[str]:
+    """Float arrays and statistics of b that are not exactly those of a."""
+    out = []
+    for name in dir(a):
+        x = getattr(a, name, None)
+        if isinstance(x, np.ndarray) and x.dtype.kind == "f":
+            if not np.array_equal(x, getattr(b, name), equal_nan=True):
+                out.append(name)
+    for s in ("meaninertia", "meanmass", "meansize", "extent"):
+        if getattr(a.stat, s) != getattr(b.stat, s):
+            out.append(f"stat.{s}")
+    if not np.array_equal(a.stat.center, b.stat.center):
+        out.append("stat.center")
+    return out
+
+
+def check_exact(variant, model) -> None:
+    ref = mujoco.MjModel.from_xml_string(variant.xml)
+    diffs = judge.compare_models(ref, model)
+    assert diffs == [], f"variant {variant.index}: {diffs[:5]}"
+    assert not_bit_identical(ref, model) == [], f"variant {variant.index}"
+
+
+def grouped(scene, n):
+    groups = collections.defaultdict(list)
+    for i in range(n):
+        v = scene.variant(i)
+        groups[v.structure_key].append(v)
+    return groups
+
+
+def test_every_patchable_kind_is_patched_exactly():
+    scene = mjcf_forge.Scene.load(PATCH / "patch.toml")
+    groups = grouped(scene, 24)
+    # Two clutter slots of two models each: four structures.
+    assert len(groups) == 4
+    cache = mjcf_forge.ModelCache(scene, max_models=4)
+    for variants in groups.values():
+        for v in variants[:4]:
+            check_exact(v, cache.model(v))
+    assert cache.compiles == 4
+    assert cache.patches > 0
+    # The scene randomizes every kind of value a patch carries, each one present.
+    fields = {(o, f) for o, _, f, _ in scene.variant(0).patch}
+    expected = {
+        ("geom", f) for f in ("rgba", "friction", "solref", "solimp", "margin", "gap", "matid")
+    } | {("site", "rgba"), ("camera", "fovy")}
+    expected |= {("material", f) for f in ("rgba", "specular", "shininess", "reflectance", "emission")}
+    expected |= {("light", f) for f in ("diffuse", "specular", "ambient", "attenuation")}
+    expected |= {("joint", f) for f in ("damping", "armature", "frictionloss", "stiffness", "qpos0", "qpos_spring")}
+    expected |= {("body", f) for f in ("mass", "inertia", "pos", "quat")}
+    assert expected <= fields, expected - fields
+    # Unnamed elements of the template (the arm's geoms, the second light) by their ids.
+    assert any(isinstance(n, int) and o == "light" for o, n, _, _ in scene.variant(0).patch)
+
+
+def test_structural_values_are_compiled_never_patched():
+    scene = mjcf_forge.Scene.load(PATCH / "structural.toml")
+    variants = [scene.variant(i) for i in range(8)]
+    # Sizes, densities, geom frames, a light's direction, a camera's position: structure.
+    assert len({v.structure_key for v in variants}) == 8
+    for v in variants:
+        assert {(o, f) for o, _, f, _ in v.patch} <= {
+            ("body", "pos"), ("body", "quat"), ("joint", "qpos0"), ("joint", "qpos_spring")
+        }
+    cache = mjcf_forge.ModelCache(scene, max_models=2)
+    for v in variants[:3]:
+        check_exact(v, cache.model(v))
+    assert cache.compiles == 3 and cache.patches == 0
+    assert len(cache) == 2
+
+
+def test_demo_scene_is_exact():
+    scene = mjcf_forge.Scene.demo()
+    cache = mjcf_forge.ModelCache(scene, max_models=64)
+    for v in (scene.variant(i) for i in range(10)):
+        check_exact(v, cache.model(v))
+
+
+@pytest.mark.skipif(not LIFT5_FIXED.is_file() or not RS_ASSETS.is_dir(), reason="setup not run")
+def test_lift5_fixed_one_structure_patched_exactly():
+    scene = mjcf_forge.Scene.load(LIFT5_FIXED)
+    variants = [scene.variant(i) for i in range(12)]
+    assert len({v.structure_key for v in variants}) == 1
+    cache = mjcf_forge.ModelCache(scene)
+    model = None
+    for v in variants:
+        model = cache.model(v)
+        check_exact(v, model)
+    assert cache.compiles == 1 and cache.patches == 11
+    # In place on a model of one's own (an environment's), and back again.
+    mine = copy.copy(model)
+    for v in (variants[3], variants[0]):
+        assert cache.apply(v, mine) is mine
+        check_exact(v, mine)
+
+
+@pytest.mark.skipif(not RS_ASSETS.is_dir(), reason="setup not run")
+def test_lift5_varying_objects_exact():
+    scene = mjcf_forge.Scene.load(LIFT5)
+    groups = grouped(scene, 40)
+    cache = mjcf_forge.ModelCache(scene, max_models=40)
+    shared = [vs for vs in groups.values() if len(vs) > 1]
+    for v in [vs[0] for vs in list(groups.values())[:2]] + [v for vs in shared for v in vs[:3]]:
+        check_exact(v, cache.model(v))
+
+
+def test_apply_refuses_another_structure():
+    scene = mjcf_forge.Scene.load(PATCH / "patch.toml")
+    groups = list(grouped(scene, 24).values())
+    cache = mjcf_forge.ModelCache(scene)
+    a, b = groups[0][0], groups[1][0]
+    model = copy.copy(cache.model(a))
+    with pytest.raises(mjcf_forge.MjcfError, match="does not have the structure"):
+        cache.apply(b, model)
+    cache.apply(groups[0][1], model)
+    with pytest.raises(mjcf_forge.MjcfError, match="a patch cannot change a structure"):
+        cache.apply(b, model)
+
+
+def test_cache_is_bounded_by_count_and_bytes():
+    scene = mjcf_forge.Scene.load(PATCH / "patch.toml")
+    firsts = [vs[0] for vs in grouped(scene, 24).values()]
+    by_count = mjcf_forge.ModelCache(scene, max_models=2)
+    for v in firsts:
+        by_count.model(v)
+    assert len(by_count) == 2
+    one = mjcf_forge.ModelCache(scene, max_models=8)
+    one.model(firsts[0])
+    by_bytes = mjcf_forge.ModelCache(scene, max_models=8, max_bytes=one.nbytes + 1)
+    for v in firsts:
+        by_bytes.model(v)
+    assert len(by_bytes) == 1 and by_bytes.nbytes <= one.nbytes + 1
+    # The most recent structure stays: asking again patches, it does not compile.
+    compiles = by_bytes.compiles
+    by_bytes.model(firsts[-1])
+    assert by_bytes.compiles == compiles
+
+
+def test_patch_survives_pickling():
+    scene = mjcf_forge.Scene.load(PATCH / "patch.toml")
+    v = scene.variant(3)
+    w = pickle.loads(pickle.dumps(v))
+    assert w.structure_key == v.structure_key
+    assert w.patch == v.patch
+    cache = mjcf_forge.ModelCache(scene)
+    check_exact(v, cache.model(w))
