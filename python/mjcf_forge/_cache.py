@@ -13,16 +13,11 @@ of a millisecond instead of the compile's tens of milliseconds.
 from __future__ import annotations
 
 import collections
-import math
-import weakref
 from typing import Any
 
 import numpy as np
 
 from ._mjcf_forge import MjcfError
-
-# The compiled model's statistics, as <statistic> names them.
-_STATISTICS = ("meaninertia", "meanmass", "meansize", "extent", "center")
 
 # Integer arrays that, with the sizes and the names, tell one structure from another.
 _SIGNATURE_ARRAYS = (
@@ -55,20 +50,11 @@ def _signature(model: Any) -> tuple:
     return sizes, bytes(model.names), arrays
 
 
-class _Plan:
-    """How to patch one model object: its structure key and where each entry of the last
-    patch lands (array name and rows). It holds no array view and no ``MjData``: both keep
-    their model alive, and plans are kept per model weakly."""
-
-    __slots__ = ("key", "fields", "targets")
-
-    def __init__(self, key: str) -> None:
-        self.key = key
-        self.fields: list[tuple[str, str, str]] | None = None
-        self.targets: list[tuple[str, Any]] = []
+def _copy(value: Any) -> Any:
+    return value.copy() if hasattr(value, "copy") else value
 
 
-# The array prefix of each accessor's fields in MjModel.
+# The array prefix of each accessor's fields in MjModel, its object type and its count.
 _PREFIX = {
     "body": "body_",
     "joint": "jnt_",
@@ -100,131 +86,158 @@ _COUNT = {
 _DOF_FIELDS = ("damping", "armature", "frictionloss")
 _QPOS_FIELDS = ("qpos0", "qpos_spring")
 _JOINT_QPOS = {0: 7, 1: 4, 2: 1, 3: 1}  # free, ball, slide, hinge
+_JOINT_DOFS = {0: 6, 1: 3, 2: 1, 3: 1}
 
 
-def _targets(mujoco: Any, model: Any, patch: list) -> list[tuple[str, Any]]:
-    """Where every entry of ``patch`` lands in ``model``: (array name, rows)."""
-    targets = []
-    for obj, name, field, _ in patch:
-        if isinstance(name, int):
-            i = name if name < getattr(model, _COUNT[obj]) else -1
-        else:
-            i = mujoco.mj_name2id(model, getattr(mujoco.mjtObj, _OBJ[obj]), name)
-        if i < 0:
-            raise _error(
-                f"the patch names {obj} '{name}', which the compiled model does not have"
-            )
-        if obj == "joint" and field in _DOF_FIELDS:
-            adr = int(model.jnt_dofadr[i])
-            n = _JOINT_QPOS[int(model.jnt_type[i])]
-            n = {7: 6, 4: 3}.get(n, n)
-            targets.append((f"dof_{field}", slice(adr, adr + n)))
-        elif obj == "joint" and field in _QPOS_FIELDS:
-            adr = int(model.jnt_qposadr[i])
-            n = _JOINT_QPOS[int(model.jnt_type[i])]
-            targets.append((field, slice(adr, adr + n)))
-        else:
-            array = _PREFIX[obj] + field
-            # A one-component field of a one-dimensional array: its row as a slice.
-            rows = i if getattr(model, array).ndim > 1 else slice(i, i + 1)
-            targets.append((array, rows))
-    return targets
+def _dist(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise distances, each computed as mju_dist3 computes it (same operations, same
+    order, so the same bits)."""
+    d = a - b
+    return np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] + d[:, 2] * d[:, 2])
 
 
-def _statistics(mujoco: Any, model: Any, data: Any) -> None:
-    """The model statistics and dof lengths the compiler derives from the model at qpos0
-    (``mj_setConst`` of MuJoCo 3.17 and 4.0 leaves them), computed as the compiler does:
-    the same operations in the same order, so the same bits."""
-    data.qpos[:] = model.qpos0
-    mujoco.mj_kinematics(model, data)
-    mujoco.mj_comPos(model, data)
-    mujoco.mj_makeM(model, data)
-    stat = model.stat
-    # Bounding box of bodies, inertial frames, joint anchors, sites and geoms.
-    lo = [1e10, 1e10, 1e10]
-    hi = [-1e10, -1e10, -1e10]
-    size = model.geom_size
-    rbound = model.geom_rbound.copy()
-    for g in np.flatnonzero(rbound <= 0):
-        if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_PLANE:
-            if size[g, 0] or size[g, 1]:
-                rbound[g] = max(size[g, 0], size[g, 1]) * 0.1
-            else:
-                rbound[g] = 0.01
-        elif model.geom_type[g] == mujoco.mjtGeom.mjGEOM_HFIELD:
+def _in_order_sum(values: np.ndarray) -> float:
+    """A left-to-right sum, as a C loop adds (``np.add.accumulate`` is sequential; ``sum``
+    is pairwise and may differ in the last bits)."""
+    return float(np.add.accumulate(values)[-1]) if len(values) else 0.0
+
+
+class _Plan:
+    """Everything patching one model object takes, made once per model: its structure key,
+    a scratch ``MjData`` (``mj_setConst`` overwrites the qpos of the data it is given), the
+    array views of the last patch's entries, and the views and constants of the statistics
+    the compiler derives (``mj_setConst`` of 3.17 and 4.0 leaves them)."""
+
+    def __init__(self, mujoco: Any, model: Any, key: str, fixed: list) -> None:
+        self.mujoco = mujoco
+        self.model = model
+        self.key = key
+        self.data = data = mujoco.MjData(model)
+        self.nbytes = model.nbuffer + data.nbuffer + data.narena
+        self.fields: list[tuple[Any, Any, str]] | None = None
+        self.views: list[Any] = []
+        # The <statistic> values the scene sets: MuJoCo keeps them over what it computes.
+        self.fixed = fixed
+        # Views (fetching one from the bindings costs microseconds) and constants.
+        self.stat = model.stat
+        self.qpos0, self.qpos = model.qpos0, data.qpos
+        self.points = (data.xpos[1:], data.xipos[1:], data.xanchor, data.site_xpos)
+        self.geom_xpos, self.xipos, self.xanchor = data.geom_xpos, data.xipos, data.xanchor
+        self.body_mass, self.M = model.body_mass[1:], data.M
+        self.M_diagonal = model.M_rowadr + model.M_rownnz - 1
+        self.nbody, self.nv = model.nbody, model.nv
+        self.dof_length = model.dof_length
+        # Geom radii for the bounding box: a plane or height field (rbound 0) counts a
+        # tenth of its largest size. Sizes are never patched: constant per structure.
+        size, kind = model.geom_size, model.geom_type
+        rbound = model.geom_rbound.copy()
+        plane = (rbound <= 0) & (kind == mujoco.mjtGeom.mjGEOM_PLANE)
+        finite = (size[:, 0] != 0) | (size[:, 1] != 0)
+        rbound[plane & finite] = np.maximum(size[:, 0], size[:, 1])[plane & finite] * 0.1
+        rbound[plane & ~finite] = 0.01
+        for g in np.flatnonzero((rbound <= 0) & (kind == mujoco.mjtGeom.mjGEOM_HFIELD)):
             h = model.hfield_size[model.geom_dataid[g]]
             rbound[g] = max(h[0], max(h[1], max(h[2], h[3]))) * 0.1
-        else:
-            rbound[g] = 0.0
-    r = rbound[:, None]
-    for points in (
-        data.xpos[1:],
-        data.xipos[1:],
-        data.xanchor,
-        data.site_xpos,
-        data.geom_xpos - r,
-        data.geom_xpos + r,
-    ):
-        if len(points):
-            lo = np.minimum(lo, points.min(axis=0))
-            hi = np.maximum(hi, points.max(axis=0))
-    stat.center[:] = (lo + hi) * 0.5
-    extent = stat.extent
-    if hi[0] > lo[0]:
-        d = hi - lo
-        extent = max(1e-5, max(d[0], max(d[1], d[2])))
-    # Body sizes: the largest com-joint distance, then geom bounds around the com.
-    nbody = model.nbody
-    body = [0.0] * nbody
-    xipos, xanchor, gxpos = data.xipos, data.xanchor, data.geom_xpos
-    parent = model.body_parentid
-    for j, b in enumerate(model.jnt_bodyid):
-        for i in (int(b), int(parent[b])):
-            a, c = xipos[i], xanchor[j]
-            dist = math.sqrt(
-                (a[0] - c[0]) * (a[0] - c[0])
-                + (a[1] - c[1]) * (a[1] - c[1])
-                + (a[2] - c[2]) * (a[2] - c[2])
-            )
-            body[i] = max(body[i], dist)
-    body[0] = 0.0
-    adr, num, grb = model.body_geomadr, model.body_geomnum, model.geom_rbound
-    for i in range(1, nbody):
-        a = xipos[i]
-        for g in range(adr[i], adr[i] + num[i]):
-            if grb[g] > 0:
-                c = gxpos[g]
-                dist = math.sqrt(
-                    (a[0] - c[0]) * (a[0] - c[0])
-                    + (a[1] - c[1]) * (a[1] - c[1])
-                    + (a[2] - c[2]) * (a[2] - c[2])
+        rbound[rbound < 0] = 0.0
+        self.box_radius = rbound[:, None]
+        self.joint_body = model.jnt_bodyid.copy()
+        self.joint_parent = model.body_parentid[self.joint_body]
+        geoms = np.flatnonzero((model.geom_rbound > 0) & (model.geom_bodyid > 0))
+        self.sized_geoms = geoms
+        self.sized_geom_body = model.geom_bodyid[geoms]
+        self.sized_geom_rbound = model.geom_rbound[geoms].copy()
+        jnt = model.dof_jntid
+        jtype = model.jnt_type[jnt]
+        offset = np.arange(model.nv) - model.jnt_dofadr[jnt]
+        self.rotational = (jtype == 1) | (jtype == 3) | ((jtype == 0) & (offset >= 3))
+        self.dof_body = model.dof_bodyid.copy()
+
+    def resolve(self, patch: list) -> None:
+        """The array view of every entry of ``patch`` (and material ids by name)."""
+        mujoco, model = self.mujoco, self.model
+        views = []
+        for obj, name, field, _ in patch:
+            if isinstance(name, int):
+                i = name if name < getattr(model, _COUNT[obj]) else -1
+            else:
+                i = mujoco.mj_name2id(model, getattr(mujoco.mjtObj, _OBJ[obj]), name)
+            if i < 0:
+                raise _error(
+                    f"the patch names {obj} '{name}', which the compiled model does not have"
                 )
-                body[i] = max(body[i], float(grb[g]) + dist)
-    if nbody > 1:
-        meansize = 0.0
-        for i in range(1, nbody):
-            body[i] = max(body[i], 1e-5)
-            meansize += body[i] / (nbody - 1)
-        stat.meansize = meansize
-    # Rotational dofs take their body's size.
-    length = model.dof_length
-    for i in range(model.nv):
-        jnt = model.dof_jntid[i]
-        kind = model.jnt_type[jnt]
-        rotational = kind in (1, 3) or (kind == 0 and i - model.jnt_dofadr[jnt] >= 3)
-        length[i] = body[model.dof_bodyid[i]] if rotational else 1.0
-    stat.extent = max(extent, 2 * stat.meansize)
-    if nbody > 1:
-        mass = 0.0
-        for m in model.body_mass[1:]:
-            mass += m
-        stat.meanmass = mass / (nbody - 1)
-    if model.nv:
-        inertia = 0.0
-        diagonal = model.M_rowadr + model.M_rownnz - 1
-        for k in diagonal:
-            inertia += data.M[k]
-        stat.meaninertia = inertia / model.nv
+            if obj == "joint" and field in _DOF_FIELDS:
+                adr = int(model.jnt_dofadr[i])
+                views.append(getattr(model, f"dof_{field}")[adr : adr + _JOINT_DOFS[int(model.jnt_type[i])]])
+            elif obj == "joint" and field in _QPOS_FIELDS:
+                adr = int(model.jnt_qposadr[i])
+                views.append(getattr(model, field)[adr : adr + _JOINT_QPOS[int(model.jnt_type[i])]])
+            else:
+                array = getattr(model, _PREFIX[obj] + field)
+                # A one-component field of a one-dimensional array: its row as a slice.
+                views.append(array[i] if array.ndim > 1 else array[i : i + 1])
+        self.views = views
+        self.fields = [(o, n, f) for o, n, f, _ in patch]
+
+    def apply(self, patch: list) -> None:
+        if self.fields is None or len(self.fields) != len(patch) or any(
+            f != (o, n, fl) for f, (o, n, fl, _) in zip(self.fields, patch)
+        ):
+            self.resolve(patch)
+        for view, entry in zip(self.views, patch):
+            value = entry[3]
+            if isinstance(value, str):
+                # A material chosen by name: its id.
+                value = self.mujoco.mj_name2id(self.model, self.mujoco.mjtObj.mjOBJ_MATERIAL, value)
+            view[...] = value
+        self.mujoco.mj_setConst(self.model, self.data)
+        self.statistics()
+        for stat, value in self.fixed:
+            if hasattr(value, "copy"):
+                getattr(self.stat, stat)[...] = value
+            else:
+                setattr(self.stat, stat, value)
+
+    def statistics(self) -> None:
+        """The model statistics and dof lengths, computed from the model at qpos0 as the
+        compiler computes them: the same operations, sums in the same order, so the same
+        bits (minima and maxima do not depend on order, so those run vectorized)."""
+        mujoco, model, data, stat = self.mujoco, self.model, self.data, self.stat
+        self.qpos[:] = self.qpos0
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_comPos(model, data)
+        mujoco.mj_makeM(model, data)
+        lo = np.full(3, 1e10)
+        hi = np.full(3, -1e10)
+        for points in self.points + (self.geom_xpos - self.box_radius, self.geom_xpos + self.box_radius):
+            if len(points):
+                lo = np.minimum(lo, points.min(axis=0))
+                hi = np.maximum(hi, points.max(axis=0))
+        stat.center[:] = (lo + hi) * 0.5
+        extent = stat.extent
+        if hi[0] > lo[0]:
+            d = hi - lo
+            extent = max(1e-5, max(d[0], max(d[1], d[2])))
+        # Body sizes: the largest com-joint distance (the joint's body and its parent),
+        # then geom bounds around the com.
+        body = np.zeros(self.nbody)
+        if len(self.joint_body):
+            xipos, xanchor = self.xipos, self.xanchor
+            np.maximum.at(body, self.joint_body, _dist(xipos[self.joint_body], xanchor))
+            np.maximum.at(body, self.joint_parent, _dist(xipos[self.joint_parent], xanchor))
+        body[0] = 0.0
+        if len(self.sized_geoms):
+            gb = self.sized_geom_body
+            far = self.sized_geom_rbound + _dist(self.xipos[gb], self.geom_xpos[self.sized_geoms])
+            np.maximum.at(body, gb, far)
+        if self.nbody > 1:
+            body[1:] = np.maximum(body[1:], 1e-5)
+            stat.meansize = _in_order_sum(body[1:] / (self.nbody - 1))
+            stat.meanmass = _in_order_sum(self.body_mass) / (self.nbody - 1)
+        # Rotational dofs take their body's size.
+        if self.nv:
+            self.dof_length[:] = np.where(self.rotational, body[self.dof_body], 1.0)
+            stat.meaninertia = _in_order_sum(self.M[self.M_diagonal]) / self.nv
+        stat.extent = max(extent, 2 * stat.meansize)
 
 
 class ModelCache:
@@ -260,14 +273,12 @@ class ModelCache:
         self._max_bytes = max_bytes
         # Cached models by structure key, least recently used first.
         self._entries: collections.OrderedDict[str, Any] = collections.OrderedDict()
-        # Every model patched or handed out: how to patch it (weakly: a user's model may go).
-        self._plans: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-        # Signatures of structures seen, kept after their models are evicted.
+        # How to patch each model seen (cached ones and the caller's), by id; holding the
+        # model keeps the id its own. Bounded: the least recently patched go first.
+        self._plans: collections.OrderedDict[int, _Plan] = collections.OrderedDict()
+        # Signatures of structures seen, kept after their models are evicted, and the
+        # <statistic> values each fixes.
         self._signatures: dict[str, tuple] = {}
-        # Per structure, the scratch MjData mj_setConst is given (it overwrites its qpos):
-        # any data of the structure's sizes serves every model of the structure.
-        self._scratch: collections.OrderedDict[str, Any] = collections.OrderedDict()
-        # Per structure, the <statistic> values the scene fixes (MuJoCo keeps them).
         self._fixed_values: dict[str, list] = {}
         #: Models compiled (misses) and patches applied so far.
         self.compiles = 0
@@ -278,10 +289,28 @@ class ModelCache:
 
     @property
     def nbytes(self) -> int:
-        """Bytes held: every cached model and every scratch ``MjData``."""
-        return sum(m.nbuffer for m in self._entries.values()) + sum(
-            d.nbuffer + d.narena for d in self._scratch.values()
-        )
+        """Bytes held: every cached model, and every model's scratch ``MjData``."""
+        return sum(p.nbytes for p in self._plans.values())
+
+    def _plan(self, model: Any, key: str) -> _Plan:
+        plan = _Plan(self._mujoco, model, key, self._fixed_values[key])
+        self._plans[id(model)] = plan
+        self._trim()
+        return plan
+
+    def _trim(self) -> None:
+        cached = {id(m) for m in self._entries.values()}
+        while len(self._entries) > 1 and (
+            len(self._entries) > self._max_models
+            or (self._max_bytes is not None and self.nbytes > self._max_bytes)
+        ):
+            _, gone = self._entries.popitem(last=False)
+            self._plans.pop(id(gone), None)
+            cached.discard(id(gone))
+        # Plans of the caller's models: as many as cached models are allowed.
+        extra = [k for k in self._plans if k not in cached]
+        for k in extra[: max(0, len(extra) - self._max_models)]:
+            del self._plans[k]
 
     def _compile(self, variant: Any) -> Any:
         model = self._mujoco.MjModel.from_xml_string(variant.xml)
@@ -289,42 +318,10 @@ class ModelCache:
         key = variant.structure_key
         self._signatures[key] = _signature(model)
         self._fixed_values[key] = [(s, _copy(getattr(model.stat, s))) for s in self._fixed]
-        self._plans[model] = _Plan(key)
         self._entries[key] = model
         self._entries.move_to_end(key)
-        while len(self._entries) > 1 and (
-            len(self._entries) > self._max_models
-            or (self._max_bytes is not None and self.nbytes > self._max_bytes)
-        ):
-            gone, _ = self._entries.popitem(last=False)
-            self._scratch.pop(gone, None)
+        self._plan(model, key)
         return model
-
-    def _patch(self, model: Any, plan: _Plan, variant: Any) -> None:
-        mujoco = self._mujoco
-        patch = variant.patch
-        fields = [(o, n, f) for o, n, f, _ in patch]
-        if plan.fields != fields:
-            plan.targets = _targets(mujoco, model, patch)
-            plan.fields = fields
-        for (array, rows), (_, _, field, value) in zip(plan.targets, patch):
-            if field == "matid":
-                value = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_MATERIAL, value)
-            getattr(model, array)[rows] = value
-        scratch = self._scratch.get(plan.key)
-        if scratch is None:
-            scratch = mujoco.MjData(model)
-            self._scratch[plan.key] = scratch
-            while len(self._scratch) > self._max_models:
-                self._scratch.popitem(last=False)
-        mujoco.mj_setConst(model, scratch)
-        _statistics(mujoco, model, scratch)
-        for stat, value in self._fixed_values.get(plan.key, ()):
-            if hasattr(value, "copy"):
-                getattr(model.stat, stat)[...] = value
-            else:
-                setattr(model.stat, stat, value)
-        self.patches += 1
 
     def model(self, variant: Any) -> Any:
         """A compiled model equal to MuJoCo's compile of ``variant.xml`` (see the class)."""
@@ -333,15 +330,17 @@ class ModelCache:
         if model is None:
             return self._compile(variant)
         self._entries.move_to_end(key)
-        self._patch(model, self._plans[model], variant)
+        plan = self._plans.get(id(model)) or self._plan(model, key)
+        plan.apply(variant.patch)
+        self.patches += 1
         return model
 
     def apply(self, variant: Any, model: Any) -> Any:
         """Patches ``model`` (of ``variant``'s structure) in place into ``variant``'s
         compiled model; returns it. Raises :class:`MjcfError` when its structure differs."""
         key = variant.structure_key
-        plan = self._plans.get(model)
-        if plan is None:
+        plan = self._plans.get(id(model))
+        if plan is None or plan.model is not model:
             if key not in self._signatures:
                 # The structure's first sight: its compile (kept) says what it is.
                 self._compile(variant)
@@ -350,12 +349,13 @@ class ModelCache:
                     f"the model does not have the structure of variant {variant.index} "
                     f"(key {key}): its sizes, names or element types differ"
                 )
-            plan = _Plan(key)
-            self._plans[model] = plan
+            plan = self._plan(model, key)
         elif plan.key != key:
             raise _error(
                 f"the model has structure {plan.key}, variant {variant.index} has {key}: "
                 "a patch cannot change a structure (cache.model(variant) compiles it)"
             )
-        self._patch(model, plan, variant)
+        self._plans.move_to_end(id(model))
+        plan.apply(variant.patch)
+        self.patches += 1
         return model

@@ -1,0 +1,124 @@
+#!/usr/bin/env python3
+"""Same-run comparison: compiled variants of a fixed-structure scene ready to step, made by
+compiling each variant's XML against patching one compiled model in place (ModelCache).
+
+For SCENE (default benches/scenes/lift5_fixed.toml: robosuite's Lift with five fixed
+objects, random poses, colours, frictions, link masses and light), in one process:
+
+  compile   mujoco.MjModel.from_xml_string(variant.xml), then MjData: what a training
+            loop pays per new scene today (asset files in the OS cache after the first);
+  variant   scene.variant(i) and its .patch (the XML and the patch, in Rust);
+  apply     cache.apply(variant, model) on the environment's own model, then
+            mj_resetData: the model patched in place (mj_setConst and the compiler's
+            statistics included) and ready to step;
+  ready     variant + apply: a new randomized variant ready to step, end to end.
+
+Best and median of RUNS (compile: COMPILES) per item, after one warm-up; a sample of the
+patched models is checked bit for bit against compiling their XML before timing (a
+failure stops the script). Prints one JSON line, then the ratios.
+
+Usage: python scripts/bench_model_cache.py [--scene S] [--runs N] [--compiles K]
+(run with .cache/venv's Python for MuJoCo 3.17.0, .cache/venv-mj4's for 4.0.0).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+import mjcf_forge
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def timed(fn, runs: int) -> list[float]:
+    fn(0)
+    out = []
+    for i in range(1, runs + 1):
+        t = time.perf_counter()
+        fn(i)
+        out.append((time.perf_counter() - t) * 1e3)
+    return out
+
+
+def summary(ms: list[float]) -> dict:
+    return {"best_ms": min(ms), "median_ms": statistics.median(ms), "runs": len(ms)}
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--scene", default=str(ROOT / "benches" / "scenes" / "lift5_fixed.toml"))
+    ap.add_argument("--runs", type=int, default=300)
+    ap.add_argument("--compiles", type=int, default=15)
+    args = ap.parse_args()
+
+    scene = mjcf_forge.Scene.load(args.scene)
+    cache = mjcf_forge.ModelCache(scene)
+    first = scene.variant(0)
+    model = mujoco.MjModel.from_xml_string(first.xml)
+    data = mujoco.MjData(model)
+
+    # Exactness first: patched equals compiled, bit for bit, on a sample.
+    for i in (1, 2, 3):
+        v = scene.variant(i)
+        if v.structure_key != first.structure_key:
+            print(f"variant {i} has another structure: not a fixed-structure scene", file=sys.stderr)
+            return 1
+        cache.apply(v, model)
+        ref = mujoco.MjModel.from_xml_string(v.xml)
+        for name in dir(ref):
+            a = getattr(ref, name, None)
+            if isinstance(a, np.ndarray) and not np.array_equal(a, getattr(model, name), equal_nan=True):
+                print(f"variant {i}: {name} differs from MuJoCo's compile", file=sys.stderr)
+                return 1
+
+    variants = [scene.variant(i) for i in range(args.runs + 1)]
+    for v in variants:
+        v.patch  # noqa: B018 (made once here; the variant item below times it)
+
+    def compile_one(i: int) -> None:
+        m = mujoco.MjModel.from_xml_string(variants[i].xml)
+        mujoco.MjData(m)
+
+    def variant_one(i: int) -> None:
+        v = scene.variant(10_000 + i)
+        v.patch  # noqa: B018
+
+    def apply_one(i: int) -> None:
+        cache.apply(variants[i], model)
+        mujoco.mj_resetData(model, data)
+
+    def ready_one(i: int) -> None:
+        v = scene.variant(20_000 + i)
+        cache.apply(v, model)
+        mujoco.mj_resetData(model, data)
+
+    result = {
+        "scene": str(Path(args.scene).relative_to(ROOT)) if args.scene.startswith(str(ROOT)) else args.scene,
+        "mujoco": mujoco.__version__,
+        "python": sys.version.split()[0],
+        "patch_entries": len(first.patch),
+        "compile": summary(timed(compile_one, args.compiles)),
+        "variant": summary(timed(variant_one, args.runs)),
+        "apply": summary(timed(apply_one, args.runs)),
+        "ready": summary(timed(ready_one, args.runs)),
+    }
+    print(json.dumps(result))
+    c, r = result["compile"], result["ready"]
+    print(
+        f"ready to step per variant: patched {r['median_ms']:.3f} ms median ({1e3 / r['median_ms']:.0f}/s), "
+        f"compiled {c['median_ms']:.1f} ms median ({1e3 / c['median_ms']:.1f}/s): "
+        f"{c['median_ms'] / r['median_ms']:.0f}x (best against best {c['best_ms'] / r['best_ms']:.0f}x); "
+        f"of which apply {result['apply']['median_ms']:.3f} ms, variant {result['variant']['median_ms']:.3f} ms"
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
