@@ -88,6 +88,21 @@ fn main() {
     if target_os != "windows" {
         println!("cargo::rustc-link-arg=-Wl,-rpath,{}", lib_dir.display());
     }
+    // The model cache's C side, against the wheel's own 3.17.0 headers.
+    #[cfg(feature = "mujoco")]
+    build_patch(&lib_dir.join("include"));
+}
+
+/// Compiles `src/mujoco_patch.c` (the model cache's C side) against MuJoCo's headers in
+/// `include`.
+#[cfg(any(feature = "mujoco", feature = "mujoco-c"))]
+fn build_patch(include: &Path) {
+    println!("cargo::rerun-if-changed=src/mujoco_patch.c");
+    cc::Build::new()
+        .file("src/mujoco_patch.c")
+        .include(include)
+        .warnings(true)
+        .compile("mjcf_forge_mujoco_patch");
 }
 
 /// `<repo>/.cache/venv/lib/python3.*/site-packages/mujoco`, the first that holds the library.
@@ -185,6 +200,7 @@ fn build_shim() {
         .include(&include)
         .warnings(true)
         .compile("mjcf_forge_mujoco_shim");
+    build_patch(&include);
     println!("cargo::rustc-link-search=native={}", dir.display());
     println!("cargo::rustc-link-lib=dylib:+verbatim={lib}");
     if env::var("CARGO_CFG_TARGET_OS").unwrap_or_default() != "windows" {

@@ -25,7 +25,7 @@ cargo test --all-targets
 echo "== cargo test --features mujoco (with doctests)"
 cargo test --features mujoco
 echo "== cargo test --features mujoco-c (MuJoCo 4.0.0: the FFI and compile --json against Python 4.0.0)"
-CARGO_TARGET_DIR=target/mujoco-c cargo test --features mujoco-c --lib --test mujoco_compile --test cli_compile
+CARGO_TARGET_DIR=target/mujoco-c cargo test --features mujoco-c --lib --test mujoco_compile --test cli_compile --test model_cache
 echo "== judge self-tests (MuJoCo 3.17.0 and 4.0.0)"
 .cache/venv/bin/python -m pytest tests/judge -q -p no:cacheprovider
 .cache/venv-mj4/bin/python -m pytest tests/judge -q -p no:cacheprovider

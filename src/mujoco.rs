@@ -64,6 +64,9 @@ use mujoco_rs::mujoco_c as ffi;
 
 use sys::{model_array, model_size};
 
+mod cache;
+pub use cache::ModelCache;
+
 /// Bytes for MuJoCo's error (or warning) text; longer text is cut at this length.
 const ERROR_BUF_LEN: usize = 4096;
 
@@ -380,7 +383,11 @@ fn load_xml(path: &CStr, vfs: Option<&sys::Vfs>) -> Result<CompiledModel, Compil
         Some(ptr) => {
             let text = text.trim_end();
             let warnings = (!text.is_empty()).then(|| text.to_owned());
-            Ok(CompiledModel { ptr, warnings })
+            Ok(CompiledModel {
+                ptr,
+                warnings,
+                serial: cache::next_serial(),
+            })
         }
         None if text.trim().is_empty() => Err(CompileError::local(
             "MuJoCo could not compile the model and gave no reason".to_owned(),
@@ -450,6 +457,22 @@ fn path_to_cstring(path: &Path) -> Result<CString, CompileError> {
 pub struct CompiledModel {
     ptr: NonNull<sys::Model>,
     warnings: Option<String>,
+    /// Unique per model made (compiled or cloned): the model cache's plans are per model.
+    serial: u64,
+}
+
+/// A deep copy (`mj_copyModel`): a model of the same structure, patched on its own.
+impl Clone for CompiledModel {
+    fn clone(&self) -> Self {
+        // SAFETY: `self` is live; mj_copyModel allocates a new model or returns null.
+        let copy = unsafe { cache::mjf_patch_copy_model(self.raw()) };
+        let ptr = NonNull::new(copy).expect("MuJoCo could not allocate a copy of the model");
+        CompiledModel {
+            ptr,
+            warnings: self.warnings.clone(),
+            serial: cache::next_serial(),
+        }
+    }
 }
 
 // SAFETY: see the type's documentation: exclusive ownership of a heap allocation without

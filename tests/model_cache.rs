@@ -1,0 +1,112 @@
+//! The Rust `ModelCache` (features `mujoco` and `mujoco-c`): every patched model equals,
+//! bit for bit in every array and statistic, MuJoCo compiling the variant's XML.
+
+#![cfg(mjcf_mujoco)]
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use mjcf_forge::mujoco::{CompiledModel, ModelCache, compile_str};
+use mjcf_forge::scene::Scene;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn compiled(scene: &Scene, i: u64) -> CompiledModel {
+    let (xml, _) = scene.variant_xml(i).unwrap();
+    compile_str(&xml, Path::new(".")).unwrap()
+}
+
+fn by_structure(scene: &Scene, n: u64) -> HashMap<String, Vec<u64>> {
+    let mut groups: HashMap<String, Vec<u64>> = HashMap::new();
+    for i in 0..n {
+        groups
+            .entry(scene.patch(i).unwrap().structure_key)
+            .or_default()
+            .push(i);
+    }
+    groups
+}
+
+#[test]
+fn every_patchable_kind_is_patched_bit_for_bit() {
+    let scene = Scene::load(root().join("corpora/scenes/patch/patch.toml")).unwrap();
+    let groups = by_structure(&scene, 24);
+    assert_eq!(groups.len(), 4);
+    let mut cache = ModelCache::new(&scene, 4, None);
+    for indices in groups.values() {
+        for &i in indices.iter().take(4) {
+            let want = compiled(&scene, i);
+            let got = cache.model(i).unwrap();
+            assert_eq!(got.differences(&want), Vec::<String>::new(), "variant {i}");
+        }
+    }
+    assert_eq!(cache.compiles(), 4);
+    assert!(cache.patches() > 0);
+}
+
+#[test]
+fn apply_patches_a_model_of_ones_own_and_refuses_another_structure() {
+    let scene = Scene::load(root().join("corpora/scenes/patch/patch.toml")).unwrap();
+    let groups: Vec<Vec<u64>> = by_structure(&scene, 24).into_values().collect();
+    let mut cache = ModelCache::new(&scene, 8, None);
+    let (a, b) = (groups[0].clone(), groups[1].clone());
+    let mut mine = cache.model(a[0]).unwrap().clone();
+    for &i in &a[1..] {
+        cache.apply(i, &mut mine).unwrap();
+        assert_eq!(mine.differences(&compiled(&scene, i)), Vec::<String>::new());
+    }
+    let err = cache.apply(b[0], &mut mine).unwrap_err();
+    assert!(err.contains("a patch cannot change a structure"), "{err}");
+    let mut fresh = compiled(&scene, a[0]);
+    let err = cache.apply(b[0], &mut fresh).unwrap_err();
+    assert!(err.contains("does not have the structure"), "{err}");
+}
+
+#[test]
+fn the_cache_is_bounded() {
+    let scene = Scene::load(root().join("corpora/scenes/patch/patch.toml")).unwrap();
+    let firsts: Vec<u64> = by_structure(&scene, 24).values().map(|v| v[0]).collect();
+    let mut cache = ModelCache::new(&scene, 2, None);
+    for &i in &firsts {
+        cache.model(i).unwrap();
+    }
+    assert_eq!(cache.len(), 2);
+    let mut one = ModelCache::new(&scene, 8, None);
+    one.model(firsts[0]).unwrap();
+    let mut small = ModelCache::new(&scene, 8, Some(one.nbytes() + 1));
+    for &i in &firsts {
+        small.model(i).unwrap();
+    }
+    assert_eq!(small.len(), 1);
+}
+
+#[test]
+fn demo_and_lift5_fixed_are_exact() {
+    let demo = Scene::demo().unwrap();
+    let mut cache = ModelCache::new(&demo, 16, None);
+    for i in 0..6 {
+        let want = compiled(&demo, i);
+        assert_eq!(
+            cache.model(i).unwrap().differences(&want),
+            Vec::<String>::new()
+        );
+    }
+    let lift = root().join("benches/scenes/lift5_fixed.toml");
+    if !root().join(".cache/corpus/robosuite-1.5.2").is_dir() {
+        eprintln!("skipped lift5_fixed: run scripts/setup.sh");
+        return;
+    }
+    let scene = Scene::load(lift).unwrap();
+    let mut cache = ModelCache::new(&scene, 2, None);
+    for i in 0..5 {
+        let want = compiled(&scene, i);
+        assert_eq!(
+            cache.model(i).unwrap().differences(&want),
+            Vec::<String>::new(),
+            "variant {i}"
+        );
+    }
+    assert_eq!((cache.compiles(), cache.patches()), (1, 4));
+}
