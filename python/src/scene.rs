@@ -365,6 +365,9 @@ pub(crate) struct PyVariant {
     xml_str: OnceLock<Py<pyo3::types::PyString>>,
     /// Structure key and patch, drawn again on first use (or shipped by pickling).
     patch: OnceLock<VariantPatch>,
+    /// The patch as the Python tuple made once on first access (a model cache reads it per
+    /// patch; a tuple, so that no caller can change what the next one reads).
+    patch_list: OnceLock<Py<PyTuple>>,
 }
 
 /// How a variant's document is made on demand.
@@ -386,6 +389,7 @@ impl PyVariant {
             document: OnceLock::new(),
             xml_str: OnceLock::new(),
             patch: OnceLock::new(),
+            patch_list: OnceLock::new(),
         }
     }
 
@@ -470,7 +474,7 @@ impl PyVariant {
     }
 
     /// The values that turn a compiled model of this variant's structure into its own:
-    /// a list of ``(object, name, field, value)``, meaning
+    /// a tuple of ``(object, name, field, value)``, meaning
     /// ``model.<object>(name).<field> = value`` with MuJoCo's named accessors (``name``
     /// is an ``int``, the element's id, for an unnamed element of the scene's template)
     /// (``("geom", "object0_g0_vis", "rgba", (r, g, b, a))``,
@@ -478,9 +482,13 @@ impl PyVariant {
     /// a tuple of floats (a ``float`` field's already rounded as MuJoCo rounds it), or
     /// for ``matid`` the material's name. See :class:`ModelCache`.
     #[getter]
-    fn patch<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+    fn patch<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        if let Some(t) = self.patch_list.get() {
+            return Ok(t.bind(py).clone());
+        }
         let p = run(py, || Ok(self.drawn_patch()?.clone()))?;
-        patch_list(py, &p.entries)
+        let t = PyTuple::new(py, patch_list(py, &p.entries)?)?;
+        Ok(self.patch_list.get_or_init(|| t.unbind()).bind(py).clone())
     }
 
     #[getter]

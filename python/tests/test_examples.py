@@ -12,6 +12,7 @@ from conftest import ROOT
 from mjcf_forge import Scene
 
 DEMO = ROOT / "corpora" / "scenes" / "demo" / "demo.toml"
+PATCH_SCENE = ROOT / "corpora" / "scenes" / "patch" / "patch.toml"
 
 
 # ---------------------------------------------------------------- Gymnasium
@@ -39,7 +40,8 @@ def test_gym_env_draws_a_new_variant_per_reset_and_the_same_for_the_same_seed():
     obs2, info2 = env.reset(seed=42)
     assert info2["variant"] == first_variant and env.variant.xml == first_xml
     np.testing.assert_array_equal(obs, obs2)
-    # Unseeded resets: a new scene each episode, each compiled anew.
+    # Unseeded resets: a new scene each episode (the demo randomizes a geom's orientation,
+    # which is structure: each is compiled anew).
     seen = {first_variant}
     models = set()
     for _ in range(5):
@@ -120,3 +122,22 @@ def test_ray_shards_equal_one_process_byte_for_byte():
         ray.shutdown()
     assert result["identical"] and result["members"] == 600
     assert again["identical"] and again["sha256"] == result["sha256"]
+
+
+def test_gym_env_patches_the_model_in_place_when_the_structure_repeats():
+    import gym_env
+    import judge
+
+    env = gym_env.SceneEnv(PATCH_SCENE, max_episode_steps=2)
+    env.reset(seed=1)
+    for _ in range(12):
+        patches = env.cache.patches
+        env.reset()
+        if env.cache.patches > patches:
+            # A cached model patched in place: the one MuJoCo compiles from the XML.
+            ref = mujoco.MjModel.from_xml_string(env.variant.xml)
+            assert judge.compare_models(ref, env.model) == []
+        env.step(env.action_space.sample())
+    # Four structures: at most four compiles in thirteen resets, the rest patches.
+    assert env.cache.compiles <= 4
+    assert env.cache.patches == 13 - env.cache.compiles
