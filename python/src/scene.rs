@@ -491,6 +491,7 @@ impl PyVariant {
         Ok(self.patch_list.get_or_init(|| t.unbind()).bind(py).clone())
     }
 
+    /// A copy of the variant's :class:`Document` (to edit before writing or compiling).
     #[getter]
     fn document(&self, py: Python<'_>) -> PyResult<PyDocument> {
         run(py, || Ok(self.doc()?.clone())).map(PyDocument::new)
