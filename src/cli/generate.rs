@@ -11,6 +11,7 @@
 use std::io::{BufWriter, IsTerminal as _, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::mpsc::sync_channel;
 use std::time::{Duration, Instant};
 
 use mjcf_forge::output::AtomicFile;
@@ -62,7 +63,6 @@ pub struct Args {
     pretty: bool,
 }
 
-/// Where the variants go.
 /// A chunk position's reused buffer: the variant's XML, or for a tar stream its two
 /// members (XML and JSON) framed.
 #[derive(Default)]
@@ -70,16 +70,28 @@ struct Slot {
     framed: String,
 }
 
-enum Sink {
-    Dir {
-        out: OutputDir,
-        manifest: BufWriter<AtomicFile>,
-    },
-    Tar {
-        tar: TarWriter<BufWriter<AtomicFile>>,
-        /// Assets written out for `--validate` (the stream itself is not on disk).
-        check_dir: Option<tempfile::TempDir>,
-    },
+/// Where the variants go.
+struct Outputs {
+    /// The output folder, which workers write the variants' XML files into.
+    files: Option<OutputDir>,
+    /// What the writing thread owns.
+    writer: Writer,
+    /// Assets written out for `--validate` of a tar stream (which is not on disk).
+    check_dir: Option<tempfile::TempDir>,
+}
+
+/// The ordered part of the output, written by its own thread while the workers make the
+/// next chunk: a folder's manifest, or the tar stream.
+enum Writer {
+    Manifest(BufWriter<AtomicFile>),
+    Tar(TarWriter<BufWriter<AtomicFile>>),
+}
+
+/// A chunk on its way to the writing thread: its buffers, and per position the variant's
+/// manifest line (`None` for a variant that failed).
+struct Chunk {
+    slots: Vec<Slot>,
+    lines: Vec<Option<String>>,
 }
 
 pub fn run(args: Args) -> ExitCode {
@@ -224,17 +236,18 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
     if lo < hi {
         scene.variant(lo).map_err(|e| e.to_string())?;
     }
-    let mut sink = open_sink(
+    let outputs = open_sink(
         &args.output,
         &store,
         args.validate,
         (k, n),
         args.shard.is_some(),
     )?;
-    let check_dir: Option<PathBuf> = match &sink {
-        Sink::Dir { out, .. } => Some(out.path().to_path_buf()),
-        Sink::Tar { check_dir, .. } => check_dir.as_ref().map(|d| d.path().to_path_buf()),
+    let check_dir: Option<PathBuf> = match (&outputs.files, &outputs.check_dir) {
+        (Some(out), _) => Some(out.path().to_path_buf()),
+        (None, dir) => dir.as_ref().map(|d| d.path().to_path_buf()),
     };
+    let files = outputs.files.as_ref();
     let progress = std::io::stderr().is_terminal().then(|| {
         let bar = indicatif::ProgressBar::new(hi - lo);
         bar.set_style(
@@ -254,87 +267,144 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
         output: args.output.display().to_string(),
         range: (lo, hi),
     };
-    // One text buffer per variant of a chunk, reused chunk after chunk: a variant is
-    // written into memory the last chunk left, not into fresh pages. Everything but the
+    // One text buffer per variant of a chunk, reused: a variant is written into memory an
+    // earlier chunk left, not into fresh pages. Two sets of buffers: the workers fill one
+    // while the writing thread writes the other, in index order. Everything but those
     // ordered writes happens on the workers (a tar stream's members are framed there), so
     // the writing thread does one write per variant.
-    let is_tar = matches!(sink, Sink::Tar { .. });
-    let mut slots: Vec<Slot> = (0..CHUNK).map(|_| Slot::default()).collect();
-    let mut at = lo;
-    while at < hi {
-        let end = (at + CHUNK).min(hi);
-        let made: Vec<Result<(String, Duration, u64), String>> = slots[..(end - at) as usize]
-            .par_iter_mut()
-            .enumerate()
-            .map(|(k, slot)| {
-                let i = at + k as u64;
-                let file = format!("{i:09}.xml");
-                let make = |buf: &mut String| -> Result<Params, String> {
-                    if args.pretty {
-                        let v = scene.variant(i).map_err(|e| e.to_string())?;
-                        buf.push_str(&v.document.to_pretty_string());
-                        Ok(v.params)
-                    } else {
-                        scene.variant_xml_append(i, buf).map_err(|e| e.to_string())
+    let is_tar = matches!(outputs.writer, Writer::Tar(_));
+    let (to_writer, chunks) = sync_channel::<Chunk>(1);
+    let (give_back, returned) = sync_channel::<Vec<Slot>>(2);
+    let mut writer = outputs.writer;
+    let written = std::thread::scope(|scope| {
+        let thread = scope.spawn(move || -> Result<Writer, String> {
+            for chunk in chunks {
+                for (line, slot) in chunk.lines.iter().zip(&chunk.slots) {
+                    if let Some(json) = line {
+                        writer.write(json, slot.framed.as_bytes())?;
                     }
-                };
-                // For a tar stream the XML is written straight into its member.
-                let (params, xml) = if is_tar {
-                    slot.framed.clear();
-                    let (params, range) = frame_text_member(&mut slot.framed, &file, |buf| {
-                        let start = buf.len();
-                        make(buf).map(|p| (p, start..buf.len()))
-                    })
-                    .map_err(|e| e.to_string())??;
-                    (params, &slot.framed[range])
-                } else {
-                    slot.framed.clear();
-                    (make(&mut slot.framed)?, slot.framed.as_str())
-                };
-                let took = match (&check_dir, args.validate) {
-                    (Some(dir), true) => check(i, &params, xml, dir)?,
-                    _ => Duration::ZERO,
-                };
-                let json = params.to_json(i, Some(&file));
-                if let Sink::Dir { out, .. } = &sink {
-                    out.write(&file, xml.as_bytes())
-                        .map_err(|e| e.to_string())?;
                 }
-                let bytes = xml.len() as u64;
-                if is_tar {
-                    frame_text_member(&mut slot.framed, &format!("{i:09}.json"), |m| {
-                        m.push_str(&json);
-                        Ok::<(), String>(())
-                    })
-                    .map_err(|e| e.to_string())??;
-                }
-                Ok((json, took, bytes))
-            })
-            .collect();
-        for (r, slot) in made.into_iter().zip(&slots) {
-            match r {
-                Ok((json, took, bytes)) => {
-                    summary.variants += 1;
-                    summary.bytes += bytes;
-                    if let Some(c) = &mut summary.compile {
-                        *c += took;
-                    }
-                    write_variant(&mut sink, &json, slot.framed.as_bytes())?;
-                }
-                Err(e) => summary.failures.push(e),
+                // The main thread may be gone (it stopped on an error): nothing to return.
+                let _ = give_back.send(chunk.slots);
             }
+            Ok(writer)
+        });
+        let mut spare: Vec<Vec<Slot>> = (0..2)
+            .map(|_| (0..CHUNK).map(|_| Slot::default()).collect())
+            .collect();
+        let mut at = lo;
+        while at < hi {
+            let end = (at + CHUNK).min(hi);
+            // A free set of buffers; none coming back means the writer stopped.
+            let Some(mut slots) = spare.pop().or_else(|| returned.recv().ok()) else {
+                break;
+            };
+            let made: Vec<Result<(String, Duration, u64), String>> = slots[..(end - at) as usize]
+                .par_iter_mut()
+                .enumerate()
+                .map(|(k, slot)| {
+                    make_one(
+                        args,
+                        &scene,
+                        at + k as u64,
+                        slot,
+                        is_tar,
+                        files,
+                        check_dir.as_deref(),
+                    )
+                })
+                .collect();
+            let mut lines = Vec::with_capacity(made.len());
+            for r in made {
+                match r {
+                    Ok((json, took, bytes)) => {
+                        summary.variants += 1;
+                        summary.bytes += bytes;
+                        if let Some(c) = &mut summary.compile {
+                            *c += took;
+                        }
+                        lines.push(Some(json));
+                    }
+                    Err(e) => {
+                        summary.failures.push(e);
+                        lines.push(None);
+                    }
+                }
+            }
+            if to_writer.send(Chunk { slots, lines }).is_err() {
+                break;
+            }
+            if let Some(bar) = &progress {
+                bar.inc(end - at);
+            }
+            at = end;
         }
-        if let Some(bar) = &progress {
-            bar.inc(end - at);
-        }
-        at = end;
-    }
+        drop(to_writer);
+        thread
+            .join()
+            .unwrap_or_else(|_| Err("internal error: the writing thread panicked".to_string()))
+    });
+    let writer = written?;
     if let Some(bar) = progress {
         bar.finish_and_clear();
     }
-    close_sink(sink)?;
+    close_sink(writer, outputs.files)?;
     summary.seconds = started.elapsed().as_secs_f64();
     Ok(summary)
+}
+
+/// Makes variant `i` into `slot` (for a tar stream, its members framed), writes its XML
+/// file into `files` when the output is a folder, checks it with `--validate`: its manifest
+/// line, the time its check took and its XML's size.
+fn make_one(
+    args: &Args,
+    scene: &Scene,
+    i: u64,
+    slot: &mut Slot,
+    is_tar: bool,
+    files: Option<&OutputDir>,
+    check_dir: Option<&Path>,
+) -> Result<(String, Duration, u64), String> {
+    let file = format!("{i:09}.xml");
+    let make = |buf: &mut String| -> Result<Params, String> {
+        if args.pretty {
+            let v = scene.variant(i).map_err(|e| e.to_string())?;
+            buf.push_str(&v.document.to_pretty_string());
+            Ok(v.params)
+        } else {
+            scene.variant_xml_append(i, buf).map_err(|e| e.to_string())
+        }
+    };
+    slot.framed.clear();
+    // For a tar stream the XML is written straight into its member.
+    let (params, xml) = if is_tar {
+        let (params, range) = frame_text_member(&mut slot.framed, &file, |buf| {
+            let start = buf.len();
+            make(buf).map(|p| (p, start..buf.len()))
+        })
+        .map_err(|e| e.to_string())??;
+        (params, &slot.framed[range])
+    } else {
+        (make(&mut slot.framed)?, slot.framed.as_str())
+    };
+    let took = match (check_dir, args.validate) {
+        (Some(dir), true) => check(i, &params, xml, dir)?,
+        _ => Duration::ZERO,
+    };
+    let json = params.to_json(i, Some(&file));
+    if let Some(out) = files {
+        out.write(&file, xml.as_bytes())
+            .map_err(|e| e.to_string())?;
+    }
+    let bytes = xml.len() as u64;
+    if is_tar {
+        frame_text_member(&mut slot.framed, &format!("{i:09}.json"), |m| {
+            m.push_str(&json);
+            Ok::<(), String>(())
+        })
+        .map_err(|e| e.to_string())??;
+    }
+    Ok((json, took, bytes))
 }
 
 #[cfg(mjcf_mujoco)]
@@ -355,7 +425,7 @@ fn open_sink(
     validate: bool,
     (k, n): (u64, u64),
     sharded: bool,
-) -> Result<Sink, String> {
+) -> Result<Outputs, String> {
     let is_tar = output == Path::new("-") || output.extension().is_some_and(|e| e == "tar");
     if !is_tar {
         let out = OutputDir::create(output).map_err(|e| e.to_string())?;
@@ -366,9 +436,10 @@ fn open_sink(
             "manifest.jsonl".to_string()
         };
         let manifest = out.create_file(&name).map_err(|e| e.to_string())?;
-        return Ok(Sink::Dir {
-            out,
-            manifest: BufWriter::with_capacity(1 << 16, manifest),
+        return Ok(Outputs {
+            files: Some(out),
+            writer: Writer::Manifest(BufWriter::with_capacity(1 << 16, manifest)),
+            check_dir: None,
         });
     }
     let check_dir = if validate {
@@ -398,34 +469,41 @@ fn open_sink(
     };
     let mut tar = TarWriter::new(BufWriter::with_capacity(1 << 20, file), label);
     store.write_to_tar(&mut tar).map_err(|e| e.to_string())?;
-    Ok(Sink::Tar { tar, check_dir })
+    Ok(Outputs {
+        files: None,
+        writer: Writer::Tar(tar),
+        check_dir,
+    })
 }
 
-/// Writes a made variant in order: its manifest line to a folder (whose XML file a worker
-/// wrote), or its framed tar members to the stream.
-fn write_variant(sink: &mut Sink, json: &str, framed: &[u8]) -> Result<(), String> {
-    match sink {
-        Sink::Dir { manifest, .. } => manifest
-            .write_all(json.as_bytes())
-            .and_then(|()| manifest.write_all(b"\n"))
-            .map_err(|e| format!("cannot write the manifest: {e}")),
-        Sink::Tar { tar, .. } => tar.append_framed(framed).map_err(|e| e.to_string()),
+impl Writer {
+    /// Writes a made variant in order: its manifest line to a folder (whose XML file a
+    /// worker wrote), or its framed tar members to the stream.
+    fn write(&mut self, json: &str, framed: &[u8]) -> Result<(), String> {
+        match self {
+            Writer::Manifest(manifest) => manifest
+                .write_all(json.as_bytes())
+                .and_then(|()| manifest.write_all(b"\n"))
+                .map_err(|e| format!("cannot write the manifest: {e}")),
+            Writer::Tar(tar) => tar.append_framed(framed).map_err(|e| e.to_string()),
+        }
     }
 }
 
 /// Puts the outputs in place: the manifest (or the tar file) appears whole, only now.
-fn close_sink(sink: Sink) -> Result<(), String> {
+fn close_sink(writer: Writer, files: Option<OutputDir>) -> Result<(), String> {
     let commit = |w: BufWriter<AtomicFile>| -> Result<(), String> {
         let file = w
             .into_inner()
             .map_err(|e| format!("cannot write the output: {}", e.error()))?;
         file.commit().map_err(|e| e.to_string())
     };
-    match sink {
-        Sink::Dir { out, manifest } => {
-            commit(manifest)?;
-            out.finish().map_err(|e| e.to_string())
-        }
-        Sink::Tar { tar, .. } => commit(tar.finish().map_err(|e| e.to_string())?),
+    match writer {
+        Writer::Manifest(manifest) => commit(manifest)?,
+        Writer::Tar(tar) => commit(tar.finish().map_err(|e| e.to_string())?)?,
+    }
+    match files {
+        Some(out) => out.finish().map_err(|e| e.to_string()),
+        None => Ok(()),
     }
 }
