@@ -110,3 +110,24 @@ fn demo_and_lift5_fixed_are_exact() {
     }
     assert_eq!((cache.compiles(), cache.patches()), (1, 4));
 }
+
+#[test]
+fn discard_visual_variants_are_patched_bit_for_bit() {
+    let dir = root().join("corpora/scenes/patch");
+    let text = std::fs::read_to_string(dir.join("patch.toml")).unwrap();
+    let scene = Scene::from_toml_str(&format!("discard_visual = true\n{text}"), &dir).unwrap();
+    let (xml, _) = scene.variant_xml(0).unwrap();
+    assert!(xml.contains(r#"discardvisual="true""#));
+    let mut cache = ModelCache::new(&scene, 4, None);
+    for indices in by_structure(&scene, 16).values() {
+        for &i in indices.iter().take(3) {
+            let want = compiled(&scene, i);
+            assert_eq!(
+                cache.model(i).unwrap().differences(&want),
+                Vec::<String>::new(),
+                "variant {i}"
+            );
+        }
+    }
+    assert!(cache.patches() > 0);
+}

@@ -171,3 +171,27 @@ def test_patch_survives_pickling():
     assert w.patch == v.patch
     cache = mjcf_forge.ModelCache(scene)
     check_exact(v, cache.model(w))
+
+
+@pytest.mark.parametrize("path", [PATCH / "patch.toml", LIFT5_FIXED])
+def test_discard_visual_is_exact_and_drops_what_only_rendering_uses(path):
+    if not path.is_file() or (path == LIFT5_FIXED and not RS_ASSETS.is_dir()):
+        pytest.skip("setup not run")
+    text = path.read_text()
+    plain = mjcf_forge.Scene.from_toml(text, base_dir=str(path.parent))
+    scene = mjcf_forge.Scene.from_toml("discard_visual = true\n" + text, base_dir=str(path.parent))
+    v0, d0 = plain.variant(0), scene.variant(0)
+    full, lean = mujoco.MjModel.from_xml_string(v0.xml), mujoco.MjModel.from_xml_string(d0.xml)
+    # MuJoCo's own rule: visual geoms, materials and textures gone; the physics kept.
+    assert lean.ngeom < full.ngeom and lean.nmat == 0
+    assert np.array_equal(lean.body_mass, full.body_mass)
+    # Values that land on discarded elements are not in the patch (nor in the key): the
+    # patch scene colours visual geoms and materials; lift5_fixed's objects have none.
+    if path == PATCH / "patch.toml":
+        assert len(d0.patch) < len(v0.patch)
+    groups = grouped(scene, 12)
+    cache = mjcf_forge.ModelCache(scene)
+    for variants in groups.values():
+        for v in variants[:3]:
+            check_exact(v, cache.model(v))
+    assert cache.patches > 0

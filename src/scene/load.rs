@@ -250,10 +250,19 @@ fn build(text: &str, file: Arc<Path>, models: &dyn ModelSource) -> Result<Scene,
         template_targets.push(targets);
     }
     let prefixes_apart = prefixes_apart(&groups);
-    let splice = splice::Template::build(&template, &template_targets, &randomizers);
+    // The template as variants are written: with `discardvisual` when the scene asks
+    // (set on the written text only: merging compares parts' settings with the template's).
+    let splice = if spec.discard_visual {
+        let mut written = template.clone();
+        super::set_discard_visual(&mut written);
+        splice::Template::build(&written, &template_targets, &randomizers)
+    } else {
+        splice::Template::build(&template, &template_targets, &randomizers)
+    };
     let mut scene = Scene {
         splice,
         structure: OnceLock::new(),
+        discard_visual: spec.discard_visual,
         prefixes_apart,
         seed: spec.seed,
         file,

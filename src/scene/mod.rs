@@ -92,6 +92,8 @@ pub struct Scene {
     /// What the scene's settings let a patch carry, and what its structure keys start
     /// from (a hash of the template and every pool model), made on first use.
     structure: OnceLock<(patch::Rules, [u8; 32])>,
+    /// Variants are written with `<compiler discardvisual="true">`.
+    discard_visual: bool,
 }
 
 /// One element a randomizer sets, with what the manifest says of it.
@@ -342,6 +344,9 @@ impl Scene {
             }
             doc.merge_unchecked(&merge, false)?;
         }
+        if self.discard_visual {
+            set_discard_visual(&mut doc);
+        }
         Ok(Variant {
             index,
             document: doc,
@@ -583,7 +588,7 @@ impl Scene {
                 h.update(text.as_bytes());
             }
             (
-                patch::Rules::new(&self.template, &parts),
+                patch::Rules::new(&self.template, &parts, self.discard_visual),
                 *h.finalize().as_bytes(),
             )
         });
@@ -629,6 +634,22 @@ impl Scene {
             .get_or_init(|| load::make_instance(self, group, slot, m))
             .as_ref()
             .map_err(Clone::clone)
+    }
+}
+
+/// Sets `discardvisual="true"` on the document's last `<compiler>` (the one whose setting
+/// MuJoCo keeps), adding one when it has none.
+pub(crate) fn set_discard_visual(doc: &mut Document) {
+    let root = doc.root();
+    let last = doc
+        .elements(root)
+        .filter(|&n| doc.tag(n) == "compiler")
+        .last();
+    match last {
+        Some(c) => doc.set_attr(c, "discardvisual", "true"),
+        None => {
+            doc.append_element(root, "compiler", &[("discardvisual", "true")]);
+        }
     }
 }
 

@@ -107,10 +107,13 @@ pub(crate) struct Rules {
     /// Compiled ids of the template's elements that can be patched unnamed, when nothing
     /// reorders them (see [`template_ids`]).
     ids: Option<ahash::AHashMap<Node, usize>>,
+    /// Variants are compiled with `discardvisual`: visual geoms and every material are
+    /// not in the compiled model.
+    discard: bool,
 }
 
 impl Rules {
-    pub(crate) fn new(template: &Document, parts: &[&Document]) -> Rules {
+    pub(crate) fn new(template: &Document, parts: &[&Document], discard: bool) -> Rules {
         let setting = |name: &str| setting(template, "compiler", name);
         let mass = setting("settotalmass").is_none_or(|v| v.trim().parse() == Ok(-1.0))
             && setting("boundmass").is_none_or(|v| v.trim().parse() == Ok(0.0))
@@ -142,7 +145,10 @@ impl Rules {
         Rules {
             mass: mass && !dampratio,
             poses,
-            ids: (!world_level).then(|| template_ids(template)).flatten(),
+            ids: (!world_level)
+                .then(|| template_ids(template, discard))
+                .flatten(),
+            discard,
         }
     }
 }
@@ -159,11 +165,35 @@ fn owner(doc: &Document, node: Node) -> Option<Node> {
     matches!(doc.tag(at), "body" | "worldbody").then_some(at)
 }
 
+/// Whether MuJoCo's `discardvisual` drops this geom: `contype` and `conaffinity` both 0,
+/// no ellipsoid fluid model (MuJoCo's reference, `compiler/discardvisual`). `None` when it
+/// is visual but named in another element (contact pairs, sensors, tendons), which keeps
+/// it: such a geom is left to the compile.
+fn discarded(doc: &Document, geom: Node) -> Option<bool> {
+    let zero = |a: &str| doc.attr(geom, a).is_some_and(|v| v.trim() == "0");
+    let visual = zero("contype")
+        && zero("conaffinity")
+        && doc.attr(geom, "fluidshape").map(str::trim) != Some("ellipsoid");
+    if !visual {
+        return Some(false);
+    }
+    let Some(name) = doc.attr(geom, "name").filter(|n| !n.is_empty()) else {
+        return Some(true);
+    };
+    let referenced = doc
+        .elements(doc.root())
+        .filter(|&s| matches!(doc.tag(s), "contact" | "sensor" | "tendon" | "equality"))
+        .flat_map(|s| doc.descendants(s))
+        .any(|n| doc.attrs(n).any(|(k, v)| k != "name" && v == name));
+    (!referenced).then_some(true)
+}
+
 /// Compiled ids of the template's geoms, sites, cameras, lights and joints: MuJoCo
 /// numbers bodies depth first in document order and each body's elements (through frames)
-/// in document order, body after body. `None` when the template has what changes that
-/// order (`replicate`, `attach`, an `include` left unexpanded).
-fn template_ids(template: &Document) -> Option<ahash::AHashMap<Node, usize>> {
+/// in document order, body after body (with `discard`, the geoms `discardvisual` drops
+/// take no id). `None` when the template has what changes that order (`replicate`,
+/// `attach`, an `include` left unexpanded).
+fn template_ids(template: &Document, discard: bool) -> Option<ahash::AHashMap<Node, usize>> {
     let world = template.worldbody()?;
     let mut order = ahash::AHashMap::new();
     order.insert(world, 0usize);
@@ -177,6 +207,9 @@ fn template_ids(template: &Document) -> Option<ahash::AHashMap<Node, usize>> {
             let next = order.len();
             order.insert(n, next);
         } else if let Some(kind) = ID_KINDS.iter().position(|k| *k == tag) {
+            if discard && tag == "geom" && discarded(template, n)? {
+                continue;
+            }
             let body = owner(template, n)?;
             // joint and freejoint share one numbering.
             elements.push((*order.get(&body)?, kind.min(4), n));
@@ -226,7 +259,14 @@ pub(crate) fn split(
         let ids = if part == 0 { rules.ids.as_ref() } else { None };
         let mut bodies: Vec<Node> = Vec::new();
         for (node, attr, value) in &overlay.values {
-            match entry(doc, *node, attr, value, rules, ids, root == Some(*node)) {
+            if rules.discard && dropped(doc, *node, attr) == Some(true) {
+                // Not in the compiled model: its value changes nothing.
+                continue;
+            }
+            let structural = rules.discard && dropped(doc, *node, attr).is_none();
+            match entry(doc, *node, attr, value, rules, ids, root == Some(*node))
+                .filter(|_| !structural)
+            {
                 Some(e) => {
                     if e.object == "body" && !bodies.contains(node) {
                         bodies.push(*node);
@@ -298,6 +338,27 @@ pub(crate) fn split(
         index,
         structure_key: hash.to_hex()[..32].to_string(),
         entries,
+    }
+}
+
+/// Under `discardvisual`: whether the value lands nowhere (every material, a discarded
+/// geom, a geom's material: `Some(true)`), or is left to the compile (a visual geom that
+/// another element names: `None`).
+fn dropped(doc: &Document, node: Node, attr: &str) -> Option<bool> {
+    // Materials stay when a sensor or a custom tuple names one: then leave them to the
+    // compile.
+    let materials_kept = || {
+        doc.find_section(Section::Custom).is_some()
+            || doc
+                .find_section(Section::Sensor)
+                .is_some_and(|s| doc.descendants(s).any(|n| doc.attr(n, "objtype").is_some()))
+    };
+    match doc.tag(node) {
+        "material" | "geom" if (doc.tag(node) == "material" || attr == "material") => {
+            (!materials_kept()).then_some(true)
+        }
+        "geom" => discarded(doc, node),
+        _ => Some(false),
     }
 }
 

@@ -17,6 +17,11 @@ pub(crate) struct SceneSpec {
     pub(crate) seed: u64,
     /// The world or arena model every variant starts from.
     pub(crate) base: Spanned<String>,
+    /// Write every variant with MuJoCo's `<compiler discardvisual="true">`: the compiled
+    /// model drops what only rendering uses (visual geoms, materials, textures, unused
+    /// meshes); opt-in, since it changes the model.
+    #[serde(default)]
+    pub(crate) discard_visual: bool,
     /// Models placed in every variant, in order.
     #[serde(default)]
     pub(crate) fixture: Vec<FixtureSpec>,
