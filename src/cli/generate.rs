@@ -168,8 +168,11 @@ struct Summary {
     variants: u64,
     bytes: u64,
     seconds: f64,
-    /// Time spent compiling with MuJoCo, summed over threads (with `--validate`).
+    /// Time spent validating with MuJoCo (compiling or patching, and the contact check),
+    /// summed over threads (with `--validate`).
     compile: Option<Duration>,
+    /// Models MuJoCo compiled for `--validate` (the other variants were patched).
+    compiled: u64,
     failures: Vec<String>,
     output: String,
     range: (u64, u64),
@@ -193,8 +196,10 @@ impl Summary {
         );
         if let Some(c) = self.compile {
             s.push_str(&format!(
-                "; MuJoCo compile {:.2} ms per variant (summed over threads)",
-                c.as_secs_f64() * 1e3 / self.variants.max(1) as f64
+                "; validated by MuJoCo in {:.2} ms per variant (summed over threads; {} models \
+                 compiled, the other variants patched)",
+                c.as_secs_f64() * 1e3 / self.variants.max(1) as f64,
+                self.compiled
             ));
         }
         s.push_str(&format!("; {} failed", self.failures.len()));
@@ -210,6 +215,7 @@ impl Summary {
             "variants_per_second": self.rate(),
             "xml_bytes": self.bytes,
             "compile_ms_per_variant": self.compile.map(|c| c.as_secs_f64() * 1e3 / self.variants.max(1) as f64),
+            "models_compiled": self.compile.map(|_| self.compiled),
             "failures": self.failures,
             "output": self.output,
         })
@@ -248,6 +254,10 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
         (None, dir) => dir.as_ref().map(|d| d.path().to_path_buf()),
     };
     let files = outputs.files.as_ref();
+    let validators = match (&check_dir, args.validate) {
+        (Some(dir), true) => Some(Validators::new(&scene, dir)),
+        _ => None,
+    };
     let progress = std::io::stderr().is_terminal().then(|| {
         let bar = indicatif::ProgressBar::new(hi - lo);
         bar.set_style(
@@ -263,6 +273,7 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
         bytes: 0,
         seconds: 0.0,
         compile: args.validate.then_some(Duration::ZERO),
+        compiled: 0,
         failures: Vec::new(),
         output: args.output.display().to_string(),
         range: (lo, hi),
@@ -310,7 +321,7 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
                         slot,
                         is_tar,
                         files,
-                        check_dir.as_deref(),
+                        validators.as_ref(),
                     )
                 })
                 .collect();
@@ -345,6 +356,7 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
             .unwrap_or_else(|_| Err("internal error: the writing thread panicked".to_string()))
     });
     let writer = written?;
+    summary.compiled = validators.as_ref().map_or(0, Validators::compiled);
     if let Some(bar) = progress {
         bar.finish_and_clear();
     }
@@ -363,7 +375,7 @@ fn make_one(
     slot: &mut Slot,
     is_tar: bool,
     files: Option<&OutputDir>,
-    check_dir: Option<&Path>,
+    validators: Option<&Validators<'_>>,
 ) -> Result<(String, Duration, u64), String> {
     let file = format!("{i:09}.xml");
     let make = |buf: &mut String| -> Result<Params, String> {
@@ -387,9 +399,9 @@ fn make_one(
     } else {
         (make(&mut slot.framed)?, slot.framed.as_str())
     };
-    let took = match (check_dir, args.validate) {
-        (Some(dir), true) => check(i, &params, xml, dir)?,
-        _ => Duration::ZERO,
+    let took = match validators {
+        Some(v) => v.check(i, &params)?,
+        None => Duration::ZERO,
     };
     let json = params.to_json(i, Some(&file));
     if let Some(out) = files {
@@ -407,16 +419,70 @@ fn make_one(
     Ok((json, took, bytes))
 }
 
+/// `--validate`: per worker thread a model cache (each structure compiled once per thread,
+/// its other variants patched: the same models, see `mjcf_forge::mujoco::ModelCache`),
+/// then the interpenetration check on the variant's model.
 #[cfg(mjcf_mujoco)]
-fn check(i: u64, params: &Params, xml: &str, dir: &Path) -> Result<Duration, String> {
-    let t = Instant::now();
-    mjcf_forge::scene::check_variant(i, params, xml, dir)?;
-    Ok(t.elapsed())
-}
+struct Validators<'s>(Vec<std::sync::Mutex<mjcf_forge::mujoco::ModelCache<'s>>>);
 
+/// Without MuJoCo `--validate` is refused before anything runs.
 #[cfg(not(mjcf_mujoco))]
-fn check(_: u64, _: &Params, _: &str, _: &Path) -> Result<Duration, String> {
-    Err(super::NO_MUJOCO.to_owned())
+struct Validators<'s>(std::marker::PhantomData<&'s Scene>);
+
+/// Models and scratch data each thread's cache may hold for `--validate`.
+#[cfg(mjcf_mujoco)]
+const VALIDATE_CACHE_BYTES: usize = 512 << 20;
+
+impl<'s> Validators<'s> {
+    #[cfg(mjcf_mujoco)]
+    fn new(scene: &'s Scene, dir: &Path) -> Self {
+        let threads = rayon::current_num_threads().max(1);
+        Validators(
+            (0..threads)
+                .map(|_| {
+                    let cache =
+                        mjcf_forge::mujoco::ModelCache::new(scene, 8, Some(VALIDATE_CACHE_BYTES))
+                            .compiling_in(dir);
+                    std::sync::Mutex::new(cache)
+                })
+                .collect(),
+        )
+    }
+
+    #[cfg(not(mjcf_mujoco))]
+    fn new(_: &'s Scene, _: &Path) -> Self {
+        Validators(std::marker::PhantomData)
+    }
+
+    #[cfg(mjcf_mujoco)]
+    fn check(&self, i: u64, params: &Params) -> Result<Duration, String> {
+        let t = Instant::now();
+        let k = rayon::current_thread_index().unwrap_or(0) % self.0.len();
+        // A thread's own cache: the lock is never contended (poisoned only by a panic
+        // elsewhere, after which the cache is still whole).
+        let mut cache = self.0[k].lock().unwrap_or_else(|p| p.into_inner());
+        let model = cache.model(i)?;
+        mjcf_forge::scene::check_model(i, params, model)?;
+        Ok(t.elapsed())
+    }
+
+    #[cfg(not(mjcf_mujoco))]
+    fn check(&self, _: u64, _: &Params) -> Result<Duration, String> {
+        Err(super::NO_MUJOCO.to_owned())
+    }
+
+    #[cfg(mjcf_mujoco)]
+    fn compiled(&self) -> u64 {
+        self.0
+            .iter()
+            .map(|m| m.lock().unwrap_or_else(|p| p.into_inner()).compiles())
+            .sum()
+    }
+
+    #[cfg(not(mjcf_mujoco))]
+    fn compiled(&self) -> u64 {
+        0
+    }
 }
 
 fn open_sink(

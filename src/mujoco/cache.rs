@@ -198,6 +198,8 @@ impl Signature {
 /// ```
 pub struct ModelCache<'s> {
     scene: &'s Scene,
+    /// The folder relative file names in the variants' XML resolve against.
+    dir: Option<std::path::PathBuf>,
     /// Cached models by structure key, least recently used first.
     entries: Vec<(String, CompiledModel)>,
     state: State,
@@ -235,6 +237,7 @@ impl<'s> ModelCache<'s> {
             .fold(0, |a, b| a | b);
         ModelCache {
             scene,
+            dir: None,
             entries: Vec::new(),
             state: State {
                 max_models: max_models.max(1),
@@ -247,6 +250,13 @@ impl<'s> ModelCache<'s> {
                 patches: 0,
             },
         }
+    }
+
+    /// Compiles variants with relative file names resolved against `dir` (a scene whose
+    /// assets were relocated into an output folder) instead of the template's folder.
+    pub fn compiling_in(mut self, dir: impl Into<std::path::PathBuf>) -> Self {
+        self.dir = Some(dir.into());
+        self
     }
 
     /// Models compiled so far (misses).
@@ -330,7 +340,11 @@ impl<'s> ModelCache<'s> {
 
     fn compile(&mut self, index: u64, key: &str) -> Result<(), String> {
         let (xml, _) = self.scene.variant_xml(index).map_err(|e| e.to_string())?;
-        let model = compile_str(&xml, self.scene.template().model_dir())
+        let dir = self
+            .dir
+            .as_deref()
+            .unwrap_or_else(|| self.scene.template().model_dir());
+        let model = compile_str(&xml, dir)
             .map_err(|e: CompileError| format!("variant {index}: MuJoCo: {e}"))?;
         let state = &mut self.state;
         state.compiles += 1;

@@ -27,6 +27,22 @@ pub fn check_variant(
     dir: &Path,
 ) -> Result<CompiledModel, String> {
     let model = compile_str(xml, dir).map_err(|e| format!("variant {index}: {e}"))?;
+    check_model(index, params, &model)?;
+    Ok(model)
+}
+
+/// [`check_variant`] on a model already compiled (or patched by a
+/// [`crate::mujoco::ModelCache`]) for variant `index`.
+///
+/// ```
+/// use mjcf_forge::mujoco::ModelCache;
+/// let scene = mjcf_forge::scene::Scene::demo()?;
+/// let mut cache = ModelCache::new(&scene, 4, None);
+/// let params = scene.variant(2)?.params;
+/// mjcf_forge::scene::check_model(2, &params, cache.model(2).unwrap()).unwrap();
+/// # Ok::<(), mjcf_forge::Errors>(())
+/// ```
+pub fn check_model(index: u64, params: &Params, model: &CompiledModel) -> Result<(), String> {
     let bodies = model.names(ObjType::Body);
     let placed: Vec<usize> = params
         .objects
@@ -59,5 +75,5 @@ pub fn check_variant(
             ));
         }
     }
-    Ok(model)
+    Ok(())
 }

@@ -48,7 +48,7 @@ use crate::merge::MergePart;
 use crate::tree::Node;
 
 #[cfg(mjcf_mujoco)]
-pub use check::{PENETRATION_TOLERANCE, check_variant};
+pub use check::{PENETRATION_TOLERANCE, check_model, check_variant};
 pub use params::{Params, PlacedObject, RandomizedValue};
 pub use patch::{PATCHABLE, PatchEntry, PatchValue, VariantPatch};
 pub use randomize::MUJOCO_DEFAULTS;
