@@ -1223,10 +1223,13 @@ impl Document {
     /// The name of an asset: its `name`, else the one MuJoCo derives from its file.
     fn asset_name(&self, n: Node) -> Option<&str> {
         let s = syms();
-        self.attr_sym(n, s.name).or_else(|| {
-            crate::prefix::named_after_file_tag(self.tag(n))?;
-            self.attr_sym(n, s.file).and_then(crate::prefix::file_stem)
-        })
+        // An empty name is no name: MuJoCo names such an asset after its file.
+        self.attr_sym(n, s.name)
+            .filter(|v| !v.is_empty())
+            .or_else(|| {
+                crate::prefix::named_after_file_tag(self.tag(n))?;
+                self.attr_sym(n, s.file).and_then(crate::prefix::file_stem)
+            })
     }
 
     /// For each asset of the part, in order: whether the base already has it (same tag,

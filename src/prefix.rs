@@ -73,7 +73,10 @@ pub(crate) fn file_stem(file: &str) -> Option<&str> {
 
 /// One rename to apply.
 enum Rename {
-    /// One name (an identifier or a reference): `old` is its text, trimmed.
+    /// One name (an identifier or a reference): `old` is its text, exactly as written.
+    /// MuJoCo 3.17.0 and 4.0.0 read names as exact strings, in declarations and references
+    /// alike: `" 0"`, `"0 "` and `"0"` are three names, and a reference `" 0"` finds only
+    /// `" 0"` (corpora/features/names_exact_strings.xml). Trimming would merge them.
     One { node: Node, name: Sym, old: StrRef },
     /// A space-separated list of names of one namespace.
     List {
@@ -84,21 +87,6 @@ enum Rename {
     },
     /// An asset named after its file gets `prefix + stem` as its name.
     Named { node: Node, stem: String },
-}
-
-/// The part of `r` (whose text is `text`) without surrounding white space.
-fn trimmed(text: &str, r: StrRef) -> StrRef {
-    let b = text.as_bytes();
-    if b.first().is_none_or(|c| !c.is_ascii_whitespace())
-        && b.last().is_none_or(|c| !c.is_ascii_whitespace())
-    {
-        return r;
-    }
-    let lead = text.len() - text.trim_start().len();
-    StrRef {
-        start: r.start + lead as u32,
-        len: text.trim().len() as u32,
-    }
 }
 
 /// Refuses a prefix that would make names MuJoCo reads differently, or output no XML 1.0
@@ -201,13 +189,15 @@ impl Document {
                 };
                 match attr_kind {
                     AttrKind::Id(ns) | AttrKind::Ref(ns) => {
-                        has_name |= matches!(attr_kind, AttrKind::Id(_));
-                        let old = trimmed(self.str(a.value), a.value);
-                        if renamed(ns, self.str(old)) {
+                        // An empty name is no name: MuJoCo names such an asset after its
+                        // file all the same.
+                        has_name |=
+                            matches!(attr_kind, AttrKind::Id(_)) && !self.str(a.value).is_empty();
+                        if renamed(ns, self.str(a.value)) {
                             edits.push(Rename::One {
                                 node,
                                 name: a.name,
-                                old,
+                                old: a.value,
                             });
                         }
                     }
@@ -222,11 +212,13 @@ impl Document {
                             crate::names::known(name_attr),
                             ns_of_objtype(self.str(a.value)),
                         ) && let Some(r) = self.attr_ref(node, t)
+                            && renamed(ns, self.str(r))
                         {
-                            let old = trimmed(self.str(r), r);
-                            if renamed(ns, self.str(old)) {
-                                edits.push(Rename::One { node, name: t, old });
-                            }
+                            edits.push(Rename::One {
+                                node,
+                                name: t,
+                                old: r,
+                            });
                         }
                     }
                     AttrKind::Plain | AttrKind::File | AttrKind::ObjName => {}

@@ -49,14 +49,15 @@ impl Document {
                 };
                 match spec.kind {
                     AttrKind::Id(ns) => {
-                        declared = true;
+                        // An empty name is no name (an asset is then named after its file).
+                        declared |= !value.is_empty();
                         self.declare(&mut ids, &mut errors, node, ns, value);
                     }
                     AttrKind::Ref(ns) => refs.push(Reference {
                         node,
                         attr: name.to_string(),
                         ns,
-                        name: value.trim().to_string(),
+                        name: value.to_string(),
                     }),
                     AttrKind::RefList(ns) => {
                         for t in value.split_ascii_whitespace() {
@@ -76,7 +77,7 @@ impl Document {
                                 node,
                                 attr: name_attr.to_string(),
                                 ns,
-                                name: target.trim().to_string(),
+                                name: target.to_string(),
                             });
                         }
                     }
@@ -128,7 +129,7 @@ impl Document {
         ns: Ns,
         name: &str,
     ) {
-        let name = name.trim();
+        // Names are exact strings (see `prefix::Rename::One`): `" a"` and `"a"` are two.
         if name.is_empty() {
             return;
         }
@@ -219,9 +220,9 @@ impl Document {
             if let Some((id, ns)) = id_attr(kind)
                 && let Some(a) = self.attr_slice(node).iter().find(|a| a.name == id)
             {
-                declared = true;
-                let v = trim(self.str(a.value));
+                let v = self.str(a.value);
                 if !v.is_empty() {
+                    declared = true;
                     out.push((ns, v, node));
                 }
             }
@@ -303,14 +304,5 @@ impl std::hash::Hasher for NameHasher {
 
     fn write_usize(&mut self, n: usize) {
         self.0 = (self.0.rotate_left(5) ^ n as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-    }
-}
-
-/// `str::trim`, with a fast path for the usual name without surrounding white space.
-fn trim(s: &str) -> &str {
-    let b = s.as_bytes();
-    match (b.first(), b.last()) {
-        (Some(f), Some(l)) if !f.is_ascii_whitespace() && !l.is_ascii_whitespace() => s,
-        _ => s.trim(),
     }
 }

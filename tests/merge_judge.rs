@@ -124,10 +124,8 @@ fn build(case: &Case, dir: &Path) -> String {
         parts_json.push(format!(
             "{{\"path\": \"{}\", \"prefix\": \"{judge_prefix}\", \"body\": {}}}",
             file.display(),
-            p.into
-                .as_ref()
-                .map(|b| format!("\"{b}\""))
-                .unwrap_or_else(|| "null".into())
+            // A JSON string: body names may hold white space such as a tab.
+            serde_json::to_string(&p.into).unwrap()
         ));
         fused_prefixes.push(format!("\"{prefix}\""));
     }
@@ -260,6 +258,21 @@ fn cases() -> Vec<Case> {
             base(ours("arm_with_keys.xml")),
             part(ours("free_objects_with_key.xml"), "obj", None),
             part(ours("free_objects_with_key.xml"), "obj2", None),
+        ],
+        fuse_keys: false,
+    });
+    // Names are exact strings: a part whose names differ from the base's only by white space
+    // merges without a prefix (nothing clashes), and a part goes into the base's body
+    // "hand\t", not the other part's "hand".
+    cases.push(Case {
+        name: "arm_into_arm_names_spaced".into(),
+        parts: vec![
+            base(ours("arm_names_spaced.xml")),
+            base(ours("arm_with_keys.xml")),
+            Part {
+                plain: true,
+                ..part(ours("gripper_radian.xml"), "g0", Some("hand\t"))
+            },
         ],
         fuse_keys: false,
     });
