@@ -13,6 +13,7 @@ of a millisecond instead of the compile's tens of milliseconds.
 from __future__ import annotations
 
 import collections
+import itertools
 from typing import Any
 
 import numpy as np
@@ -115,7 +116,8 @@ class _Plan:
         self.data = data = mujoco.MjData(model)
         self.nbytes = model.nbuffer + data.nbuffer + data.narena
         self.fields: list[tuple[Any, Any, str]] | None = None
-        self.views: list[Any] = []
+        self.groups: list[tuple[Any, np.ndarray, np.ndarray]] = []
+        self.matids: list[tuple[Any, int, int]] = []
         # The <statistic> values the scene sets: MuJoCo keeps them over what it computes.
         self.fixed = fixed
         # Views (fetching one from the bindings costs microseconds) and constants.
@@ -153,10 +155,15 @@ class _Plan:
         self.dof_body = model.dof_bodyid.copy()
 
     def resolve(self, patch: list) -> None:
-        """The array view of every entry of ``patch`` (and material ids by name)."""
+        """Where every entry of ``patch`` lands: per target array, the flat indices its
+        numbers go to and where they come from in the patch's numbers laid end to end
+        (a one-number entry fills all its rows, as a joint's damping fills each of its
+        dofs); material names apart."""
         mujoco, model = self.mujoco, self.model
-        views = []
-        for obj, name, field, _ in patch:
+        groups: dict[str, tuple[Any, list[int], list[int]]] = {}
+        matids: list[tuple[Any, int, int]] = []
+        numbers = 0
+        for k, (obj, name, field, value) in enumerate(patch):
             if isinstance(name, int):
                 i = name if name < getattr(model, _COUNT[obj]) else -1
             else:
@@ -166,29 +173,50 @@ class _Plan:
                     f"the patch names {obj} '{name}', which the compiled model does not have"
                 )
             if obj == "joint" and field in _DOF_FIELDS:
-                adr = int(model.jnt_dofadr[i])
-                views.append(getattr(model, f"dof_{field}")[adr : adr + _JOINT_DOFS[int(model.jnt_type[i])]])
+                array = f"dof_{field}"
+                first = int(model.jnt_dofadr[i])
+                rows = range(first, first + _JOINT_DOFS[int(model.jnt_type[i])])
             elif obj == "joint" and field in _QPOS_FIELDS:
-                adr = int(model.jnt_qposadr[i])
-                views.append(getattr(model, field)[adr : adr + _JOINT_QPOS[int(model.jnt_type[i])]])
+                array = field
+                first = int(model.jnt_qposadr[i])
+                rows = range(first, first + _JOINT_QPOS[int(model.jnt_type[i])])
             else:
-                array = getattr(model, _PREFIX[obj] + field)
-                # A one-component field of a one-dimensional array: its row as a slice.
-                views.append(array[i] if array.ndim > 1 else array[i : i + 1])
-        self.views = views
+                array = _PREFIX[obj] + field
+                width = 1 if isinstance(value, str) else len(value)
+                rows = range(i * width, (i + 1) * width)
+            whole = getattr(model, array)
+            flat = whole.reshape(-1)
+            if not np.shares_memory(flat, whole):
+                raise _error(f"mjModel.{array} is not one contiguous array here")
+            if isinstance(value, str):
+                matids.append((flat, rows[0], k))
+                continue
+            _, targets, sources = groups.setdefault(array, (flat, [], []))
+            targets.extend(rows)
+            sources.extend(
+                [numbers] * len(rows) if len(value) == 1 else range(numbers, numbers + len(value))
+            )
+            numbers += len(value)
+        self.groups = [(flat, np.array(t), np.array(s)) for flat, t, s in groups.values()]
+        self.matids = matids
         self.fields = [(o, n, f) for o, n, f, _ in patch]
 
     def apply(self, patch: list) -> None:
-        if self.fields is None or len(self.fields) != len(patch) or any(
-            f != (o, n, fl) for f, (o, n, fl, _) in zip(self.fields, patch)
-        ):
+        # One structure gives one list of (object, name, field) (the key says which
+        # models stand where, and the randomizers are the scene's): resolved once.
+        if self.fields is None or len(self.fields) != len(patch):
             self.resolve(patch)
-        for view, entry in zip(self.views, patch):
-            value = entry[3]
-            if isinstance(value, str):
-                # A material chosen by name: its id.
-                value = self.mujoco.mj_name2id(self.model, self.mujoco.mjtObj.mjOBJ_MATERIAL, value)
-            view[...] = value
+        values = np.fromiter(
+            itertools.chain.from_iterable(e[3] for e in patch if not isinstance(e[3], str)),
+            dtype=np.float64,
+        )
+        for flat, targets, sources in self.groups:
+            # A float32 array takes the numbers rounded as MuJoCo rounds them (they are).
+            flat[targets] = values[sources]
+        for flat, index, k in self.matids:
+            flat[index] = self.mujoco.mj_name2id(
+                self.model, self.mujoco.mjtObj.mjOBJ_MATERIAL, patch[k][3]
+            )
         self.mujoco.mj_setConst(self.model, self.data)
         self.statistics()
         for stat, value in self.fixed:
