@@ -13,6 +13,7 @@ of a millisecond instead of the compile's tens of milliseconds.
 from __future__ import annotations
 
 import collections
+import copy
 import itertools
 from typing import Any
 
@@ -32,6 +33,10 @@ _SIGNATURE_ARRAYS = (
 )
 
 
+# Sizes mj_setConst recomputes from patched values (bodies with gravity compensation).
+_SET_BY_PATCHING = frozenset({"ngravcomp"})
+
+
 def _error(message: str) -> MjcfError:
     err = MjcfError(message)
     err.errors = [message]
@@ -43,12 +48,22 @@ def _signature(model: Any) -> tuple:
     sizes = tuple(
         getattr(model, a)
         for a in sorted(dir(model))
-        if a.startswith("n") and isinstance(getattr(model, a, None), int)
+        if a.startswith("n")
+        and a not in _SET_BY_PATCHING
+        and isinstance(getattr(model, a, None), int)
     )
     arrays = tuple(
         getattr(model, a).tobytes() for a in _SIGNATURE_ARRAYS if hasattr(model, a)
     )
     return sizes, bytes(model.names), arrays
+
+
+# Model arrays no patch changes (meshes, textures, height fields, skins, flexes, bounding
+# volumes, names): left out of batch().
+_STATIC_PREFIXES = (
+    "mesh_", "tex_", "hfield_", "skin_", "flex", "bvh_", "oct_", "name", "text_", "paths",
+    "tuple_", "numeric_", "plugin", "sensor_", "key_",
+)
 
 
 def _copy(value: Any) -> Any:
@@ -109,8 +124,9 @@ class _Plan:
     array views of the last patch's entries, and the views and constants of the statistics
     the compiler derives (``mj_setConst`` of 3.17 and 4.0 leaves them)."""
 
-    def __init__(self, mujoco: Any, model: Any, key: str, fixed: list) -> None:
+    def __init__(self, mujoco: Any, model: Any, key: str, fixed: list, superset: bool) -> None:
         self.mujoco = mujoco
+        self.superset = superset
         self.model = model
         self.key = key
         self.data = data = mujoco.MjData(model)
@@ -199,12 +215,16 @@ class _Plan:
             numbers += len(value)
         self.groups = [(flat, np.array(t), np.array(s)) for flat, t, s in groups.values()]
         self.matids = matids
-        self.fields = [(o, n, f) for o, n, f, _ in patch]
+        self.fields = [tuple(e[:3]) for e in patch]
 
     def apply(self, patch: list) -> None:
-        # One structure gives one list of (object, name, field) (the key says which
-        # models stand where, and the randomizers are the scene's): resolved once.
-        if self.fields is None or len(self.fields) != len(patch):
+        # A structure key covers its patch's layout, so a variant's targets are resolved
+        # once per structure; a superset patch's layout follows which objects are placed.
+        if (
+            self.fields is None
+            or len(self.fields) != len(patch)
+            or (self.superset and any(f != e[:3] for f, e in zip(self.fields, patch)))
+        ):
             self.resolve(patch)
         values = np.fromiter(
             itertools.chain.from_iterable(e[3] for e in patch if not isinstance(e[3], str)),
@@ -281,6 +301,12 @@ class ModelCache:
     ``reset``: no allocation, no copy); it must have the variant's structure, else an
     :class:`MjcfError` says so.
 
+    With ``superset=True`` every variant is a patch of one model, the scene's
+    :class:`Superset` (every object any slot can hold; those a variant does not place are
+    parked: no contacts, invisible, held still, below the world): ``cache.model(variant)``
+    is that model patched, and ``cache.batch(variants)`` gives the per-world arrays that
+    batched simulators (MJX, MuJoCo Warp, MuJoCo's batch API) take.
+
     >>> import mjcf_forge
     >>> scene = mjcf_forge.Scene.demo()
     >>> cache = mjcf_forge.ModelCache(scene, max_models=4)
@@ -289,7 +315,13 @@ class ModelCache:
     True
     """
 
-    def __init__(self, scene: Any, max_models: int = 8, max_bytes: int | None = None) -> None:
+    def __init__(
+        self,
+        scene: Any,
+        max_models: int = 8,
+        max_bytes: int | None = None,
+        superset: bool = False,
+    ) -> None:
         import mujoco
 
         if max_models < 1:
@@ -299,6 +331,8 @@ class ModelCache:
         self._fixed = list(scene.fixed_statistics)
         self._max_models = max_models
         self._max_bytes = max_bytes
+        #: The scene's :class:`Superset` when every variant is a patch of it, else None.
+        self.superset = scene.superset() if superset else None
         # Cached models by structure key, least recently used first.
         self._entries: collections.OrderedDict[str, Any] = collections.OrderedDict()
         # How to patch each model seen (cached ones and the caller's), by id; holding the
@@ -321,7 +355,7 @@ class ModelCache:
         return sum(p.nbytes for p in self._plans.values())
 
     def _plan(self, model: Any, key: str) -> _Plan:
-        plan = _Plan(self._mujoco, model, key, self._fixed_values[key])
+        plan = _Plan(self._mujoco, model, key, self._fixed_values[key], self.superset is not None)
         self._plans[id(model)] = plan
         self._trim()
         return plan
@@ -340,33 +374,66 @@ class ModelCache:
         for k in extra[: max(0, len(extra) - self._max_models)]:
             del self._plans[k]
 
+    def _variant_inertia(self, model: Any, plan: "_Plan", variant: Any) -> None:
+        """Superset: ``stat.meaninertia`` (which scales the constraint solver's tolerance)
+        as the variant's own model has it: the mean of the mass matrix's diagonal over the
+        dofs of what the variant places (in the superset's dof order, which is the
+        variant's), parked objects left out."""
+        parked = set()
+        for root in self.superset.parked(variant.index):
+            b = model.body(root).id
+            stack = [b]
+            while stack:
+                c = stack.pop()
+                parked.update(range(model.body_dofadr[c], model.body_dofadr[c] + model.body_dofnum[c]))
+                stack.extend(np.flatnonzero(model.body_parentid == c).tolist())
+        keep = np.array([i for i in range(model.nv) if i not in parked], dtype=int)
+        if len(keep):
+            model.stat.meaninertia = _in_order_sum(plan.M[plan.M_diagonal[keep]]) / len(keep)
+
+    def _key_and_patch(self, variant: Any) -> tuple[str, Any]:
+        if self.superset is not None:
+            return self.superset.structure_key, self.superset.patch(variant.index)
+        return variant.structure_key, variant.patch
+
     def _compile(self, variant: Any) -> Any:
-        model = self._mujoco.MjModel.from_xml_string(variant.xml)
+        """Compiles the variant's structure (the superset, or the variant itself) and keeps
+        it; the model returned is already the variant's."""
+        xml = self.superset.xml if self.superset is not None else variant.xml
+        model = self._mujoco.MjModel.from_xml_string(xml)
         self.compiles += 1
-        key = variant.structure_key
+        key = self.superset.structure_key if self.superset is not None else variant.structure_key
         self._signatures[key] = _signature(model)
         self._fixed_values[key] = [(s, _copy(getattr(model.stat, s))) for s in self._fixed]
         self._entries[key] = model
         self._entries.move_to_end(key)
-        self._plan(model, key)
+        plan = self._plan(model, key)
+        if self.superset is not None:
+            # The superset as compiled parks every object: the variant's patch places its own.
+            plan.apply(self.superset.patch(variant.index))
+            self._variant_inertia(model, plan, variant)
+            self.patches += 1
         return model
 
     def model(self, variant: Any) -> Any:
-        """A compiled model equal to MuJoCo's compile of ``variant.xml`` (see the class)."""
-        key = variant.structure_key
+        """A compiled model equal to MuJoCo's compile of ``variant.xml`` (see the class);
+        with ``superset=True``, the superset model patched for the variant."""
+        key, patch = self._key_and_patch(variant)
         model = self._entries.get(key)
         if model is None:
             return self._compile(variant)
         self._entries.move_to_end(key)
         plan = self._plans.get(id(model)) or self._plan(model, key)
-        plan.apply(variant.patch)
+        plan.apply(patch)
+        if self.superset is not None:
+            self._variant_inertia(model, plan, variant)
         self.patches += 1
         return model
 
     def apply(self, variant: Any, model: Any) -> Any:
         """Patches ``model`` (of ``variant``'s structure) in place into ``variant``'s
         compiled model; returns it. Raises :class:`MjcfError` when its structure differs."""
-        key = variant.structure_key
+        key, patch = self._key_and_patch(variant)
         plan = self._plans.get(id(model))
         if plan is None or plan.model is not model:
             if key not in self._signatures:
@@ -384,6 +451,43 @@ class ModelCache:
                 "a patch cannot change a structure (cache.model(variant) compiles it)"
             )
         self._plans.move_to_end(id(model))
-        plan.apply(variant.patch)
+        plan.apply(patch)
+        if self.superset is not None:
+            self._variant_inertia(model, plan, variant)
         self.patches += 1
         return model
+
+    def batch(self, variants: Any) -> dict[str, np.ndarray]:
+        """Per-world arrays for batched simulation (``superset=True``): for every field of
+        the superset model that differs between the given variants, one row per variant
+        (``{"geom_rgba": (n, ngeom, 4), "qpos0": (n, nq), "stat.meaninertia": (n,), ...}``),
+        each row what the patched superset model holds for that variant: the form MJX and
+        MuJoCo Warp take for per-world model fields. Fields every variant shares are left
+        out (they are the superset model's)."""
+        if self.superset is None:
+            raise ValueError("batch() needs ModelCache(scene, superset=True)")
+        variants = list(variants)
+        if not variants:
+            return {}
+        model = copy.copy(self.model(variants[0]))
+        names = [
+            n
+            for n in dir(model)
+            if not n.startswith("_")
+            and isinstance(getattr(model, n, None), np.ndarray)
+            and not n.startswith(_STATIC_PREFIXES)
+        ]
+        rows: dict[str, list[np.ndarray]] = {n: [] for n in names}
+        stats = {f"stat.{s}": [] for s in ("meaninertia", "meanmass", "meansize", "extent", "center")}
+        for v in variants:
+            self.apply(v, model)
+            for n in names:
+                rows[n].append(getattr(model, n).copy())
+            for s in stats:
+                stats[s].append(np.array(getattr(model.stat, s[5:]), dtype=np.float64))
+        out = {}
+        for n, r in list(rows.items()) + list(stats.items()):
+            stacked = np.stack(r)
+            if not (stacked == stacked[0]).all():
+                out[n] = stacked
+        return out

@@ -9,6 +9,7 @@ mod document;
 mod errors;
 mod model;
 mod scene;
+mod superset;
 
 use pyo3::prelude::*;
 
@@ -38,6 +39,7 @@ fn _mjcf_forge(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::PyScene>()?;
     m.add_class::<scene::PyVariant>()?;
     m.add_class::<scene::PyVariantIter>()?;
+    m.add_class::<superset::PySuperset>()?;
     m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

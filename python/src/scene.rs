@@ -175,6 +175,22 @@ impl PyScene {
         self.scene.fixed_statistics()
     }
 
+    /// The scene's :class:`Superset`: one model holding every object any slot can hold,
+    /// of which every variant is a patch.
+    fn superset(&self, py: Python<'_>) -> PyResult<crate::superset::PySuperset> {
+        let scene = Arc::clone(&self.scene);
+        let (superset, xml) = run(py, move || {
+            let s = scene.superset()?;
+            let xml = s.document.to_xml_string();
+            Ok((s, xml))
+        })?;
+        Ok(crate::superset::PySuperset {
+            scene: Arc::clone(&self.scene),
+            superset,
+            xml,
+        })
+    }
+
     /// A copy of the template every variant starts from: the base with the fixtures.
     #[getter]
     fn template(&self, py: Python<'_>) -> PyResult<PyDocument> {
@@ -581,7 +597,10 @@ impl PyVariant {
 type PatchTuple<'py> = (String, Bound<'py, PyAny>, String, Bound<'py, PyAny>);
 
 /// A patch as Python tuples (see `Variant.patch`).
-fn patch_list<'py>(py: Python<'py>, entries: &[PatchEntry]) -> PyResult<Bound<'py, PyList>> {
+pub(crate) fn patch_list<'py>(
+    py: Python<'py>,
+    entries: &[PatchEntry],
+) -> PyResult<Bound<'py, PyList>> {
     let items = entries
         .iter()
         .map(|e| {
@@ -623,7 +642,15 @@ fn patch_entry(
         mjcf_forge::scene::PATCHABLE
             .iter()
             .map(|p| p.2)
-            .chain(["qpos0", "qpos_spring", "ipos", "iquat"])
+            .chain([
+                "qpos0",
+                "qpos_spring",
+                "ipos",
+                "iquat",
+                "gravcomp",
+                "contype",
+                "conaffinity",
+            ])
             .find(|f| *f == field)
             .ok_or_else(unknown)?
     };

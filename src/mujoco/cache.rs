@@ -141,8 +141,9 @@ struct Target {
     ptr: *mut u8,
     elem: usize,
     n: usize,
-    /// The field holds an id (`geom_matid`), the value a material's name.
-    id: bool,
+    /// The field holds integers: an id (`geom_matid`, the value a material's name) or
+    /// collision bits (`geom_contype`, `geom_conaffinity`).
+    int: bool,
 }
 
 /// How to patch one model: its structure key, scratch data and resolved targets.
@@ -455,7 +456,7 @@ fn write(model: *mut sys::Model, t: &Target, value: &PatchValue) -> Result<(), S
             let name = CString::new(name.as_str()).map_err(|e| e.to_string())?;
             // SAFETY: the model is live; both strings are NUL-terminated.
             let id = unsafe { mjf_patch_name2id(model, kind.as_ptr(), name.as_ptr()) };
-            if id < 0 || !t.id || t.elem != 4 {
+            if id < 0 || !t.int || t.elem != 4 {
                 return Err(format!("no {} named '{}'", object, name.to_string_lossy()));
             }
             // SAFETY: `ptr` points at `n` >= 1 ints of the live model (see `resolve`).
@@ -467,8 +468,9 @@ fn write(model: *mut sys::Model, t: &Target, value: &PatchValue) -> Result<(), S
                 // SAFETY: `ptr` points at `n` elements of `elem` bytes of the live model,
                 // checked against the array's length in `resolve`.
                 unsafe {
-                    match t.elem {
-                        4 => t.ptr.cast::<f32>().add(k).write_unaligned(x as f32),
+                    match (t.elem, t.int) {
+                        (4, true) => t.ptr.cast::<c_int>().add(k).write_unaligned(x as c_int),
+                        (4, false) => t.ptr.cast::<f32>().add(k).write_unaligned(x as f32),
                         _ => t.ptr.cast::<f64>().add(k).write_unaligned(x),
                     }
                 }
@@ -565,7 +567,7 @@ fn resolve(model: &mut CompiledModel, entries: &[PatchEntry]) -> Result<Vec<Targ
             ptr: unsafe { p.add(offset * elem) },
             elem,
             n,
-            id: e.field == "matid",
+            int: matches!(e.field, "matid" | "contype" | "conaffinity"),
         });
     }
     Ok(out)

@@ -35,6 +35,7 @@ mod randomize;
 mod rng;
 mod spec;
 mod splice;
+mod superset;
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -52,6 +53,7 @@ pub use check::{PENETRATION_TOLERANCE, check_model, check_variant};
 pub use params::{Params, PlacedObject, RandomizedValue};
 pub use patch::{PATCHABLE, PatchEntry, PatchValue, VariantPatch};
 pub use randomize::MUJOCO_DEFAULTS;
+pub use superset::Superset;
 
 use place::Placement;
 use randomize::{AttrTarget, Overlay, Randomizer};
@@ -155,6 +157,8 @@ pub(crate) struct Drawn<'s> {
     template: Overlay<'s>,
     /// Each placed object: its instance and its values (root pose first).
     placed: Vec<(&'s Instance, Overlay<'s>)>,
+    /// Each placed object's (group, slot, pool model), in the order of `placed`.
+    choices: Vec<(usize, u32, usize)>,
     params: Params,
 }
 
@@ -505,7 +509,8 @@ impl Scene {
         let mut placed: Vec<place::Placed> = Vec::new();
         let mut instances: Vec<(&Instance, Overlay<'_>)> = Vec::new();
         let mut group_members: Vec<Vec<usize>> = Vec::with_capacity(self.groups.len());
-        for group in &self.groups {
+        let mut choices = Vec::new();
+        for (gi, group) in self.groups.iter().enumerate() {
             let count = rng.int_in(u64::from(group.count.0), u64::from(group.count.1)) as u32;
             let mut members = Vec::with_capacity(count as usize);
             for slot in 0..count {
@@ -548,12 +553,14 @@ impl Scene {
                 members.push(placed.len());
                 placed.push(pose);
                 instances.push((inst, overlay));
+                choices.push((gi, slot, m));
             }
             group_members.push(members);
         }
         Ok(Drawn {
             template,
             placed: instances,
+            choices,
             params,
         })
     }
@@ -575,7 +582,14 @@ impl Scene {
     /// ```
     pub fn patch(&self, index: u64) -> Result<VariantPatch, Errors> {
         let drawn = self.draw(index)?;
-        let (rules, fingerprint) = self.structure.get_or_init(|| {
+        let (rules, fingerprint) = self.structure();
+        Ok(patch::split(fingerprint, rules, index, &drawn))
+    }
+
+    /// What the scene's settings let a patch carry, and the hash structure keys start
+    /// from; made on first use.
+    fn structure(&self) -> &(patch::Rules, [u8; 32]) {
+        self.structure.get_or_init(|| {
             let parts: Vec<&Document> = self
                 .groups
                 .iter()
@@ -591,8 +605,7 @@ impl Scene {
                 patch::Rules::new(&self.template, &parts, self.discard_visual),
                 *h.finalize().as_bytes(),
             )
-        });
-        Ok(patch::split(fingerprint, rules, index, &drawn))
+        })
     }
 
     /// The `<statistic>` values the scene's model sets itself (`extent`, `center`...):

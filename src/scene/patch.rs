@@ -109,7 +109,7 @@ pub(crate) struct Rules {
     ids: Option<ahash::AHashMap<Node, usize>>,
     /// Variants are compiled with `discardvisual`: visual geoms and every material are
     /// not in the compiled model.
-    discard: bool,
+    pub(crate) discard: bool,
 }
 
 impl Rules {
@@ -156,8 +156,16 @@ impl Rules {
 /// The element types an unnamed element of the template can be patched by id.
 const ID_KINDS: [&str; 6] = ["geom", "site", "camera", "light", "joint", "freejoint"];
 
+/// Whether a body has neither `<inertial>` nor geoms of its own: it has no mass, and MuJoCo
+/// gives it its own frame as inertial frame (seen in 3.17.0 and 4.0.0).
+pub(crate) fn massless(doc: &Document, body: Node) -> bool {
+    !doc.descendants(body).any(|n| {
+        n != body && matches!(doc.tag(n), "inertial" | "geom") && owner(doc, n) == Some(body)
+    })
+}
+
 /// The body an element belongs to: its nearest body or world body, through frames.
-fn owner(doc: &Document, node: Node) -> Option<Node> {
+pub(crate) fn owner(doc: &Document, node: Node) -> Option<Node> {
     let mut at = doc.parent(node)?;
     while doc.tag(at) == "frame" {
         at = doc.parent(at)?;
@@ -169,7 +177,7 @@ fn owner(doc: &Document, node: Node) -> Option<Node> {
 /// no ellipsoid fluid model (MuJoCo's reference, `compiler/discardvisual`). `None` when it
 /// is visual but named in another element (contact pairs, sensors, tendons), which keeps
 /// it: such a geom is left to the compile.
-fn discarded(doc: &Document, geom: Node) -> Option<bool> {
+pub(crate) fn discarded(doc: &Document, geom: Node) -> Option<bool> {
     let zero = |a: &str| doc.attr(geom, a).is_some_and(|v| v.trim() == "0");
     let visual = zero("contype")
         && zero("conaffinity")
@@ -242,9 +250,22 @@ pub(crate) fn split(
     index: u64,
     drawn: &Drawn<'_>,
 ) -> VariantPatch {
+    split_parts(fingerprint, rules, index, drawn).0
+}
+
+/// [`split`], with per entry the part it came from (0: the template, k: placed object
+/// k - 1) and how many values went into the key (values, not object choices).
+pub(crate) fn split_parts(
+    fingerprint: &[u8; 32],
+    rules: &Rules,
+    index: u64,
+    drawn: &Drawn<'_>,
+) -> (VariantPatch, Vec<usize>, usize) {
     let mut key = blake3::Hasher::new();
     key.update(fingerprint);
     let mut entries = Vec::new();
+    let mut parts = Vec::new();
+    let mut in_key = 0;
     for o in &drawn.params.objects {
         for s in [o.group.as_str(), &o.slot.to_string(), &o.model] {
             key.update(&(s.len() as u64).to_le_bytes());
@@ -272,8 +293,10 @@ pub(crate) fn split(
                         bodies.push(*node);
                     }
                     entries.push(e);
+                    parts.push(part);
                 }
                 None => {
+                    in_key += 1;
                     key.update(&(part as u64).to_le_bytes());
                     key.update(&(crate::tree::Tree::index(*node) as u64).to_le_bytes());
                     for s in [attr.as_str(), value.as_str()] {
@@ -302,12 +325,9 @@ pub(crate) fn split(
             };
             // A body with neither <inertial> nor geoms has no mass, and MuJoCo gives it
             // its own frame as inertial frame (seen in 3.17.0 and 4.0.0).
-            let massless = !doc.descendants(body).any(|n| {
-                n != body
-                    && matches!(doc.tag(n), "inertial" | "geom")
-                    && owner(doc, n) == Some(body)
-            });
-            if massless && let Some(name) = doc.attr(body, "name") {
+            if massless(doc, body)
+                && let Some(name) = doc.attr(body, "name")
+            {
                 for (field, v) in [("ipos", &pos), ("iquat", &quat)] {
                     entries.push(PatchEntry {
                         object: "body",
@@ -316,6 +336,7 @@ pub(crate) fn split(
                         field,
                         value: PatchValue::Numbers(v.clone()),
                     });
+                    parts.push(part);
                 }
             }
             let Some(joint) = free_joint(doc, body) else {
@@ -330,21 +351,32 @@ pub(crate) fn split(
                     field,
                     value: PatchValue::Numbers(qpos.clone()),
                 });
+                parts.push(part);
             }
         }
     }
+    // The patch's layout too, so that one key always means one list of targets (a model
+    // cache resolves a structure's targets once).
+    for e in &entries {
+        for s in [e.object, e.name.as_str(), e.field] {
+            key.update(&(s.len() as u64).to_le_bytes());
+            key.update(s.as_bytes());
+        }
+        key.update(&e.id.map_or(u64::MAX, |i| i as u64).to_le_bytes());
+    }
     let hash = key.finalize();
-    VariantPatch {
+    let patch = VariantPatch {
         index,
         structure_key: hash.to_hex()[..32].to_string(),
         entries,
-    }
+    };
+    (patch, parts, in_key)
 }
 
 /// Under `discardvisual`: whether the value lands nowhere (every material, a discarded
 /// geom, a geom's material: `Some(true)`), or is left to the compile (a visual geom that
 /// another element names: `None`).
-fn dropped(doc: &Document, node: Node, attr: &str) -> Option<bool> {
+pub(crate) fn dropped(doc: &Document, node: Node, attr: &str) -> Option<bool> {
     // Materials stay when a sensor or a custom tuple names one: then leave them to the
     // compile.
     let materials_kept = || {
@@ -365,7 +397,7 @@ fn dropped(doc: &Document, node: Node, attr: &str) -> Option<bool> {
 /// The patch entry for `attr = value` on `node`, or `None` when it is structure.
 /// `placed_root`: the node is a placed object's root body, whose written orientation is
 /// its `quat` alone (placement clears the others).
-fn entry(
+pub(crate) fn entry(
     doc: &Document,
     node: Node,
     attr: &str,
@@ -455,7 +487,7 @@ fn object_of(tag: &str) -> &'static str {
 }
 
 /// The body's free joint's name, when its only joint is a named free joint.
-fn free_joint(doc: &Document, body: Node) -> Option<&str> {
+pub(crate) fn free_joint(doc: &Document, body: Node) -> Option<&str> {
     let mut joints = doc
         .elements(body)
         .filter(|&k| matches!(doc.tag(k), "joint" | "freejoint"));

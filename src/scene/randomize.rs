@@ -108,7 +108,7 @@ pub const MUJOCO_DEFAULTS: &[(&str, &str, &str)] = &[
     ("site", "pos", "0 0 0"),
 ];
 
-fn mujoco_default(kind: &str, attribute: &str) -> Option<&'static str> {
+pub(crate) fn mujoco_default(kind: &str, attribute: &str) -> Option<&'static str> {
     MUJOCO_DEFAULTS
         .iter()
         .find(|(k, a, _)| *k == kind && *a == attribute)

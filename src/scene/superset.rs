@@ -1,0 +1,370 @@
+//! One structure for a whole scene (`superset`): a model holding the template and every
+//! object any slot of any group can hold, so that every variant, structural ones included,
+//! is a patch of one compiled model, as batched simulators (MJX, MuJoCo Warp, MuJoCo's
+//! batch API) need: all worlds share one structure.
+//!
+//! Every candidate object is compiled as it is authored (colliding geoms colliding: MuJoCo
+//! cannot switch on a geom compiled as non-colliding in a body whose other geoms collide),
+//! with gravity compensation on its bodies (so that `ngravcomp` counts them and switching
+//! it per body works). A variant's superset patch then sets, per candidate:
+//! - placed in the variant: its authored `contype`, `conaffinity`, `rgba` and `gravcomp`,
+//!   and the variant's own values (pose, colours, ...);
+//! - not placed (parked): no contacts (`contype` = `conaffinity` = 0), invisible (alpha
+//!   0), held still (`gravcomp` 1, at rest), below the world, one place per candidate.
+
+use crate::document::Document;
+use crate::error::{Error, ErrorKind, Errors};
+use crate::merge::MergePart;
+use crate::tree::Node;
+
+use super::patch::{self, PatchEntry, PatchValue, VariantPatch};
+use super::{Scene, place};
+
+/// Where parked objects wait: straight below the world's origin, this deep, one candidate
+/// every `PARK_STEP` further down.
+const PARK_DEPTH: f64 = -50.0;
+const PARK_STEP: f64 = 5.0;
+
+/// The superset of a scene (see the module).
+#[derive(Debug)]
+pub struct Superset {
+    /// The model: the template with every candidate object parked.
+    pub document: Document,
+    /// The structure key every variant's superset patch carries.
+    pub structure_key: String,
+    members: Vec<Member>,
+}
+
+/// One candidate object: group, slot and pool model, and what switching it takes.
+#[derive(Debug)]
+struct Member {
+    choice: (usize, u32, usize),
+    /// Added before the instance's names in the superset (when a slot can hold several
+    /// pool models, their instances would otherwise share names).
+    tag: String,
+    root: String,
+    joint: Option<String>,
+    root_massless: bool,
+    parked: [f64; 3],
+    /// Superset names of its bodies and their authored `gravcomp`.
+    bodies: Vec<(String, f64)>,
+    /// Superset names of its geoms (those the compiled model keeps), their authored
+    /// `contype`, `conaffinity` and `rgba` (as `f32`).
+    geoms: Vec<(String, f64, f64, [f64; 4])>,
+}
+
+fn number(doc: &Document, node: Node, attr: &str, default: f64) -> f64 {
+    doc.attr(node, attr)
+        .and_then(|v| v.trim().parse().ok())
+        .unwrap_or(default)
+}
+
+impl Scene {
+    /// The scene's superset (see [`Superset`]): every object any slot can hold, parked.
+    ///
+    /// ```
+    /// let scene = mjcf_forge::scene::Scene::demo()?;
+    /// let sup = scene.superset()?;
+    /// // Slots of clutter (up to 4, each one of 3 models), blocks (2), coins (1).
+    /// let xml = sup.document.to_xml_string();
+    /// assert!(xml.contains("m2_clutter3_"));
+    /// # Ok::<(), mjcf_forge::Errors>(())
+    /// ```
+    pub fn superset(&self) -> Result<Superset, Errors> {
+        let mut doc = self.template.clone();
+        let mut parts: Vec<(Document, String)> = Vec::new();
+        let mut members = Vec::new();
+        for (gi, group) in self.groups.iter().enumerate() {
+            for slot in 0..group.count.1 {
+                for m in 0..group.pool.len() {
+                    let inst = self.instance(group, slot, m)?;
+                    let mut part = inst.doc.clone();
+                    place::clear_orientation(&mut part, inst.root);
+                    let tag = if group.pool.len() > 1 {
+                        format!("m{m}_")
+                    } else {
+                        String::new()
+                    };
+                    if !tag.is_empty() {
+                        part.apply_prefix(&tag).map_err(|e| Errors(vec![e]))?;
+                    }
+                    let k = members.len() as f64;
+                    let parked = [0.0, 0.0, PARK_DEPTH - PARK_STEP * k];
+                    members.push(member(
+                        &mut part,
+                        inst.root,
+                        (gi, slot, m),
+                        tag,
+                        parked,
+                        self.discard_visual,
+                    )?);
+                    parts.push((part, inst.prefix.clone()));
+                }
+            }
+        }
+        let docs: Vec<&Document> = parts.iter().map(|(d, _)| d).collect();
+        let clashes = doc.name_clashes(&docs);
+        if !clashes.is_empty() {
+            return Err(Errors(clashes));
+        }
+        let merge: Vec<MergePart<'_>> = parts
+            .iter()
+            .map(|(d, prefix)| MergePart {
+                doc: d,
+                into: None,
+                prefix,
+            })
+            .collect();
+        doc.merge_unchecked(&merge, false)?;
+        if self.discard_visual {
+            super::set_discard_visual(&mut doc);
+        }
+        let (_, fingerprint) = self.structure();
+        let mut key = blake3::Hasher::new();
+        key.update(fingerprint);
+        key.update(b"superset");
+        Ok(Superset {
+            document: doc,
+            structure_key: key.finalize().to_hex()[..32].to_string(),
+            members,
+        })
+    }
+
+    /// Variant `index` as a patch of the scene's superset: which candidates are placed
+    /// (and their values), which are parked. An error when the variant randomizes a value
+    /// no patch can carry (see [`super::PATCHABLE`]): its model is not a patch of any
+    /// other.
+    pub fn superset_patch(&self, superset: &Superset, index: u64) -> Result<VariantPatch, Errors> {
+        let drawn = self.draw(index)?;
+        let (rules, fingerprint) = self.structure();
+        let (own, parts, in_key) = patch::split_parts(fingerprint, rules, index, &drawn);
+        if in_key > 0 {
+            return Err(Errors(vec![Error::bare(ErrorKind::Invalid(format!(
+                "variant {index}: {in_key} randomized value(s) cannot be patched (see \
+                 PATCHABLE), so the variant is not a patch of the superset"
+            )))]));
+        }
+        let placed: Vec<Option<usize>> = drawn
+            .choices
+            .iter()
+            .map(|c| superset.members.iter().position(|m| m.choice == *c))
+            .collect();
+        let mut entries = Vec::new();
+        let numbers = |v: &[f64]| PatchValue::Numbers(v.to_vec());
+        let push = |entries: &mut Vec<PatchEntry>, object, name: &str, field, value| {
+            entries.push(PatchEntry {
+                object,
+                name: name.to_string(),
+                id: None,
+                field,
+                value,
+            });
+        };
+        for (k, m) in superset.members.iter().enumerate() {
+            let active = placed.contains(&Some(k));
+            for (body, gravcomp) in &m.bodies {
+                let g = if active { *gravcomp } else { 1.0 };
+                push(&mut entries, "body", body, "gravcomp", numbers(&[g]));
+            }
+            for (geom, contype, conaffinity, rgba) in &m.geoms {
+                let (c, a, alpha) = if active {
+                    (*contype, *conaffinity, rgba[3])
+                } else {
+                    (0.0, 0.0, 0.0)
+                };
+                push(&mut entries, "geom", geom, "contype", numbers(&[c]));
+                push(&mut entries, "geom", geom, "conaffinity", numbers(&[a]));
+                push(
+                    &mut entries,
+                    "geom",
+                    geom,
+                    "rgba",
+                    numbers(&[rgba[0], rgba[1], rgba[2], alpha]),
+                );
+            }
+            if !active {
+                // Every value a randomizer may give this object, back to as authored: a
+                // parked object's model is the same whichever variants came before.
+                let (g, slot, model) = m.choice;
+                let inst = self.instance(&self.groups[g], slot, model)?;
+                for (k, targets) in &inst.targets {
+                    for t in targets {
+                        for attr in self.randomizers[*k].attributes_set(&inst.doc, t.node) {
+                            let tag = inst.doc.tag(t.node);
+                            let Some(authored) = inst
+                                .doc
+                                .attr(t.node, attr)
+                                .or_else(|| super::randomize::mujoco_default(tag, attr))
+                            else {
+                                continue;
+                            };
+                            if rules.discard
+                                && patch::dropped(&inst.doc, t.node, attr) != Some(false)
+                            {
+                                continue;
+                            }
+                            let root = t.node == inst.root;
+                            if let Some(mut e) =
+                                patch::entry(&inst.doc, t.node, attr, authored, rules, None, root)
+                            {
+                                e.name = format!("{}{}", m.tag, e.name);
+                                entries.push(e);
+                            }
+                        }
+                    }
+                }
+                let quat = [1.0, 0.0, 0.0, 0.0];
+                push(&mut entries, "body", &m.root, "pos", numbers(&m.parked));
+                push(&mut entries, "body", &m.root, "quat", numbers(&quat));
+                if m.root_massless {
+                    push(&mut entries, "body", &m.root, "ipos", numbers(&m.parked));
+                    push(&mut entries, "body", &m.root, "iquat", numbers(&quat));
+                }
+                if let Some(j) = &m.joint {
+                    let qpos: Vec<f64> = m.parked.iter().chain(&quat).copied().collect();
+                    push(&mut entries, "joint", j, "qpos0", numbers(&qpos));
+                    push(&mut entries, "joint", j, "qpos_spring", numbers(&qpos));
+                }
+            }
+        }
+        for (mut e, part) in own.entries.into_iter().zip(parts) {
+            if part > 0 {
+                let m = placed[part - 1].map(|k| &superset.members[k]);
+                if let Some(m) = m
+                    && e.id.is_none()
+                {
+                    e.name = format!("{}{}", m.tag, e.name);
+                }
+            }
+            entries.push(e);
+        }
+        Ok(VariantPatch {
+            index,
+            structure_key: superset.structure_key.clone(),
+            entries,
+        })
+    }
+}
+
+impl Scene {
+    /// For variant `index`, each placed object's prefix and the tag its names carry in the
+    /// superset (a superset name is tag + the variant's name; the tag is empty when the
+    /// object's group draws from one model).
+    pub fn superset_names(
+        &self,
+        superset: &Superset,
+        index: u64,
+    ) -> Result<Vec<(String, String)>, Errors> {
+        let drawn = self.draw(index)?;
+        Ok(drawn
+            .placed
+            .iter()
+            .zip(&drawn.choices)
+            .filter_map(|((inst, _), c)| {
+                let m = superset.members.iter().find(|m| m.choice == *c)?;
+                Some((inst.prefix.clone(), m.tag.clone()))
+            })
+            .collect())
+    }
+}
+
+impl Scene {
+    /// For variant `index`, the superset names of the root bodies of the objects it does
+    /// not place (parked).
+    pub fn superset_parked(&self, superset: &Superset, index: u64) -> Result<Vec<String>, Errors> {
+        let drawn = self.draw(index)?;
+        Ok(superset
+            .members
+            .iter()
+            .filter(|m| !drawn.choices.contains(&m.choice))
+            .map(|m| m.root.clone())
+            .collect())
+    }
+}
+
+/// Prepares one candidate's instance for the superset (parked, gravity-compensated, every
+/// body and geom named) and records what switching it takes.
+fn member(
+    part: &mut Document,
+    root: Node,
+    choice: (usize, u32, usize),
+    tag: String,
+    parked: [f64; 3],
+    discard: bool,
+) -> Result<Member, Errors> {
+    let unnamed = |part: &Document, what: &str| {
+        Errors(vec![part.error_at(
+            root,
+            ErrorKind::Invalid(format!(
+                "the superset needs every {what} of a placed object named (give it a name, or \
+                 set name_unnamed_geoms for geoms)"
+            )),
+        )])
+    };
+    let root_name = part
+        .attr(root, "name")
+        .ok_or_else(|| unnamed(part, "root body"))?
+        .to_string();
+    let joint = patch::free_joint(part, root).map(str::to_string);
+    let root_massless = patch::massless(part, root);
+    part.set_attr(root, "pos", &place::join(&parked));
+    part.set_attr(root, "quat", "1 0 0 0");
+    let nodes: Vec<Node> = std::iter::once(root)
+        .chain(part.descendants(root))
+        .collect();
+    let mut bodies = Vec::new();
+    let mut geoms = Vec::new();
+    for n in nodes {
+        match part.tag(n) {
+            "body"
+                if !bodies
+                    .iter()
+                    .any(|(b, _): &(String, f64)| Some(b.as_str()) == part.attr(n, "name")) =>
+            {
+                let name = part
+                    .attr(n, "name")
+                    .ok_or_else(|| unnamed(part, "body"))?
+                    .to_string();
+                bodies.push((name, number(part, n, "gravcomp", 0.0)));
+                part.set_attr(n, "gravcomp", "1");
+            }
+            "geom" => {
+                if discard && patch::discarded(part, n) != Some(false) {
+                    // Not in the compiled model (or kept by a reference: left alone).
+                    continue;
+                }
+                let name = part
+                    .attr(n, "name")
+                    .ok_or_else(|| unnamed(part, "geom"))?
+                    .to_string();
+                let rgba: Vec<f64> = part
+                    .attr(n, "rgba")
+                    .unwrap_or("0.5 0.5 0.5 1")
+                    .split_ascii_whitespace()
+                    .filter_map(|t| t.parse::<f32>().ok().map(f64::from))
+                    .collect();
+                let rgba = match rgba[..] {
+                    [r, g, b, a] => [r, g, b, a],
+                    _ => return Err(unnamed(part, "geom with a readable rgba,")),
+                };
+                geoms.push((
+                    name,
+                    number(part, n, "contype", 1.0),
+                    number(part, n, "conaffinity", 1.0),
+                    rgba,
+                ));
+            }
+            _ => {}
+        }
+    }
+    Ok(Member {
+        choice,
+        tag,
+        root: root_name,
+        joint,
+        root_massless,
+        parked,
+        bodies,
+        geoms,
+    })
+}
