@@ -17,7 +17,13 @@ Best and median of RUNS (compile: COMPILES) per item, after one warm-up; a sampl
 patched models is checked bit for bit against compiling their XML before timing (a
 failure stops the script). Prints one JSON line, then the ratios.
 
-Usage: python scripts/bench_model_cache.py [--scene S] [--runs N] [--compiles K]
+With --superset (default scene then benches/scenes/lift5.toml: five slots of six
+robosuite objects), the scene's superset instead: its size against a variant's own model,
+its compile, a variant patched into it (`cache.model(variant)`), and the simulation speed
+of the superset model against the variant's own (mj_step, STEPS steps from the initial
+pose, best of 3).
+
+Usage: python scripts/bench_model_cache.py [--scene S] [--runs N] [--compiles K] [--superset]
 (run with .cache/venv's Python for MuJoCo 3.17.0, .cache/venv-mj4's for 4.0.0).
 """
 from __future__ import annotations
@@ -51,12 +57,59 @@ def summary(ms: list[float]) -> dict:
     return {"best_ms": min(ms), "median_ms": statistics.median(ms), "runs": len(ms)}
 
 
+def steps_per_second(model, steps: int) -> float:
+    data = mujoco.MjData(model)
+    best = float("inf")
+    for _ in range(3):
+        mujoco.mj_resetData(model, data)
+        t = time.perf_counter()
+        mujoco.mj_step(model, data, nstep=steps)
+        best = min(best, time.perf_counter() - t)
+    return steps / best
+
+
+def superset(args) -> int:
+    scene = mjcf_forge.Scene.load(args.scene)
+    t = time.perf_counter()
+    cache = mjcf_forge.ModelCache(scene, superset=True)
+    first = scene.variant(0)
+    model = cache.model(first)
+    compile_ms = (time.perf_counter() - t) * 1e3
+    own = mujoco.MjModel.from_xml_string(first.xml)
+    variants = [scene.variant(i) for i in range(args.runs + 1)]
+    patch_ms = summary(timed(lambda i: cache.model(variants[i]), args.runs))
+    cache.model(first)
+    result = {
+        "scene": args.scene,
+        "mujoco": mujoco.__version__,
+        "superset": {"nbody": model.nbody, "nv": model.nv, "ngeom": model.ngeom,
+                     "compile_ms": compile_ms},
+        "variant_0": {"nbody": own.nbody, "nv": own.nv, "ngeom": own.ngeom},
+        "patch": patch_ms,
+        "steps_per_second": {"superset": steps_per_second(model, args.steps),
+                             "own_model": steps_per_second(own, args.steps)},
+    }
+    print(json.dumps(result))
+    sp = result["steps_per_second"]
+    print(f"superset: {model.nbody} bodies / {model.nv} dofs against {own.nbody} / {own.nv}; "
+          f"compiled once in {compile_ms:.0f} ms; a variant patched in {patch_ms['median_ms']:.3f} ms "
+          f"median; mj_step {sp['superset']:.0f}/s against {sp['own_model']:.0f}/s on the variant's "
+          f"own model ({sp['superset'] / sp['own_model']:.2f}x)")
+    return 0
+
+
 def main() -> int:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--scene", default=str(ROOT / "benches" / "scenes" / "lift5_fixed.toml"))
+    ap.add_argument("--scene", default=None)
     ap.add_argument("--runs", type=int, default=300)
     ap.add_argument("--compiles", type=int, default=15)
+    ap.add_argument("--superset", action="store_true")
+    ap.add_argument("--steps", type=int, default=2000)
     args = ap.parse_args()
+    if args.superset:
+        args.scene = args.scene or str(ROOT / "benches" / "scenes" / "lift5.toml")
+        return superset(args)
+    args.scene = args.scene or str(ROOT / "benches" / "scenes" / "lift5_fixed.toml")
 
     scene = mjcf_forge.Scene.load(args.scene)
     cache = mjcf_forge.ModelCache(scene)
