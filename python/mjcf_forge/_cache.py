@@ -333,6 +333,8 @@ class ModelCache:
         self._max_bytes = max_bytes
         #: The scene's :class:`Superset` when every variant is a patch of it, else None.
         self.superset = scene.superset() if superset else None
+        # Superset: per set of parked objects, the dofs the variant's own model has.
+        self._kept_dofs: dict[tuple[str, ...], np.ndarray] = {}
         # Cached models by structure key, least recently used first.
         self._entries: collections.OrderedDict[str, Any] = collections.OrderedDict()
         # How to patch each model seen (cached ones and the caller's), by id; holding the
@@ -379,15 +381,19 @@ class ModelCache:
         as the variant's own model has it: the mean of the mass matrix's diagonal over the
         dofs of what the variant places (in the superset's dof order, which is the
         variant's), parked objects left out."""
-        parked = set()
-        for root in self.superset.parked(variant.index):
-            b = model.body(root).id
-            stack = [b]
-            while stack:
-                c = stack.pop()
-                parked.update(range(model.body_dofadr[c], model.body_dofadr[c] + model.body_dofnum[c]))
-                stack.extend(np.flatnonzero(model.body_parentid == c).tolist())
-        keep = np.array([i for i in range(model.nv) if i not in parked], dtype=int)
+        roots = tuple(self.superset.parked(variant.index))
+        keep = self._kept_dofs.get(roots)
+        if keep is None:
+            parked: set[int] = set()
+            for root in roots:
+                stack = [model.body(root).id]
+                while stack:
+                    c = stack.pop()
+                    first = model.body_dofadr[c]
+                    parked.update(range(first, first + model.body_dofnum[c]))
+                    stack.extend(np.flatnonzero(model.body_parentid == c).tolist())
+            keep = np.array([i for i in range(model.nv) if i not in parked], dtype=int)
+            self._kept_dofs[roots] = keep
         if len(keep):
             model.stat.meaninertia = _in_order_sum(plan.M[plan.M_diagonal[keep]]) / len(keep)
 

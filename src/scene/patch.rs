@@ -499,7 +499,7 @@ pub(crate) fn free_joint(doc: &Document, body: Node) -> Option<&str> {
 }
 
 /// Exactly `n` numbers, each as MuJoCo reads it (`f32` for a `float` field).
-fn numbers(text: &str, n: usize, float: bool) -> Option<Vec<f64>> {
+pub(crate) fn numbers(text: &str, n: usize, float: bool) -> Option<Vec<f64>> {
     let v: Vec<f64> = text
         .split_ascii_whitespace()
         .map(|t| {
@@ -516,7 +516,7 @@ fn numbers(text: &str, n: usize, float: bool) -> Option<Vec<f64>> {
 /// A quaternion normalized as MuJoCo's compiler does (`mjuu_normvec`, `mjEPS` = 1e-14):
 /// left alone when its norm is within 1e-14 of 1 (3.17.0 and 4.0.0 both keep
 /// `quat="1.0000000000000002 0 0 0"` as written).
-fn normalized(q: Vec<f64>) -> Vec<f64> {
+pub(crate) fn normalized(q: Vec<f64>) -> Vec<f64> {
     const EPS: f64 = 1e-14;
     let squares = q.iter().fold(0.0, |acc, x| acc + x * x);
     if squares < EPS {

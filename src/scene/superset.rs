@@ -18,6 +18,7 @@ use crate::merge::MergePart;
 use crate::tree::Node;
 
 use super::patch::{self, PatchEntry, PatchValue, VariantPatch};
+use super::randomize::AttrTarget as _;
 use super::{Scene, place};
 
 /// Where parked objects wait: straight below the world's origin, this deep, one candidate
@@ -160,15 +161,61 @@ impl Scene {
                 value,
             });
         };
+        // Per candidate, in one layout whatever the variant (so that a model cache resolves
+        // the superset's targets once): every value a randomizer may give it (placed: the
+        // variant's; parked: as authored, so that its model never depends on earlier
+        // variants), then its switches (gravity compensation, collision bits, colour with
+        // alpha 0 when parked), then its pose.
         for (k, m) in superset.members.iter().enumerate() {
-            let active = placed.contains(&Some(k));
+            let at = placed.iter().position(|p| *p == Some(k));
+            let overlay = at.map(|j| &drawn.placed[j].1);
+            let (g, slot, model) = m.choice;
+            let inst = self.instance(&self.groups[g], slot, model)?;
+            let mut rgba: Vec<(String, Vec<f64>)> = Vec::new();
+            for (r, targets) in &inst.targets {
+                for t in targets {
+                    for attr in self.randomizers[*r].attributes_set(&inst.doc, t.node) {
+                        let tag = inst.doc.tag(t.node);
+                        let value = match overlay {
+                            Some(o) => o.get(t.node, attr),
+                            None => inst
+                                .doc
+                                .attr(t.node, attr)
+                                .or_else(|| super::randomize::mujoco_default(tag, attr)),
+                        };
+                        let Some(value) = value else { continue };
+                        if rules.discard && patch::dropped(&inst.doc, t.node, attr) != Some(false) {
+                            continue;
+                        }
+                        let root = t.node == inst.root;
+                        let Some(mut e) =
+                            patch::entry(&inst.doc, t.node, attr, value, rules, None, root)
+                        else {
+                            continue;
+                        };
+                        e.name = format!("{}{}", m.tag, e.name);
+                        match (&e.value, e.object, e.field) {
+                            (PatchValue::Numbers(v), "geom", "rgba") => {
+                                rgba.push((e.name.clone(), v.clone()));
+                            }
+                            _ => entries.push(e),
+                        }
+                    }
+                }
+            }
+            let active = overlay.is_some();
             for (body, gravcomp) in &m.bodies {
                 let g = if active { *gravcomp } else { 1.0 };
                 push(&mut entries, "body", body, "gravcomp", numbers(&[g]));
             }
-            for (geom, contype, conaffinity, rgba) in &m.geoms {
+            for (geom, contype, conaffinity, authored) in &m.geoms {
+                let colour = rgba
+                    .iter()
+                    .rev()
+                    .find(|(n, _)| n == geom)
+                    .map_or(authored.to_vec(), |(_, v)| v.clone());
                 let (c, a, alpha) = if active {
-                    (*contype, *conaffinity, rgba[3])
+                    (*contype, *conaffinity, colour[3])
                 } else {
                     (0.0, 0.0, 0.0)
                 };
@@ -179,64 +226,44 @@ impl Scene {
                     "geom",
                     geom,
                     "rgba",
-                    numbers(&[rgba[0], rgba[1], rgba[2], alpha]),
+                    numbers(&[colour[0], colour[1], colour[2], alpha]),
                 );
             }
-            if !active {
-                // Every value a randomizer may give this object, back to as authored: a
-                // parked object's model is the same whichever variants came before.
-                let (g, slot, model) = m.choice;
-                let inst = self.instance(&self.groups[g], slot, model)?;
-                for (k, targets) in &inst.targets {
-                    for t in targets {
-                        for attr in self.randomizers[*k].attributes_set(&inst.doc, t.node) {
-                            let tag = inst.doc.tag(t.node);
-                            let Some(authored) = inst
-                                .doc
-                                .attr(t.node, attr)
-                                .or_else(|| super::randomize::mujoco_default(tag, attr))
-                            else {
-                                continue;
-                            };
-                            if rules.discard
-                                && patch::dropped(&inst.doc, t.node, attr) != Some(false)
-                            {
-                                continue;
-                            }
-                            let root = t.node == inst.root;
-                            if let Some(mut e) =
-                                patch::entry(&inst.doc, t.node, attr, authored, rules, None, root)
-                            {
-                                e.name = format!("{}{}", m.tag, e.name);
-                                entries.push(e);
-                            }
+            let (pos, quat) = match overlay {
+                Some(o) => {
+                    let read = |a: &str, n| {
+                        o.get(inst.root, a)
+                            .and_then(|v| patch::numbers(v, n, false))
+                    };
+                    match (read("pos", 3), read("quat", 4)) {
+                        (Some(p), Some(q)) => (p, patch::normalized(q)),
+                        _ => {
+                            return Err(Errors(vec![Error::bare(ErrorKind::Invalid(format!(
+                                "variant {index}: the pose of '{}' cannot be read",
+                                m.root
+                            )))]));
                         }
                     }
                 }
-                let quat = [1.0, 0.0, 0.0, 0.0];
-                push(&mut entries, "body", &m.root, "pos", numbers(&m.parked));
-                push(&mut entries, "body", &m.root, "quat", numbers(&quat));
-                if m.root_massless {
-                    push(&mut entries, "body", &m.root, "ipos", numbers(&m.parked));
-                    push(&mut entries, "body", &m.root, "iquat", numbers(&quat));
-                }
-                if let Some(j) = &m.joint {
-                    let qpos: Vec<f64> = m.parked.iter().chain(&quat).copied().collect();
-                    push(&mut entries, "joint", j, "qpos0", numbers(&qpos));
-                    push(&mut entries, "joint", j, "qpos_spring", numbers(&qpos));
-                }
+                None => (m.parked.to_vec(), vec![1.0, 0.0, 0.0, 0.0]),
+            };
+            push(&mut entries, "body", &m.root, "pos", numbers(&pos));
+            push(&mut entries, "body", &m.root, "quat", numbers(&quat));
+            if m.root_massless {
+                push(&mut entries, "body", &m.root, "ipos", numbers(&pos));
+                push(&mut entries, "body", &m.root, "iquat", numbers(&quat));
+            }
+            if let Some(j) = &m.joint {
+                let qpos: Vec<f64> = pos.iter().chain(&quat).copied().collect();
+                push(&mut entries, "joint", j, "qpos0", numbers(&qpos));
+                push(&mut entries, "joint", j, "qpos_spring", numbers(&qpos));
             }
         }
-        for (mut e, part) in own.entries.into_iter().zip(parts) {
-            if part > 0 {
-                let m = placed[part - 1].map(|k| &superset.members[k]);
-                if let Some(m) = m
-                    && e.id.is_none()
-                {
-                    e.name = format!("{}{}", m.tag, e.name);
-                }
+        // The template's own values.
+        for (e, part) in own.entries.into_iter().zip(parts) {
+            if part == 0 {
+                entries.push(e);
             }
-            entries.push(e);
         }
         Ok(VariantPatch {
             index,
