@@ -192,3 +192,16 @@ const char* mjf_patch_array_name(int i) {
   if (i < 0 || (size_t)i >= sizeof(names) / sizeof(names[0])) return NULL;
   return names[i];
 }
+
+// Superset: stat.meaninertia as the variant's own model has it, the mean of the mass
+// matrix's diagonal (at qpos0, as the statistics left it in `d`) over the `n` dofs in
+// `keep` (the variant's, in order).
+void mjf_patch_meaninertia(mjModel* m, const mjData* d, const int* keep, int n) {
+  if (n <= 0) return;
+  double inertia = 0;
+  for (int k = 0; k < n; k++) {
+    int i = keep[k];
+    inertia += d->M[m->M_rowadr[i] + m->M_rownnz[i] - 1];
+  }
+  m->stat.meaninertia = inertia / n;
+}

@@ -131,3 +131,78 @@ fn discard_visual_variants_are_patched_bit_for_bit() {
     }
     assert!(cache.patches() > 0);
 }
+
+#[test]
+fn superset_holds_every_variant() {
+    use mjcf_forge::mujoco::ObjType;
+    let scene = Scene::load(root().join("corpora/scenes/patch/patch.toml")).unwrap();
+    let superset = scene.superset().unwrap();
+    let mut cache = ModelCache::new(&scene, 2, None).with_superset().unwrap();
+    for i in 0..6 {
+        let want = compiled(&scene, i);
+        let tags = scene.superset_names(&superset, i).unwrap();
+        let name = |n: &str| {
+            tags.iter()
+                .find(|(p, _)| n.starts_with(p.as_str()))
+                .map_or(n.to_string(), |(_, t)| format!("{t}{n}"))
+        };
+        let got = cache.model(i).unwrap();
+        let (got_bodies, got_geoms) = (got.names(ObjType::Body), got.names(ObjType::Geom));
+        for (b, n) in want.names(ObjType::Body).iter().enumerate().skip(1) {
+            let k = got_bodies.iter().position(|x| *x == name(n)).unwrap();
+            assert_eq!(got.body_mass()[k], want.body_mass()[b], "variant {i}: {n}");
+            assert_eq!(
+                got.body_pos()[3 * k..3 * k + 3],
+                want.body_pos()[3 * b..3 * b + 3]
+            );
+            assert_eq!(
+                got.body_quat()[4 * k..4 * k + 4],
+                want.body_quat()[4 * b..4 * b + 4]
+            );
+            assert_eq!(
+                got.body_inertia()[3 * k..3 * k + 3],
+                want.body_inertia()[3 * b..3 * b + 3]
+            );
+            assert_eq!(
+                got.body_ipos()[3 * k..3 * k + 3],
+                want.body_ipos()[3 * b..3 * b + 3]
+            );
+        }
+        for (g, n) in want.names(ObjType::Geom).iter().enumerate() {
+            if n.is_empty() {
+                continue;
+            }
+            let k = got_geoms.iter().position(|x| *x == name(n)).unwrap();
+            assert_eq!(
+                got.geom_rgba()[4 * k..4 * k + 4],
+                want.geom_rgba()[4 * g..4 * g + 4],
+                "variant {i}: {n}"
+            );
+            assert_eq!(
+                got.geom_friction()[3 * k..3 * k + 3],
+                want.geom_friction()[3 * g..3 * g + 3]
+            );
+            assert_eq!(
+                got.geom_size()[3 * k..3 * k + 3],
+                want.geom_size()[3 * g..3 * g + 3]
+            );
+        }
+        // The same contacts at the initial pose: parked objects touch nothing.
+        let pairs = |m: &CompiledModel, rename: &dyn Fn(&str) -> String| {
+            let geoms = m.names(ObjType::Geom);
+            let mut v: Vec<(String, String)> = m
+                .initial_contacts()
+                .iter()
+                .map(|c| {
+                    let (a, b) = (rename(&geoms[c.geom1]), rename(&geoms[c.geom2]));
+                    if a < b { (a, b) } else { (b, a) }
+                })
+                .collect();
+            v.sort();
+            v
+        };
+        let got = cache.model(i).unwrap();
+        assert_eq!(pairs(got, &|n: &str| n.to_string()), pairs(&want, &name));
+    }
+    assert_eq!(cache.compiles(), 1);
+}

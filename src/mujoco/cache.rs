@@ -15,7 +15,7 @@ use std::ptr::NonNull;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use super::{CompileError, CompiledModel, ObjType, Sizes, compile_str, sys};
-use crate::scene::{PatchEntry, PatchValue, Scene};
+use crate::scene::{PatchEntry, PatchValue, Scene, Superset, VariantPatch};
 
 /// mjData, opaque here: only the C side reads it.
 #[repr(C)]
@@ -38,6 +38,7 @@ unsafe extern "C" {
     fn mjf_patch_get_stat(m: *const sys::Model, out: *mut f64);
     fn mjf_patch_finish(m: *mut sys::Model, d: *mut RawData, fixed: c_int, values: *const f64);
     fn mjf_patch_array_name(i: c_int) -> *const c_char;
+    fn mjf_patch_meaninertia(m: *mut sys::Model, d: *const RawData, keep: *const c_int, n: c_int);
 }
 
 impl CompiledModel {
@@ -201,6 +202,10 @@ pub struct ModelCache<'s> {
     scene: &'s Scene,
     /// The folder relative file names in the variants' XML resolve against.
     dir: Option<std::path::PathBuf>,
+    /// With [`ModelCache::with_superset`]: the scene's superset and its XML.
+    superset: Option<(Superset, String)>,
+    /// Superset: per set of parked objects, the dofs of the variant's own model.
+    kept_dofs: HashMap<Vec<String>, Vec<c_int>>,
     /// Cached models by structure key, least recently used first.
     entries: Vec<(String, CompiledModel)>,
     state: State,
@@ -239,6 +244,8 @@ impl<'s> ModelCache<'s> {
         ModelCache {
             scene,
             dir: None,
+            superset: None,
+            kept_dofs: HashMap::new(),
             entries: Vec::new(),
             state: State {
                 max_models: max_models.max(1),
@@ -258,6 +265,24 @@ impl<'s> ModelCache<'s> {
     pub fn compiling_in(mut self, dir: impl Into<std::path::PathBuf>) -> Self {
         self.dir = Some(dir.into());
         self
+    }
+
+    /// Makes every variant a patch of one model, the scene's superset
+    /// ([`Scene::superset`]): `model(i)` is that model patched for variant `i`.
+    pub fn with_superset(mut self) -> Result<Self, String> {
+        let superset = self.scene.superset().map_err(|e| e.to_string())?;
+        let xml = superset.document.to_xml_string();
+        self.superset = Some((superset, xml));
+        Ok(self)
+    }
+
+    /// The variant's patch: of its own structure, or of the superset.
+    fn patch_of(&self, index: u64) -> Result<VariantPatch, String> {
+        match &self.superset {
+            Some((s, _)) => self.scene.superset_patch(s, index),
+            None => self.scene.patch(index),
+        }
+        .map_err(|e| e.to_string())
     }
 
     /// Models compiled so far (misses).
@@ -289,20 +314,33 @@ impl<'s> ModelCache<'s> {
     /// structure patched in place, or on a miss the variant compiled (and kept). The model
     /// stays the cache's: the next call for the same structure patches it again.
     pub fn model(&mut self, index: u64) -> Result<&CompiledModel, String> {
-        let patch = self.scene.patch(index).map_err(|e| e.to_string())?;
+        let patch = self.patch_of(index)?;
         let key = patch.structure_key;
-        match self.entries.iter().position(|(k, _)| *k == key) {
+        let at = match self.entries.iter().position(|(k, _)| *k == key) {
             None => {
                 self.compile(index, &key)?;
+                // The superset as compiled parks every object: place the variant's.
+                self.superset.is_some()
             }
             Some(at) => {
                 let entry = self.entries.remove(at);
                 self.entries.push(entry);
-                let last = self.entries.len() - 1;
-                let model = &mut self.entries[last].1;
-                self.state.patch_model(model, &key, &patch.entries)?;
-                self.state.trim(&mut self.entries);
+                true
             }
+        };
+        let last = self.entries.len() - 1;
+        if at {
+            let model = &mut self.entries[last].1;
+            self.state.patch_model(model, &key, &patch.entries)?;
+            variant_inertia(
+                self.scene,
+                &self.superset,
+                &mut self.kept_dofs,
+                &self.state,
+                index,
+                model,
+            )?;
+            self.state.trim(&mut self.entries);
         }
         Ok(&self.entries[self.entries.len() - 1].1)
     }
@@ -310,7 +348,7 @@ impl<'s> ModelCache<'s> {
     /// Patches `model`, a model of variant `index`'s structure, in place into variant
     /// `index`'s compiled model. A model of another structure is refused.
     pub fn apply(&mut self, index: u64, model: &mut CompiledModel) -> Result<(), String> {
-        let patch = self.scene.patch(index).map_err(|e| e.to_string())?;
+        let patch = self.patch_of(index)?;
         let key = patch.structure_key;
         let known = self.state.plans.iter().find(|p| p.serial == model.serial);
         match known {
@@ -335,12 +373,23 @@ impl<'s> ModelCache<'s> {
             }
         }
         self.state.patch_model(model, &key, &patch.entries)?;
+        variant_inertia(
+            self.scene,
+            &self.superset,
+            &mut self.kept_dofs,
+            &self.state,
+            index,
+            model,
+        )?;
         self.state.trim(&mut self.entries);
         Ok(())
     }
 
     fn compile(&mut self, index: u64, key: &str) -> Result<(), String> {
-        let (xml, _) = self.scene.variant_xml(index).map_err(|e| e.to_string())?;
+        let xml = match &self.superset {
+            Some((_, xml)) => xml.clone(),
+            None => self.scene.variant_xml(index).map_err(|e| e.to_string())?.0,
+        };
         let dir = self
             .dir
             .as_deref()
@@ -446,6 +495,88 @@ impl State {
         self.patches += 1;
         Ok(())
     }
+}
+
+/// Superset: `stat.meaninertia` (which scales the constraint solver's tolerance) as the
+/// variant's own model has it: the mass matrix's diagonal over the dofs of what the variant
+/// places (the superset's dof order is the variant's), parked objects left out.
+fn variant_inertia(
+    scene: &Scene,
+    superset: &Option<(Superset, String)>,
+    kept: &mut HashMap<Vec<String>, Vec<c_int>>,
+    state: &State,
+    index: u64,
+    model: &mut CompiledModel,
+) -> Result<(), String> {
+    let Some((superset, _)) = superset else {
+        return Ok(());
+    };
+    let roots = scene
+        .superset_parked(superset, index)
+        .map_err(|e| e.to_string())?;
+    if !kept.contains_key(&roots) {
+        let keep = kept_dofs(model, &roots)?;
+        kept.insert(roots.clone(), keep);
+    }
+    let keep = &kept[&roots];
+    let Some(plan) = state.plans.iter().find(|p| p.serial == model.serial) else {
+        return Ok(());
+    };
+    // SAFETY: live model and its scratch data (left at qpos0 by the statistics); `keep`
+    // holds valid dof indices of this structure.
+    unsafe {
+        mjf_patch_meaninertia(
+            model.ptr.as_ptr(),
+            plan.scratch.0.as_ptr(),
+            keep.as_ptr(),
+            keep.len() as c_int,
+        );
+    }
+    Ok(())
+}
+
+/// The dofs of `model` outside the subtrees of the bodies named in `parked`, in order.
+fn kept_dofs(model: &mut CompiledModel, parked: &[String]) -> Result<Vec<c_int>, String> {
+    let nbody = model.sizes().nbody;
+    let nv = model.sizes().nv;
+    let parent = model.body_parentid().to_vec();
+    let ints = |model: &mut CompiledModel, name: &str| -> Result<Vec<c_int>, String> {
+        let c = CString::new(name).map_err(|e| e.to_string())?;
+        let (mut elem, mut count) = (0usize, 0usize);
+        // SAFETY: live model; NUL-terminated name.
+        let p = unsafe { mjf_patch_array(model.ptr.as_ptr(), c.as_ptr(), &mut elem, &mut count) };
+        if elem != 4 || p.is_null() {
+            return Err(format!("this MuJoCo's mjModel has no int array {name}"));
+        }
+        // SAFETY: `count` ints at `p`.
+        Ok(unsafe { std::slice::from_raw_parts(p.cast::<c_int>(), count) }.to_vec())
+    };
+    let dofadr = ints(model, "body_dofadr")?;
+    let dofnum = ints(model, "body_dofnum")?;
+    let mut out_of = vec![false; nbody];
+    for root in parked {
+        let kind = CString::new("body").map_err(|e| e.to_string())?;
+        let name = CString::new(root.as_str()).map_err(|e| e.to_string())?;
+        // SAFETY: live model; NUL-terminated strings.
+        let id = unsafe { mjf_patch_name2id(model.ptr.as_ptr(), kind.as_ptr(), name.as_ptr()) };
+        let id = usize::try_from(id).map_err(|_| format!("the superset has no body '{root}'"))?;
+        out_of[id] = true;
+    }
+    // Bodies come after their parents: one pass marks whole subtrees.
+    for b in 1..nbody {
+        if out_of[parent[b] as usize] {
+            out_of[b] = true;
+        }
+    }
+    let mut parked_dof = vec![false; nv];
+    for b in (0..nbody).filter(|&b| out_of[b]) {
+        let first = usize::try_from(dofadr[b]).unwrap_or(0);
+        let n = usize::try_from(dofnum[b]).unwrap_or(0);
+        parked_dof[first..first + n].fill(true);
+    }
+    Ok((0..nv as c_int)
+        .filter(|&d| !parked_dof[d as usize])
+        .collect())
 }
 
 /// Writes one entry's value at its target.
