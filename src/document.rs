@@ -19,7 +19,11 @@ pub(crate) struct Span {
 /// A source file of a document and the `<include>` that brought it in.
 #[derive(Clone, Debug)]
 pub(crate) struct SourceFile {
+    /// The file as the user would name it (shown in messages).
     pub(crate) path: Arc<Path>,
+    /// The absolute folder of the path the file was read from (`..` resolved by name, as
+    /// MuJoCo does): a nested include or an asset of an included file may be found here.
+    pub(crate) dir: Arc<Path>,
     /// The include element's span in its own file, `None` for the main file.
     pub(crate) included_at: Option<Span>,
 }
@@ -121,7 +125,7 @@ pub struct Document {
     pub(crate) spans: Vec<Span>,
     pub(crate) files: Arc<Vec<SourceFile>>,
     pub(crate) names: Names,
-    /// The folder of the main file: MuJoCo resolves includes and asset paths from here.
+    /// The folder of the main file: MuJoCo looks for included and asset files here first.
     pub(crate) model_dir: Arc<Path>,
     /// The bounds it was loaded with; files read later (meshes, skins) keep to them too.
     pub(crate) limits: Limits,

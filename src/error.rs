@@ -52,6 +52,16 @@ pub enum ErrorKind {
     NotMjcf(String),
     /// `<include>` without a `file` attribute.
     IncludeWithoutFile,
+    /// A nested `<include>` whose file is neither beside the main file nor beside the file
+    /// that includes it (the two places MuJoCo looks, in that order).
+    IncludeNotFound {
+        /// The path beside the main file, as the user would name it.
+        beside_main: PathBuf,
+        /// The path beside the including file.
+        beside_includer: PathBuf,
+        /// The operating system's words about the second one.
+        reason: String,
+    },
     /// An included file is part of its own include chain.
     IncludeCycle {
         /// The chain of files, outermost first, ending with the repeated one.
@@ -90,6 +100,16 @@ impl fmt::Display for ErrorKind {
             ErrorKind::Syntax(msg) => write!(f, "malformed XML: {msg}"),
             ErrorKind::NotMjcf(msg) => write!(f, "not an MJCF model: {msg}"),
             ErrorKind::IncludeWithoutFile => write!(f, "<include> needs a 'file' attribute"),
+            ErrorKind::IncludeNotFound {
+                beside_main,
+                beside_includer,
+                reason,
+            } => write!(
+                f,
+                "cannot read '{}' (beside the main file) nor '{}' (beside the including file): {reason}",
+                beside_main.display(),
+                beside_includer.display()
+            ),
             ErrorKind::IncludeCycle { chain } => {
                 let names: Vec<String> = chain.iter().map(|p| p.display().to_string()).collect();
                 write!(f, "include cycle: {}", names.join(" -> "))

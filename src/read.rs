@@ -18,6 +18,7 @@ use crate::document::{Document, SourceFile, Span};
 use crate::error::{Error, ErrorKind, Errors, Location};
 use crate::limits::{Limits, read_regular_file};
 use crate::names::{Names, Sym};
+use crate::paths::join_by_name;
 use crate::tree::{Node, NodeData, Tree};
 
 /// Turns byte offsets of one source text into 1-based line:col. The reader asks for
@@ -747,6 +748,7 @@ impl Builder {
             },
             files: vec![SourceFile {
                 path: name.clone(),
+                dir: model_dir.clone(),
                 included_at: None,
             }],
             chain: Vec::new(),
@@ -1438,6 +1440,36 @@ impl Builder {
         }
     }
 
+    /// Where the file an `<include>` in source file `includer` names is: the path to read
+    /// and the path to show. MuJoCo (3.17.0 and 4.0.0 alike, with the main file named by an
+    /// absolute path) looks beside the main file first and, when nothing is there, beside
+    /// the file that holds the `<include>` (the folder it was read from, which may itself
+    /// have been found either way). "Nothing is there" is a failed `stat`: a folder or an
+    /// unreadable file beside the main file is taken, and then refused. Paths are joined
+    /// and `..` is resolved by name, before the file system sees them, as MuJoCo does.
+    fn find_included(&self, file: &str, includer: u32) -> Result<(PathBuf, PathBuf), ErrorKind> {
+        let beside_main = join_by_name(&self.doc.model_dir, file);
+        let shown_beside_main = self.display_dir.join(file);
+        let from = &self.files[includer as usize];
+        let beside_includer = join_by_name(&from.dir, file);
+        // The main file's own includes (and absolute names) have one place to look.
+        if beside_includer == beside_main || std::fs::metadata(&beside_main).is_ok() {
+            return Ok((beside_main, shown_beside_main));
+        }
+        let shown_beside_includer = match from.included_at {
+            Some(_) => from.path.parent().unwrap_or(Path::new("")).join(file),
+            None => self.display_dir.join(file),
+        };
+        match std::fs::metadata(&beside_includer) {
+            Ok(_) => Ok((beside_includer, shown_beside_includer)),
+            Err(err) => Err(ErrorKind::IncludeNotFound {
+                beside_main: shown_beside_main,
+                beside_includer: shown_beside_includer,
+                reason: err.to_string(),
+            }),
+        }
+    }
+
     /// Reads the file an `<include>` (read into the detached `node`) names, in its place
     /// under `host`. With `fast`, the file is read by [`Builder::parse_fast`], and `Ok(false)`
     /// means it was not in that reader's reach (the load then starts over with quick-xml).
@@ -1465,9 +1497,9 @@ impl Builder {
         let Some(file) = self.doc.attr(node, "file").map(str::to_owned) else {
             return Err(Error::at(here(self), ErrorKind::IncludeWithoutFile).into());
         };
-        // MuJoCo resolves every include against the main file's folder, not the including one.
-        let full = self.doc.model_dir.join(&file);
-        let path = self.display_dir.join(&file);
+        let (full, path) = self
+            .find_included(&file, span.file)
+            .map_err(|kind| Error::at(here(self), kind))?;
         let canonical = std::fs::canonicalize(&full).map_err(|err| {
             Error::at(
                 here(self),
@@ -1506,6 +1538,7 @@ impl Builder {
         let index = self.files.len() as u32;
         self.files.push(SourceFile {
             path: Arc::from(path.as_path()),
+            dir: Arc::from(full.parent().unwrap_or(Path::new("/"))),
             included_at: Some(span),
         });
         self.chain.push(canonical.clone());

@@ -10,7 +10,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use common::{forge, path_arg, python_linked, root, scratch, stderr, stdout, wheel_models};
+use common::{
+    forge, include_cases, path_arg, python_linked, root, scratch, stderr, stdout, wheel_models,
+};
 use mjcf_forge::Document;
 
 /// A JSON value of the flat objects both sides print.
@@ -177,10 +179,19 @@ fn sizes_json_parser_reads_both_sides() {
 
 #[test]
 fn compile_json_agrees_with_python_mujoco_on_every_wheel_model() {
-    let dir = scratch("cli_compile_sizes");
-    let models = wheel_models();
-    let expected = python_sizes(&models, &dir);
-    let got = parallel_map(&models, |model| {
+    compile_json_agrees_with_python_mujoco(&wheel_models(), "cli_compile_sizes");
+}
+
+#[test]
+fn compile_json_agrees_with_python_mujoco_on_the_include_cases() {
+    compile_json_agrees_with_python_mujoco(&include_cases(), "cli_compile_include_sizes");
+}
+
+/// `compile --json` of each model prints the sizes Python MuJoCo compiles it to.
+fn compile_json_agrees_with_python_mujoco(models: &[PathBuf], scratch_name: &str) {
+    let dir = scratch(scratch_name);
+    let expected = python_sizes(models, &dir);
+    let got = parallel_map(models, |model| {
         forge(&["compile", "--json", path_arg(model)])
     });
 

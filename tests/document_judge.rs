@@ -1,12 +1,13 @@
 //! The document tier judged by MuJoCo: what `Document::load` writes compiles to the same
 //! model as what it read, on every compiling model of the robosuite and dm-control wheels
-//! and on the feature cases in corpora/features; error cases give their exact messages.
+//! and on the feature cases in corpora/features and corpora/includes; error cases give their
+//! exact messages.
 
 mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{Pair, judge, root, scratch, wheel_models};
+use common::{Pair, include_cases, judge, root, scratch, wheel_models};
 use mjcf_forge::Document;
 
 /// Loads every model, writes it pretty to `dir`, and has MuJoCo compare each pair.
@@ -51,6 +52,7 @@ fn feature_models() -> Vec<PathBuf> {
         .collect();
     v.sort();
     assert!(v.len() >= 14, "feature corpus incomplete");
+    v.extend(include_cases());
     v
 }
 

@@ -595,6 +595,44 @@ fn thousands_of_sibling_includes_stay_linear() {
     );
 }
 
+#[test]
+fn thousands_of_includes_found_beside_an_included_file_stay_linear() {
+    // Each include is looked for beside the main file first (absent), then beside the
+    // including file; each file names a mesh that is nowhere, which is asked for in the mesh
+    // folder and then written beside its file: a few `stat`s per include, no more.
+    let dir = tempfile::tempdir().unwrap();
+    let n = 3000;
+    let sub = dir.path().join("sub");
+    std::fs::create_dir(&sub).unwrap();
+    let mut hub = String::from("<mujoco>");
+    for i in 0..n {
+        std::fs::write(
+            sub.join(format!("b{i}.xml")),
+            format!("<mujoco><asset><mesh name=\"m{i}\" file=\"m{i}.obj\"/></asset></mujoco>"),
+        )
+        .unwrap();
+        hub.push_str(&format!("<include file=\"b{i}.xml\"/>"));
+    }
+    hub.push_str("</mujoco>");
+    std::fs::write(sub.join("hub.xml"), &hub).unwrap();
+    let path = dir.path().join("main.xml");
+    std::fs::write(
+        &path,
+        "<mujoco><compiler meshdir=\"meshes\"/><include file=\"sub/hub.xml\"/></mujoco>",
+    )
+    .unwrap();
+    let files = on_both(move || {
+        Document::load(&path).map_err(|e| e.to_string()).map(|doc| {
+            doc.descendants(doc.root())
+                .filter_map(|n| doc.attr(n, "file").map(str::to_string))
+                .collect::<Vec<_>>()
+        })
+    })
+    .unwrap();
+    assert_eq!(files.len(), n);
+    assert_eq!(files[7], sub.join("m7.obj").to_str().unwrap());
+}
+
 // --- 4. Output that must read back --------------------------------------------------------
 
 #[test]

@@ -276,6 +276,24 @@ fn cases() -> Vec<Case> {
         ],
         fuse_keys: false,
     });
+    // Parts whose included files include their neighbours and name files beside them.
+    cases.push(Case {
+        name: "nested_includes_into_arm".into(),
+        parts: vec![
+            base(ours("arm_with_keys.xml")),
+            part(
+                root().join("corpora/includes/nested_beside_includer/main.xml"),
+                "inc",
+                None,
+            ),
+            part(
+                root().join("corpora/includes/strippath/main.xml"),
+                "sp",
+                None,
+            ),
+        ],
+        fuse_keys: false,
+    });
     cases.push(Case {
         name: "robot_radians_into_arm_degrees".into(),
         parts: vec![

@@ -1,11 +1,11 @@
-//! Prefixing judged by MuJoCo: every compiling wheel model and every feature case, prefixed,
-//! compiles to the same model with every name = prefix + name.
+//! Prefixing judged by MuJoCo: every compiling wheel model and every feature and include case,
+//! prefixed, compiles to the same model with every name = prefix + name.
 
 mod common;
 
 use std::path::PathBuf;
 
-use common::{Pair, judge, root, scratch, wheel_models};
+use common::{Pair, include_cases, judge, root, scratch, wheel_models};
 use mjcf_forge::Document;
 
 fn prefix_and_judge(models: &[PathBuf], dir: &std::path::Path, prefix: &str) {
@@ -46,5 +46,6 @@ fn feature_cases_prefixed_compile_to_the_same_model() {
         .filter(|p| p.extension().is_some_and(|e| e == "xml"))
         .collect();
     models.sort();
+    models.extend(include_cases());
     prefix_and_judge(&models, &scratch("feature_prefix"), "robot1/");
 }

@@ -143,6 +143,20 @@ pub fn wheel_models() -> Vec<PathBuf> {
     models
 }
 
+/// The include cases of ours: `corpora/includes/<case>/main.xml`. Each case is a folder of
+/// files that include each other; the other files there are parts and decoys (files MuJoCo
+/// must not read), not models of their own.
+pub fn include_cases() -> Vec<PathBuf> {
+    let mut cases: Vec<PathBuf> = std::fs::read_dir(root().join("corpora/includes"))
+        .unwrap()
+        .map(|e| e.unwrap().path().join("main.xml"))
+        .filter(|p| p.is_file())
+        .collect();
+    cases.sort();
+    assert!(cases.len() >= 2, "include cases missing");
+    cases
+}
+
 /// A fresh scratch folder under target/.
 pub fn scratch(name: &str) -> PathBuf {
     let dir = root().join("target/test-scratch").join(name);
