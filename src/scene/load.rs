@@ -19,7 +19,8 @@ use super::randomize::{self, Dist, Randomizer};
 use super::spec::{self, SceneSpec};
 use super::{Group, Instance, PoolModel, Scene, splice};
 
-/// The largest count a group may ask for (each slot keeps its prefixed instances).
+/// The largest count a group, and all groups together, may ask for per variant (each slot
+/// keeps its prefixed instances; placement compares every object with the ones before).
 const MAX_COUNT: u32 = 10_000;
 
 /// Where model files come from: the disk, or the demo's built-in texts.
@@ -369,6 +370,19 @@ fn group(
             &g.count,
             format!("count must be n or [min, max] with min <= max <= {MAX_COUNT}"),
         ));
+    } else {
+        // All groups together: placement compares every object with the ones before it.
+        let before: u64 = earlier.iter().map(|e| u64::from(e.count.1)).sum();
+        if before + u64::from(count.1) > u64::from(MAX_COUNT) {
+            errors.push(src.error(
+                &g.count,
+                format!(
+                    "the groups would place up to {} objects per variant; at most {MAX_COUNT} \
+                     in all",
+                    before + u64::from(count.1)
+                ),
+            ));
+        }
     }
     let prefix_pattern = match &g.prefix {
         Some(p) if !p.as_ref().contains("{i}") => {
