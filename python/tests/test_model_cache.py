@@ -87,7 +87,7 @@ def test_structural_values_are_compiled_never_patched():
     assert randomized == {
         ("geom", "size"), ("geom", "density"), ("geom", "euler"), ("geom", "pos"),
         ("light", "dir"), ("light", "cutoff"), ("camera", "pos"),
-        ("joint", "range"), ("joint", "ref"),
+        ("joint", "range"), ("joint", "ref"), ("position", "gear"), ("mesh", "file"),
     }
     # Each of them is structure: every variant its own key, compiled.
     assert len({v.structure_key for v in variants}) == 8
