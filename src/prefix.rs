@@ -174,6 +174,11 @@ impl Document {
         while let Some((node, kind)) = stack.pop() {
             let mut has_name = false;
             let naming = name_attrs(kind);
+            let attach = kind.spec().name == "attach";
+            if attach {
+                self.prefix_attach(node, prefix, &renamed, &mut edits)?;
+                continue;
+            }
             let file_named = named_after_file(kind);
             if naming.is_empty() && file_named.is_none() {
                 for kid in self.elements(node) {
@@ -223,6 +228,16 @@ impl Document {
                     }
                     AttrKind::Plain | AttrKind::File | AttrKind::ObjName => {}
                 }
+            }
+            if kind.spec().name == "model"
+                && self.attr(node, "name").is_none()
+                && let Some(stem) = self.child_model_name(node)?
+                && renamed(Ns::Model, &stem)
+            {
+                // MuJoCo names a `<model>` asset without `name` after the model it holds
+                // (`name=""` stays no name): the `<attach model>` that uses it needs that
+                // name, prefixed.
+                edits.push(Rename::Named { node, stem });
             }
             if let Some(ns) = file_named.filter(|_| !has_name) {
                 // An asset named after its file gets that name explicitly, prefixed.
@@ -287,6 +302,81 @@ impl Document {
 }
 
 impl Document {
+    /// The renames of an `<attach>` (it has no children).
+    ///
+    /// With `model`, it attaches a model asset: `model` names the asset (our namespace),
+    /// `body` and `frame` name elements of the attached model (its namespace, not ours:
+    /// they stay), and MuJoCo 3.17.0 and 4.0.0 name every attached element `prefix` + its
+    /// name, so our prefix goes in front of the attach's own (`prefix="a_"` becomes
+    /// `"p_a_"`, and the attached `x` compiles to `p_a_x`; nested attaches inside the
+    /// asset follow, `p_a_c_y`).
+    ///
+    /// Without `model` it copies a body or frame of this same model (self-attach), naming
+    /// the copies `prefix` + the copied names. Those names are ours, so they are prefixed,
+    /// and the copies would come out as `top_p_belt` where `p_top_belt` is wanted: no
+    /// value of the attach's `prefix` gives that, so we refuse.
+    fn prefix_attach(
+        &self,
+        node: Node,
+        prefix: &str,
+        renamed: &impl Fn(Ns, &str) -> bool,
+        edits: &mut Vec<Rename>,
+    ) -> Result<(), Error> {
+        let syms = [crate::names::sym("model"), crate::names::sym("prefix")];
+        let model = self.attr_ref(node, syms[0]);
+        let Some(model) = model.filter(|m| !self.str(*m).is_empty()) else {
+            let theirs = self.attr(node, "prefix").unwrap_or_default();
+            let what = self.attr(node, "body").map_or_else(
+                || self.attr(node, "frame").map(|f| format!("frame '{f}'")),
+                |b| Some(format!("body '{b}'")),
+            );
+            let what = what.unwrap_or_else(|| "the world body".to_string());
+            let ours = crate::read::clip(prefix, 60);
+            return Err(self.error_at(
+                node,
+                crate::error::ErrorKind::Invalid(format!(
+                    "cannot prefix a self-attach (<attach> of {what} without 'model'): \
+                     MuJoCo names the copies '{theirs}' + the copied names, which prefixing \
+                     renames, so they would compile to '{theirs}{ours}...', not \
+                     '{ours}{theirs}...'"
+                )),
+            ));
+        };
+        if renamed(Ns::Model, self.str(model)) {
+            edits.push(Rename::One {
+                node,
+                name: syms[0],
+                old: model,
+            });
+        }
+        if let Some(theirs) = self.attr_ref(node, syms[1]) {
+            edits.push(Rename::One {
+                node,
+                name: syms[1],
+                old: theirs,
+            });
+        }
+        Ok(())
+    }
+
+    /// The name MuJoCo gives a `<model>` asset without `name`: the `model` attribute of
+    /// the file it names (`MuJoCo Model` when that has none, as in 3.17.0 and 4.0.0).
+    fn child_model_name(&self, node: Node) -> Result<Option<String>, Error> {
+        let Some(file) = self.attr(node, "file") else {
+            return Ok(None);
+        };
+        let child =
+            crate::read::read_file(std::path::Path::new(file), &self.limits).map_err(|e| {
+                self.error_at(
+                    node,
+                    crate::error::ErrorKind::Invalid(format!("model file '{file}': {e}")),
+                )
+            })?;
+        Ok(Some(
+            child.model_name().unwrap_or("MuJoCo Model").to_string(),
+        ))
+    }
+
     /// The value of an attribute, as a range of the string buffer.
     fn attr_ref(&self, node: Node, name: Sym) -> Option<StrRef> {
         self.attr_slice(node)

@@ -303,6 +303,25 @@ fn cases() -> Vec<Case> {
         ],
         fuse_keys: false,
     });
+    // Parts that attach model assets (with `body`, `frame`, the whole model, an unnamed
+    // asset, an attach inside the attached model): the attached names come out as the
+    // part's prefix + the attach's prefix + their name, into a body and into the world.
+    let attach = || root().join("corpora/prefix/attach_model_asset.xml");
+    cases.push(Case {
+        name: "attach_model_assets_into_attach_model_assets".into(),
+        parts: vec![
+            base(attach()),
+            Part {
+                plain: true,
+                ..part(attach(), "q", Some("base"))
+            },
+            Part {
+                plain: true,
+                ..part(attach(), "r", None)
+            },
+        ],
+        fuse_keys: false,
+    });
     // A part with inertiagrouprange="4 5" into a base with "0 5": builds with MuJoCo write
     // the inferred inertias out (mujoco::write_inertials); without MuJoCo it is refused
     // (merge_rules).

@@ -49,3 +49,35 @@ fn feature_cases_prefixed_compile_to_the_same_model() {
     models.extend(include_cases());
     prefix_and_judge(&models, &scratch("feature_prefix"), "robot1/");
 }
+
+/// What prefixing refuses (`corpora/errors/prefix/*.xml`, prefix `p_`): each case's exact
+/// message is its `.err` file.
+#[test]
+fn prefix_error_cases_give_their_exact_messages() {
+    let dir = root().join("corpora/errors/prefix");
+    let mut cases: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "xml"))
+        .collect();
+    cases.sort();
+    assert!(!cases.is_empty());
+    let mut wrong = Vec::new();
+    for case in cases {
+        let relative = case.strip_prefix(root()).unwrap();
+        let expected = std::fs::read_to_string(case.with_extension("err")).unwrap();
+        // Paths in messages are as the user named them: run from the repository root.
+        std::env::set_current_dir(root()).unwrap();
+        let mut doc = Document::load(relative).unwrap();
+        match doc.apply_prefix("p_") {
+            Ok(()) => wrong.push(format!("{}: prefixed without error", relative.display())),
+            Err(e) if e.to_string().trim_end() != expected.trim_end() => wrong.push(format!(
+                "{}:\n  expected: {}\n  got:      {e}",
+                relative.display(),
+                expected.trim_end()
+            )),
+            Err(_) => {}
+        }
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
