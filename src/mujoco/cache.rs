@@ -202,10 +202,8 @@ pub struct ModelCache<'s> {
     scene: &'s Scene,
     /// The folder relative file names in the variants' XML resolve against.
     dir: Option<std::path::PathBuf>,
-    /// With [`ModelCache::with_superset`]: the scene's superset and its XML.
-    superset: Option<(Superset, String)>,
-    /// Superset: per set of parked objects, the dofs of the variant's own model.
-    kept_dofs: HashMap<Vec<String>, Vec<c_int>>,
+    /// With [`ModelCache::with_superset`]: the scene's superset.
+    superset: Option<SupersetState>,
     /// Cached models by structure key, least recently used first.
     entries: Vec<(String, CompiledModel)>,
     state: State,
@@ -245,7 +243,6 @@ impl<'s> ModelCache<'s> {
             scene,
             dir: None,
             superset: None,
-            kept_dofs: HashMap::new(),
             entries: Vec::new(),
             state: State {
                 max_models: max_models.max(1),
@@ -272,14 +269,18 @@ impl<'s> ModelCache<'s> {
     pub fn with_superset(mut self) -> Result<Self, String> {
         let superset = self.scene.superset().map_err(|e| e.to_string())?;
         let xml = superset.document.to_xml_string();
-        self.superset = Some((superset, xml));
+        self.superset = Some(SupersetState {
+            superset,
+            xml,
+            kept_dofs: HashMap::new(),
+        });
         Ok(self)
     }
 
     /// The variant's patch: of its own structure, or of the superset.
     fn patch_of(&self, index: u64) -> Result<VariantPatch, String> {
         match &self.superset {
-            Some((s, _)) => self.scene.superset_patch(s, index),
+            Some(s) => self.scene.superset_patch(&s.superset, index),
             None => self.scene.patch(index),
         }
         .map_err(|e| e.to_string())
@@ -331,13 +332,12 @@ impl<'s> ModelCache<'s> {
         let last = self.entries.len() - 1;
         if at {
             let model = &mut self.entries[last].1;
-            self.state.patch_model(model, &key, &patch.entries)?;
-            variant_inertia(
+            let target = (index, key.as_str(), patch.entries.as_slice());
+            patch_variant(
                 self.scene,
-                &self.superset,
-                &mut self.kept_dofs,
-                &self.state,
-                index,
+                &mut self.superset,
+                &mut self.state,
+                target,
                 model,
             )?;
             self.state.trim(&mut self.entries);
@@ -372,13 +372,12 @@ impl<'s> ModelCache<'s> {
                 }
             }
         }
-        self.state.patch_model(model, &key, &patch.entries)?;
-        variant_inertia(
+        let target = (index, key.as_str(), patch.entries.as_slice());
+        patch_variant(
             self.scene,
-            &self.superset,
-            &mut self.kept_dofs,
-            &self.state,
-            index,
+            &mut self.superset,
+            &mut self.state,
+            target,
             model,
         )?;
         self.state.trim(&mut self.entries);
@@ -387,7 +386,7 @@ impl<'s> ModelCache<'s> {
 
     fn compile(&mut self, index: u64, key: &str) -> Result<(), String> {
         let xml = match &self.superset {
-            Some((_, xml)) => xml.clone(),
+            Some(s) => s.xml.clone(),
             None => self.scene.variant_xml(index).map_err(|e| e.to_string())?.0,
         };
         let dir = self
@@ -497,28 +496,37 @@ impl State {
     }
 }
 
-/// Superset: `stat.meaninertia` (which scales the constraint solver's tolerance) as the
-/// variant's own model has it: the mass matrix's diagonal over the dofs of what the variant
-/// places (the superset's dof order is the variant's), parked objects left out.
-fn variant_inertia(
+/// A superset cache's own state: the superset, its XML, and per set of parked objects the
+/// dofs of the variant's own model.
+struct SupersetState {
+    superset: Superset,
+    xml: String,
+    kept_dofs: HashMap<Vec<String>, Vec<c_int>>,
+}
+
+/// Writes variant `index`'s patch (`key`, `entries`) into `model`, and for a superset
+/// `stat.meaninertia` (which scales the constraint solver's tolerance) as the variant's own
+/// model has it: the mass matrix's diagonal over the dofs of what the variant places (the
+/// superset's dof order is the variant's), parked objects left out.
+fn patch_variant(
     scene: &Scene,
-    superset: &Option<(Superset, String)>,
-    kept: &mut HashMap<Vec<String>, Vec<c_int>>,
-    state: &State,
-    index: u64,
+    superset: &mut Option<SupersetState>,
+    state: &mut State,
+    (index, key, entries): (u64, &str, &[PatchEntry]),
     model: &mut CompiledModel,
 ) -> Result<(), String> {
-    let Some((superset, _)) = superset else {
+    state.patch_model(model, key, entries)?;
+    let Some(sup) = superset else {
         return Ok(());
     };
     let roots = scene
-        .superset_parked(superset, index)
+        .superset_parked(&sup.superset, index)
         .map_err(|e| e.to_string())?;
-    if !kept.contains_key(&roots) {
+    if !sup.kept_dofs.contains_key(&roots) {
         let keep = kept_dofs(model, &roots)?;
-        kept.insert(roots.clone(), keep);
+        sup.kept_dofs.insert(roots.clone(), keep);
     }
-    let keep = &kept[&roots];
+    let keep = &sup.kept_dofs[&roots];
     let Some(plan) = state.plans.iter().find(|p| p.serial == model.serial) else {
         return Ok(());
     };
