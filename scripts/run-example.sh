@@ -38,3 +38,5 @@ echo "== info --json (the can as one instance)"
 
 echo "== python: a Gymnasium environment drawing a new scene variant per reset (the built-in demo scene)"
 .cache/venv/bin/python python/examples/gym_env.py --episodes 3
+echo "== python: the same on a scene of four structures: repeated ones are patched, not compiled"
+.cache/venv/bin/python python/examples/gym_env.py corpora/scenes/patch/patch.toml --episodes 8
