@@ -11,21 +11,23 @@
 use std::io::{BufWriter, IsTerminal as _, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::mpsc::sync_channel;
 use std::time::{Duration, Instant};
 
 use mjcf_forge::output::AtomicFile;
 use mjcf_forge::scene::{Params, Scene};
 use mjcf_forge::{AssetStore, OutputDir, TarWriter, frame_text_member};
-use rayon::prelude::*;
 
 use super::{USAGE, refuse_validate_without_mujoco};
 
-/// Variants made in parallel before their chunk is written: enough to keep every thread
-/// busy, few enough that the chunk's texts (~50 KB each for a robot scene) are reused
-/// memory rather than fresh pages for every chunk (512 spent a fifth of the time in
-/// page faults).
-const CHUNK: u64 = 64;
+/// Variants made but not yet written, at most: enough that no worker waits for the
+/// writing thread, few enough that their texts (~90 KB each for a robot scene as tar
+/// members) are reused memory rather than fresh pages (a batch of 512 at a time spent a
+/// fifth of the time in page faults).
+const RING: usize = 128;
+
+/// The writing thread sleeps until this many variants are ready to write, rather than
+/// being woken for each one.
+const WAKE_BATCH: u64 = 16;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -63,7 +65,7 @@ pub struct Args {
     pretty: bool,
 }
 
-/// A chunk position's reused buffer: the variant's XML, or for a tar stream its two
+/// A ring slot's reused buffer: the variant's XML, or for a tar stream its two
 /// members (XML and JSON) framed.
 #[derive(Default)]
 struct Slot {
@@ -81,17 +83,14 @@ struct Outputs {
 }
 
 /// The ordered part of the output, written by its own thread while the workers make the
-/// next chunk: a folder's manifest, or the tar stream.
+/// next variants: a folder's manifest, or the tar stream (the assets first).
 enum Writer {
     Manifest(BufWriter<AtomicFile>),
-    Tar(TarWriter<BufWriter<AtomicFile>>),
-}
-
-/// A chunk on its way to the writing thread: its buffers, and per position the variant's
-/// manifest line (`None` for a variant that failed).
-struct Chunk {
-    slots: Vec<Slot>,
-    lines: Vec<Option<String>>,
+    Tar {
+        tar: TarWriter<BufWriter<AtomicFile>>,
+        /// The assets are not in the stream yet (they are the writing thread's first job).
+        assets_pending: bool,
+    },
 }
 
 pub fn run(args: Args) -> ExitCode {
@@ -278,89 +277,40 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
         output: args.output.display().to_string(),
         range: (lo, hi),
     };
-    // One text buffer per variant of a chunk, reused: a variant is written into memory an
-    // earlier chunk left, not into fresh pages. Two sets of buffers: the workers fill one
-    // while the writing thread writes the other, in index order. Everything but those
-    // ordered writes happens on the workers (a tar stream's members are framed there), so
-    // the writing thread does one write per variant.
-    let is_tar = matches!(outputs.writer, Writer::Tar(_));
-    let (to_writer, chunks) = sync_channel::<Chunk>(1);
-    let (give_back, returned) = sync_channel::<Vec<Slot>>(2);
+    // One text buffer per ring slot, reused: a variant is written into memory an earlier
+    // variant left, not into fresh pages. Everything but the ordered writes happens on the
+    // workers (a tar stream's members are framed there), so the writing thread does one
+    // write per variant, after the assets (its first job, while the workers begin).
+    let is_tar = matches!(outputs.writer, Writer::Tar { .. });
     let mut writer = outputs.writer;
-    let written = std::thread::scope(|scope| {
-        let thread = scope.spawn(move || -> Result<Writer, String> {
-            for chunk in chunks {
-                for (line, slot) in chunk.lines.iter().zip(&chunk.slots) {
-                    if let Some(json) = line {
-                        writer.write(json, slot.framed.as_bytes())?;
+    super::ordered::for_each_ordered(
+        lo..hi,
+        RING,
+        WAKE_BATCH,
+        |i, slot: &mut Slot| make_one(args, &scene, i, slot, is_tar, files, validators.as_ref()),
+        |_, slot, made| {
+            match made {
+                Ok((json, took, bytes)) => {
+                    writer.write(&store, &json, slot.framed.as_bytes())?;
+                    summary.variants += 1;
+                    summary.bytes += bytes;
+                    if let Some(c) = &mut summary.compile {
+                        *c += took;
                     }
                 }
-                // The main thread may be gone (it stopped on an error): nothing to return.
-                let _ = give_back.send(chunk.slots);
-            }
-            Ok(writer)
-        });
-        let mut spare: Vec<Vec<Slot>> = (0..2)
-            .map(|_| (0..CHUNK).map(|_| Slot::default()).collect())
-            .collect();
-        let mut at = lo;
-        while at < hi {
-            let end = (at + CHUNK).min(hi);
-            // A free set of buffers; none coming back means the writer stopped.
-            let Some(mut slots) = spare.pop().or_else(|| returned.recv().ok()) else {
-                break;
-            };
-            let made: Vec<Result<(String, Duration, u64), String>> = slots[..(end - at) as usize]
-                .par_iter_mut()
-                .enumerate()
-                .map(|(k, slot)| {
-                    make_one(
-                        args,
-                        &scene,
-                        at + k as u64,
-                        slot,
-                        is_tar,
-                        files,
-                        validators.as_ref(),
-                    )
-                })
-                .collect();
-            let mut lines = Vec::with_capacity(made.len());
-            for r in made {
-                match r {
-                    Ok((json, took, bytes)) => {
-                        summary.variants += 1;
-                        summary.bytes += bytes;
-                        if let Some(c) = &mut summary.compile {
-                            *c += took;
-                        }
-                        lines.push(Some(json));
-                    }
-                    Err(e) => {
-                        summary.failures.push(e);
-                        lines.push(None);
-                    }
-                }
-            }
-            if to_writer.send(Chunk { slots, lines }).is_err() {
-                break;
+                Err(e) => summary.failures.push(e),
             }
             if let Some(bar) = &progress {
-                bar.inc(end - at);
+                bar.inc(1);
             }
-            at = end;
-        }
-        drop(to_writer);
-        thread
-            .join()
-            .unwrap_or_else(|_| Err("internal error: the writing thread panicked".to_string()))
-    });
-    let writer = written?;
+            Ok(())
+        },
+    )?;
     summary.compiled = validators.as_ref().map_or(0, Validators::compiled);
     if let Some(bar) = progress {
         bar.finish_and_clear();
     }
-    close_sink(writer, outputs.files)?;
+    close_sink(writer, &store, outputs.files)?;
     summary.seconds = started.elapsed().as_secs_f64();
     Ok(summary)
 }
@@ -533,31 +483,54 @@ fn open_sink(
     } else {
         path
     };
-    let mut tar = TarWriter::new(BufWriter::with_capacity(1 << 20, file), label);
-    store.write_to_tar(&mut tar).map_err(|e| e.to_string())?;
+    let tar = TarWriter::new(BufWriter::with_capacity(1 << 20, file), label);
     Ok(Outputs {
         files: None,
-        writer: Writer::Tar(tar),
+        writer: Writer::Tar {
+            tar,
+            assets_pending: true,
+        },
         check_dir,
     })
 }
 
 impl Writer {
     /// Writes a made variant in order: its manifest line to a folder (whose XML file a
-    /// worker wrote), or its framed tar members to the stream.
-    fn write(&mut self, json: &str, framed: &[u8]) -> Result<(), String> {
+    /// worker wrote), or its framed tar members to the stream, after the assets.
+    fn write(&mut self, store: &AssetStore, json: &str, framed: &[u8]) -> Result<(), String> {
+        self.write_assets(store)?;
         match self {
             Writer::Manifest(manifest) => manifest
                 .write_all(json.as_bytes())
                 .and_then(|()| manifest.write_all(b"\n"))
                 .map_err(|e| format!("cannot write the manifest: {e}")),
-            Writer::Tar(tar) => tar.append_framed(framed).map_err(|e| e.to_string()),
+            Writer::Tar { tar, .. } => tar.append_framed(framed).map_err(|e| e.to_string()),
         }
+    }
+
+    /// A tar stream's assets, once, before its first variant.
+    fn write_assets(&mut self, store: &AssetStore) -> Result<(), String> {
+        if let Writer::Tar {
+            tar,
+            assets_pending,
+        } = self
+            && *assets_pending
+        {
+            *assets_pending = false;
+            store.write_to_tar(tar).map_err(|e| e.to_string())?;
+        }
+        Ok(())
     }
 }
 
 /// Puts the outputs in place: the manifest (or the tar file) appears whole, only now.
-fn close_sink(writer: Writer, files: Option<OutputDir>) -> Result<(), String> {
+fn close_sink(
+    mut writer: Writer,
+    store: &AssetStore,
+    files: Option<OutputDir>,
+) -> Result<(), String> {
+    // A stream of no variants still holds the assets.
+    writer.write_assets(store)?;
     let commit = |w: BufWriter<AtomicFile>| -> Result<(), String> {
         let file = w
             .into_inner()
@@ -566,7 +539,7 @@ fn close_sink(writer: Writer, files: Option<OutputDir>) -> Result<(), String> {
     };
     match writer {
         Writer::Manifest(manifest) => commit(manifest)?,
-        Writer::Tar(tar) => commit(tar.finish().map_err(|e| e.to_string())?)?,
+        Writer::Tar { tar, .. } => commit(tar.finish().map_err(|e| e.to_string())?)?,
     }
     match files {
         Some(out) => out.finish().map_err(|e| e.to_string()),
