@@ -155,7 +155,7 @@ where
                     }
                     // Waiting workers are woken once per `batch` freed slots (and when
                     // this thread is about to wait itself, above).
-                    if (st.workers_waiting > 0 && (i + 1) % batch == 0) || st.stopped {
+                    if (st.workers_waiting > 0 && (i + 1).is_multiple_of(batch)) || st.stopped {
                         shared.freed.notify_all();
                     }
                     drop(st);
