@@ -3,7 +3,7 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use crate::error::{Error, ErrorKind, Errors, Location};
+use crate::error::{Error, ErrorKind, Location};
 use crate::limits::Limits;
 use crate::names::{Names, Sym};
 use crate::tree::{Attr, AttrRange, Node, NodeData, StrRef, Tree};
@@ -132,80 +132,9 @@ pub struct Document {
 }
 
 impl Document {
-    /// Loads an MJCF file: includes expanded, defaults inlined, file paths made absolute.
-    ///
-    /// ```no_run
-    /// let doc = mjcf_forge::Document::load("robot.xml")?;
-    /// println!("{}", doc.to_xml_string());
-    /// # Ok::<(), mjcf_forge::Errors>(())
-    /// ```
-    pub fn load(path: impl AsRef<Path>) -> Result<Document, Errors> {
-        Document::load_with(path, &Limits::default())
-    }
-
-    /// [`Document::load`] within other [`Limits`] than the default ones.
-    ///
-    /// ```
-    /// use mjcf_forge::{Document, Limits};
-    /// let path = std::env::temp_dir().join("mjcf_forge_load_with_doc.xml");
-    /// std::fs::write(&path, "<mujoco><worldbody/></mujoco>").unwrap();
-    /// let tiny = Limits { max_file_size: 10, ..Limits::default() };
-    /// let err = Document::load_with(&path, &tiny).unwrap_err().to_string();
-    /// assert!(err.ends_with("29 bytes, more than the limit of 10 (Limits::max_file_size)"), "{err}");
-    /// assert!(Document::load_with(&path, &Limits::default()).is_ok());
-    /// # std::fs::remove_file(&path).unwrap();
-    /// ```
-    pub fn load_with(path: impl AsRef<Path>, limits: &Limits) -> Result<Document, Errors> {
-        let mut doc = crate::read::read_file(path.as_ref(), limits)?;
-        doc.finish_load()?;
-        Ok(doc)
-    }
-
-    /// Loads MJCF text; `base_dir` plays the part of the main file's folder (includes and
-    /// asset files are found from there). Positions are reported in `<string>`.
-    ///
-    /// ```
-    /// let doc = mjcf_forge::Document::from_str("<mujoco/>", ".")?;
-    /// assert_eq!(doc.to_xml_string(), "<mujoco/>");
-    /// # Ok::<(), mjcf_forge::Errors>(())
-    /// ```
-    #[allow(clippy::should_implement_trait)]
-    pub fn from_str(xml: &str, base_dir: impl AsRef<Path>) -> Result<Document, Errors> {
-        Document::from_str_with(xml, base_dir, &Limits::default())
-    }
-
-    /// [`Document::from_str`] within other [`Limits`] than the default ones.
-    ///
-    /// ```
-    /// use mjcf_forge::{Document, Limits};
-    /// let few = Limits { max_attributes: 2, ..Limits::default() };
-    /// let xml = r#"<mujoco><worldbody><geom size="1" rgba="1 0 0 1" name="g"/></worldbody></mujoco>"#;
-    /// let err = Document::from_str_with(xml, ".", &few).unwrap_err();
-    /// assert_eq!(
-    ///     err.to_string(),
-    ///     "<string>:1:50: more than 2 attributes on one element (Limits::max_attributes)"
-    /// );
-    /// ```
-    pub fn from_str_with(
-        xml: &str,
-        base_dir: impl AsRef<Path>,
-        limits: &Limits,
-    ) -> Result<Document, Errors> {
-        let mut doc = crate::read::read_str(xml, base_dir.as_ref(), limits)?;
-        doc.finish_load()?;
-        Ok(doc)
-    }
-
     /// The bounds this document was loaded with (files it reads later keep to them).
     pub fn limits(&self) -> &Limits {
         &self.limits
-    }
-
-    pub(crate) fn finish_load(&mut self) -> Result<(), Errors> {
-        crate::defaults::inline_defaults(self)?;
-        crate::paths::absolutize_paths(self)?;
-        self.merge_repeated_sections();
-        Ok(())
     }
 
     /// The root `<mujoco>` element.
@@ -242,7 +171,7 @@ impl Document {
 
     /// Merges repeated container sections (`<asset>`, `<worldbody>`, ...) into the first one
     /// of each kind, keeping order: MuJoCo reads all of them in order, so this changes nothing.
-    fn merge_repeated_sections(&mut self) {
+    pub(crate) fn merge_repeated_sections(&mut self) {
         // One pass in document order: sections of different kinds do not interact, so this
         // is the same as merging each kind in turn.
         static TAGS: std::sync::OnceLock<[Sym; Section::ALL.len()]> = std::sync::OnceLock::new();

@@ -3,12 +3,12 @@
 use std::path::Path;
 
 /// The outcome of loading `bytes` through the fast reader (falling back as every load does)
-/// and through quick-xml's path alone, each as text (see `read::describe_load`): equal for
+/// and through quick-xml's path alone, each as text (see `load::describe_load`): equal for
 /// every input, or one of the readers is wrong.
 pub fn read_both_ways(bytes: &[u8], base_dir: &str) -> (String, String) {
     let dir = Path::new(base_dir);
     (
-        crate::read::describe_load(bytes, dir, true),
-        crate::read::describe_load(bytes, dir, false),
+        crate::load::describe_load(bytes, dir, true),
+        crate::load::describe_load(bytes, dir, false),
     )
 }

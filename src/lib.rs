@@ -30,6 +30,7 @@ mod error;
 pub mod fuzzing;
 pub mod geometry;
 mod limits;
+mod load;
 mod merge;
 mod model;
 #[cfg(mjcf_mujoco)]

@@ -675,6 +675,19 @@ pub(crate) fn read_str(xml: &str, base_dir: &Path, limits: &Limits) -> Result<Do
     read_bytes(xml.as_bytes(), name, &dir, base_dir, Main::Text, limits)
 }
 
+/// Reads `bytes` as the text `<string>` found in `dir`, through the fast reader first (as
+/// every load does) with `fast`, through quick-xml's path alone without: the two must give
+/// the same document or the same errors (the tests and the `readers` fuzz target).
+pub(crate) fn read_bytes_as_text(
+    bytes: &[u8],
+    dir: &Path,
+    limits: &Limits,
+    fast: bool,
+) -> Result<Document, Errors> {
+    let name = Arc::from(Path::new("<string>"));
+    read_bytes_with(bytes, name, dir, dir, Main::Text, limits, fast)
+}
+
 /// Where the main text came from: a file (which takes part in include cycles) or a string.
 enum Main {
     File { abs: PathBuf },
@@ -1593,82 +1606,9 @@ impl Builder {
     }
 }
 
-/// What a load of `bytes` (as `<string>`, from `dir`) gives, as text: the document (compact,
-/// pretty, every node's position) or the errors. With `fast`, the fast reader is tried
-/// first (as every load does); without, only quick-xml's path is used. The tests and the
-/// `readers` fuzz target hold the two to the same outcome.
-pub(crate) fn describe_load(bytes: &[u8], dir: &Path, fast: bool) -> String {
-    let name = Arc::from(Path::new("<string>"));
-    let limits = Limits::default();
-    match read_bytes_with(bytes, name, dir, dir, Main::Text, &limits, fast)
-        .and_then(|mut d| d.finish_load().map(|()| d))
-    {
-        Ok(d) => {
-            let mut out = format!("{}\n{}", d.to_xml_string(), d.to_pretty_string());
-            for n in d.descendants(d.root()) {
-                let l = d.location(n);
-                out.push_str(&format!(" {}:{}", l.line, l.col));
-            }
-            out
-        }
-        Err(e) => format!("error: {e}"),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn outcome(xml: &str, fast: bool) -> String {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("corpora/features");
-        describe_load(xml.as_bytes(), &dir, fast)
-    }
-
-    #[test]
-    fn both_readers_build_the_same_document() {
-        let cases = [
-            "<mujoco/>",
-            "<?xml version=\"1.0\"?>\n<!-- c\n -->\n<mujoco model='m'>\n <worldbody>\n  <geom size=\"1\"\n    rgba=\"1 0 0 1\"/>\n </worldbody>\n</mujoco>",
-            "<mujoco><default><geom size=\"1 2\"/></default><worldbody><body name=\"b\" pos='0 0 0'><geom size=\"3\"/></body></worldbody></mujoco>",
-            "<mujoco><worldbody><body>some text<geom/>  <!-- c -->more\ntext<?pi x?><geom/></body></worldbody></mujoco>",
-            "<mujoco><custom><text name=\"t\" data=\"a&amp;b\nc\"/></custom></mujoco>",
-            "<mujoco><worldbody><body>a &amp; b<![CDATA[x]]></body></worldbody></mujoco>",
-            "<mujoco><worldbody><geom a=\"1\"b=\"2\" c = '3' /></worldbody ></mujoco>",
-            "<mujoco><worldbody><geom a=\"1\" a=\"2\"/></worldbody></mujoco>",
-            "<mujoco><worldbody><geom a=\"1/></worldbody></mujoco>",
-            "<mujoco><worldbody></body></mujoco>",
-            "<mujoco><worldbody><geom/ ></worldbody></mujoco>",
-            "<mujoco><worldbody><geom size=\"1\">></geom></worldbody></mujoco>",
-            "<mujoco><!--></mujoco>--></mujoco>",
-            "<mujoco><?></mujoco>",
-            "\u{feff}<mujoco/>",
-            "<robot/>",
-            "",
-            "<mujoco><include file=\"parts/defaults.xml\"/><worldbody><include file=\"parts/arm.xml\"/></worldbody></mujoco>",
-            "<mujoco><worldbody><include file=\"parts/arm.xml\"/><include file=\"parts/arm.xml\"/></worldbody></mujoco>",
-            "<mujoco><worldbody><include file=\"parts/missing.xml\"/></worldbody></mujoco>",
-        ];
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("corpora/features");
-        let mut files: Vec<String> = std::fs::read_dir(&dir)
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .filter(|p| p.extension().is_some_and(|e| e == "xml"))
-            .map(|p| std::fs::read_to_string(p).unwrap())
-            .collect();
-        files.sort();
-        for xml in cases
-            .iter()
-            .copied()
-            .chain(files.iter().map(String::as_str))
-        {
-            assert_eq!(outcome(xml, true), outcome(xml, false), "{xml:?}");
-            // And every prefix of it, which cuts markup at every place.
-            for cut in (0..xml.len()).filter(|&i| xml.is_char_boundary(i)) {
-                let part = &xml[..cut];
-                assert_eq!(outcome(part, true), outcome(part, false), "{part:?}");
-            }
-        }
-    }
 
     #[test]
     fn finds_the_closing_quote_like_a_byte_loop() {
