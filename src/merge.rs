@@ -49,9 +49,12 @@ pub struct MergeReport {
     pub shared_assets: usize,
 }
 
-/// Compiler attributes that change the compiled model and have no exact conversion: a
-/// part must agree with the base on them (value if absent, as MuJoCo's defaults).
-const MUST_AGREE: [(&str, &str); 12] = [
+/// Compiler attributes that change the compiled model: a part must agree with the base on
+/// them unless `convert_compiler` converts it (value if absent, as MuJoCo's defaults).
+/// Not here: `saveinertial` (how MuJoCo saves a model, not what it compiles; checked by
+/// experiment in 3.17.0 and 4.0.0) and the settings converted everywhere (`angle`,
+/// `eulerseq`, `autolimits`).
+const MUST_AGREE: [(&str, &str); 11] = [
     ("boundmass", "0"),
     ("boundinertia", "0"),
     ("settotalmass", "-1"),
@@ -62,7 +65,6 @@ const MUST_AGREE: [(&str, &str); 12] = [
     ("inertiafromgeom", "auto"),
     ("inertiagrouprange", "0 5"),
     ("alignfree", "false"),
-    ("saveinertial", "false"),
     ("coordinate", "local"),
 ];
 
@@ -102,6 +104,37 @@ impl<'a> Compiler<'a> {
             .iter()
             .find(|(k, _, _)| *k == attr)
             .map(|&(_, v, n)| (v, n))
+    }
+}
+
+/// Why a compiler setting that differs between a part and the base cannot be converted
+/// (the text after "has no exact conversion"): each of these applies to the whole merged
+/// model, and nothing on the part's own elements can stand in for it.
+fn no_conversion_reason(attr: &str, base: &str, default: &str) -> &'static str {
+    match attr {
+        "boundmass" | "boundinertia" | "settotalmass" | "balanceinertia" | "inertiafromgeom"
+        | "inertiagrouprange" => {
+            if !same_value(base, default) {
+                ": the base's own setting would also change the part's masses and inertias"
+            } else if cfg!(mjcf_mujoco) {
+                ": the part's inertias could not be written out"
+            } else {
+                ": writing the part's inertias out needs a build with the `mujoco` feature"
+            }
+        }
+        "fusestatic" => {
+            ": it decides which bodies without joints are fused into their parents, over the \
+             whole merged model"
+        }
+        "discardvisual" => {
+            ": it decides whether visual geoms, and the assets only they use, are dropped, \
+             over the whole merged model"
+        }
+        "fitaabb" => {
+            ": it decides how geoms fitted to meshes are sized, over the whole merged model"
+        }
+        "coordinate" => ": MuJoCo no longer reads global coordinates",
+        _ => "",
     }
 }
 
@@ -902,8 +935,21 @@ impl Document {
             converted
         };
         #[cfg(not(mjcf_mujoco))]
-        let converted: Vec<&str> = Vec::new();
+        let mut converted: Vec<&str> = Vec::new();
+        #[cfg(mjcf_mujoco)]
+        let mut converted = converted;
         let theirs = compiler_settings(part);
+        // alignfree is the default of each <freejoint>'s own `align`: a part's free joints
+        // keep its setting when they say it themselves. A <joint type="free"> has no
+        // `align`, so a part with one on a body MuJoCo would align is refused (below).
+        let align = value(&theirs, "alignfree", "false");
+        let align_free_joints = !same_value(&value(&base, "alignfree", "false"), &align)
+            && !part
+                .descendants(part.root)
+                .any(|n| part.is_free_joint_element(n));
+        if align_free_joints {
+            converted.push("alignfree");
+        }
         for (attr, default) in MUST_AGREE {
             if (attr == "inertiafromgeom" && drop_inertials) || converted.contains(&attr) {
                 continue;
@@ -923,10 +969,27 @@ impl Document {
             }
             if !same_value(&b, &p) {
                 let at = theirs.get(attr).map(|(_, n)| n).unwrap_or(part.root);
+                let why = match attr {
+                    "alignfree" => part
+                        .descendants(part.root)
+                        .find(|&n| part.is_free_joint_element(n))
+                        .map(|j| {
+                            let l = part.location(j);
+                            format!(
+                                ": the <joint type=\"free\"> at {}:{}:{} has no `align` of its \
+                                 own to keep the part's setting (only <freejoint> has one)",
+                                l.file.display(),
+                                l.line,
+                                l.col
+                            )
+                        })
+                        .unwrap_or_default(),
+                    _ => no_conversion_reason(attr, &b, default).to_string(),
+                };
                 errors.push(part.error_at(
                     at,
                     ErrorKind::Invalid(format!(
-                        "cannot merge: compiler {attr}=\"{p}\" differs from the base's \"{b}\" and has no exact conversion"
+                        "cannot merge: compiler {attr}=\"{p}\" differs from the base's \"{b}\" and has no exact conversion{why}"
                     )),
                 ));
             }
@@ -938,6 +1001,16 @@ impl Document {
         drop(theirs);
         if !errors.is_empty() {
             return;
+        }
+        if align_free_joints {
+            let free: Vec<Node> = part
+                .descendants(part.root)
+                .filter(|&n| part.tag(n) == "freejoint")
+                .filter(|&n| part.attr(n, "align").is_none_or(|a| a.trim() == "auto"))
+                .collect();
+            for n in free {
+                part.set_attr(n, "align", &align);
+            }
         }
         if drop_inertials {
             let inertials: Vec<Node> = part
@@ -961,6 +1034,54 @@ impl Document {
         if ba != pa {
             part.make_limits_explicit(pa == "true");
         }
+    }
+
+    /// Whether `node` is a `<joint type="free">` (a `<freejoint>` is not) whose body
+    /// `alignfree` would align.
+    fn is_free_joint_element(&self, node: Node) -> bool {
+        self.tag(node) == "joint"
+            && self.attr(node, "type").is_some_and(|t| t.trim() == "free")
+            && self.joint_body_is_a_leaf(node)
+    }
+
+    /// Whether the body of `joint` has no child bodies: MuJoCo aligns only such free bodies
+    /// with their inertial frames (`freejoint/align` in its reference; seen in 3.17.0 and
+    /// 4.0.0).
+    fn joint_body_is_a_leaf(&self, joint: Node) -> bool {
+        let mut body = self.parent(joint);
+        while let Some(b) = body
+            && self.tag(b) != "body"
+        {
+            body = self.parent(b);
+        }
+        body.is_none_or(|b| !self.descendants(b).skip(1).any(|n| self.tag(n) == "body"))
+    }
+
+    /// Whether MuJoCo aligns the body of the free joint `joint` (a `<freejoint>` or a
+    /// `<joint type="free">`) with its inertial frame: `align="true"` on a `<freejoint>`,
+    /// or the compiler's `alignfree="true"` where the joint does not say (a
+    /// `<joint type="free">` never does), for a body without child bodies. Its frame and
+    /// `qpos0` are then the inertial frame's, which only MuJoCo's compiler knows exactly.
+    pub(crate) fn aligns_free_body(&self, joint: Node) -> bool {
+        let free = match self.tag(joint) {
+            "freejoint" => true,
+            "joint" => self.attr(joint, "type").is_some_and(|t| t.trim() == "free"),
+            _ => false,
+        };
+        if !free {
+            return false;
+        }
+        let global = || {
+            compiler_settings(self)
+                .get("alignfree")
+                .is_some_and(|(v, _)| v == "true")
+        };
+        let on = match self.attr(joint, "align").map(str::trim) {
+            Some("true") if self.tag(joint) == "freejoint" => true,
+            Some("false") if self.tag(joint) == "freejoint" => false,
+            _ => global(),
+        };
+        on && self.joint_body_is_a_leaf(joint)
     }
 
     /// The bodies whose mass and inertia MuJoCo infers from their geoms (under
@@ -1353,6 +1474,26 @@ impl Offsets {
     }
 }
 
+/// `qpos0` of a free joint whose body MuJoCo aligns with its inertial frame, as MuJoCo
+/// compiles `doc` alone (a free body is in the world, where merging does not move it).
+#[cfg(mjcf_mujoco)]
+fn aligned_free_qpos0(doc: &Document, joint: Node) -> Result<Vec<String>, String> {
+    crate::mujoco::free_joint_qpos0(doc, joint)
+        .map(|q| q.iter().map(|&x| format!("{x:?}")).collect())
+        .map_err(|e| format!("the initial pose of an aligned free body: {e}"))
+}
+
+/// Without MuJoCo the inertial frame a free body is aligned with is not known exactly.
+#[cfg(not(mjcf_mujoco))]
+fn aligned_free_qpos0(_: &Document, _: Node) -> Result<Vec<String>, String> {
+    Err(
+        "MuJoCo aligns this free body with its inertial frame (alignfree, or the \
+         <freejoint>'s align), so its initial pose in the keyframes is known only to MuJoCo's \
+         compiler: remapping keyframes over it needs a build with the `mujoco` feature"
+            .to_string(),
+    )
+}
+
 impl Document {
     /// The world pose of a body as written (through enclosing frames), quaternion normalized.
     fn written_world_pose(
@@ -1394,6 +1535,7 @@ impl Document {
             0 => {
                 let (w, _) = joint_widths(self, item);
                 match w {
+                    7 if self.aligns_free_body(item) => aligned_free_qpos0(self, item),
                     7 => {
                         let body = self.parent(item).ok_or("joint without a body")?;
                         let (p, q) = self.written_world_pose(body, angles)?;

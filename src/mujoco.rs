@@ -264,6 +264,51 @@ pub fn write_all_inertials(doc: &mut crate::Document) -> Result<usize, CompileEr
     write_inertials_of(doc, true)
 }
 
+/// `qpos0` of the free joint `joint` of `doc` (7 numbers) as MuJoCo compiles `doc` alone:
+/// for a free body MuJoCo aligns with its inertial frame, the only exact source. Joints
+/// are matched to `doc`'s joint elements in document order, which must be one to one.
+pub(crate) fn free_joint_qpos0(
+    doc: &crate::Document,
+    joint: crate::tree::Node,
+) -> Result<[f64; 7], CompileError> {
+    let joints: Vec<crate::tree::Node> = doc
+        .find_section(crate::Section::Worldbody)
+        .map(|w| {
+            doc.descendants(w)
+                .filter(|&n| matches!(doc.tag(n), "joint" | "freejoint"))
+                .collect()
+        })
+        .unwrap_or_default();
+    let model = compile_str(&doc.to_xml_string(), doc.model_dir())?;
+    let types = model.jnt_type();
+    if types.len() != joints.len() {
+        return Err(CompileError::local(format!(
+            "MuJoCo compiled {} joints from {} joint elements",
+            types.len(),
+            joints.len()
+        )));
+    }
+    let k = joints
+        .iter()
+        .position(|&n| n == joint)
+        .ok_or_else(|| CompileError::local("not a joint of the model's bodies".to_string()))?;
+    if types[k] != 0 {
+        return Err(CompileError::local("not a free joint".to_string()));
+    }
+    // qpos widths by joint type: free 7, ball 4, slide and hinge 1.
+    let at: usize = types[..k]
+        .iter()
+        .map(|&t| match t {
+            0 => 7,
+            1 => 4,
+            _ => 1,
+        })
+        .sum();
+    let mut q = [0.0; 7];
+    q.copy_from_slice(&model.qpos0()[at..at + 7]);
+    Ok(q)
+}
+
 fn write_inertials_of(doc: &mut crate::Document, all: bool) -> Result<usize, CompileError> {
     let refused = ["replicate", "attach", "composite", "flexcomp"];
     if let Some(n) = doc

@@ -322,6 +322,38 @@ fn cases() -> Vec<Case> {
         ],
         fuse_keys: false,
     });
+    // alignfree differing between base and part: the part's <freejoint>s say their
+    // alignment themselves; a `type="free"` joint on a body with children is not aligned
+    // by MuJoCo, so it may stay.
+    cases.push(Case {
+        name: "free_objects_alignfree_into_table".into(),
+        parts: vec![
+            base(rs("arenas/table_arena.xml")),
+            part(ours("free_objects_alignfree.xml"), "obj", None),
+        ],
+        fuse_keys: false,
+    });
+    // With keyframes, both ways: an aligned free body's qpos0 in the keys comes from
+    // MuJoCo's compile (builds without MuJoCo refuse: merge_rules).
+    if cfg!(mjcf_mujoco) {
+        cases.push(Case {
+            name: "free_objects_alignfree_into_arm".into(),
+            parts: vec![
+                base(ours("arm_with_keys.xml")),
+                part(ours("free_objects_alignfree.xml"), "obj", None),
+                part(rs("grippers/panda_gripper.xml"), "gripper0", Some("hand")),
+            ],
+            fuse_keys: false,
+        });
+        cases.push(Case {
+            name: "free_objects_into_alignfree_base".into(),
+            parts: vec![
+                base(ours("free_objects_alignfree.xml")),
+                part(ours("free_objects_with_key.xml"), "k", None),
+            ],
+            fuse_keys: false,
+        });
+    }
     // A part with inertiagrouprange="4 5" into a base with "0 5": builds with MuJoCo write
     // the inferred inertias out (mujoco::write_inertials); without MuJoCo it is refused
     // (merge_rules).

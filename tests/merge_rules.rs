@@ -43,7 +43,42 @@ fn same_asset_name_with_other_content_names_both_origins() {
 fn compiler_settings_without_exact_conversion_are_refused() {
     assert_eq!(
         merge_error("corpora/errors/merge/part_settotalmass.xml", "p_", None),
-        "corpora/errors/merge/part_settotalmass.xml:2:3: cannot merge: compiler settotalmass=\"2\" differs from the base's \"-1\" and has no exact conversion"
+        "corpora/errors/merge/part_settotalmass.xml:2:3: cannot merge: compiler settotalmass=\"2\" differs from the base's \"-1\" and has no exact conversion: writing the part's inertias out needs a build with the `mujoco` feature"
+    );
+}
+
+/// alignfree is kept through each <freejoint>'s `align`; a `<joint type="free">` has none.
+#[test]
+fn alignfree_with_a_free_joint_element_is_refused_with_the_joint() {
+    assert_eq!(
+        merge_error("corpora/errors/merge/part_alignfree_joint.xml", "p_", None),
+        "corpora/errors/merge/part_alignfree_joint.xml:2:3: cannot merge: compiler alignfree=\"true\" differs from the base's \"false\" and has no exact conversion: the <joint type=\"free\"> at corpora/errors/merge/part_alignfree_joint.xml:5:7 has no `align` of its own to keep the part's setting (only <freejoint> has one)"
+    );
+}
+
+/// Keys over a free body MuJoCo aligns need its compiled qpos0 (merge_judge:
+/// free_objects_alignfree_into_arm in builds with MuJoCo).
+#[cfg(not(mjcf_mujoco))]
+#[test]
+fn keys_over_aligned_free_bodies_need_mujoco() {
+    let mut base = load("corpora/merge/arm_with_keys.xml");
+    let mut part = load("corpora/merge/free_objects_alignfree.xml");
+    part.apply_prefix("p_").unwrap();
+    let err = base
+        .merge(&part, None, &MergeOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        err,
+        "corpora/merge/free_objects_alignfree.xml:11:7: MuJoCo aligns this free body with its inertial frame (alignfree, or the <freejoint>'s align), so its initial pose in the keyframes is known only to MuJoCo's compiler: remapping keyframes over it needs a build with the `mujoco` feature"
+    );
+}
+
+#[test]
+fn settings_without_a_conversion_say_why() {
+    assert_eq!(
+        merge_error("corpora/errors/merge/part_fusestatic.xml", "p_", None),
+        "corpora/errors/merge/part_fusestatic.xml:2:3: cannot merge: compiler fusestatic=\"true\" differs from the base's \"false\" and has no exact conversion: it decides which bodies without joints are fused into their parents, over the whole merged model"
     );
 }
 
@@ -127,7 +162,7 @@ fn inertiagrouprange_converts_when_no_body_infers_inertia() {
 fn inertiagrouprange_with_inferred_inertia_is_refused_without_mujoco() {
     assert_eq!(
         merge_error("corpora/merge/objects_inertiagroups_4_5.xml", "p_", None),
-        "corpora/merge/objects_inertiagroups_4_5.xml:7:3: cannot merge: compiler inertiagrouprange=\"4 5\" differs from the base's \"0 5\" and has no exact conversion"
+        "corpora/merge/objects_inertiagroups_4_5.xml:7:3: cannot merge: compiler inertiagrouprange=\"4 5\" differs from the base's \"0 5\" and has no exact conversion: writing the part's inertias out needs a build with the `mujoco` feature"
     );
 }
 
@@ -148,6 +183,6 @@ fn mass_settings_of_the_base_are_never_converted() {
         .to_string();
     assert_eq!(
         err,
-        "corpora/errors/merge/part_settotalmass.xml:2:3: cannot merge: compiler settotalmass=\"2\" differs from the base's \"5\" and has no exact conversion"
+        "corpora/errors/merge/part_settotalmass.xml:2:3: cannot merge: compiler settotalmass=\"2\" differs from the base's \"5\" and has no exact conversion: the base's own setting would also change the part's masses and inertias"
     );
 }

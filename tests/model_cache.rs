@@ -206,3 +206,32 @@ fn superset_holds_every_variant() {
     }
     assert_eq!(cache.compiles(), 1);
 }
+
+#[test]
+fn aligned_free_bodies_make_their_poses_structure() {
+    let scene = Scene::load(root().join("corpora/scenes/patch/aligned.toml")).unwrap();
+    let mut cache = ModelCache::new(&scene, 4, None);
+    let mut aligned = 0;
+    for i in 0..8 {
+        let (xml, _) = scene.variant_xml(i).unwrap();
+        let patch = scene.patch(i).unwrap();
+        if xml.contains(r#"align="true""#) {
+            aligned += 1;
+            // The object's pose is not in the patch: it is compiled.
+            assert!(
+                !patch
+                    .entries
+                    .iter()
+                    .any(|e| e.field == "qpos0" || e.field == "pos"),
+                "variant {i}"
+            );
+        }
+        let got = cache.model(i).unwrap();
+        assert_eq!(
+            got.differences(&compiled(&scene, i)),
+            Vec::<String>::new(),
+            "variant {i}"
+        );
+    }
+    assert!(aligned >= 4, "{aligned} variants with an aligned object");
+}

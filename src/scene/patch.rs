@@ -102,7 +102,8 @@ pub(crate) struct Rules {
     /// inertia from geoms over `<inertial>`).
     mass: bool,
     /// Body frames land unchanged (no keyframes, whose rows would follow a placed free
-    /// joint; no static bodies fused away).
+    /// joint; no static bodies fused away; no free bodies aligned with their inertial
+    /// frames).
     poses: bool,
     /// Compiled ids of the template's elements that can be patched unnamed, when nothing
     /// reorders them (see [`template_ids`]).
@@ -124,9 +125,14 @@ impl Rules {
             d.find_section(Section::Keyframe)
                 .is_some_and(|k| d.elements(k).next().is_some())
         };
+        // A free body MuJoCo aligns with its inertial frame lands in the inertial frame's
+        // pose, which only the compiler knows.
+        let aligned = |d: &Document| d.descendants(d.root()).any(|n| d.aligns_free_body(n));
         let poses = setting("fusestatic").is_none_or(|v| v.trim() == "false")
             && !has_keys(template)
-            && !parts.iter().any(|d| has_keys(d));
+            && !parts.iter().any(|d| has_keys(d))
+            && !aligned(template)
+            && !parts.iter().any(|d| aligned(d));
         // A dampratio actuator's damping is derived from the masses at compile time.
         let dampratio = std::iter::once(template)
             .chain(parts.iter().copied())
