@@ -1292,7 +1292,10 @@ impl Resolver<'_> {
                 return Err(self.doc.error_at(
                     node,
                     ErrorKind::Inexpressible(format!(
-                        "<{other}> pre-reads its parameters from a <general> default; not supported for <{other}>"
+                        "<{other}> would pre-read its parameters from a <general> class default, \
+                         through a mapping of gain, bias and dynamics parameters that is not \
+                         reproduced for <{other}> (give them on the <{other}> or in a <{other}> \
+                         default)"
                     )),
                 ));
             }

@@ -287,7 +287,13 @@ impl Layout {
                 t @ ("replicate" | "composite" | "flexcomp" | "attach")
                     if self.opaque.is_none() =>
                 {
-                    self.opaque = Some((k, format!("<{t}> creates objects at compile time")));
+                    self.opaque = Some((
+                        k,
+                        format!(
+                            "<{t}> creates bodies and joints when MuJoCo compiles, whose places \
+                             in the keyframes' vectors are not modelled"
+                        ),
+                    ));
                 }
                 _ => {}
             }

@@ -74,6 +74,25 @@ fn keys_over_aligned_free_bodies_need_mujoco() {
     );
 }
 
+/// A base with keyframes takes no part whose objects MuJoCo makes at compile time: the
+/// keys could not be extended over their joints.
+#[test]
+fn keys_are_not_remapped_over_replicate() {
+    let mut base = load("corpora/merge/arm_with_keys.xml");
+    let before = base.to_xml_string();
+    let mut part = load("corpora/errors/merge/part_replicate.xml");
+    part.apply_prefix("p_").unwrap();
+    let err = base
+        .merge(&part, None, &MergeOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        err,
+        "corpora/errors/merge/part_replicate.xml:3:5: cannot remap keyframes: <replicate> creates bodies and joints when MuJoCo compiles, whose places in the keyframes' vectors are not modelled"
+    );
+    assert_eq!(base.to_xml_string(), before);
+}
+
 #[test]
 fn settings_without_a_conversion_say_why() {
     assert_eq!(
