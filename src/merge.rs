@@ -123,8 +123,8 @@ fn no_conversion_reason(attr: &str, base: &str, default: &str) -> &'static str {
             }
         }
         "fusestatic" => {
-            ": it decides which bodies without joints are fused into their parents, over the \
-             whole merged model"
+            ": the part's static bodies are fused into their parents when it compiles alone, \
+             and a base that does not fuse them would keep them"
         }
         "discardvisual" => {
             ": it decides whether visual geoms, and the assets only they use, are dropped, \
@@ -956,6 +956,14 @@ impl Document {
         if align_free_joints {
             converted.push("alignfree");
         }
+        // A base that fuses static bodies would fuse the part's too; `fuse="false"` on each
+        // of the part's bodies keeps them (3.17.0 and 4.0.0). The other way round (a part
+        // that fuses its own, into a base that does not) has no conversion.
+        let keep_bodies = value(&base, "fusestatic", "false") == "true"
+            && value(&theirs, "fusestatic", "false") == "false";
+        if keep_bodies {
+            converted.push("fusestatic");
+        }
         for (attr, default) in MUST_AGREE {
             if (attr == "inertiafromgeom" && drop_inertials) || converted.contains(&attr) {
                 continue;
@@ -1007,6 +1015,15 @@ impl Document {
         drop(theirs);
         if !errors.is_empty() {
             return;
+        }
+        if keep_bodies {
+            let bodies: Vec<Node> = part
+                .descendants(part.root)
+                .filter(|&n| part.tag(n) == "body")
+                .collect();
+            for b in bodies {
+                part.set_attr(b, "fuse", "false");
+            }
         }
         if align_free_joints {
             let free: Vec<Node> = part

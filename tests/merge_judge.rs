@@ -333,6 +333,18 @@ fn cases() -> Vec<Case> {
         ],
         fuse_keys: false,
     });
+    // A base that fuses its static bodies, with parts that do not (robosuite objects, whose
+    // outer bodies have no joints, and a robot): every part's body is kept (fuse="false").
+    cases.push(Case {
+        name: "objects_into_fusestatic_base".into(),
+        parts: vec![
+            base(ours("table_fusestatic.xml")),
+            part(rs("objects/bread.xml"), "bread", Some("door")),
+            part(rs("objects/milk.xml"), "milk", None),
+            part(ours("free_objects_with_key.xml"), "k", None),
+        ],
+        fuse_keys: false,
+    });
     // With keyframes, both ways: an aligned free body's qpos0 in the keys comes from
     // MuJoCo's compile (builds without MuJoCo refuse: merge_rules).
     if cfg!(mjcf_mujoco) {

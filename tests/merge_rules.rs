@@ -97,7 +97,7 @@ fn keys_are_not_remapped_over_replicate() {
 fn settings_without_a_conversion_say_why() {
     assert_eq!(
         merge_error("corpora/errors/merge/part_fusestatic.xml", "p_", None),
-        "corpora/errors/merge/part_fusestatic.xml:2:3: cannot merge: compiler fusestatic=\"true\" differs from the base's \"false\" and has no exact conversion: it decides which bodies without joints are fused into their parents, over the whole merged model"
+        "corpora/errors/merge/part_fusestatic.xml:2:3: cannot merge: compiler fusestatic=\"true\" differs from the base's \"false\" and has no exact conversion: the part's static bodies are fused into their parents when it compiles alone, and a base that does not fuse them would keep them"
     );
 }
 
