@@ -120,14 +120,11 @@ where
         let consumer = scope.spawn(move || -> Result<(), String> {
             let mut i = range.start;
             while i < end {
-                {
+                // The run of made indices from `i` on, waiting for one if none is made: the
+                // consumer sleeps until `batch` of them are (one wake-up per run).
+                let run = {
                     let mut st = lock(&shared.state);
                     if !st.ready[at(i)] {
-                        // Workers waiting for slots freed since the last wake-up go on.
-                        if st.workers_waiting > 0 {
-                            shared.freed.notify_all();
-                        }
-                        // Sleep until a whole run is made: one wake-up per `batch`.
                         let last = (i + batch - 1).min(end - 1);
                         st.consumer_waits_to = Some(last);
                         while !st.ready[at(i)] && !st.worker_panicked {
@@ -138,33 +135,36 @@ where
                             return Err("internal error: a worker thread panicked".to_string());
                         }
                     }
-                }
-                // Every made index from `i` on, without the state lock.
-                loop {
-                    let mut slot = lock(&shared.slots[at(i)]);
-                    let Some(result) = slot.result.take() else {
-                        break;
+                    (i..end.min(i + ring_len))
+                        .take_while(|&k| st.ready[at(k)])
+                        .count() as u64
+                };
+                // Their slots are the consumer's until it frees them: no lock is contended.
+                let mut outcome = Ok(());
+                let mut done = 0;
+                while done < run && outcome.is_ok() {
+                    let k = i + done;
+                    let mut slot = lock(&shared.slots[at(k)]);
+                    outcome = match slot.result.take() {
+                        Some(result) => consume(k, &slot.buffers, result),
+                        None => Err("internal error: a made slot is empty".to_string()),
                     };
-                    let outcome = consume(i, &slot.buffers, result);
-                    drop(slot);
-                    let mut st = lock(&shared.state);
-                    st.ready[at(i)] = false;
-                    st.consumed = i + 1;
-                    if outcome.is_err() {
-                        st.stopped = true;
-                    }
-                    // Waiting workers are woken once per `batch` freed slots (and when
-                    // this thread is about to wait itself, above).
-                    if (st.workers_waiting > 0 && (i + 1).is_multiple_of(batch)) || st.stopped {
-                        shared.freed.notify_all();
-                    }
-                    drop(st);
-                    outcome?;
-                    i += 1;
-                    if i == end {
-                        break;
-                    }
+                    done += 1;
                 }
+                let mut st = lock(&shared.state);
+                for k in i..i + done {
+                    st.ready[at(k)] = false;
+                }
+                st.consumed = i + done;
+                if outcome.is_err() {
+                    st.stopped = true;
+                }
+                if st.workers_waiting > 0 || st.stopped {
+                    shared.freed.notify_all();
+                }
+                drop(st);
+                outcome?;
+                i += done;
             }
             Ok(())
         });
@@ -174,13 +174,26 @@ where
                 made: &shared.made,
                 freed: &shared.freed,
             };
+            // One lock of the state per index: the last one marked made, the next one taken
+            // (waiting while its slot is still the consumer's).
+            let mut made: Option<u64> = None;
             loop {
-                let i = shared.next.fetch_add(1, Ordering::Relaxed);
-                if i >= end {
-                    return;
-                }
-                {
+                let i = {
                     let mut st = lock(&shared.state);
+                    if let Some(m) = made {
+                        st.ready[at(m)] = true;
+                        // Wake the consumer once every index of the run it waits for is made.
+                        if let Some(last) = st.consumer_waits_to {
+                            let from = st.consumed;
+                            if (from..=last).all(|k| st.ready[at(k)]) {
+                                shared.made.notify_one();
+                            }
+                        }
+                    }
+                    let i = shared.next.fetch_add(1, Ordering::Relaxed);
+                    if i >= end {
+                        return;
+                    }
                     while !st.stopped && i >= st.consumed + ring_len {
                         st.workers_waiting += 1;
                         st = shared
@@ -192,20 +205,12 @@ where
                     if st.stopped {
                         return;
                     }
-                }
+                    i
+                };
                 let mut slot = lock(&shared.slots[at(i)]);
-                let result = make(i, &mut slot.buffers);
-                slot.result = Some(result);
+                slot.result = Some(make(i, &mut slot.buffers));
                 drop(slot);
-                let mut st = lock(&shared.state);
-                st.ready[at(i)] = true;
-                // Wake the consumer once every index of the run it waits for is made.
-                if let Some(last) = st.consumer_waits_to {
-                    let from = st.consumed;
-                    if (from..=last).all(|k| st.ready[at(k)]) {
-                        shared.made.notify_one();
-                    }
-                }
+                made = Some(i);
             }
         });
         consumer
