@@ -181,7 +181,7 @@ pub fn frame_text_member<T, E>(
     fill: impl FnOnce(&mut String) -> Result<T, E>,
 ) -> Result<Result<T, E>, Error> {
     let at = out.len();
-    out.extend(std::iter::repeat_n('\0', BLOCK));
+    out.push_str(ZEROS);
     let made = match fill(out) {
         Ok(made) => made,
         Err(e) => {
@@ -204,9 +204,18 @@ pub fn frame_text_member<T, E>(
     let header = std::str::from_utf8(&header).expect("a tar header of a UTF-8 name is UTF-8");
     out.replace_range(at..at + BLOCK, header);
     let padding = (BLOCK - size % BLOCK) % BLOCK;
-    out.extend(std::iter::repeat_n('\0', padding));
+    out.push_str(&ZEROS[..padding]);
     Ok(Ok(made))
 }
+
+/// A block of NUL bytes, appended whole rather than a `char` at a time.
+const ZEROS: &str = {
+    const BYTES: [u8; BLOCK] = [0; BLOCK];
+    match std::str::from_utf8(&BYTES) {
+        Ok(s) => s,
+        Err(_) => panic!("NUL bytes are UTF-8"),
+    }
+};
 
 /// The ustar header of a regular file `name` of `size` bytes, or why it cannot be stored.
 fn header(name: &str, size: u64) -> Result<[u8; BLOCK], String> {
