@@ -3,8 +3,9 @@
 //! output (`-`: a WebDataset-style tar stream: `assets/...` first, then
 //! `NNNNNNNNN.xml` and `NNNNNNNNN.json` per variant).
 //!
-//! Variants are made in chunks, each chunk in parallel and written in index order, so
-//! memory stays bounded and the output is the same bytes for any thread count. With
+//! Variants are made in parallel into a ring of reused slots and written in index order
+//! (`super::ordered`), so memory stays bounded and the output is the same bytes for any
+//! thread count. With
 //! `--shard K/N` this process makes only its share of the indices; N processes given the
 //! same folder together write what one process writes (each its own manifest).
 
