@@ -53,5 +53,7 @@ pub use error::{Error, ErrorKind, Errors, Location};
 pub use limits::Limits;
 pub use merge::{MergeOptions, MergePart, MergeReport};
 pub use model::{MujocoModel, Offsets, XmlModel, XmlModelOptions};
-pub use output::{AssetStore, OutputDir, TarWriter, frame_text_member, write_atomic};
+pub use output::{
+    AssetStore, OutputDir, PendingHeader, TarWriter, frame_text_member, write_atomic,
+};
 pub use tree::Node;

@@ -70,7 +70,7 @@ pub struct Args {
 /// members (XML and JSON) framed.
 #[derive(Default)]
 struct Slot {
-    framed: String,
+    framed: Vec<u8>,
 }
 
 /// Where the variants go.
@@ -292,7 +292,7 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
         |_, slot, made| {
             match made {
                 Ok((json, took, bytes)) => {
-                    writer.write(&store, &json, slot.framed.as_bytes())?;
+                    writer.write(&store, &json, &slot.framed)?;
                     summary.variants += 1;
                     summary.bytes += bytes;
                     if let Some(c) = &mut summary.compile {
@@ -338,17 +338,22 @@ fn make_one(
             scene.variant_xml_append(i, buf).map_err(|e| e.to_string())
         }
     };
+    // The slot's buffer as text again: empty, so nothing is validated, and its capacity
+    // is kept.
     slot.framed.clear();
+    let mut text = String::from_utf8(std::mem::take(&mut slot.framed)).unwrap_or_default();
     // For a tar stream the XML is written straight into its member.
-    let (params, xml) = if is_tar {
-        let (params, range) = frame_text_member(&mut slot.framed, &file, |buf| {
+    let (params, xml, header) = if is_tar {
+        let ((params, range), header) = frame_text_member(&mut text, &file, |buf| {
             let start = buf.len();
             make(buf).map(|p| (p, start..buf.len()))
         })
         .map_err(|e| e.to_string())??;
-        (params, &slot.framed[range])
+        (params, range, Some(header))
     } else {
-        (make(&mut slot.framed)?, slot.framed.as_str())
+        let params = make(&mut text)?;
+        let all = 0..text.len();
+        (params, all, None)
     };
     let took = match validators {
         Some(v) => v.check(i, &params)?,
@@ -356,16 +361,23 @@ fn make_one(
     };
     let json = params.to_json(i, Some(&file));
     if let Some(out) = files {
-        out.write(&file, xml.as_bytes())
+        out.write(&file, text[xml.clone()].as_bytes())
             .map_err(|e| e.to_string())?;
     }
     let bytes = xml.len() as u64;
-    if is_tar {
-        frame_text_member(&mut slot.framed, &format!("{i:09}.json"), |m| {
+    let json_header = if is_tar {
+        let ((), h) = frame_text_member(&mut text, &format!("{i:09}.json"), |m| {
             m.push_str(&json);
             Ok::<(), String>(())
         })
         .map_err(|e| e.to_string())??;
+        Some(h)
+    } else {
+        None
+    };
+    slot.framed = text.into_bytes();
+    for h in header.iter().chain(&json_header) {
+        h.write_into(&mut slot.framed).map_err(|e| e.to_string())?;
     }
     Ok((json, took, bytes))
 }

@@ -9,4 +9,4 @@ mod tar;
 
 pub use assets::AssetStore;
 pub use files::{AtomicFile, OutputDir, write_atomic};
-pub use tar::{TarWriter, frame_text_member};
+pub use tar::{PendingHeader, TarWriter, frame_text_member};

@@ -157,29 +157,34 @@ impl<W: Write> TarWriter<BufWriter<W>> {
 }
 
 /// Appends one whole tar member named `name` to `out`, its bytes the text `fill` appends
-/// (written straight into place: a variant's XML is never copied into its member), then
-/// the header [`TarWriter::append`] writes for them before, and the padding to a whole
-/// block after. A header is ASCII and NUL bytes, so the member stays a `String`. For
-/// laying out members on worker threads, then writing them in order with
-/// [`TarWriter::append_framed`]. Gives what `fill` gives, or the header's error (a name
-/// that does not fit); if either fails, `out` is as it was.
+/// (written straight into place: a variant's XML is never copied into its member), after
+/// a placeholder block for the header [`TarWriter::append`] writes and before the padding
+/// to a whole block. The header itself is given back as a [`PendingHeader`], written over
+/// its placeholder once the text is bytes (`String::into_bytes`, which copies nothing):
+/// rewriting a block of a `String` in place goes a byte at a time. For laying out members
+/// on worker threads, then writing them in order with [`TarWriter::append_framed`]. Gives
+/// what `fill` gives, or the header's error (a name that does not fit); if either fails,
+/// `out` is as it was.
 ///
 /// ```
 /// let mut out = String::new();
-/// mjcf_forge::frame_text_member(&mut out, "a.json", |m| {
+/// let ((), header) = mjcf_forge::frame_text_member(&mut out, "a.json", |m| {
 ///     m.push_str("{}");
 ///     Ok::<(), std::fmt::Error>(())
 /// })?
 /// .unwrap();
-/// assert_eq!(out.len(), 1024);
-/// assert_eq!(&out[512..514], "{}");
+/// let mut bytes = out.into_bytes();
+/// header.write_into(&mut bytes)?;
+/// assert_eq!(bytes.len(), 1024);
+/// assert!(bytes.starts_with(b"a.json\0"));
+/// assert_eq!(&bytes[512..514], b"{}");
 /// # Ok::<(), mjcf_forge::Error>(())
 /// ```
 pub fn frame_text_member<T, E>(
     out: &mut String,
     name: &str,
     fill: impl FnOnce(&mut String) -> Result<T, E>,
-) -> Result<Result<T, E>, Error> {
+) -> Result<Result<(T, PendingHeader), E>, Error> {
     let at = out.len();
     out.push_str(ZEROS);
     let made = match fill(out) {
@@ -200,12 +205,40 @@ pub fn frame_text_member<T, E>(
             }));
         }
     };
-    // The header's bytes are the name's (UTF-8), ASCII digits and NULs.
-    let header = std::str::from_utf8(&header).expect("a tar header of a UTF-8 name is UTF-8");
-    out.replace_range(at..at + BLOCK, header);
     let padding = (BLOCK - size % BLOCK) % BLOCK;
     out.push_str(&ZEROS[..padding]);
-    Ok(Ok(made))
+    Ok(Ok((made, PendingHeader { at, header })))
+}
+
+/// The header of a member [`frame_text_member`] laid out, and where its placeholder is.
+#[derive(Clone, Copy, Debug)]
+pub struct PendingHeader {
+    at: usize,
+    header: [u8; BLOCK],
+}
+
+impl PendingHeader {
+    /// Writes the header over its placeholder in `framed`: the text the member was laid
+    /// out in, as bytes. An error if `framed` is too short to hold it (another buffer).
+    ///
+    /// ```
+    /// let mut out = String::new();
+    /// let ((), header) =
+    ///     mjcf_forge::frame_text_member(&mut out, "x", |_| Ok::<(), ()>(()))?.unwrap();
+    /// assert!(header.write_into(&mut [0u8; 16]).is_err());
+    /// # Ok::<(), mjcf_forge::Error>(())
+    /// ```
+    pub fn write_into(&self, framed: &mut [u8]) -> Result<(), Error> {
+        let len = framed.len();
+        let place = framed.get_mut(self.at..self.at + BLOCK).ok_or_else(|| {
+            Error::bare(ErrorKind::Invalid(format!(
+                "a tar header at byte {} does not fit in {len} bytes of framed members",
+                self.at
+            )))
+        })?;
+        place.copy_from_slice(&self.header);
+        Ok(())
+    }
 }
 
 /// A block of NUL bytes, appended whole rather than a `char` at a time.
