@@ -1,7 +1,8 @@
 //! Merging judged by MuJoCo on real parts: robosuite robots with grippers in their hands,
 //! two instances of one robot, Lift-like scenes (arena, robot, mount, gripper, objects),
 //! dm-control models in robosuite arenas, degree/radian and eulerseq mixes, keyframes (kept
-//! apart and fused). Every part's objects compile to the same values inside the merged
+//! apart and fused), and every wheel model from outside robosuite and dm-control merged
+//! into a robosuite arena. Every part's objects compile to the same values inside the merged
 //! model as alone, counts add up, keyframe values sit on the right joints
 //! (tests/judge/merge_judge.py).
 
