@@ -883,19 +883,32 @@ impl Document {
 
     /// Brings `part` to this document's compiler settings, or reports why it cannot be.
     fn convert_compiler(&self, part: &mut Document, errors: &mut Vec<Error>) {
-        // Builds with MuJoCo first make a part's inertiafromgeom="true" "auto" with every
-        // body's compiled inertia written out (`mujoco::write_all_inertials_from_geoms`), after
-        // which its mass settings have nothing left to change: a locomotion model with
-        // `inertiafromgeom="true" settotalmass="14"` (Gymnasium's half_cheetah) merges exactly
-        // into a base with MuJoCo's defaults.
+        // A part's inertiafromgeom="true" alone becomes "auto" below, in every build, by
+        // dropping the <inertial>s that "true" overrides. With mass settings, another
+        // inertiagrouprange or a base with "false" as well, builds with MuJoCo first make it
+        // "auto" with every body's compiled inertia written out
+        // (`mujoco::write_all_inertials_from_geoms`), after which those settings have nothing
+        // left to change: a locomotion model with `inertiafromgeom="true"
+        // settotalmass="14"` (Gymnasium's half_cheetah) merges exactly into a base with
+        // MuJoCo's defaults.
         #[cfg(mjcf_mujoco)]
         {
-            let from_geoms = |d: &Document| {
-                compiler_settings(d)
-                    .get("inertiafromgeom")
-                    .is_some_and(|(v, _)| v == "true")
+            let (ours, theirs) = (compiler_settings(self), compiler_settings(part));
+            let setting = |m: &Compiler<'_>, k: &str, d: &str| {
+                m.get(k)
+                    .map_or_else(|| d.to_string(), |(v, _)| v.to_string())
             };
-            if from_geoms(part) && !from_geoms(self) {
+            let differs =
+                |k: &str, d: &str| !same_value(&setting(&ours, k, d), &setting(&theirs, k, d));
+            let (bi, pi) = (
+                setting(&ours, "inertiafromgeom", "auto"),
+                setting(&theirs, "inertiafromgeom", "auto"),
+            );
+            let more = INERTIA_ONLY.iter().any(|&(k, d)| differs(k, d))
+                || differs("inertiagrouprange", "0 5")
+                || bi == "false";
+            drop((ours, theirs));
+            if pi == "true" && bi != "true" && more {
                 let at = part.location(part.root);
                 if let Err(e) = crate::mujoco::write_all_inertials_from_geoms(part) {
                     errors.push(Error::at(
