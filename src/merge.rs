@@ -1144,12 +1144,17 @@ impl Document {
     }
 
     /// Converts every angle-valued attribute between degrees and radians: Euler angles, the
-    /// angle of `axisangle`, and hinge/ball joint `range`, `ref`, `springref` (the ones
-    /// MuJoCo's `compiler angle` applies to).
+    /// angle of `axisangle`, and hinge/ball joint `ref`, `springref` and, of a limited joint,
+    /// `range` (the ones MuJoCo's `compiler angle` applies to: it keeps the range of a joint
+    /// that is not limited as written, in 3.17.0 and 4.0.0, as dm-control's testing arm has
+    /// `range="-6.28319 6.28319" limited="false"`).
     fn convert_angles(&mut self, from_degrees: bool, to_degrees: bool) {
         if from_degrees == to_degrees {
             return;
         }
+        let autolimits = compiler_settings(self)
+            .get("autolimits")
+            .is_none_or(|(v, _)| v == "true");
         let factor = if from_degrees {
             std::f64::consts::PI / 180.0
         } else {
@@ -1177,9 +1182,14 @@ impl Document {
             }
             if self.tag_sym(n) == Some(s.joint) && self.is_body_child(n) {
                 let ty = self.attr_sym(n, s.ty).map(str::trim).unwrap_or("hinge");
+                let limited = match self.attr(n, "limited").map(str::trim) {
+                    Some("true") => true,
+                    Some("false") => false,
+                    _ => autolimits && self.attr_sym(n, s.range).is_some(),
+                };
                 if ty == "hinge" || ty == "ball" {
                     for a in [s.range, s.reference, s.springref] {
-                        if ty == "ball" && a != s.range {
+                        if (ty == "ball" && a != s.range) || (a == s.range && !limited) {
                             continue;
                         }
                         if let Some(v) = self.attr_sym(n, a) {
