@@ -42,11 +42,16 @@ def _quiet_worker() -> None:
 
 
 def try_compile(path: str) -> tuple[str, str | None]:
-    """(path, None) when it compiles, else (path, first error line)."""
+    """(path, None) when it compiles, else (path, first error line).
+
+    Compiled from its absolute path, as the tests name every model: named by a relative
+    path with a folder, MuJoCo 3.17.0 looks for a nested include's second place in a
+    doubled folder (the "double prefix" 4.0.0 fixed) and rejects models (myo-sim's elbows)
+    that it reads from their absolute path."""
     import mujoco
 
     try:
-        mujoco.MjModel.from_xml_path(path)
+        mujoco.MjModel.from_xml_path(str(ROOT / path))
     except Exception as e:  # MuJoCo raises ValueError; be lenient with the rest
         lines = [l.strip() for l in str(e).splitlines() if l.strip()]
         return path, (lines[0] if lines else type(e).__name__)
@@ -82,7 +87,7 @@ def main() -> int:
                     not_mujoco += 1
     candidates.sort()
 
-    # Compile relative to the repo root so the paths we record are the ones compiled.
+    # From the repository root: a `<model file>` is read from the working directory.
     os.chdir(ROOT)
     results: dict[str, str | None] = {}
     workers = max(1, min(len(candidates), os.cpu_count() or 1))

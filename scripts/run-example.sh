@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Sets up everything (Python venv with the pinned MuJoCo, the robosuite and dm-control
-# wheel corpora, a release build with MuJoCo compiled in) and runs the main jobs on built-in
+# Sets up everything (Python venv with the pinned MuJoCo, the wheel corpora of
+# scripts/setup.sh, a release build with MuJoCo compiled in) and runs the main jobs on built-in
 # examples, writing to out/:
 #   0. generate: 500 seeded variants of the built-in demo scene, validated by MuJoCo;
 #   1. inline: a feature model with includes, default classes and compiler dirs;

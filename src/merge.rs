@@ -439,7 +439,42 @@ fn keys_of(doc: &Document) -> Vec<Key> {
         .collect()
 }
 
+/// How many keys `<size nkey="N">` adds to the `<key>` elements written: MuJoCo allocates
+/// the larger of N and their number, the ones added coming after the written ones, each
+/// holding the model's defaults as an empty `<key/>` does (checked with MuJoCo 3.17.0 and
+/// 4.0.0; Gymnasium's humanoid has `nkey="5"` and no `<key>`).
+fn implicit_keys(doc: &Document) -> usize {
+    let nkey = doc
+        .elements(doc.root)
+        .filter(|&n| doc.tag(n) == "size")
+        .filter_map(|n| doc.attr(n, "nkey"))
+        .last()
+        .and_then(|v| v.trim().parse::<usize>().ok())
+        .unwrap_or(0);
+    nkey.saturating_sub(keys_of(doc).len())
+}
+
 impl Document {
+    /// Writes the keys that `<size nkey>` adds ([`implicit_keys`]) as empty `<key/>`s and
+    /// drops `nkey`: a merge keeps the base's `<size>` only, and adds keys of its own.
+    fn write_implicit_keys(&mut self) {
+        let n = implicit_keys(self);
+        if n == 0 {
+            return;
+        }
+        let section = self.section(Section::Keyframe);
+        for _ in 0..n {
+            self.append_element(section, "key", &[]);
+        }
+        let sizes: Vec<Node> = self
+            .elements(self.root)
+            .filter(|&n| self.tag(n) == "size")
+            .collect();
+        for s in sizes {
+            self.remove_attr(s, "nkey");
+        }
+    }
+
     /// Merges `part` into this document (see the module documentation): into the world
     /// body, or into the body named `into`. On error nothing changes and every problem found
     /// is reported.
@@ -500,7 +535,8 @@ impl Document {
         }
         // Every check runs before the document changes, except keyframe remapping: with
         // keys, or with several parts, work on a copy so that a failure changes nothing.
-        let keys = !keys_of(self).is_empty() || parts.iter().any(|p| !keys_of(p.doc).is_empty());
+        let has_keys = |d: &Document| !keys_of(d).is_empty() || implicit_keys(d) > 0;
+        let keys = has_keys(self) || parts.iter().any(|p| has_keys(p.doc));
         // A base smaller than its part may adopt the part's angle unit before the checks
         // (`adopt_angle_unit_if_smaller`): then it too works on a copy (a small one).
         if !keys && parts.len() == 1 && self.node_count() >= parts[0].doc.node_count() {
@@ -557,7 +593,20 @@ impl Document {
         if !errors.is_empty() {
             return Err(Errors(errors));
         }
-        let part: &Document = converted.as_ref().unwrap_or(part);
+        let mut part: &Document = converted.as_ref().unwrap_or(part);
+
+        // Keys that `<size nkey>` adds become `<key/>`s, in the base too when the part
+        // brings keys (else the base's `nkey` would count them): see `implicit_keys`.
+        let with_keys;
+        if implicit_keys(part) > 0 {
+            let mut p = part.clone();
+            p.write_implicit_keys();
+            with_keys = p;
+            part = &with_keys;
+        }
+        if !keys_of(part).is_empty() {
+            self.write_implicit_keys();
+        }
 
         // Keyframes are remapped from the layouts before the merge.
         let base_keys = keys_of(self);
@@ -873,6 +922,45 @@ impl Document {
 
     /// Brings `part` to this document's compiler settings, or reports why it cannot be.
     fn convert_compiler(&self, part: &mut Document, errors: &mut Vec<Error>) {
+        // A part's inertiafromgeom="true" alone becomes "auto" below, in every build, by
+        // dropping the <inertial>s that "true" overrides. With mass settings, another
+        // inertiagrouprange or a base with "false" as well, builds with MuJoCo first make it
+        // "auto" with every body's compiled inertia written out
+        // (`mujoco::write_all_inertials_from_geoms`), after which those settings have nothing
+        // left to change: a locomotion model with `inertiafromgeom="true"
+        // settotalmass="14"` (Gymnasium's half_cheetah) merges exactly into a base with
+        // MuJoCo's defaults.
+        #[cfg(mjcf_mujoco)]
+        {
+            let (ours, theirs) = (compiler_settings(self), compiler_settings(part));
+            let setting = |m: &Compiler<'_>, k: &str, d: &str| {
+                m.get(k)
+                    .map_or_else(|| d.to_string(), |(v, _)| v.to_string())
+            };
+            let differs =
+                |k: &str, d: &str| !same_value(&setting(&ours, k, d), &setting(&theirs, k, d));
+            let (bi, pi) = (
+                setting(&ours, "inertiafromgeom", "auto"),
+                setting(&theirs, "inertiafromgeom", "auto"),
+            );
+            let more = INERTIA_ONLY.iter().any(|&(k, d)| differs(k, d))
+                || differs("inertiagrouprange", "0 5")
+                || bi == "false";
+            drop((ours, theirs));
+            if pi == "true" && bi != "true" && more {
+                let at = part.location(part.root);
+                if let Err(e) = crate::mujoco::write_all_inertials_from_geoms(part) {
+                    errors.push(Error::at(
+                        at,
+                        ErrorKind::Invalid(format!(
+                            "cannot merge: compiler inertiafromgeom=\"true\" differs from the \
+                             base's and the part's inertias could not be written out: {e}"
+                        )),
+                    ));
+                    return;
+                }
+            }
+        }
         let base = compiler_settings(self);
         let theirs = compiler_settings(part);
         let value = |m: &Compiler<'_>, k: &str, d: &str| {
@@ -1036,9 +1124,14 @@ impl Document {
             }
         }
         if drop_inertials {
+            let range = value(&compiler_settings(part), "inertiagrouprange", "0 5");
             let inertials: Vec<Node> = part
                 .descendants(part.root)
                 .filter(|&n| part.tag(n) == "inertial")
+                .filter(|&n| {
+                    part.parent(n)
+                        .is_some_and(|b| part.has_massive_geom_in_range(b, &range))
+                })
                 .collect();
             for n in inertials {
                 part.remove(n);
@@ -1107,6 +1200,48 @@ impl Document {
         on && self.joint_body_is_a_leaf(joint)
     }
 
+    /// Whether `body` has a geom (directly or in a `<frame>` inside it) in the compiler's
+    /// `inertiagrouprange` ("lo hi") whose mass is not zero (`mass="0"`, or `density="0"`
+    /// without `mass`). Under inertiafromgeom="true" such a body takes its inertia from its
+    /// geoms; a body without one keeps its `<inertial>` (MuJoCo 3.17.0 and 4.0.0: a body with
+    /// no geom, only geoms of other groups, or only massless ones).
+    fn has_massive_geom_in_range(&self, body: Node, range: &str) -> bool {
+        let bounds: Vec<i64> = range
+            .split_ascii_whitespace()
+            .filter_map(|t| t.parse().ok())
+            .collect();
+        let (lo, hi) = match bounds[..] {
+            [lo, hi] => (lo, hi),
+            _ => (0, 5),
+        };
+        let zero = |n: Node, k: &str| {
+            self.attr(n, k)
+                .and_then(|v| v.trim().parse::<f64>().ok())
+                .is_some_and(|x| x == 0.0)
+        };
+        let mut stack: Vec<Node> = self.elements(body).collect();
+        while let Some(n) = stack.pop() {
+            match self.tag(n) {
+                "geom" => {
+                    let group = self
+                        .attr(n, "group")
+                        .and_then(|v| v.trim().parse::<i64>().ok())
+                        .unwrap_or(0);
+                    let massless = match self.attr(n, "mass") {
+                        Some(_) => zero(n, "mass"),
+                        None => zero(n, "density"),
+                    };
+                    if (lo..=hi).contains(&group) && !massless {
+                        return true;
+                    }
+                }
+                "frame" => stack.extend(self.elements(n)),
+                _ => {}
+            }
+        }
+        false
+    }
+
     /// The bodies whose mass and inertia MuJoCo infers from their geoms (under
     /// `inertiafromgeom="auto"`): those without an `<inertial>` that have a geom, directly or
     /// in a `<frame>` (or `<replicate>`) inside them.
@@ -1153,12 +1288,17 @@ impl Document {
     }
 
     /// Converts every angle-valued attribute between degrees and radians: Euler angles, the
-    /// angle of `axisangle`, and hinge/ball joint `range`, `ref`, `springref` (the ones
-    /// MuJoCo's `compiler angle` applies to).
+    /// angle of `axisangle`, and hinge/ball joint `ref`, `springref` and, of a limited joint,
+    /// `range` (the ones MuJoCo's `compiler angle` applies to: it keeps the range of a joint
+    /// that is not limited as written, in 3.17.0 and 4.0.0, as dm-control's testing arm has
+    /// `range="-6.28319 6.28319" limited="false"`).
     fn convert_angles(&mut self, from_degrees: bool, to_degrees: bool) {
         if from_degrees == to_degrees {
             return;
         }
+        let autolimits = compiler_settings(self)
+            .get("autolimits")
+            .is_none_or(|(v, _)| v == "true");
         let factor = if from_degrees {
             std::f64::consts::PI / 180.0
         } else {
@@ -1186,9 +1326,14 @@ impl Document {
             }
             if self.tag_sym(n) == Some(s.joint) && self.is_body_child(n) {
                 let ty = self.attr_sym(n, s.ty).map(str::trim).unwrap_or("hinge");
+                let limited = match self.attr(n, "limited").map(str::trim) {
+                    Some("true") => true,
+                    Some("false") => false,
+                    _ => autolimits && self.attr_sym(n, s.range).is_some(),
+                };
                 if ty == "hinge" || ty == "ball" {
                     for a in [s.range, s.reference, s.springref] {
-                        if ty == "ball" && a != s.range {
+                        if (ty == "ball" && a != s.range) || (a == s.range && !limited) {
                             continue;
                         }
                         if let Some(v) = self.attr_sym(n, a) {

@@ -309,7 +309,35 @@ pub(crate) fn free_joint_qpos0(
     Ok(q)
 }
 
+/// For a document with `compiler inertiafromgeom="true"`: every body's compiled inertia
+/// written out as by [`write_all_inertials`] (compiled under "true", whatever the body's
+/// `<inertial>` says), then the setting made `"auto"`, under which every written `<inertial>`
+/// counts: the same masses and inertias, and no mass setting left with anything to change.
+pub(crate) fn write_all_inertials_from_geoms(
+    doc: &mut crate::Document,
+) -> Result<usize, CompileError> {
+    let n = write_inertials_checked(doc, true, false)?;
+    let compilers: Vec<crate::tree::Node> = doc
+        .elements(doc.root())
+        .filter(|&c| doc.tag(c) == "compiler" && doc.attr(c, "inertiafromgeom").is_some())
+        .collect();
+    for c in compilers {
+        doc.set_attr(c, "inertiafromgeom", "auto");
+    }
+    Ok(n)
+}
+
 fn write_inertials_of(doc: &mut crate::Document, all: bool) -> Result<usize, CompileError> {
+    write_inertials_checked(doc, all, true)
+}
+
+/// `from_geoms_refused`: refuse inertiafromgeom="true", under which the written inertials
+/// would be ignored (callers that then make the setting "auto" pass false).
+fn write_inertials_checked(
+    doc: &mut crate::Document,
+    all: bool,
+    from_geoms_refused: bool,
+) -> Result<usize, CompileError> {
     let refused = ["replicate", "attach", "composite", "flexcomp"];
     if let Some(n) = doc
         .descendants(doc.root())
@@ -327,7 +355,9 @@ fn write_inertials_of(doc: &mut crate::Document, all: bool) -> Result<usize, Com
         .filter(|&c| doc.tag(c) == "compiler")
     {
         let setting = |k: &str, bad: &str| doc.attr(c, k).is_some_and(|v| v.trim() == bad);
-        if setting("inertiafromgeom", "true") || setting("fusestatic", "true") {
+        if (from_geoms_refused && setting("inertiafromgeom", "true"))
+            || setting("fusestatic", "true")
+        {
             return Err(CompileError::local(format!(
                 "{}: compiler inertiafromgeom=\"true\" or fusestatic=\"true\": explicit \
                  inertials would not carry the compiled inertia",

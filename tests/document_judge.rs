@@ -1,5 +1,5 @@
 //! The document tier judged by MuJoCo: what `Document::load` writes compiles to the same
-//! model as what it read, on every compiling model of the robosuite and dm-control wheels
+//! model as what it read, on every compiling model of the corpus wheels (scripts/setup.sh)
 //! and on the feature cases in corpora/features and corpora/includes; error cases give their
 //! exact messages.
 

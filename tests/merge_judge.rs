@@ -1,7 +1,8 @@
 //! Merging judged by MuJoCo on real parts: robosuite robots with grippers in their hands,
 //! two instances of one robot, Lift-like scenes (arena, robot, mount, gripper, objects),
 //! dm-control models in robosuite arenas, degree/radian and eulerseq mixes, keyframes (kept
-//! apart and fused). Every part's objects compile to the same values inside the merged
+//! apart and fused), and every wheel model from outside robosuite and dm-control merged
+//! into a robosuite arena. Every part's objects compile to the same values inside the merged
 //! model as alone, counts add up, keyframe values sit on the right joints
 //! (tests/judge/merge_judge.py).
 
@@ -9,7 +10,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{root, run_each_judge, scratch};
+use common::{root, run_each_judge, scratch, wheel_models_in_every_version};
 use mjcf_forge::{Document, MergeOptions, XmlModel, XmlModelOptions};
 
 fn rs(rel: &str) -> PathBuf {
@@ -97,7 +98,9 @@ fn instance(p: &Part) -> Document {
     doc
 }
 
-fn build(case: &Case, dir: &Path) -> String {
+/// Writes the case's base, parts and merged scene into `dir`; its entry for the judge, or
+/// the merge's error.
+fn build(case: &Case, dir: &Path) -> Result<String, String> {
     let base_part = &case.parts[0];
     let mut scene = instance(base_part);
     let base_file = dir.join(format!("{}_base.xml", case.name));
@@ -120,7 +123,7 @@ fn build(case: &Case, dir: &Path) -> String {
         };
         scene
             .merge(&doc, p.into.as_deref(), &options)
-            .unwrap_or_else(|e| panic!("{}: merging {}:\n{e}", case.name, p.path.display()));
+            .map_err(|e| format!("{}: merging {}:\n{e}", case.name, p.path.display()))?;
         parts_json.push(format!(
             "{{\"path\": \"{}\", \"prefix\": \"{judge_prefix}\", \"body\": {}}}",
             file.display(),
@@ -136,13 +139,13 @@ fn build(case: &Case, dir: &Path) -> String {
     } else {
         String::new()
     };
-    format!(
+    Ok(format!(
         "{{\"name\": \"{}\", \"merged\": \"{}\", \"base\": \"{}\", \"base_prefix\": \"\", \"parts\": [{}]{fused}}}",
         case.name,
         merged.display(),
         base_file.display(),
         parts_json.join(", ")
-    )
+    ))
 }
 
 fn cases() -> Vec<Case> {
@@ -366,6 +369,61 @@ fn cases() -> Vec<Case> {
             fuse_keys: false,
         });
     }
+    // Keys that <size nkey> adds, in the base and in a part, and user data of another width:
+    // next to parts with keys of their own.
+    let implicit = || ours("implicit_keys_user_widths.xml");
+    cases.push(Case {
+        name: "implicit_keys_and_user_widths_into_each_other".into(),
+        parts: vec![
+            base(implicit()),
+            part(implicit(), "k", None),
+            part(ours("free_objects_with_key.xml"), "obj", None),
+        ],
+        fuse_keys: false,
+    });
+    cases.push(Case {
+        name: "implicit_keys_and_user_widths_into_arm".into(),
+        parts: vec![
+            base(ours("arm_with_keys.xml")),
+            Part {
+                plain: true,
+                ..part(implicit(), "k", None)
+            },
+        ],
+        fuse_keys: false,
+    });
+    // Ranges of joints that are not limited stay as written when angles are converted: a
+    // radian part into a degree base, and a smaller radian base adopting a degree part's unit.
+    cases.push(Case {
+        name: "radian_unlimited_ranges_into_degree_arm".into(),
+        parts: vec![
+            base(ours("arm_with_keys.xml")),
+            part(ours("radian_unlimited_ranges.xml"), "r", None),
+        ],
+        fuse_keys: false,
+    });
+    cases.push(Case {
+        name: "degree_arm_into_radian_unlimited_ranges".into(),
+        parts: vec![
+            base(ours("radian_unlimited_ranges.xml")),
+            part(ours("arm_with_keys.xml"), "a", None),
+        ],
+        fuse_keys: false,
+    });
+    // inertiafromgeom="true" into "auto": the <inertial> of bodies that infer nothing from
+    // their geoms stays.
+    cases.push(Case {
+        name: "objects_inertia_from_geom_into_arm".into(),
+        parts: vec![
+            base(ours("arm_with_keys.xml")),
+            part(
+                ours("objects_inertia_from_geom_kept_inertials.xml"),
+                "t",
+                None,
+            ),
+        ],
+        fuse_keys: false,
+    });
     // A part with inertiagrouprange="4 5" into a base with "0 5": builds with MuJoCo write
     // the inferred inertias out (mujoco::write_inertials); without MuJoCo it is refused
     // (merge_rules).
@@ -387,6 +445,7 @@ fn cases() -> Vec<Case> {
                 base(ours("arm_with_keys.xml")),
                 part(ours("objects_mass_settings.xml"), "m", None),
                 part(ours("objects_inertia_from_inertials_only.xml"), "f", None),
+                part(ours("objects_inertia_from_geom_total_mass.xml"), "g", None),
             ],
             fuse_keys: false,
         });
@@ -394,16 +453,88 @@ fn cases() -> Vec<Case> {
     cases
 }
 
+/// Every wheel model that every judging MuJoCo compiles (robosuite's and dm-control's, and
+/// gymnasium, brax, myo-sim, fancy-gym, gym-xarm, gym-aloha: locomotion, musculoskeletal
+/// models, arms, their tasks), prefixed as a part of robosuite's empty arena: a base in
+/// degrees with MuJoCo's default compiler settings, so radian parts, `inertiafromgeom="true"`
+/// and the mass settings (`settotalmass`, `boundmass`...) are converted.
+fn corpus_cases() -> Vec<Case> {
+    let corpus = root().join(".cache/corpus");
+    let models = wheel_models_in_every_version();
+    assert!(models.len() >= 200, "{} models", models.len());
+    models
+        .into_iter()
+        .map(|m| {
+            let rel = m.strip_prefix(&corpus).unwrap().with_extension("");
+            let name: String = rel
+                .to_string_lossy()
+                .chars()
+                .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+                .collect();
+            Case {
+                name: format!("corpus_{name}"),
+                parts: vec![
+                    base(rs("arenas/empty_arena.xml")),
+                    Part {
+                        plain: true,
+                        ..part(m, "m0", None)
+                    },
+                ],
+                fuse_keys: false,
+            }
+        })
+        .collect()
+}
+
 #[test]
 fn merged_scenes_keep_every_part_s_physics() {
     let dir = scratch("merge");
     let cases = cases();
     assert!(cases.len() >= 50, "{} cases", cases.len());
+    judge_merged(&cases, &dir);
+}
+
+#[test]
+fn corpus_models_merged_into_an_arena_keep_their_physics() {
+    let dir = scratch("merge_corpus");
+    // Without MuJoCo, mass settings (Gymnasium's half_cheetah: settotalmass="14") have no
+    // exact conversion: such a part must be refused, saying so.
+    let refusal = (!cfg!(mjcf_mujoco)).then_some("has no exact conversion");
+    judge_merged_allowing(&corpus_cases(), &dir, refusal);
+}
+
+/// Builds every case into `dir` and has the merge judge of every MuJoCo version check them.
+fn judge_merged(cases: &[Case], dir: &Path) {
+    judge_merged_allowing(cases, dir, None);
+}
+
+/// [`judge_merged`], where a case whose merge is refused with a message containing
+/// `refusal` is left out (any other refusal fails).
+fn judge_merged_allowing(cases: &[Case], dir: &Path, refusal: Option<&str>) {
+    let (built, refused): (Vec<_>, Vec<_>) =
+        cases.iter().map(|c| build(c, dir)).partition(Result::is_ok);
+    let (expected, refused): (Vec<String>, Vec<String>) = refused
+        .into_iter()
+        .filter_map(Result::err)
+        .partition(|e| refusal.is_some_and(|r| e.contains(r)));
+    assert!(
+        refused.is_empty(),
+        "merges refused:\n{}",
+        refused.join("\n")
+    );
+    if !expected.is_empty() {
+        println!(
+            "{} merges refused as expected:\n{}",
+            expected.len(),
+            expected.join("\n")
+        );
+    }
+    let count = built.len();
     let json = format!(
         "[\n{}\n]\n",
-        cases
-            .iter()
-            .map(|c| build(c, &dir))
+        built
+            .into_iter()
+            .filter_map(Result::ok)
             .collect::<Vec<_>>()
             .join(",\n")
     );
@@ -416,7 +547,7 @@ fn merged_scenes_keep_every_part_s_physics() {
             file.clone().into(),
         ]
     });
-    let expected = format!("{} passed, 0 failed", cases.len());
+    let expected = format!("{count} passed, 0 failed");
     let mut failed = Vec::new();
     for (j, out) in runs {
         let stdout = String::from_utf8_lossy(&out.stdout);

@@ -514,8 +514,12 @@ CAM_INTRINSIC = "default [znear, znear, 0, 0] follows vis.map.znear (from B); un
 ADDITIVE_SIZES = ("nq", "nv", "nu", "na", "nmocap", "nwrap", "nsensordata", "nnumericdata",
                   "ntextdata", "ntupledata", "nflexvert", "nflexedge", "nflexelem", "nflexnode")
 # <size> values: come from B.
-SIZE_FROM_BASE = ("nuserdata", "nuser_body", "nuser_jnt", "nuser_geom", "nuser_site", "nuser_cam",
-                  "nuser_tendon", "nuser_actuator", "nuser_sensor", "nconmax", "njmax")
+SIZE_FROM_BASE = ("nuserdata", "nconmax", "njmax")
+# User-data widths: the largest of the inputs' (a part whose geoms carry user values widens
+# the base's); MuJoCo pads shorter `<kind>_user` rows with zeros, so each input's rows are
+# compared padded to the merged width.
+USER_WIDTHS = ("nuser_body", "nuser_jnt", "nuser_geom", "nuser_site", "nuser_cam",
+               "nuser_tendon", "nuser_actuator", "nuser_sensor")
 
 
 def excluded_reason(name: str) -> str | None:
@@ -791,6 +795,8 @@ def _compare_object(out: list[str], ctx: _Ctx, v: View, kind: str, i: int, j: in
         if arr == "cam_intrinsic" and not np.any(v.m.cam_sensorsize[i]) and ctx.skip:
             continue  # see CAM_INTRINSIC
         a, b = getattr(v.m, arr)[i], getattr(mv.m, arr)[j]
+        if arr.endswith("_user") and np.ndim(a) == 1 and np.ndim(b) == 1 and len(a) < len(b):
+            a = np.concatenate([a, np.zeros(len(b) - len(a), dtype=a.dtype)])  # USER_WIDTHS
         if arr == "dof_simplenum":
             # The run of simple dofs starting here may continue into the next part's
             # dofs when those are simple too (two free objects side by side in the dof
@@ -1069,6 +1075,11 @@ def compare_merge_models(merged: mujoco.MjModel, base: mujoco.MjModel,
     out.extend(diff_struct("vis", base.vis, merged.vis))
     for size in SIZE_FROM_BASE:
         d = diff_value(f"size {size} (from base)", getattr(base, size), getattr(merged, size))
+        if d:
+            out.append(d)
+    for size in USER_WIDTHS:
+        widest = max(getattr(m, size) for m in [base, *(p for p, _prefix, _body in parts)])
+        d = diff_value(f"size {size} (the widest input's)", widest, getattr(merged, size))
         if d:
             out.append(d)
     return out

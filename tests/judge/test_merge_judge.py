@@ -241,6 +241,28 @@ def test_compile_error_is_a_difference(tmp_path):
     assert diffs[0].startswith("part 'n_' (") and "does not compile" in diffs[0]
 
 
+def test_user_data_is_compared_at_the_widest_width(tmp_path):
+    # The merged <size nuser_jnt> is the widest input's; MuJoCo pads shorter rows with zeros.
+    base = tmp_path / "base.xml"
+    base.write_text('<mujoco><worldbody><body name="a"><joint name="i" user="3"/>'
+                    '<geom size="0.1"/></body></worldbody></mujoco>')
+    part = tmp_path / "part.xml"
+    part.write_text('<mujoco><size nuser_jnt="2"/><worldbody><body name="b"><joint name="j" user="1 2"/>'
+                    '<geom size="0.1"/></body></worldbody></mujoco>')
+
+    def merged(width: int, user: str) -> list[str]:
+        out = tmp_path / f"merged_{width}_{user.replace(' ', '_')}.xml"
+        out.write_text(f'<mujoco><size nuser_jnt="{width}"/><worldbody>'
+                       f'<body name="a"><joint name="i" user="{user}"/><geom size="0.1"/></body>'
+                       '<body name="p_b"><joint name="p_j" user="1 2"/><geom size="0.1"/></body>'
+                       '</worldbody></mujoco>')
+        return mj.compare_merge(out, base, [(part, "p_", None)])
+
+    assert merged(2, "3") == []
+    assert merged(2, "3 1") == ["base: joint 'i' jnt_user[1]: 0.0 != 1.0"]
+    assert merged(3, "3") == ["size nuser_jnt (the widest input's): 2 != 3"]
+
+
 # ---------------------------------------------------------------------------
 # the judge's own tables
 # ---------------------------------------------------------------------------
