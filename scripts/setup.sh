@@ -22,8 +22,9 @@ PY="$VENV/bin/python"
 PYTHON="${PYTHON:-python3}"
 
 # Corpora: pip name, version, unpack dir name. PyPI wheels that ship MJCF models with their
-# meshes and textures (robosuite 157 MB, dm-control 56 MB, the six others 44 MB together). Left out on purpose, for checks outside
-# our tests: MuJoCo Menagerie, MuJoCo's own models, metaworld, gymnasium-robotics, LIBERO.
+# meshes and textures (robosuite 157 MB, dm-control 56 MB, the seven others 53 MB together).
+# Left out on purpose, for checks outside our tests: MuJoCo Menagerie, MuJoCo's own models,
+# metaworld, gymnasium-robotics, LIBERO.
 CORPORA=(
   "robosuite 1.5.2 robosuite-1.5.2"
   "dm-control 1.0.50 dm_control-1.0.50"
@@ -33,6 +34,7 @@ CORPORA=(
   "fancy-gym 0.3.0 fancy_gym-0.3.0"
   "gym-xarm 0.1.1 gym_xarm-0.1.1"
   "gym-aloha 0.1.5 gym_aloha-0.1.5"
+  "dexterity 0.0.15 dexterity-0.0.15"
 )
 
 mkdir -p "$CACHE/wheels" "$CACHE/corpus"

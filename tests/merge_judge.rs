@@ -454,8 +454,9 @@ fn cases() -> Vec<Case> {
 }
 
 /// Every wheel model that every judging MuJoCo compiles (robosuite's and dm-control's, and
-/// gymnasium, brax, myo-sim, fancy-gym, gym-xarm, gym-aloha: locomotion, musculoskeletal
-/// models, arms, their tasks), prefixed as a part of robosuite's empty arena: a base in
+/// gymnasium, brax, myo-sim, fancy-gym, gym-xarm, gym-aloha, dexterity: locomotion,
+/// musculoskeletal models, arms, hands, their tasks), prefixed as a part of robosuite's empty
+/// arena: a base in
 /// degrees with MuJoCo's default compiler settings, so radian parts, `inertiafromgeom="true"`
 /// and the mass settings (`settotalmass`, `boundmass`...) are converted.
 fn corpus_cases() -> Vec<Case> {
