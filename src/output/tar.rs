@@ -129,14 +129,16 @@ impl<W: Write> TarWriter<BufWriter<W>> {
     ///
     /// ```
     /// use mjcf_forge::{TarWriter, frame_text_member};
-    /// let mut framed = String::new();
-    /// frame_text_member(&mut framed, "000000000.xml", |m| {
+    /// let mut text = String::new();
+    /// let ((), header) = frame_text_member(&mut text, "000000000.xml", |m| {
     ///     m.push_str("<mujoco/>");
     ///     Ok::<(), std::fmt::Error>(())
     /// })?
     /// .unwrap();
+    /// let mut framed = text.into_bytes();
+    /// header.write_into(&mut framed)?;
     /// let mut tar = TarWriter::new(std::io::BufWriter::new(Vec::new()), "t.tar");
-    /// tar.append_framed(framed.as_bytes())?;
+    /// tar.append_framed(&framed)?;
     /// let mut same = TarWriter::new(Vec::new(), "t.tar");
     /// same.append("000000000.xml", b"<mujoco/>")?;
     /// assert_eq!(tar.finish()?.into_inner().unwrap(), same.finish()?);
