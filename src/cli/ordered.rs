@@ -280,6 +280,33 @@ mod tests {
     }
 
     #[test]
+    fn a_worker_panic_reaches_the_caller_instead_of_hanging_the_writer() {
+        let (done, finished) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(2)
+                .build()
+                .unwrap();
+            let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                pool.install(|| {
+                    for_each_ordered(
+                        0..10_000,
+                        8,
+                        4,
+                        |i, _: &mut ()| assert!(i != 100, "made to fail"),
+                        |_, _, ()| Ok(()),
+                    )
+                })
+            }));
+            let _ = done.send(outcome.is_err());
+        });
+        let panicked = finished
+            .recv_timeout(std::time::Duration::from_secs(20))
+            .expect("the pipeline hung after a worker panicked");
+        assert!(panicked);
+    }
+
+    #[test]
     fn an_empty_range_makes_nothing() {
         let r = for_each_ordered(3..3, 4, 2, |_, _: &mut ()| (), |_, _, ()| Ok(()));
         assert_eq!(r, Ok(()));
