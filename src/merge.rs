@@ -1037,10 +1037,12 @@ impl Document {
         // keep its setting when they say it themselves. A <joint type="free"> has no
         // `align`, so a part with one on a body MuJoCo would align is refused (below).
         let align = value(&theirs, "alignfree", "false");
-        let align_free_joints = !same_value(&value(&base, "alignfree", "false"), &align)
-            && !part
-                .descendants(part.root)
-                .any(|n| part.is_free_joint_element(n));
+        // The first <joint type="free"> MuJoCo would align, which no `align` can reach.
+        let unalignable = part
+            .descendants(part.root)
+            .find(|&n| part.is_free_joint_element(n));
+        let align_free_joints =
+            !same_value(&value(&base, "alignfree", "false"), &align) && unalignable.is_none();
         if align_free_joints {
             converted.push("alignfree");
         }
@@ -1072,9 +1074,7 @@ impl Document {
             if !same_value(&b, &p) {
                 let at = theirs.get(attr).map(|(_, n)| n).unwrap_or(part.root);
                 let why = match attr {
-                    "alignfree" => part
-                        .descendants(part.root)
-                        .find(|&n| part.is_free_joint_element(n))
+                    "alignfree" => unalignable
                         .map(|j| {
                             let l = part.location(j);
                             format!(
