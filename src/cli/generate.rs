@@ -20,15 +20,11 @@ use mjcf_forge::{AssetStore, OutputDir, TarWriter, frame_text_member};
 
 use super::{USAGE, refuse_validate_without_mujoco};
 
-/// Variants made but not yet written, at most: enough that no worker waits for the
-/// writing thread, few enough that their texts (~90 KB each for a robot scene as tar
+/// Variants made but not yet written, at most: enough that no worker waits while another
+/// one writes, few enough that their texts (~90 KB each for a robot scene as tar
 /// members) are reused memory rather than fresh pages (a batch of 512 at a time spent a
 /// fifth of the time in page faults).
 const RING: usize = 128;
-
-/// The writing thread sleeps until this many variants are ready to write, rather than
-/// being woken for each one.
-const WAKE_BATCH: u64 = 16;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -47,7 +43,7 @@ pub struct Args {
     /// First index.
     #[arg(long, default_value_t = 0)]
     start: u64,
-    /// Worker threads (all cores without it).
+    /// Threads, writing included (all cores without it).
     #[arg(long)]
     threads: Option<usize>,
     /// This process's share, K/N with K counted from 0 (as Slurm array task ids are).
@@ -77,19 +73,20 @@ struct Slot {
 struct Outputs {
     /// The output folder, which workers write the variants' XML files into.
     files: Option<OutputDir>,
-    /// What the writing thread owns.
+    /// The ordered writes (made by one worker at a time).
     writer: Writer,
     /// Assets written out for `--validate` of a tar stream (which is not on disk).
     check_dir: Option<tempfile::TempDir>,
 }
 
-/// The ordered part of the output, written by its own thread while the workers make the
-/// next variants: a folder's manifest, or the tar stream (the assets first).
+/// The ordered part of the output, written by whichever worker finds the next variant
+/// made while the others make the next ones: a folder's manifest, or the tar stream (the
+/// assets first).
 enum Writer {
     Manifest(BufWriter<AtomicFile>),
     Tar {
         tar: TarWriter<BufWriter<AtomicFile>>,
-        /// The assets are not in the stream yet (they are the writing thread's first job).
+        /// The assets are not in the stream yet (written before the first variant).
         assets_pending: bool,
     },
 }
@@ -279,15 +276,13 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
         range: (lo, hi),
     };
     // One text buffer per ring slot, reused: a variant is written into memory an earlier
-    // variant left, not into fresh pages. Everything but the ordered writes happens on the
-    // workers (a tar stream's members are framed there), so the writing thread does one
-    // write per variant, after the assets (its first job, while the workers begin).
+    // variant left, not into fresh pages. A tar stream's members are framed as they are
+    // made, so the ordered part is one write per variant, after the assets.
     let is_tar = matches!(outputs.writer, Writer::Tar { .. });
     let mut writer = outputs.writer;
     super::ordered::for_each_ordered(
         lo..hi,
         RING,
-        WAKE_BATCH,
         |i, slot: &mut Slot| make_one(args, &scene, i, slot, is_tar, files, validators.as_ref()),
         |_, slot, made| {
             match made {

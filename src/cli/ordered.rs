@@ -1,27 +1,47 @@
-//! Made in parallel, consumed in order, with no barrier between batches: every thread of
-//! the current rayon pool takes the next index as soon as it is done with one, into a ring
-//! of reused slots, while a consuming thread of its own takes the made ones in index
-//! order. Workers wait only when the ring is full (the consumer is behind by `ring`
-//! indices), the consumer only when the next index is not made yet.
+//! Made in parallel, consumed in order, with no barrier between batches and no thread of
+//! its own for consuming: every thread of the current rayon pool takes the next index as
+//! soon as it is done with one, into a ring of reused slots, and whichever thread finds
+//! the next index in order made consumes it (and every made one after it), while the
+//! others go on making. A worker waits only when the ring is full (the consumer is
+//! behind by `ring` indices).
 //!
-//! A pipeline made of chunks (each made in parallel, then handed over) stops every worker
-//! at the end of each chunk until the slowest is done; on two cores that idled about 5%
-//! of the time.
+//! Why no consuming thread: with one, two workers and the consumer share two cores, and
+//! every hand-over is a wake-up, a context switch and a contended lock (about 9% of the
+//! workers' time on two cores). Here a hand-over is a few atomic operations, and
+//! `--threads T` runs on T cores, the writing included.
+//!
+//! The hand-over without a lock: a slot's `ready` holds the index made into it (plus one),
+//! `consumed` the next index to consume, and the consumer's role is a flag taken with a
+//! compare-and-swap. A worker that made an index and cannot take the role leaves it to the
+//! thread holding it, which looks once more after letting go. Every store and load of
+//! the three is sequentially consistent: of a worker's "made, then try the role" and the
+//! holder's "let go, then look", one sees the other.
 
 use std::ops::Range;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering::SeqCst};
 use std::sync::{Condvar, Mutex, MutexGuard, PoisonError};
 
-/// Where the workers and the consumer meet. Indices are taken from `next`; index `i` is
-/// made into `slots[i % ring]` once the consumer is done with index `i - ring`.
-struct Ring<S, R> {
+/// Where the workers meet.
+struct Ring<S, R, C> {
     slots: Vec<Mutex<Slot<S, R>>>,
+    /// Per slot: the index made into it, plus one (0: none yet).
+    ready: Vec<AtomicU64>,
+    /// The next index to take.
     next: AtomicU64,
-    state: Mutex<State>,
-    /// Workers waiting for the consumer to free a slot.
+    /// The next index to consume; every index before it is consumed.
+    consumed: AtomicU64,
+    /// A thread is consuming.
+    consuming: AtomicBool,
+    /// The consumer, with the first error it gave.
+    consumer: Mutex<(C, Option<String>)>,
+    /// Stop taking indices: the consumer failed, or a worker panicked.
+    stopped: AtomicBool,
+    /// Workers waiting for a free slot, and what they wait on.
+    waiting: AtomicUsize,
+    waits: Mutex<()>,
     freed: Condvar,
-    /// The consumer waiting for made indices.
-    made: Condvar,
+    ring: u64,
+    end: u64,
 }
 
 struct Slot<S, R> {
@@ -29,68 +49,123 @@ struct Slot<S, R> {
     result: Option<R>,
 }
 
-struct State {
-    /// The next index the consumer takes; every index before it is consumed.
-    consumed: u64,
-    /// Per slot: made and not yet consumed.
-    ready: Vec<bool>,
-    /// While the consumer waits: the last index of the run it waits for.
-    consumer_waits_to: Option<u64>,
-    workers_waiting: usize,
-    /// The consumer stopped on an error, or a worker panicked: workers take no more
-    /// indices.
-    stopped: bool,
-    /// A worker panicked: the index it was making never comes.
-    worker_panicked: bool,
-}
-
-/// Tells the consumer when a worker unwinds, so that it stops waiting for the index that
-/// worker was making (the panic itself goes on to the caller).
-struct PanicGuard<'a> {
-    state: &'a Mutex<State>,
-    made: &'a Condvar,
-    freed: &'a Condvar,
-}
-
-impl Drop for PanicGuard<'_> {
-    fn drop(&mut self) {
-        if std::thread::panicking() {
-            let mut st = lock(self.state);
-            st.stopped = true;
-            st.worker_panicked = true;
-            self.made.notify_all();
-            self.freed.notify_all();
-        }
-    }
-}
-
 /// Lock, ignoring poisoning: a panic on one side is reported by the scope that joins it,
-/// and the state is whole between statements.
+/// and the data is whole between statements.
 fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
     m.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
+/// Stops the others when a worker unwinds, so that none waits for the index it was making
+/// or for the consumer's role it held (the panic itself goes on to the caller).
+struct PanicGuard<'a, S, R, C>(&'a Ring<S, R, C>);
+
+impl<S, R, C> Drop for PanicGuard<'_, S, R, C> {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            self.0.stop();
+        }
+    }
+}
+
+impl<S, R, C> Ring<S, R, C> {
+    /// No more indices are taken; waiting workers go.
+    fn stop(&self) {
+        self.stopped.store(true, SeqCst);
+        let _g = lock(&self.waits);
+        self.freed.notify_all();
+    }
+}
+
+impl<S, R, C> Ring<S, R, C>
+where
+    C: FnMut(u64, &S, R) -> Result<(), String>,
+{
+    fn at(&self, i: u64) -> usize {
+        (i % self.ring) as usize
+    }
+
+    fn is_made(&self, i: u64) -> bool {
+        self.ready[self.at(i)].load(SeqCst) == i + 1
+    }
+
+    /// Consumes the made indices in order from `consumed` on, unless another thread is
+    /// (which then looks again after letting go).
+    fn consume_made(&self) {
+        loop {
+            if self
+                .consuming
+                .compare_exchange(false, true, SeqCst, SeqCst)
+                .is_err()
+            {
+                return;
+            }
+            {
+                let mut consumer = lock(&self.consumer);
+                let (consume, error) = &mut *consumer;
+                let mut k = self.consumed.load(SeqCst);
+                while k < self.end && error.is_none() && self.is_made(k) {
+                    let mut slot = lock(&self.slots[self.at(k)]);
+                    let outcome = match slot.result.take() {
+                        Some(result) => consume(k, &slot.buffers, result),
+                        None => Err("internal error: a made slot is empty".to_string()),
+                    };
+                    drop(slot);
+                    if let Err(e) = outcome {
+                        *error = Some(e);
+                        self.stop();
+                        break;
+                    }
+                    k += 1;
+                    self.consumed.store(k, SeqCst);
+                    if self.waiting.load(SeqCst) > 0 {
+                        let _g = lock(&self.waits);
+                        self.freed.notify_all();
+                    }
+                }
+            }
+            self.consuming.store(false, SeqCst);
+            let k = self.consumed.load(SeqCst);
+            if self.stopped.load(SeqCst) || k >= self.end || !self.is_made(k) {
+                return;
+            }
+        }
+    }
+
+    /// Waits until index `i`'s slot is free (the consumer is done with `i - ring`), or
+    /// the run stopped: whether to go on.
+    fn wait_for_slot(&self, i: u64) -> bool {
+        let free = |r: &Self| r.stopped.load(SeqCst) || i < r.consumed.load(SeqCst) + r.ring;
+        if !free(self) {
+            let mut g = lock(&self.waits);
+            self.waiting.fetch_add(1, SeqCst);
+            while !free(self) {
+                g = self.freed.wait(g).unwrap_or_else(PoisonError::into_inner);
+            }
+            self.waiting.fetch_sub(1, SeqCst);
+        }
+        !self.stopped.load(SeqCst)
+    }
+}
+
 /// Makes every index of `range` with `make` on all threads of the current rayon pool and
-/// hands each result, in index order, to `consume` on a thread of its own. `make` fills
-/// the reused buffers of its slot (`ring` slots, each `S::default()` at first) and gives
-/// its result; `consume` sees the slot's buffers and the result. The consumer is woken
-/// for runs of `batch` made indices (fewer at the end), not for each one. An error from
-/// `consume` stops the workers and is returned; indices already taken are still made.
+/// hands each result, in index order, to `consume`, which runs on whichever of those
+/// threads finds the next index made (never on two at once). `make` fills the reused
+/// buffers of its slot (`ring` slots, each `S::default()` at first) and gives its result;
+/// `consume` sees the slot's buffers and the result. An error from `consume` stops the
+/// workers and is returned; indices already taken are still made, not consumed.
 ///
 /// Called from inside a rayon pool (`ThreadPool::install`), it uses that pool's threads.
 pub fn for_each_ordered<S, R>(
     range: Range<u64>,
     ring: usize,
-    batch: u64,
     make: impl Fn(u64, &mut S) -> R + Sync,
-    mut consume: impl FnMut(u64, &S, R) -> Result<(), String> + Send,
+    consume: impl FnMut(u64, &S, R) -> Result<(), String> + Send,
 ) -> Result<(), String>
 where
     S: Default + Send,
     R: Send,
 {
     let ring = ring.max(1);
-    let batch = batch.clamp(1, ring as u64);
     let shared = Ring {
         slots: (0..ring)
             .map(|_| {
@@ -100,123 +175,46 @@ where
                 })
             })
             .collect(),
+        ready: (0..ring).map(|_| AtomicU64::new(0)).collect(),
         next: AtomicU64::new(range.start),
-        state: Mutex::new(State {
-            consumed: range.start,
-            ready: vec![false; ring],
-            consumer_waits_to: None,
-            workers_waiting: 0,
-            stopped: false,
-            worker_panicked: false,
-        }),
+        consumed: AtomicU64::new(range.start),
+        consuming: AtomicBool::new(false),
+        consumer: Mutex::new((consume, None)),
+        stopped: AtomicBool::new(false),
+        waiting: AtomicUsize::new(0),
+        waits: Mutex::new(()),
         freed: Condvar::new(),
-        made: Condvar::new(),
+        ring: ring as u64,
+        end: range.end,
     };
-    let at = |i: u64| (i % ring as u64) as usize;
-    let ring_len = ring as u64;
-    let end = range.end;
-    std::thread::scope(|scope| {
-        let shared = &shared;
-        let consumer = scope.spawn(move || -> Result<(), String> {
-            let mut i = range.start;
-            while i < end {
-                // The run of made indices from `i` on, waiting for one if none is made: the
-                // consumer sleeps until `batch` of them are (one wake-up per run).
-                let run = {
-                    let mut st = lock(&shared.state);
-                    if !st.ready[at(i)] {
-                        let last = (i + batch - 1).min(end - 1);
-                        st.consumer_waits_to = Some(last);
-                        while !st.ready[at(i)] && !st.worker_panicked {
-                            st = shared.made.wait(st).unwrap_or_else(PoisonError::into_inner);
-                        }
-                        st.consumer_waits_to = None;
-                        if st.worker_panicked {
-                            return Err("internal error: a worker thread panicked".to_string());
-                        }
-                    }
-                    (i..end.min(i + ring_len))
-                        .take_while(|&k| st.ready[at(k)])
-                        .count() as u64
-                };
-                // Their slots are the consumer's until it frees them: no lock is contended.
-                let mut outcome = Ok(());
-                let mut done = 0;
-                while done < run && outcome.is_ok() {
-                    let k = i + done;
-                    let mut slot = lock(&shared.slots[at(k)]);
-                    outcome = match slot.result.take() {
-                        Some(result) => consume(k, &slot.buffers, result),
-                        None => Err("internal error: a made slot is empty".to_string()),
-                    };
-                    done += 1;
-                }
-                let mut st = lock(&shared.state);
-                for k in i..i + done {
-                    st.ready[at(k)] = false;
-                }
-                st.consumed = i + done;
-                if outcome.is_err() {
-                    st.stopped = true;
-                }
-                if st.workers_waiting > 0 || st.stopped {
-                    shared.freed.notify_all();
-                }
-                drop(st);
-                outcome?;
-                i += done;
+    rayon::broadcast(|_| {
+        let _guard = PanicGuard(&shared);
+        loop {
+            let i = shared.next.fetch_add(1, SeqCst);
+            if i >= shared.end || !shared.wait_for_slot(i) {
+                return;
             }
-            Ok(())
-        });
-        rayon::broadcast(|_| {
-            let _guard = PanicGuard {
-                state: &shared.state,
-                made: &shared.made,
-                freed: &shared.freed,
-            };
-            // One lock of the state per index: the last one marked made, the next one taken
-            // (waiting while its slot is still the consumer's).
-            let mut made: Option<u64> = None;
-            loop {
-                let i = {
-                    let mut st = lock(&shared.state);
-                    if let Some(m) = made {
-                        st.ready[at(m)] = true;
-                        // Wake the consumer once every index of the run it waits for is made.
-                        if let Some(last) = st.consumer_waits_to {
-                            let from = st.consumed;
-                            if (from..=last).all(|k| st.ready[at(k)]) {
-                                shared.made.notify_one();
-                            }
-                        }
-                    }
-                    let i = shared.next.fetch_add(1, Ordering::Relaxed);
-                    if i >= end {
-                        return;
-                    }
-                    while !st.stopped && i >= st.consumed + ring_len {
-                        st.workers_waiting += 1;
-                        st = shared
-                            .freed
-                            .wait(st)
-                            .unwrap_or_else(PoisonError::into_inner);
-                        st.workers_waiting -= 1;
-                    }
-                    if st.stopped {
-                        return;
-                    }
-                    i
-                };
-                let mut slot = lock(&shared.slots[at(i)]);
-                slot.result = Some(make(i, &mut slot.buffers));
-                drop(slot);
-                made = Some(i);
-            }
-        });
-        consumer
-            .join()
-            .unwrap_or_else(|_| Err("internal error: the writing thread panicked".to_string()))
-    })
+            let at = shared.at(i);
+            let mut slot = lock(&shared.slots[at]);
+            slot.result = Some(make(i, &mut slot.buffers));
+            drop(slot);
+            shared.ready[at].store(i + 1, SeqCst);
+            shared.consume_made();
+        }
+    });
+    let consumed = shared.consumed.load(SeqCst);
+    let (_, error) = shared
+        .consumer
+        .into_inner()
+        .unwrap_or_else(PoisonError::into_inner);
+    match error {
+        Some(e) => Err(e),
+        None if consumed < range.end => Err(format!(
+            "internal error: {consumed} of {} consumed",
+            range.end
+        )),
+        None => Ok(()),
+    }
 }
 
 #[cfg(test)]
@@ -230,13 +228,12 @@ mod tests {
                 .num_threads(threads)
                 .build()
                 .unwrap();
-            for (ring, batch) in [(1, 1), (3, 2), (128, 16)] {
+            for ring in [1, 3, 128] {
                 let mut seen = Vec::new();
                 pool.install(|| {
                     for_each_ordered(
                         5..1_005,
                         ring,
-                        batch,
                         |i, buf: &mut String| {
                             buf.clear();
                             buf.push_str(&i.to_string());
@@ -257,6 +254,36 @@ mod tests {
     }
 
     #[test]
+    fn the_consumer_runs_on_one_thread_at_a_time_and_waits_free_the_ring() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(4)
+            .build()
+            .unwrap();
+        let inside = AtomicBool::new(false);
+        let mut seen = 0;
+        pool.install(|| {
+            for_each_ordered(
+                0..400,
+                2,
+                |i, _: &mut ()| i,
+                |i, _, r| {
+                    assert!(!inside.swap(true, SeqCst), "two consumers at once");
+                    assert_eq!(i, r);
+                    // A slow consumer: the workers fill the ring of 2 and wait.
+                    if i % 50 == 0 {
+                        std::thread::sleep(std::time::Duration::from_millis(2));
+                    }
+                    seen += 1;
+                    inside.store(false, SeqCst);
+                    Ok(())
+                },
+            )
+        })
+        .unwrap();
+        assert_eq!(seen, 400);
+    }
+
+    #[test]
     fn a_consumer_error_stops_the_workers_and_is_returned() {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(2)
@@ -267,16 +294,15 @@ mod tests {
             for_each_ordered(
                 0..1_000_000,
                 8,
-                4,
                 |_, _: &mut ()| {
-                    made.fetch_add(1, Ordering::Relaxed);
+                    made.fetch_add(1, SeqCst);
                 },
                 |i, _, ()| if i == 10 { Err("full".into()) } else { Ok(()) },
             )
         });
         assert_eq!(r, Err("full".to_string()));
         // At most the ring and the indices the two workers had taken.
-        assert!(made.load(Ordering::Relaxed) <= 11 + 8 + 2);
+        assert!(made.load(SeqCst) <= 11 + 8 + 2);
     }
 
     #[test]
@@ -292,7 +318,6 @@ mod tests {
                     for_each_ordered(
                         0..10_000,
                         8,
-                        4,
                         |i, _: &mut ()| assert!(i != 100, "made to fail"),
                         |_, _, ()| Ok(()),
                     )
@@ -308,7 +333,7 @@ mod tests {
 
     #[test]
     fn an_empty_range_makes_nothing() {
-        let r = for_each_ordered(3..3, 4, 2, |_, _: &mut ()| (), |_, _, ()| Ok(()));
+        let r = for_each_ordered(3..3, 4, |_, _: &mut ()| (), |_, _, ()| Ok(()));
         assert_eq!(r, Ok(()));
     }
 }
