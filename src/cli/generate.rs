@@ -62,11 +62,15 @@ pub struct Args {
     pretty: bool,
 }
 
-/// A ring slot's reused buffer: the variant's XML, or for a tar stream its two
-/// members (XML and JSON) framed.
+/// A ring slot's reused buffers: the variant's XML, or for a tar stream its two members
+/// (XML and JSON) framed; and its manifest line. What a worker makes stays in the slot
+/// for whichever worker writes it: a buffer allocated on one thread and freed on another
+/// takes the allocator's lock of the first (with glibc's malloc, two workers waited on it
+/// thousands of times per second).
 #[derive(Default)]
 struct Slot {
     framed: Vec<u8>,
+    json: String,
 }
 
 /// Where the variants go.
@@ -286,8 +290,8 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
         |i, slot: &mut Slot| make_one(args, &scene, i, slot, is_tar, files, validators.as_ref()),
         |_, slot, made| {
             match made {
-                Ok((json, took, bytes)) => {
-                    writer.write(&store, &json, &slot.framed)?;
+                Ok((took, bytes)) => {
+                    writer.write(&store, &slot.json, &slot.framed)?;
                     summary.variants += 1;
                     summary.bytes += bytes;
                     if let Some(c) = &mut summary.compile {
@@ -311,9 +315,9 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
     Ok(summary)
 }
 
-/// Makes variant `i` into `slot` (for a tar stream, its members framed), writes its XML
-/// file into `files` when the output is a folder, checks it with `--validate`: its manifest
-/// line, the time its check took and its XML's size.
+/// Makes variant `i` into `slot` (for a tar stream, its members framed; its manifest
+/// line), writes its XML file into `files` when the output is a folder, checks it with
+/// `--validate`: the time its check took and its XML's size.
 fn make_one(
     args: &Args,
     scene: &Scene,
@@ -322,7 +326,7 @@ fn make_one(
     is_tar: bool,
     files: Option<&OutputDir>,
     validators: Option<&Validators<'_>>,
-) -> Result<(String, Duration, u64), String> {
+) -> Result<(Duration, u64), String> {
     let file = format!("{i:09}.xml");
     let make = |buf: &mut String| -> Result<Params, String> {
         if args.pretty {
@@ -354,7 +358,8 @@ fn make_one(
         Some(v) => v.check(i, &params)?,
         None => Duration::ZERO,
     };
-    let json = params.to_json(i, Some(&file));
+    slot.json.clear();
+    slot.json.push_str(&params.to_json(i, Some(&file)));
     if let Some(out) = files {
         out.write(&file, text[xml.clone()].as_bytes())
             .map_err(|e| e.to_string())?;
@@ -362,7 +367,7 @@ fn make_one(
     let bytes = xml.len() as u64;
     let json_header = if is_tar {
         let ((), h) = frame_text_member(&mut text, &format!("{i:09}.json"), |m| {
-            m.push_str(&json);
+            m.push_str(&slot.json);
             Ok::<(), String>(())
         })
         .map_err(|e| e.to_string())??;
@@ -374,7 +379,7 @@ fn make_one(
     for h in header.iter().chain(&json_header) {
         h.write_into(&mut slot.framed).map_err(|e| e.to_string())?;
     }
-    Ok((json, took, bytes))
+    Ok((took, bytes))
 }
 
 /// `--validate`: per worker thread a model cache (each structure compiled once per thread,
