@@ -134,7 +134,8 @@ where
     /// Waits until index `i`'s slot is free (the consumer is done with `i - ring`), or
     /// the run stopped: whether to go on.
     fn wait_for_slot(&self, i: u64) -> bool {
-        let free = |r: &Self| r.stopped.load(SeqCst) || i < r.consumed.load(SeqCst) + r.ring;
+        let free =
+            |r: &Self| r.stopped.load(SeqCst) || i < r.consumed.load(SeqCst).saturating_add(r.ring);
         if !free(self) {
             let mut g = lock(&self.waits);
             self.waiting.fetch_add(1, SeqCst);
