@@ -2,9 +2,10 @@
 //!
 //! A `Scene` is an `Arc` of the library's `Scene` (`Send + Sync`), so Python threads share
 //! one and every call releases the GIL. `Scene.variants` runs a producer thread that makes
-//! a window of variants at a time on a rayon pool and hands them over through a bounded
-//! channel, so at most about two windows exist at once however many indices are asked for,
-//! and they arrive in index order because each window is collected in order.
+//! variants on a rayon pool into a ring of `window` slots
+//! (`mjcf_forge::output::for_each_ordered`: no worker waits for another) and hands them
+//! over in order through a bounded channel of `window` more, so memory stays bounded
+//! however many indices are asked for.
 
 use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
@@ -15,7 +16,6 @@ use mjcf_forge::scene::{PatchEntry, PatchValue, Scene, VariantPatch};
 use pyo3::exceptions::{PyImportError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
-use rayon::prelude::*;
 
 use crate::document::PyDocument;
 use crate::errors::{Failure, catch, run};
@@ -207,9 +207,9 @@ impl PyScene {
 
     /// Variants for ``indices`` (a ``range`` or any iterable of ints), made on
     /// ``threads`` Rust threads (default: one per core) with the GIL released, yielded in
-    /// the order of ``indices``. Memory stays bounded: variants are made ``window`` at a
-    /// time (default ``8 * threads``, at least 16), and at most one finished window waits
-    /// to be taken while the next is made. The bytes of each variant do not depend on
+    /// the order of ``indices``. Memory stays bounded: at most ``window`` variants (default
+    /// ``8 * threads``, at least 16) are made ahead of the next one handed over, and at
+    /// most ``window`` more wait to be taken. The bytes of each variant do not depend on
     /// ``threads`` or ``window``.
     ///
     /// A variant that cannot be made raises :class:`MjcfError` when its turn comes, and
@@ -301,8 +301,8 @@ fn absolute(path: PathBuf) -> PathBuf {
     std::path::absolute(&path).unwrap_or(path)
 }
 
-/// The producer: windows of variants made in parallel, sent in order; stops when the
-/// receiver is gone (the Python iterator was dropped) or after the first failure.
+/// The producer: variants made in parallel into a ring of `window`, sent in order; stops
+/// when the receiver is gone (the Python iterator was dropped) or after the first failure.
 fn produce(
     scene: Arc<Scene>,
     indices: Vec<u64>,
@@ -310,20 +310,25 @@ fn produce(
     window: usize,
     tx: SyncSender<Result<Made, Failure>>,
 ) {
-    for chunk in indices.chunks(window) {
-        let make_all = || -> Vec<Result<Made, Failure>> {
-            chunk.par_iter().map(|&i| make(&scene, i)).collect()
-        };
-        let made = match &pool {
-            Some(pool) => pool.install(make_all),
-            None => make_all(),
-        };
-        for result in made {
-            let failed = result.is_err();
-            if tx.send(result).is_err() || failed {
-                return;
-            }
-        }
+    let run = move || {
+        // Err(()) only stops the workers: the receiver is gone or has its failure.
+        let _ = mjcf_forge::output::for_each_ordered(
+            0..indices.len() as u64,
+            window,
+            |k, _: &mut ()| make(&scene, indices[k as usize]),
+            move |_, (), made| {
+                let failed = made.is_err();
+                if tx.send(made).is_err() || failed {
+                    Err(())
+                } else {
+                    Ok(())
+                }
+            },
+        );
+    };
+    match &pool {
+        Some(pool) => pool.install(run),
+        None => run(),
     }
 }
 

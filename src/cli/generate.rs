@@ -4,7 +4,7 @@
 //! `NNNNNNNNN.xml` and `NNNNNNNNN.json` per variant).
 //!
 //! Variants are made in parallel into a ring of reused slots and written in index order
-//! (`super::ordered`), so memory stays bounded and the output is the same bytes for any
+//! (`mjcf_forge::output::for_each_ordered`), so memory stays bounded and the output is the same bytes for any
 //! thread count. With
 //! `--shard K/N` this process makes only its share of the indices; N processes given the
 //! same folder together write what one process writes (each its own manifest).
@@ -284,7 +284,7 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
     // made, so the ordered part is one write per variant, after the assets.
     let is_tar = matches!(outputs.writer, Writer::Tar { .. });
     let mut writer = outputs.writer;
-    super::ordered::for_each_ordered(
+    mjcf_forge::output::for_each_ordered(
         lo..hi,
         RING,
         |i, slot: &mut Slot| make_one(args, &scene, i, slot, is_tar, files, validators.as_ref()),
@@ -303,7 +303,7 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
             if let Some(bar) = &progress {
                 bar.inc(1);
             }
-            Ok(())
+            Ok::<(), String>(())
         },
     )?;
     summary.compiled = validators.as_ref().map_or(0, Validators::compiled);

@@ -7,7 +7,6 @@ pub mod generate;
 pub mod info;
 pub mod inline;
 pub mod merge;
-mod ordered;
 pub mod prefix;
 
 use std::io::Write as _;

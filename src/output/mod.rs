@@ -1,12 +1,15 @@
 //! Where outputs go: files that are never partial or clobbered ([`write_atomic`],
 //! [`OutputDir`]), asset files gathered under content-derived names so an output folder
-//! can be moved ([`AssetStore`]), and a tar stream of a whole output folder
-//! ([`TarWriter`]).
+//! can be moved ([`AssetStore`]), a tar stream of a whole output folder
+//! ([`TarWriter`]), and things made in parallel but consumed in order, in bounded memory
+//! ([`for_each_ordered`]).
 
 mod assets;
 mod files;
+mod ordered;
 mod tar;
 
 pub use assets::AssetStore;
 pub use files::{AtomicFile, OutputDir, write_atomic};
+pub use ordered::for_each_ordered;
 pub use tar::{PendingHeader, TarWriter, frame_text_member};

@@ -416,10 +416,12 @@ impl Scene {
         Ok(v.params)
     }
 
-    /// Makes variants `range` as XML in parallel, in chunks of `chunk`, and hands each to
-    /// `sink` in index order, so memory stays bounded however long the range. A variant
-    /// that fails is handed over as its error; `sink` stops everything by returning an
-    /// error.
+    /// Makes variants `range` as XML in parallel (on the current rayon pool) and hands each
+    /// to `sink` in index order, with [`crate::output::for_each_ordered`]: at most `ring`
+    /// variants are made and not yet handed over, so memory stays bounded however long
+    /// the range, and each variant's text is written into a reused buffer. `sink` runs on
+    /// the workers, one at a time. A variant that fails is handed over as its error;
+    /// `sink` stops everything by returning an error.
     ///
     /// ```
     /// let scene = mjcf_forge::scene::Scene::demo()?;
@@ -432,26 +434,18 @@ impl Scene {
     /// assert_eq!(seen.iter().map(|s| s.0).collect::<Vec<_>>(), (10..20).collect::<Vec<_>>());
     /// # Ok::<(), mjcf_forge::Errors>(())
     /// ```
-    pub fn stream<E>(
+    pub fn stream<E: Send>(
         &self,
         range: Range<u64>,
-        chunk: u64,
-        mut sink: impl FnMut(u64, Result<(String, Params), Errors>) -> Result<(), E>,
+        ring: usize,
+        mut sink: impl FnMut(u64, Result<(&str, Params), Errors>) -> Result<(), E> + Send,
     ) -> Result<(), E> {
-        let chunk = chunk.max(1);
-        let mut at = range.start;
-        while at < range.end {
-            let end = (at + chunk).min(range.end);
-            let made: Vec<_> = (at as usize..end as usize)
-                .into_par_iter()
-                .map(|i| self.variant_xml(i as u64))
-                .collect();
-            for (i, m) in (at..end).zip(made) {
-                sink(i, m)?;
-            }
-            at = end;
-        }
-        Ok(())
+        crate::output::for_each_ordered(
+            range,
+            ring,
+            |i, xml: &mut String| self.variant_xml_into(i, xml),
+            |i, xml, made| sink(i, made.map(|params| (xml.as_str(), params))),
+        )
     }
 
     /// Writes variants `range` to `out` as a tar stream in the layout of `generate -o -`
@@ -467,12 +461,12 @@ impl Scene {
     /// assert!(bytes.len() > 3 * 2 * 512);
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
-    pub fn write_tar<W: std::io::Write>(
+    pub fn write_tar<W: std::io::Write + Send>(
         &self,
         range: Range<u64>,
         tar: &mut crate::output::TarWriter<W>,
     ) -> Result<(), Errors> {
-        self.stream(range, 512, |i, made| {
+        self.stream(range, 128, |i, made| {
             let (xml, params) = made?;
             let file = format!("{i:09}.xml");
             tar.append(&file, xml.as_bytes())?;

@@ -22,7 +22,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering::SeqCst};
 use std::sync::{Condvar, Mutex, MutexGuard, PoisonError};
 
 /// Where the workers meet.
-struct Ring<S, R, C> {
+struct Ring<S, R, C, E> {
     slots: Vec<Mutex<Slot<S, R>>>,
     /// Per slot: the index made into it, plus one (0: none yet).
     ready: Vec<AtomicU64>,
@@ -33,7 +33,7 @@ struct Ring<S, R, C> {
     /// A thread is consuming.
     consuming: AtomicBool,
     /// The consumer, with the first error it gave.
-    consumer: Mutex<(C, Option<String>)>,
+    consumer: Mutex<(C, Option<E>)>,
     /// Stop taking indices: the consumer failed, or a worker panicked.
     stopped: AtomicBool,
     /// Workers waiting for a free slot, and what they wait on.
@@ -57,9 +57,9 @@ fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
 
 /// Stops the others when a worker unwinds, so that none waits for the index it was making
 /// or for the consumer's role it held (the panic itself goes on to the caller).
-struct PanicGuard<'a, S, R, C>(&'a Ring<S, R, C>);
+struct PanicGuard<'a, S, R, C, E>(&'a Ring<S, R, C, E>);
 
-impl<S, R, C> Drop for PanicGuard<'_, S, R, C> {
+impl<S, R, C, E> Drop for PanicGuard<'_, S, R, C, E> {
     fn drop(&mut self) {
         if std::thread::panicking() {
             self.0.stop();
@@ -67,7 +67,7 @@ impl<S, R, C> Drop for PanicGuard<'_, S, R, C> {
     }
 }
 
-impl<S, R, C> Ring<S, R, C> {
+impl<S, R, C, E> Ring<S, R, C, E> {
     /// No more indices are taken; waiting workers go.
     fn stop(&self) {
         self.stopped.store(true, SeqCst);
@@ -76,9 +76,9 @@ impl<S, R, C> Ring<S, R, C> {
     }
 }
 
-impl<S, R, C> Ring<S, R, C>
+impl<S, R, C, E> Ring<S, R, C, E>
 where
-    C: FnMut(u64, &S, R) -> Result<(), String>,
+    C: FnMut(u64, &S, R) -> Result<(), E>,
 {
     fn at(&self, i: u64) -> usize {
         (i % self.ring) as usize
@@ -105,10 +105,11 @@ where
                 let mut k = self.consumed.load(SeqCst);
                 while k < self.end && error.is_none() && self.is_made(k) {
                     let mut slot = lock(&self.slots[self.at(k)]);
-                    let outcome = match slot.result.take() {
-                        Some(result) => consume(k, &slot.buffers, result),
-                        None => Err("internal error: a made slot is empty".to_string()),
-                    };
+                    let result = slot
+                        .result
+                        .take()
+                        .expect("a slot holds its result from the moment it is marked made");
+                    let outcome = consume(k, &slot.buffers, result);
                     drop(slot);
                     if let Err(e) = outcome {
                         *error = Some(e);
@@ -152,19 +153,43 @@ where
 /// hands each result, in index order, to `consume`, which runs on whichever of those
 /// threads finds the next index made (never on two at once). `make` fills the reused
 /// buffers of its slot (`ring` slots, each `S::default()` at first) and gives its result;
-/// `consume` sees the slot's buffers and the result. An error from `consume` stops the
-/// workers and is returned; indices already taken are still made, not consumed.
+/// `consume` sees the slot's buffers and the result. So at most `ring` results exist at
+/// once however long the range, and a buffer is reused rather than allocated per index.
+/// An error from `consume` stops the workers and is returned; indices already taken are
+/// still made, not consumed. A panic in either goes on to the caller.
 ///
-/// Called from inside a rayon pool (`ThreadPool::install`), it uses that pool's threads.
-pub fn for_each_ordered<S, R>(
+/// Called from inside a rayon pool (`ThreadPool::install`), it uses that pool's threads;
+/// otherwise rayon's global pool.
+///
+/// ```
+/// let mut lines = Vec::new();
+/// mjcf_forge::output::for_each_ordered(
+///     0..1_000,
+///     16,
+///     |i, text: &mut String| {
+///         text.clear();
+///         text.push_str(&format!("line {i}"));
+///         i % 7
+///     },
+///     |i, text, rest| {
+///         assert_eq!(rest, i % 7);
+///         lines.push(text.clone());
+///         Ok::<(), std::io::Error>(())
+///     },
+/// )?;
+/// assert_eq!(lines[999], "line 999");
+/// # Ok::<(), std::io::Error>(())
+/// ```
+pub fn for_each_ordered<S, R, E>(
     range: Range<u64>,
     ring: usize,
     make: impl Fn(u64, &mut S) -> R + Sync,
-    consume: impl FnMut(u64, &S, R) -> Result<(), String> + Send,
-) -> Result<(), String>
+    consume: impl FnMut(u64, &S, R) -> Result<(), E> + Send,
+) -> Result<(), E>
 where
     S: Default + Send,
     R: Send,
+    E: Send,
 {
     let ring = ring.max(1);
     let shared = Ring {
@@ -203,18 +228,19 @@ where
             shared.consume_made();
         }
     });
-    let consumed = shared.consumed.load(SeqCst);
     let (_, error) = shared
         .consumer
         .into_inner()
         .unwrap_or_else(PoisonError::into_inner);
     match error {
         Some(e) => Err(e),
-        None if consumed < range.end => Err(format!(
-            "internal error: {consumed} of {} consumed",
-            range.end
-        )),
-        None => Ok(()),
+        None => {
+            debug_assert!(
+                range.is_empty() || shared.consumed.load(SeqCst) == range.end,
+                "every index made is consumed"
+            );
+            Ok(())
+        }
     }
 }
 
@@ -244,7 +270,7 @@ mod tests {
                             assert_eq!(buf, &i.to_string());
                             assert_eq!(r, i * 2);
                             seen.push(i);
-                            Ok(())
+                            Ok::<(), String>(())
                         },
                     )
                 })
@@ -276,7 +302,7 @@ mod tests {
                     }
                     seen += 1;
                     inside.store(false, SeqCst);
-                    Ok(())
+                    Ok::<(), String>(())
                 },
             )
         })
@@ -320,7 +346,7 @@ mod tests {
                         0..10_000,
                         8,
                         |i, _: &mut ()| assert!(i != 100, "made to fail"),
-                        |_, _, ()| Ok(()),
+                        |_, _, ()| Ok::<(), String>(()),
                     )
                 })
             }));
@@ -334,7 +360,7 @@ mod tests {
 
     #[test]
     fn an_empty_range_makes_nothing() {
-        let r = for_each_ordered(3..3, 4, |_, _: &mut ()| (), |_, _, ()| Ok(()));
+        let r = for_each_ordered(3..3, 4, |_, _: &mut ()| (), |_, _, ()| Ok::<(), String>(()));
         assert_eq!(r, Ok(()));
     }
 }
