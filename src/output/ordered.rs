@@ -7,8 +7,8 @@
 //!
 //! Why no consuming thread: with one, two workers and the consumer share two cores, and
 //! every hand-over is a wake-up, a context switch and a contended lock (about 9% of the
-//! workers' time on two cores). Here a hand-over is a few atomic operations, and
-//! `--threads T` runs on T cores, the writing included.
+//! workers' time on two cores). Here a hand-over is a few atomic operations, and a pool
+//! of T threads runs on T cores, the consuming included.
 //!
 //! The hand-over without a lock: a slot's `ready` holds the index made into it (plus one),
 //! `consumed` the next index to consume, and the consumer's role is a flag taken with a
