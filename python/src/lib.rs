@@ -13,6 +13,14 @@ mod superset;
 
 use pyo3::prelude::*;
 
+/// mimalloc for everything Rust allocates in the module: a variant made on a worker thread
+/// is freed on the Python thread, and glibc's malloc takes the worker's arena lock for
+/// each such free (`Scene.variants` made about one futex call per variant for it).
+/// Nothing allocated here is freed by Python's allocator or the other way round: Python
+/// objects are made by copying.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 /// Panics on purpose inside the edge where every call runs, with the GIL released
 /// (`detached=True`) or held: the tests' proof that a panic reaches Python as an
 /// `MjcfError`, never as PyO3's `PanicException`. Not part of the API.

@@ -4,9 +4,12 @@
 //! one and every call releases the GIL. `Scene.variants` runs a producer thread that makes
 //! variants on a rayon pool into a ring of `window` slots
 //! (`mjcf_forge::output::for_each_ordered`: no worker waits for another) and hands them
-//! over in order through a bounded channel of `window` more, so memory stays bounded
-//! however many indices are asked for.
+//! over in order, in batches of half a window through a channel of one batch, so memory
+//! stays bounded however many indices are asked for. Batches, because a hand-over per
+//! variant cost a wake-up of the Python thread and a release of the GIL each: two futex
+//! calls and about one context switch per variant.
 
+use std::collections::VecDeque;
 use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::sync::{Arc, Mutex, OnceLock};
@@ -208,9 +211,9 @@ impl PyScene {
     /// Variants for ``indices`` (a ``range`` or any iterable of ints), made on
     /// ``threads`` Rust threads (default: one per core) with the GIL released, yielded in
     /// the order of ``indices``. Memory stays bounded: at most ``window`` variants (default
-    /// ``8 * threads``, at least 16) are made ahead of the next one handed over, and at
-    /// most ``window`` more wait to be taken. The bytes of each variant do not depend on
-    /// ``threads`` or ``window``.
+    /// ``8 * threads``, at least 16) are made ahead of the next one handed over, and they
+    /// are handed over in batches of half a window, at most about three batches waiting
+    /// to be taken. The bytes of each variant do not depend on ``threads`` or ``window``.
     ///
     /// A variant that cannot be made raises :class:`MjcfError` when its turn comes, and
     /// ends the iteration.
@@ -242,14 +245,18 @@ impl PyScene {
         };
         let workers = threads.unwrap_or_else(rayon::current_num_threads);
         let window = window.unwrap_or((8 * workers).max(16));
-        let (tx, rx) = sync_channel(window);
+        let batch = (window / 2).max(1);
+        let (tx, rx) = sync_channel(1);
         let scene = self.scene.clone();
         std::thread::Builder::new()
             .name("mjcf-forge-variants".into())
-            .spawn(move || produce(scene, indices, pool, window, tx))
+            .spawn(move || produce(scene, indices, pool, window, batch, tx))
             .map_err(|e| Failure(vec![format!("cannot start the producer thread: {e}")]))?;
         Ok(PyVariantIter {
-            rx: Mutex::new(Some(rx)),
+            taken: Mutex::new(Taken {
+                rx: Some(rx),
+                batch: VecDeque::new(),
+            }),
             scene: self.scene.clone(),
         })
     }
@@ -301,28 +308,38 @@ fn absolute(path: PathBuf) -> PathBuf {
     std::path::absolute(&path).unwrap_or(path)
 }
 
-/// The producer: variants made in parallel into a ring of `window`, sent in order; stops
-/// when the receiver is gone (the Python iterator was dropped) or after the first failure.
+/// What a batch of the variant stream holds: made variants in order, a failure last.
+type Batch = Vec<Result<Made, Failure>>;
+
+/// The producer: variants made in parallel into a ring of `window`, sent in order in
+/// batches of `batch` (the last one shorter); stops when the receiver is gone (the Python
+/// iterator was dropped) or after the first failure, which ends its batch.
 fn produce(
     scene: Arc<Scene>,
     indices: Vec<u64>,
     pool: Option<rayon::ThreadPool>,
     window: usize,
-    tx: SyncSender<Result<Made, Failure>>,
+    batch: usize,
+    tx: SyncSender<Batch>,
 ) {
     let run = move || {
+        let last = indices.len() as u64;
+        let mut pending: Batch = Vec::with_capacity(batch);
         // Err(()) only stops the workers: the receiver is gone or has its failure.
         let _ = mjcf_forge::output::for_each_ordered(
-            0..indices.len() as u64,
+            0..last,
             window,
             |k, _: &mut ()| make(&scene, indices[k as usize]),
-            move |_, (), made| {
+            move |k, (), made| {
                 let failed = made.is_err();
-                if tx.send(made).is_err() || failed {
-                    Err(())
-                } else {
-                    Ok(())
+                pending.push(made);
+                if failed || pending.len() >= batch || k + 1 == last {
+                    let full = std::mem::replace(&mut pending, Vec::with_capacity(batch));
+                    if tx.send(full).is_err() || failed {
+                        return Err(());
+                    }
                 }
+                Ok(())
             },
         );
     };
@@ -335,10 +352,36 @@ fn produce(
 /// An iterator over variants made on Rust threads (see :meth:`Scene.variants`).
 #[pyclass(name = "VariantIterator", module = "mjcf_forge", frozen)]
 pub(crate) struct PyVariantIter {
-    /// `None` once exhausted or failed.
-    rx: Mutex<Option<Receiver<Result<Made, Failure>>>>,
+    taken: Mutex<Taken>,
     /// For the variants' documents, made on demand.
     scene: Arc<Scene>,
+}
+
+/// The stream's receiving end and the batch being handed out.
+struct Taken {
+    /// `None` once exhausted or failed.
+    rx: Option<Receiver<Batch>>,
+    batch: VecDeque<Result<Made, Failure>>,
+}
+
+impl Taken {
+    /// The next variant of the batch at hand, or of the next batch (waiting for it if
+    /// `wait`). `None`: the stream is over, or (without `wait`) nothing is at hand.
+    fn next(&mut self, wait: bool) -> Option<Result<Made, Failure>> {
+        if self.batch.is_empty() && wait {
+            match self.rx.as_ref().and_then(|r| r.recv().ok()) {
+                Some(batch) => self.batch.extend(batch),
+                None => self.rx = None,
+            }
+        }
+        let got = self.batch.pop_front();
+        if matches!(got, Some(Err(_))) {
+            // A failure ends the stream: later calls stop at once.
+            self.rx = None;
+            self.batch.clear();
+        }
+        got
+    }
 }
 
 #[pymethods]
@@ -348,15 +391,20 @@ impl PyVariantIter {
     }
 
     fn __next__(&self, py: Python<'_>) -> PyResult<Option<PyVariant>> {
-        // Waiting for the next variant releases the GIL: the workers never need it.
-        let next = py.detach(|| {
-            let mut rx = self.rx.lock().unwrap_or_else(|p| p.into_inner());
-            let got = rx.as_ref().and_then(|r| r.recv().ok());
-            if !matches!(got, Some(Ok(_))) {
-                *rx = None; // exhausted or failed: later calls stop at once
-            }
-            got
-        });
+        // A variant of the batch at hand is taken with the GIL held; waiting for the next
+        // batch releases it (the workers never need it). The lock is never waited for
+        // with the GIL held: a thread that holds it may be waiting for a batch.
+        let at_hand = match self.taken.try_lock() {
+            Ok(mut taken) => taken.next(false),
+            Err(_) => None,
+        };
+        let next = match at_hand {
+            Some(made) => Some(made),
+            None => py.detach(|| {
+                let mut taken = self.taken.lock().unwrap_or_else(|p| p.into_inner());
+                taken.next(true)
+            }),
+        };
         match next {
             Some(Ok(made)) => Ok(Some(PyVariant::new(
                 made,
