@@ -4,10 +4,10 @@
 //! `NNNNNNNNN.xml` and `NNNNNNNNN.json` per variant).
 //!
 //! Variants are made in parallel into a ring of reused slots and written in index order
-//! (`mjcf_forge::output::for_each_ordered`), so memory stays bounded and the output is the same bytes for any
-//! thread count. With
-//! `--shard K/N` this process makes only its share of the indices; N processes given the
-//! same folder together write what one process writes (each its own manifest).
+//! (`mjcf_forge::output::for_each_ordered`), so memory stays bounded and the output is
+//! the same bytes for any thread count. With `--shard K/N` this process makes only its
+//! share of the indices; N processes given the same folder together write what one
+//! process writes (each its own manifest).
 
 use std::io::{BufWriter, IsTerminal as _, Write};
 use std::path::{Path, PathBuf};
@@ -359,7 +359,7 @@ fn make_one(
         None => Duration::ZERO,
     };
     slot.json.clear();
-    slot.json.push_str(&params.to_json(i, Some(&file)));
+    params.write_json(i, Some(&file), &mut slot.json);
     if let Some(out) = files {
         out.write(&file, text[xml.clone()].as_bytes())
             .map_err(|e| e.to_string())?;

@@ -56,10 +56,23 @@ impl Params {
     pub fn to_json(&self, index: u64, file: Option<&str>) -> String {
         let mut out =
             String::with_capacity(128 + 160 * (self.objects.len() + self.randomized.len()));
+        self.write_json(index, file, &mut out);
+        out
+    }
+
+    /// [`Params::to_json`] appended to `out` (for a buffer that is reused).
+    ///
+    /// ```
+    /// let p = mjcf_forge::scene::Params::default();
+    /// let mut line = String::from("> ");
+    /// p.write_json(4, None, &mut line);
+    /// assert_eq!(line, format!("> {}", p.to_json(4, None)));
+    /// ```
+    pub fn write_json(&self, index: u64, file: Option<&str>, out: &mut String) {
         let _ = write!(out, "{{\"index\":{index}");
         if let Some(f) = file {
             out.push_str(",\"file\":");
-            json_str(&mut out, f);
+            json_str(out, f);
         }
         out.push_str(",\"objects\":[");
         for (i, o) in self.objects.iter().enumerate() {
@@ -67,18 +80,18 @@ impl Params {
                 out.push(',');
             }
             out.push_str("{\"group\":");
-            json_str(&mut out, &o.group);
+            json_str(out, &o.group);
             let _ = write!(out, ",\"slot\":{}", o.slot);
             out.push_str(",\"model\":");
-            json_str(&mut out, &o.model);
+            json_str(out, &o.model);
             out.push_str(",\"prefix\":");
-            json_str(&mut out, &o.prefix);
+            json_str(out, &o.prefix);
             out.push_str(",\"body\":");
-            json_str(&mut out, &o.body);
+            json_str(out, &o.body);
             out.push_str(",\"pos\":");
-            json_str(&mut out, &o.pos);
+            json_str(out, &o.pos);
             out.push_str(",\"quat\":");
-            json_str(&mut out, &o.quat);
+            json_str(out, &o.quat);
             out.push('}');
         }
         out.push_str("],\"randomized\":[");
@@ -87,22 +100,21 @@ impl Params {
                 out.push(',');
             }
             out.push_str("{\"kind\":");
-            json_str(&mut out, &r.kind);
+            json_str(out, &r.kind);
             out.push_str(",\"name\":");
             match &r.name {
-                Some(n) => json_str(&mut out, n),
+                Some(n) => json_str(out, n),
                 None => out.push_str("null"),
             }
             out.push_str(",\"part\":");
-            json_str(&mut out, &r.part);
+            json_str(out, &r.part);
             out.push_str(",\"attribute\":");
-            json_str(&mut out, &r.attribute);
+            json_str(out, &r.attribute);
             out.push_str(",\"value\":");
-            json_str(&mut out, &r.value);
+            json_str(out, &r.value);
             out.push('}');
         }
         out.push_str("]}");
-        out
     }
 }
 
