@@ -159,8 +159,9 @@ where
 /// buffers of its slot (`ring` slots, each `S::default()` at first) and gives its result;
 /// `consume` sees the slot's buffers and the result. So at most `ring` results exist at
 /// once however long the range, and a buffer is reused rather than allocated per index.
-/// An error from `consume` stops the workers and is returned; indices already taken are
-/// still made, not consumed. A panic in either goes on to the caller.
+/// An error from `consume` stops the workers and is returned: indices being made then are
+/// finished but not consumed, and no other is made. A panic in either goes on to the
+/// caller.
 ///
 /// Called from inside a rayon pool (`ThreadPool::install`), it uses that pool's threads;
 /// otherwise rayon's global pool.
