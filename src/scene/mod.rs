@@ -423,6 +423,12 @@ impl Scene {
     /// the workers, one at a time. A variant that fails is handed over as its error;
     /// `sink` stops everything by returning an error.
     ///
+    /// `sink` drops on one worker the [`Params`] another one made. glibc's malloc takes a
+    /// lock for such frees, and on two threads that can cost more than the second thread
+    /// gains: a program that streams many variants should use an allocator that frees
+    /// across threads without one, such as mimalloc, which the command line and the Python
+    /// module use.
+    ///
     /// ```
     /// let scene = mjcf_forge::scene::Scene::demo()?;
     /// let mut seen = Vec::new();
