@@ -145,6 +145,13 @@ fn bytes_do_not_depend_on_threads_shards_or_sink() {
         tar_member(&lib_tar, "000000042.json"),
         tar_member(&tar1.stdout, "000000042.json")
     );
+    // Its XML members are the scene's own (file references as the scene has them).
+    assert_eq!(
+        tar_member(&lib_tar, "000000042.xml"),
+        Some(scene.variant_xml(42).unwrap().0.into_bytes())
+    );
+    assert!(tar_member(&lib_tar, "000000064.xml").is_some());
+    assert!(tar_member(&lib_tar, "000000065.xml").is_none());
 
     // Another seed gives other variants.
     let other = path("seed");

@@ -472,16 +472,29 @@ impl Scene {
         range: Range<u64>,
         tar: &mut crate::output::TarWriter<W>,
     ) -> Result<(), Errors> {
-        self.stream(range, 128, |i, made| {
-            let (xml, params) = made?;
-            let file = format!("{i:09}.xml");
-            tar.append(&file, xml.as_bytes())?;
-            tar.append(
-                &format!("{i:09}.json"),
-                params.to_json(i, Some(&file)).as_bytes(),
-            )?;
-            Ok(())
-        })
+        /// A variant's two members, written on the worker that made it (so its `Params`
+        /// are dropped there too, see [`Scene::stream`]).
+        #[derive(Default)]
+        struct Members {
+            xml: String,
+            json: String,
+        }
+        crate::output::for_each_ordered(
+            range,
+            128,
+            |i, m: &mut Members| -> Result<(), Errors> {
+                let params = self.variant_xml_into(i, &mut m.xml)?;
+                m.json.clear();
+                params.write_json(i, Some(&format!("{i:09}.xml")), &mut m.json);
+                Ok(())
+            },
+            |i, m, made| {
+                made?;
+                tar.append(&format!("{i:09}.xml"), m.xml.as_bytes())?;
+                tar.append(&format!("{i:09}.json"), m.json.as_bytes())?;
+                Ok(())
+            },
+        )
     }
 
     /// Whether [`Scene::variant_xml`] writes by splicing text (rather than building each
