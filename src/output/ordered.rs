@@ -254,6 +254,13 @@ mod tests {
     use super::*;
     use std::time::Duration;
 
+    fn pool(threads: usize) -> rayon::ThreadPool {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+    }
+
     /// Runs `test` on a thread of its own and fails if it is not done within `limit`: a
     /// lost hand-over hangs the pipeline rather than failing an assertion. A panic of
     /// `test` comes out as it is.
@@ -273,10 +280,7 @@ mod tests {
     /// every result, with `pause(i, side)` called before making (side 1) and consuming
     /// (side 2) index `i`.
     fn in_order(threads: usize, ring: usize, range: Range<u64>, pause: impl Fn(u64, u64) + Sync) {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
+        let pool = pool(threads);
         let mut next = range.start;
         pool.install(|| {
             for_each_ordered(
@@ -337,10 +341,7 @@ mod tests {
     #[test]
     fn the_consumer_runs_on_one_thread_at_a_time_and_waits_free_the_ring() {
         within(Duration::from_secs(60), || {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(4)
-                .build()
-                .unwrap();
+            let pool = pool(4);
             let inside = AtomicBool::new(false);
             let mut seen = 0;
             pool.install(|| {
@@ -369,10 +370,7 @@ mod tests {
     #[test]
     fn a_consumer_error_stops_the_workers_and_is_returned() {
         within(Duration::from_secs(60), || {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(2)
-                .build()
-                .unwrap();
+            let pool = pool(2);
             let made = AtomicU64::new(0);
             let r = pool.install(|| {
                 for_each_ordered(
@@ -393,10 +391,7 @@ mod tests {
     #[test]
     fn a_worker_panic_reaches_the_caller_instead_of_hanging_the_writer() {
         within(Duration::from_secs(60), || {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(2)
-                .build()
-                .unwrap();
+            let pool = pool(2);
             let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                 pool.install(|| {
                     for_each_ordered(
