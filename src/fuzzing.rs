@@ -8,7 +8,7 @@ use std::path::Path;
 pub fn read_both_ways(bytes: &[u8], base_dir: &str) -> (String, String) {
     let dir = Path::new(base_dir);
     (
-        crate::load::describe_load(bytes, dir, true),
-        crate::load::describe_load(bytes, dir, false),
+        crate::document::load::describe_load(bytes, dir, true),
+        crate::document::load::describe_load(bytes, dir, false),
     )
 }

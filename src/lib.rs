@@ -23,37 +23,26 @@
 #![cfg_attr(mjcf_mujoco, deny(unsafe_code))]
 #![warn(missing_docs)]
 
-mod defaults;
+// The tiers, from the bottom up; each `mod.rs` says what its tier may use.
 mod document;
 mod error;
 #[doc(hidden)]
 pub mod fuzzing;
-pub mod geometry;
-mod limits;
-mod load;
-mod merge;
 mod model;
 #[cfg(mjcf_mujoco)]
 pub mod mujoco;
-mod names;
 pub mod output;
-mod paths;
-mod prefix;
-mod read;
 pub mod scene;
-mod schema;
-mod skin;
-mod tree;
-mod validate;
-pub mod vocab;
-mod write;
 
+pub use document::limits::Limits;
+pub use document::tree::Node;
+pub use document::vocab;
 pub use document::{Document, Section};
 pub use error::{Error, ErrorKind, Errors, Location};
-pub use limits::Limits;
-pub use merge::{MergeOptions, MergePart, MergeReport};
-pub use model::{MujocoModel, Offsets, XmlModel, XmlModelOptions};
+pub use model::geometry;
+pub use model::{
+    MergeOptions, MergePart, MergeReport, MujocoModel, Offsets, XmlModel, XmlModelOptions,
+};
 pub use output::{
     AssetStore, OutputDir, PendingHeader, TarWriter, frame_text_member, write_atomic,
 };
-pub use tree::Node;

@@ -24,12 +24,12 @@ use rayon::prelude::*;
 
 use super::{OutputDir, TarWriter};
 use crate::document::Document;
+use crate::document::names::{Sym, sym};
+use crate::document::prefix::{file_stem, named_after_file};
+use crate::document::schema::Kind;
+use crate::document::tree::Node;
+use crate::document::vocab::AttrKind;
 use crate::error::{Error, ErrorKind, Errors};
-use crate::names::{Sym, sym};
-use crate::prefix::{file_stem, named_after_file};
-use crate::schema::Kind;
-use crate::tree::Node;
-use crate::vocab::AttrKind;
 
 /// The folder of the output that asset files go to.
 const ASSETS: &str = "assets";

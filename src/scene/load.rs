@@ -7,12 +7,12 @@ use std::sync::{Arc, OnceLock};
 use toml::Spanned;
 
 use crate::document::Document;
+use crate::document::tree::{Node, Tree};
+use crate::document::vocab::{self, AttrKind};
 use crate::error::{Error, ErrorKind, Errors, Location};
-use crate::geometry::{self, Angles, Pose};
-use crate::merge::MergeOptions;
+use crate::model::geometry::{self, Angles, Pose};
+use crate::model::merge::MergeOptions;
 use crate::model::{XmlModel, XmlModelOptions};
-use crate::tree::{Node, Tree};
-use crate::vocab::{self, AttrKind};
 
 use super::place::{self, Placement, Rotation};
 use super::randomize::{self, Dist, Randomizer};

@@ -43,10 +43,10 @@ use std::sync::{Arc, OnceLock};
 
 use rayon::prelude::*;
 
+use crate::document::tree::Node;
 use crate::document::{Document, Section};
 use crate::error::{Error, ErrorKind, Errors, Location};
-use crate::merge::MergePart;
-use crate::tree::Node;
+use crate::model::merge::MergePart;
 
 #[cfg(mjcf_mujoco)]
 pub use check::{PENETRATION_TOLERANCE, check_model, check_variant};
@@ -135,7 +135,7 @@ struct PoolModel {
     file: String,
     doc: Document,
     /// Extent in the root body's frame.
-    bounds: crate::geometry::Bounds,
+    bounds: crate::model::geometry::Bounds,
 }
 
 /// A pool model prefixed for one slot of its group.
@@ -196,7 +196,7 @@ impl Scene {
         let path = path.as_ref();
         // Only a regular file within the size limit (a FIFO would block, a device never end).
         let max = crate::Limits::default().max_file_size;
-        let bytes = crate::limits::read_regular_file(path, max).map_err(|reason| {
+        let bytes = crate::document::limits::read_regular_file(path, max).map_err(|reason| {
             Error::bare(ErrorKind::Io {
                 path: path.to_path_buf(),
                 reason,

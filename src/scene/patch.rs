@@ -12,8 +12,8 @@
 //! rules; `tests/scene_patch.rs` and `python/tests/test_model_cache.py` hold each against
 //! MuJoCo compiling the variant's XML.
 
+use crate::document::tree::Node;
 use crate::document::{Document, Section};
-use crate::tree::Node;
 
 use super::Drawn;
 
@@ -304,7 +304,7 @@ pub(crate) fn split_parts(
                 None => {
                     in_key += 1;
                     key.update(&(part as u64).to_le_bytes());
-                    key.update(&(crate::tree::Tree::index(*node) as u64).to_le_bytes());
+                    key.update(&(crate::document::tree::Tree::index(*node) as u64).to_le_bytes());
                     for s in [attr.as_str(), value.as_str()] {
                         key.update(&(s.len() as u64).to_le_bytes());
                         key.update(s.as_bytes());

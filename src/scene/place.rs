@@ -4,8 +4,8 @@
 //! another).
 
 use crate::document::Document;
-use crate::geometry::{Bounds, Pose};
-use crate::tree::Node;
+use crate::document::tree::Node;
+use crate::model::geometry::{Bounds, Pose};
 
 use super::rng::Rng;
 

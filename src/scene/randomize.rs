@@ -12,8 +12,8 @@
 use std::sync::Arc;
 
 use crate::document::Document;
+use crate::document::tree::Node;
 use crate::error::{Error, ErrorKind, Errors, Location};
-use crate::tree::Node;
 
 use super::Target;
 use super::params::{Params, RandomizedValue};

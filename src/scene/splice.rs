@@ -11,8 +11,8 @@
 //! to remap, a section the template does not have, settings, residual classes, an asset
 //! the template shares), [`Template::write`] says no and the document path is taken.
 
+use crate::document::tree::Node;
 use crate::document::{Document, Section};
-use crate::tree::Node;
 
 use super::randomize::{AttrTarget, Overlay, Randomizer};
 use super::{Drawn, Target};
@@ -195,7 +195,7 @@ impl Template {
             done = *at;
             match cut {
                 Cut::Hole(node, attr) => {
-                    crate::write::escape_attr(out, drawn.template.get(*node, attr)?);
+                    crate::document::write::escape_attr(out, drawn.template.get(*node, attr)?);
                 }
                 Cut::Insert(i) => {
                     for (inst, overlay) in &drawn.placed {
@@ -225,7 +225,7 @@ impl Pieces {
             let Cut::Hole(node, attr) = cut else {
                 return None;
             };
-            crate::write::escape_attr(out, values.get(*node, attr)?);
+            crate::document::write::escape_attr(out, values.get(*node, attr)?);
         }
         out.push_str(&self.text[done..]);
         Some(())

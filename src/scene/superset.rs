@@ -13,9 +13,9 @@
 //!   0), held still (`gravcomp` 1, at rest), below the world, one place per candidate.
 
 use crate::document::Document;
+use crate::document::tree::Node;
 use crate::error::{Error, ErrorKind, Errors};
-use crate::merge::MergePart;
-use crate::tree::Node;
+use crate::model::merge::MergePart;
 
 use super::patch::{self, PatchEntry, PatchValue, VariantPatch};
 use super::randomize::AttrTarget as _;

@@ -10,9 +10,9 @@
 use std::path::Path;
 
 use crate::document::Document;
+use crate::document::limits::Limits;
+use crate::document::read;
 use crate::error::Errors;
-use crate::limits::Limits;
-use crate::read;
 
 impl Document {
     /// Loads an MJCF file: includes expanded, defaults inlined, file paths made absolute.
@@ -80,8 +80,8 @@ impl Document {
 /// after it), every file reference made absolute (on the elements as they now are), then
 /// repeated sections joined.
 fn finish(mut doc: Document) -> Result<Document, Errors> {
-    crate::defaults::inline_defaults(&mut doc)?;
-    crate::paths::absolutize_paths(&mut doc)?;
+    crate::document::defaults::inline_defaults(&mut doc)?;
+    crate::document::paths::absolutize_paths(&mut doc)?;
     doc.merge_repeated_sections();
     Ok(doc)
 }

@@ -269,9 +269,9 @@ pub fn write_all_inertials(doc: &mut crate::Document) -> Result<usize, CompileEr
 /// are matched to `doc`'s joint elements in document order, which must be one to one.
 pub(crate) fn free_joint_qpos0(
     doc: &crate::Document,
-    joint: crate::tree::Node,
+    joint: crate::document::tree::Node,
 ) -> Result<[f64; 7], CompileError> {
-    let joints: Vec<crate::tree::Node> = doc
+    let joints: Vec<crate::document::tree::Node> = doc
         .find_section(crate::Section::Worldbody)
         .map(|w| {
             doc.descendants(w)
@@ -317,7 +317,7 @@ pub(crate) fn write_all_inertials_from_geoms(
     doc: &mut crate::Document,
 ) -> Result<usize, CompileError> {
     let n = write_inertials_checked(doc, true, false)?;
-    let compilers: Vec<crate::tree::Node> = doc
+    let compilers: Vec<crate::document::tree::Node> = doc
         .elements(doc.root())
         .filter(|&c| doc.tag(c) == "compiler" && doc.attr(c, "inertiafromgeom").is_some())
         .collect();
@@ -371,7 +371,7 @@ fn write_inertials_checked(
     }
     let model = compile_str(&doc.to_xml_string(), doc.model_dir())?;
     // MuJoCo numbers bodies depth first in document order, the world body first.
-    let bodies: Vec<crate::tree::Node> = doc
+    let bodies: Vec<crate::document::tree::Node> = doc
         .descendants(doc.root())
         .filter(|&n| doc.tag(n) == "body")
         .collect();
@@ -407,7 +407,7 @@ fn write_inertials_checked(
     };
     let own_inertial =
         |doc: &crate::Document, b| doc.elements(b).find(|&c| doc.tag(c) == "inertial");
-    let targets: Vec<crate::tree::Node> = if all {
+    let targets: Vec<crate::document::tree::Node> = if all {
         bodies
             .iter()
             .enumerate()

@@ -3,11 +3,11 @@
 //! polymorphic `objname`/`refname` typed by `objtype`/`reftype`).
 
 use crate::document::Document;
+use crate::document::names::Sym;
+use crate::document::schema::Kind;
+use crate::document::tree::{Node, StrRef};
+use crate::document::vocab::{AttrKind, Ns};
 use crate::error::Error;
-use crate::names::Sym;
-use crate::schema::Kind;
-use crate::tree::{Node, StrRef};
-use crate::vocab::{AttrKind, Ns};
 
 /// The namespace an `objtype`/`reftype` keyword names (MuJoCo's `mjtObj` names).
 pub(crate) fn ns_of_objtype(keyword: &str) -> Option<Ns> {
@@ -45,7 +45,7 @@ pub(crate) fn named_after_file(kind: Kind) -> Option<Ns> {
     // Asked for every element of every walk: a table, not a string match.
     static TABLE: std::sync::OnceLock<Vec<Option<Ns>>> = std::sync::OnceLock::new();
     let table = TABLE.get_or_init(|| {
-        crate::vocab::elements()
+        crate::document::vocab::elements()
             .iter()
             .map(|e| named_after_file_tag(e.name))
             .collect()
@@ -103,7 +103,7 @@ enum Rename {
 /// # Ok::<(), mjcf_forge::Errors>(())
 /// ```
 pub(crate) fn check_prefix(prefix: &str) -> Result<(), Error> {
-    let shown = crate::read::clip(prefix, 60);
+    let shown = crate::document::read::clip(prefix, 60);
     let refuse = |why: String| {
         Err(Error::bare(crate::error::ErrorKind::Invalid(format!(
             "prefix '{shown}' {why}"
@@ -214,7 +214,7 @@ impl Document {
                     }),
                     AttrKind::ObjType { name_attr } => {
                         if let (Some(t), Some(ns)) = (
-                            crate::names::known(name_attr),
+                            crate::document::names::known(name_attr),
                             ns_of_objtype(self.str(a.value)),
                         ) && let Some(r) = self.attr_ref(node, t)
                             && renamed(ns, self.str(r))
@@ -256,7 +256,7 @@ impl Document {
                 }
             }
         }
-        let name_sym = crate::names::sym("name");
+        let name_sym = crate::document::names::sym("name");
         self.strings.reserve(edits.len() * (prefix.len() + 24));
         for e in edits {
             let start = self.strings.len();
@@ -322,7 +322,10 @@ impl Document {
         renamed: &impl Fn(Ns, &str) -> bool,
         edits: &mut Vec<Rename>,
     ) -> Result<(), Error> {
-        let syms = [crate::names::sym("model"), crate::names::sym("prefix")];
+        let syms = [
+            crate::document::names::sym("model"),
+            crate::document::names::sym("prefix"),
+        ];
         let model = self.attr_ref(node, syms[0]);
         let Some(model) = model.filter(|m| !self.str(*m).is_empty()) else {
             let theirs = self.attr(node, "prefix").unwrap_or_default();
@@ -331,7 +334,7 @@ impl Document {
                 |b| Some(format!("body '{b}'")),
             );
             let what = what.unwrap_or_else(|| "the world body".to_string());
-            let ours = crate::read::clip(prefix, 60);
+            let ours = crate::document::read::clip(prefix, 60);
             return Err(self.error_at(
                 node,
                 crate::error::ErrorKind::Invalid(format!(
@@ -365,8 +368,8 @@ impl Document {
         let Some(file) = self.attr(node, "file") else {
             return Ok(None);
         };
-        let child =
-            crate::read::read_file(std::path::Path::new(file), &self.limits).map_err(|e| {
+        let child = crate::document::read::read_file(std::path::Path::new(file), &self.limits)
+            .map_err(|e| {
                 self.error_at(
                     node,
                     crate::error::ErrorKind::Invalid(format!("model file '{file}': {e}")),
@@ -391,7 +394,7 @@ impl Document {
 pub(crate) fn name_attrs(kind: Kind) -> &'static [(Sym, AttrKind)] {
     static TABLE: std::sync::OnceLock<Vec<Vec<(Sym, AttrKind)>>> = std::sync::OnceLock::new();
     let table = TABLE.get_or_init(|| {
-        (0..crate::vocab::elements().len())
+        (0..crate::document::vocab::elements().len())
             .map(|i| {
                 Kind(i as u16)
                     .spec()
@@ -400,7 +403,7 @@ pub(crate) fn name_attrs(kind: Kind) -> &'static [(Sym, AttrKind)] {
                     .filter(|a| {
                         !matches!(a.kind, AttrKind::Plain | AttrKind::File | AttrKind::ObjName)
                     })
-                    .filter_map(|a| crate::names::known(a.name).map(|s| (s, a.kind)))
+                    .filter_map(|a| crate::document::names::known(a.name).map(|s| (s, a.kind)))
                     .collect()
             })
             .collect()

@@ -8,7 +8,7 @@
 
 use super::{err_at, exact};
 use crate::document::Document;
-use crate::tree::Node;
+use crate::document::tree::Node;
 
 /// MuJoCo's `mjEPS`: below this a vector counts as zero.
 const EPS: f64 = 1e-14;
@@ -54,7 +54,7 @@ impl Angles {
     /// ```
     pub fn new(degrees: bool, seq: &str) -> Result<Angles, String> {
         let bytes: [u8; 3] = seq.as_bytes().try_into().map_err(|_| {
-            let seq = crate::read::clip(seq, 40);
+            let seq = crate::document::read::clip(seq, 40);
             format!("eulerseq '{seq}' must have exactly 3 letters")
         })?;
         if !bytes.iter().all(|c| b"xyzXYZ".contains(c)) {
@@ -94,7 +94,7 @@ impl Angles {
                             c,
                             format_args!(
                                 "angle must be 'degree' or 'radian', not '{}'",
-                                crate::read::clip(other, 40)
+                                crate::document::read::clip(other, 40)
                             ),
                         ));
                     }
@@ -109,7 +109,7 @@ impl Angles {
                         c,
                         format_args!(
                             "eulerseq '{}' must have exactly 3 letters",
-                            crate::read::clip(s, 40)
+                            crate::document::read::clip(s, 40)
                         ),
                     )
                 })?;

@@ -1,6 +1,6 @@
 //! Interned element and attribute names.
 //!
-//! Every tag and attribute name of MJCF is known up front (from [`crate::vocab`]), so those
+//! Every tag and attribute name of MJCF is known up front (from [`crate::document::vocab`]), so those
 //! get fixed ids in a frozen table shared read-only by every document and thread. A name
 //! outside the vocabulary (a user's typo, a newer MuJoCo attribute) gets an id local to its
 //! document; merges remap such ids. Ids are `u32`: a merged scene never runs out.
@@ -136,7 +136,7 @@ fn base() -> &'static Base {
         };
         add("include");
         add("file");
-        for spec in crate::vocab::elements() {
+        for spec in crate::document::vocab::elements() {
             add(spec.tag);
             for a in spec.attrs {
                 add(a.name);

@@ -16,8 +16,8 @@ use std::path::Path;
 
 use super::frame::quat_to_mat;
 use super::{err_at, exact, numbers};
+use crate::document::tree::Node;
 use crate::document::{Document, Section};
-use crate::tree::Node;
 
 /// The `<mesh>` asset that a geom's `mesh` attribute names: by its `name`, or, for an
 /// unnamed mesh, by its file name without folder and extension (MuJoCo's rule).
@@ -81,8 +81,9 @@ pub fn mesh_vertices(doc: &Document, mesh: Node) -> Result<Vec<[f64; 3]>, String
         };
         // Only a regular file within the size limit: a mesh naming a FIFO or a device must
         // not hang or fill memory.
-        let bytes = crate::limits::read_regular_file(Path::new(file), doc.limits.max_file_size)
-            .map_err(|e| err_at(doc, mesh, format_args!("cannot read '{file}': {e}")))?;
+        let bytes =
+            crate::document::limits::read_regular_file(Path::new(file), doc.limits.max_file_size)
+                .map_err(|e| err_at(doc, mesh, format_args!("cannot read '{file}': {e}")))?;
         let parsed = match kind.as_str() {
             "stl" => read_stl(&bytes),
             "obj" => read_obj(&bytes),

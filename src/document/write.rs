@@ -3,9 +3,9 @@
 use std::path::Path;
 
 use crate::document::Document;
+use crate::document::tree::{Node, NodeData, StrRef};
 use crate::error::Error;
 use crate::output::write_atomic;
-use crate::tree::{Node, NodeData, StrRef};
 
 /// The bytes an attribute value cannot hold as they are: markup, the quote, and white
 /// space other than the space (parsers normalise raw white-space characters to spaces).
@@ -175,7 +175,7 @@ impl Document {
             },
             /// Close an element whose children are written; `lined`: they were indented.
             Leave {
-                tag: crate::names::Sym,
+                tag: crate::document::names::Sym,
                 indent: Option<usize>,
                 lined: bool,
             },

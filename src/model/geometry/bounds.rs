@@ -22,7 +22,7 @@ use super::frame::{Angles, Pose, element_pose, fromto};
 use super::mesh::{find_mesh, mesh_vertices};
 use super::{err_at, up_to};
 use crate::document::Document;
-use crate::tree::Node;
+use crate::document::tree::Node;
 
 /// An axis-aligned box and a horizontal radius, in the frame of the measured body.
 ///

@@ -25,11 +25,11 @@
 use ahash::AHashMap;
 
 use crate::document::Document;
+use crate::document::names::{Sym, sym};
+use crate::document::schema::Kind;
+use crate::document::tree::{Node, StrRef};
+use crate::document::vocab::{self, DefaultSlot, ElementSpec};
 use crate::error::{Error, ErrorKind, Errors};
-use crate::names::{Sym, sym};
-use crate::schema::Kind;
-use crate::tree::{Node, StrRef};
-use crate::vocab::{self, DefaultSlot, ElementSpec};
 
 /// Attributes that together give one orientation: a new one replaces all of them.
 const ORIENTATION: [&str; 5] = ["quat", "axisangle", "xyaxes", "zaxis", "euler"];
@@ -232,7 +232,7 @@ struct Resolver<'a> {
 struct Scratch {
     own: Vec<(Sym, StrRef)>,
     set: AttrSet,
-    out: Vec<crate::tree::Attr>,
+    out: Vec<crate::document::tree::Attr>,
     text: String,
 }
 
@@ -324,9 +324,9 @@ impl Resolver<'_> {
             self.doc.set_attr_ref(class, self.syms.class, name);
             let tag = self.doc.intern(slot_tag(*slot));
             let row = self.doc.new_element(tag, None);
-            let attrs: Vec<crate::tree::Attr> = attrs
+            let attrs: Vec<crate::document::tree::Attr> = attrs
                 .iter()
-                .map(|&(name, value)| crate::tree::Attr { name, value })
+                .map(|&(name, value)| crate::document::tree::Attr { name, value })
                 .collect();
             self.doc.replace_attrs(row, &attrs);
             self.doc.tree.append(class, row);
@@ -637,7 +637,7 @@ impl Resolver<'_> {
         let mut residual: Vec<(Sym, StrRef)> = Vec::new();
         for &(name, _) in &own {
             if let Some(v) = merged.get(name) {
-                out.push(crate::tree::Attr { name, value: v });
+                out.push(crate::document::tree::Attr { name, value: v });
             }
         }
         for &(name, value) in &merged.0 {
@@ -648,7 +648,7 @@ impl Resolver<'_> {
                 residual.push((name, value));
                 continue;
             }
-            out.push(crate::tree::Attr { name, value });
+            out.push(crate::document::tree::Attr { name, value });
         }
         if !residual.is_empty() {
             let key: Vec<(Sym, String)> = residual
@@ -668,7 +668,7 @@ impl Resolver<'_> {
                 self.residuals.len() - 1
             });
             let value = self.doc.push_str(&residual_class(i));
-            out.push(crate::tree::Attr {
+            out.push(crate::document::tree::Attr {
                 name: self.syms.class,
                 value,
             });
@@ -763,11 +763,11 @@ impl Resolver<'_> {
             self.doc.replace_attrs(
                 layer,
                 &[
-                    crate::tree::Attr {
+                    crate::document::tree::Attr {
                         name: self.syms.role,
                         value: role,
                     },
-                    crate::tree::Attr {
+                    crate::document::tree::Attr {
                         name: self.syms.texture,
                         value: texture,
                     },
@@ -784,8 +784,8 @@ impl Resolver<'_> {
     /// match gridsize`). corpora/features/default_texture_gridsize_resets_layout.xml.
     fn reset_gridlayout(&self, class_set: &mut AttrSet, own: &[(Sym, StrRef)]) {
         let (Some(gridsize), Some(gridlayout)) = (
-            crate::names::known("gridsize"),
-            crate::names::known("gridlayout"),
+            crate::document::names::known("gridsize"),
+            crate::document::names::known("gridlayout"),
         ) else {
             return;
         };
@@ -825,7 +825,7 @@ impl Resolver<'_> {
         let is_general = tag == self.syms.general || tag_name == "plugin";
         let params: Vec<Sym> = vocab::shortcut_params(&tag_name)
             .iter()
-            .filter_map(|p| crate::names::known(p))
+            .filter_map(|p| crate::document::names::known(p))
             .collect();
         let (spec, _) = self.actuator_kinds(tag);
         let is_control = |n: Sym| {
@@ -954,12 +954,12 @@ impl Resolver<'_> {
             "pid" => &["ctrlrange", "posrange"],
             _ => return,
         };
-        let Some(inheritrange) = crate::names::known("inheritrange") else {
+        let Some(inheritrange) = crate::document::names::known("inheritrange") else {
             return;
         };
         let ranges: Vec<Sym> = ranges
             .iter()
-            .filter_map(|r| crate::names::known(r))
+            .filter_map(|r| crate::document::names::known(r))
             .collect();
         let is_own = |n: Sym| own.iter().any(|(m, _)| *m == n);
         if ranges.iter().any(|r| is_own(*r)) && !is_own(inheritrange) {
@@ -976,7 +976,7 @@ impl Resolver<'_> {
         if let Some(&(_, spec, child)) = self.actuator_kinds.iter().find(|(t, _, _)| *t == tag) {
             return (spec, child);
         }
-        let kinds = if crate::names::is_vocabulary(tag) {
+        let kinds = if crate::document::names::is_vocabulary(tag) {
             let actuator = Kind::named(self.syms.actuator).expect("actuator kind");
             let child = actuator.child(tag);
             (Kind::named(tag).or(child), child)
@@ -1013,7 +1013,7 @@ impl Resolver<'_> {
     /// shortcuts), for parameters `s` over the shortcut's documented defaults.
     fn shortcut_table(&mut self, tag: &str, s: &AttrSet, node: Node) -> Result<AttrSet, Error> {
         let get = |doc: &Document, k: &str| -> Option<Vec<f64>> {
-            let sym = crate::names::known(k)?;
+            let sym = crate::document::names::known(k)?;
             let r = s.get(sym)?;
             Some(
                 doc.str(r)
@@ -1231,7 +1231,7 @@ impl Resolver<'_> {
         let nums = |doc: &Document, name: &str, builtin: &[f64]| -> Vec<f64> {
             let mut v = builtin.to_vec();
             v.resize(10, 0.0);
-            if let Some(r) = crate::names::known(name).and_then(|s| control.get(s)) {
+            if let Some(r) = crate::document::names::known(name).and_then(|s| control.get(s)) {
                 for (i, t) in doc.str(r).split_ascii_whitespace().enumerate().take(10) {
                     v[i] = t.parse().unwrap_or(0.0);
                 }
@@ -1241,11 +1241,11 @@ impl Resolver<'_> {
         let g = nums(self.doc, "gainprm", &[1.0]);
         let b = nums(self.doc, "biasprm", &[0.0]);
         let d = nums(self.doc, "dynprm", &[1.0]);
-        let dyntype = crate::names::known("dyntype")
+        let dyntype = crate::document::names::known("dyntype")
             .and_then(|s| control.get(s))
             .map(|r| self.doc.str(r).trim().to_string())
             .unwrap_or_else(|| "none".into());
-        let inheritrange = crate::names::known("inheritrange")
+        let inheritrange = crate::document::names::known("inheritrange")
             .and_then(|s| control.get(s))
             .map(|r| self.doc.str(r).to_string());
         let mut out: Vec<(&str, String)> = Vec::new();

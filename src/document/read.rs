@@ -14,12 +14,12 @@ use std::sync::Arc;
 use quick_xml::Reader;
 use quick_xml::events::{BytesStart, Event};
 
+use crate::document::limits::{Limits, read_regular_file};
+use crate::document::names::{Names, Sym};
+use crate::document::paths::join_by_name;
+use crate::document::tree::{Node, NodeData, Tree};
 use crate::document::{Document, SourceFile, Span};
 use crate::error::{Error, ErrorKind, Errors, Location};
-use crate::limits::{Limits, read_regular_file};
-use crate::names::{Names, Sym};
-use crate::paths::join_by_name;
-use crate::tree::{Node, NodeData, Tree};
 
 /// Turns byte offsets of one source text into 1-based line:col. The reader asks for
 /// offsets in increasing order, so a cursor counts only the bytes in between; error paths
@@ -742,7 +742,7 @@ impl Builder {
         // that loading seldom grows a table.
         let mut tree = Tree::with_capacity(size / 80 + 16);
         let placeholder = tree.new_node(NodeData::Text {
-            text: crate::tree::StrRef { start: 0, len: 0 },
+            text: crate::document::tree::StrRef { start: 0, len: 0 },
             cdata: false,
         });
         let mut spans = Vec::with_capacity(size / 80 + 16);
@@ -1303,7 +1303,7 @@ impl Builder {
             } else {
                 doc.push_str(raw)
             };
-            doc.attrs.push(crate::tree::Attr { name, value });
+            doc.attrs.push(crate::document::tree::Attr { name, value });
         }
         if !few {
             let mut names: Vec<Sym> = self.doc.attrs[attrs_at..].iter().map(|a| a.name).collect();
@@ -1313,7 +1313,7 @@ impl Builder {
             }
         }
         let doc = &mut self.doc;
-        let attrs = crate::tree::AttrRange {
+        let attrs = crate::document::tree::AttrRange {
             start: attrs_at as u32,
             len: (doc.attrs.len() - attrs_at) as u32,
         };
@@ -1348,7 +1348,7 @@ impl Builder {
             .map_err(|why| syntax(self.loc_in(span, lines, tag_bytes.as_ref(), 0), why))?;
         let node = self.doc.tree.new_node(NodeData::Element {
             tag,
-            attrs: crate::tree::AttrRange::default(),
+            attrs: crate::document::tree::AttrRange::default(),
         });
         self.doc.set_span(node, span);
         let start = self.doc.attrs.len() as u32;
@@ -1413,11 +1413,13 @@ impl Builder {
             let value = expand_refs(&text)
                 .map_err(|(at, why)| syntax(self.loc_in(span, lines, raw, at), why))?;
             let value = self.doc.push_str(&value);
-            self.doc.attrs.push(crate::tree::Attr { name, value });
+            self.doc
+                .attrs
+                .push(crate::document::tree::Attr { name, value });
         }
         let len = self.doc.attrs.len() as u32 - start;
         if let NodeData::Element { attrs, .. } = self.doc.tree.data_mut(node) {
-            *attrs = crate::tree::AttrRange { start, len };
+            *attrs = crate::document::tree::AttrRange { start, len };
         }
         Ok(node)
     }

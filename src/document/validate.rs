@@ -3,12 +3,14 @@
 use ahash::AHashMap;
 
 use crate::document::Document;
+use crate::document::names::Sym;
+use crate::document::prefix::{
+    file_stem, name_attrs, named_after_file, named_after_file_tag, ns_of_objtype,
+};
+use crate::document::schema::Kind;
+use crate::document::tree::Node;
+use crate::document::vocab::{AttrKind, Ns};
 use crate::error::{Error, ErrorKind, Errors};
-use crate::names::Sym;
-use crate::prefix::{file_stem, name_attrs, named_after_file, named_after_file_tag, ns_of_objtype};
-use crate::schema::Kind;
-use crate::tree::Node;
-use crate::vocab::{AttrKind, Ns};
 
 /// A reference found in the document, checked once every name is known.
 struct Reference {
@@ -44,7 +46,8 @@ impl Document {
         while let Some((node, kind)) = stack.pop() {
             let mut declared = false;
             for (name, value) in self.attrs(node) {
-                let Some(spec) = crate::names::known(name).and_then(|s| kind.attr(s)) else {
+                let Some(spec) = crate::document::names::known(name).and_then(|s| kind.attr(s))
+                else {
                     continue;
                 };
                 match spec.kind {
@@ -115,7 +118,7 @@ impl Document {
             return Ok(());
         }
         errors.sort_by_key(|(n, _)| {
-            let s = self.spans[crate::tree::Tree::index(*n)];
+            let s = self.spans[crate::document::tree::Tree::index(*n)];
             (s.file, s.line, s.col)
         });
         Err(Errors(errors.into_iter().map(|(_, e)| e).collect()))
@@ -228,7 +231,7 @@ impl Document {
             }
             if !declared && let Some(ns) = named_after_file(kind) {
                 static FILE: std::sync::OnceLock<Sym> = std::sync::OnceLock::new();
-                let file = *FILE.get_or_init(|| crate::names::sym("file"));
+                let file = *FILE.get_or_init(|| crate::document::names::sym("file"));
                 if let Some(stem) = self.attr_sym(node, file).and_then(file_stem) {
                     out.push((ns, stem, node));
                 }
@@ -250,7 +253,7 @@ impl Document {
 fn id_attr(kind: Kind) -> Option<(Sym, Ns)> {
     static TABLE: std::sync::OnceLock<Vec<Option<(Sym, Ns)>>> = std::sync::OnceLock::new();
     let table = TABLE.get_or_init(|| {
-        (0..crate::vocab::elements().len())
+        (0..crate::document::vocab::elements().len())
             .map(|i| {
                 name_attrs(Kind(i as u16))
                     .iter()

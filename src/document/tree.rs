@@ -6,7 +6,7 @@
 
 use indextree::{Arena, NodeId};
 
-use crate::names::Sym;
+use crate::document::names::Sym;
 
 /// A range of bytes in the document's string buffer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -1,10 +1,10 @@
-//! A fast index over [`crate::vocab`]: element kinds and attributes looked up by interned
+//! A fast index over [`crate::document::vocab`]: element kinds and attributes looked up by interned
 //! name, built once and shared read-only by every document and thread.
 
 use std::sync::OnceLock;
 
-use crate::names::{Sym, known};
-use crate::vocab::{self, AttrKind, AttrSpec, ElementSpec};
+use crate::document::names::{Sym, known};
+use crate::document::vocab::{self, AttrKind, AttrSpec, ElementSpec};
 
 /// An element kind: an index into [`vocab::elements`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -213,7 +213,7 @@ impl Kind {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::names::sym;
+    use crate::document::names::sym;
 
     #[test]
     fn resolves_context() {
@@ -236,7 +236,7 @@ mod tests {
                 .reaches_file_attrs()
         );
         for spec in vocab::elements() {
-            if let Some(s) = crate::names::known(spec.name) {
+            if let Some(s) = crate::document::names::known(spec.name) {
                 assert_eq!(
                     Kind::named(s).map(Kind::spec).map(|e| e.name),
                     vocab::element(spec.name).map(|e| e.name)

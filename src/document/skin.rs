@@ -5,8 +5,8 @@
 //! bit for bit).
 
 use crate::document::Document;
+use crate::document::tree::Node;
 use crate::error::{Error, ErrorKind};
-use crate::tree::Node;
 
 /// The content of an SKN file.
 struct Skn {
@@ -139,7 +139,7 @@ impl Document {
         for skin in skins {
             let file = self.attr(skin, "file").unwrap_or_default().to_string();
             let bad = |reason: String| ErrorKind::Invalid(format!("skin file '{file}': {reason}"));
-            let bytes = crate::limits::read_regular_file(
+            let bytes = crate::document::limits::read_regular_file(
                 std::path::Path::new(&file),
                 self.limits.max_file_size,
             )

@@ -1,12 +1,42 @@
-//! The document tier: an MJCF model held in an arena, with flat side tables.
+//! The document tier: one MJCF model held in an arena, read exactly as MuJoCo reads it.
+//!
+//! [`Document`] (this file) is the tier's type: the arena ([`tree`], the only file that
+//! names indextree), interned names ([`names`]), flat side tables for source positions and
+//! files. Around it, one file per operation on a single model:
+//!
+//! - reading: [`read`] (the markup into the arena, `<include>` expanded), [`load`] (read,
+//!   then [`defaults`] inlined and [`paths`] made absolute), [`skin`] (binary skin files);
+//! - the MJCF vocabulary: [`vocab`] (generated from MuJoCo's schema) and its index
+//!   [`schema`] (which attributes declare names and which refer to them);
+//! - editing and checking: [`prefix`] (renaming every name and reference), [`validate`]
+//!   (duplicate names, dangling references);
+//! - writing: [`write`] (compact and pretty XML; files through `output`);
+//! - [`limits`]: the input limits every reader honours.
+//!
+//! May use: `crate::error` and `crate::output` (atomic files). Knows nothing of models,
+//! MuJoCo, scenes or the faces above.
+
+pub(crate) mod defaults;
+pub(crate) mod limits;
+pub(crate) mod load;
+pub(crate) mod names;
+pub(crate) mod paths;
+pub(crate) mod prefix;
+pub(crate) mod read;
+pub(crate) mod schema;
+pub(crate) mod skin;
+pub(crate) mod tree;
+pub(crate) mod validate;
+pub mod vocab;
+pub(crate) mod write;
 
 use std::path::Path;
 use std::sync::Arc;
 
+use crate::document::limits::Limits;
+use crate::document::names::{Names, Sym};
+use crate::document::tree::{Attr, AttrRange, Node, NodeData, StrRef, Tree};
 use crate::error::{Error, ErrorKind, Location};
-use crate::limits::Limits;
-use crate::names::{Names, Sym};
-use crate::tree::{Attr, AttrRange, Node, NodeData, StrRef, Tree};
 
 /// Where a node came from: index into the document's file table, 1-based line and column.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -175,7 +205,7 @@ impl Document {
         // One pass in document order: sections of different kinds do not interact, so this
         // is the same as merging each kind in turn.
         static TAGS: std::sync::OnceLock<[Sym; Section::ALL.len()]> = std::sync::OnceLock::new();
-        let tags = TAGS.get_or_init(|| Section::ALL.map(|s| crate::names::sym(s.tag())));
+        let tags = TAGS.get_or_init(|| Section::ALL.map(|s| crate::document::names::sym(s.tag())));
         let mut first: [Option<Node>; Section::ALL.len()] = [None; Section::ALL.len()];
         let mut next = self.tree.first_child(self.root);
         while let Some(node) = next {

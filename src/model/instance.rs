@@ -4,13 +4,13 @@
 use std::collections::BTreeMap;
 use std::sync::OnceLock;
 
+use crate::document::names::{Sym, sym};
+use crate::document::tree::Node;
+use crate::document::vocab::Ns;
 use crate::document::{Document, Section};
 use crate::error::{Error, ErrorKind, Errors};
-use crate::geometry;
-use crate::merge::MergeReport;
-use crate::names::{Sym, sym};
-use crate::tree::Node;
-use crate::vocab::Ns;
+use crate::model::geometry;
+use crate::model::merge::MergeReport;
 
 /// What a model in a scene offers: its names, its parts sorted by role, and where it sits.
 /// Names returned by the list methods carry the model's prefix.
@@ -454,9 +454,9 @@ impl XmlModel {
         others: &[(&XmlModel, Option<&str>)],
         fuse_keys: bool,
     ) -> Result<MergeReport, Errors> {
-        let parts: Vec<crate::merge::MergePart<'_>> = others
+        let parts: Vec<crate::model::merge::MergePart<'_>> = others
             .iter()
-            .map(|(m, into)| crate::merge::MergePart {
+            .map(|(m, into)| crate::model::merge::MergePart {
                 doc: &m.doc,
                 into: *into,
                 prefix: &m.prefix,

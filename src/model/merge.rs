@@ -12,11 +12,11 @@
 
 use ahash::AHashMap;
 
+use crate::document::names::Sym;
+use crate::document::tree::{Attr, Node, NodeData, StrRef, Tree};
 use crate::document::{Document, Section, SourceFile};
 use crate::error::{Error, ErrorKind, Errors};
-use crate::geometry::{self, Angles};
-use crate::names::Sym;
-use crate::tree::{Attr, Node, NodeData, StrRef, Tree};
+use crate::model::geometry::{self, Angles};
 
 /// How to merge.
 #[derive(Clone, Debug, Default)]
@@ -80,7 +80,7 @@ const INERTIA_ONLY: [(&str, &str); 4] = [
 
 /// The effective value of each `compiler` attribute (later elements win).
 fn compiler_settings(doc: &Document) -> Compiler<'_> {
-    let compiler = crate::names::sym("compiler");
+    let compiler = crate::document::names::sym("compiler");
     let mut out = Compiler(Vec::new());
     for c in doc
         .elements(doc.root)
@@ -174,7 +174,7 @@ struct Syms {
 fn syms() -> &'static Syms {
     static SYMS: std::sync::OnceLock<Syms> = std::sync::OnceLock::new();
     SYMS.get_or_init(|| {
-        let s = crate::names::sym;
+        let s = crate::document::names::sym;
         Syms {
             name: s("name"),
             file: s("file"),
@@ -333,7 +333,7 @@ fn angles_checked(doc: &Document) -> Result<Angles, Error> {
                 "degree" => true,
                 "radian" => false,
                 other => {
-                    let other = crate::read::clip(other, 40);
+                    let other = crate::document::read::clip(other, 40);
                     let msg = format!("compiler angle must be 'degree' or 'radian', not '{other}'");
                     return Err(invalid(c, msg));
                 }
@@ -341,7 +341,7 @@ fn angles_checked(doc: &Document) -> Result<Angles, Error> {
         }
         if let Some(seq) = doc.attr(c, "eulerseq") {
             angles.seq = seq.as_bytes().try_into().map_err(|_| {
-                let seq = crate::read::clip(seq, 40);
+                let seq = crate::document::read::clip(seq, 40);
                 invalid(
                     c,
                     format!("compiler eulerseq '{seq}' must have exactly 3 letters"),
@@ -739,8 +739,12 @@ impl Document {
     pub fn find_body(&self, name: &str) -> Option<Node> {
         static SYMS: std::sync::OnceLock<(Sym, Sym)> = std::sync::OnceLock::new();
         let world = self.find_section(Section::Worldbody)?;
-        let &(body, name_sym) =
-            SYMS.get_or_init(|| (crate::names::sym("body"), crate::names::sym("name")));
+        let &(body, name_sym) = SYMS.get_or_init(|| {
+            (
+                crate::document::names::sym("body"),
+                crate::document::names::sym("name"),
+            )
+        });
         self.descendants(world)
             .find(|&n| self.tag_sym(n) == Some(body) && self.attr_sym(n, name_sym) == Some(name))
     }
@@ -782,7 +786,7 @@ impl Document {
                 }
                 NodeData::Element {
                     tag,
-                    attrs: crate::tree::AttrRange {
+                    attrs: crate::document::tree::AttrRange {
                         start,
                         len: attrs.len,
                     },
@@ -881,7 +885,7 @@ impl Document {
         errors: &mut Vec<Error>,
     ) -> Option<Document> {
         let mut conv = self.converted_part(part, errors)?;
-        let compiler = crate::names::sym("compiler");
+        let compiler = crate::document::names::sym("compiler");
         let theirs: Vec<Node> = conv
             .elements(conv.root)
             .filter(|&n| conv.tag_sym(n) == Some(compiler))
@@ -1516,8 +1520,9 @@ impl Document {
         self.attr_sym(n, s.name)
             .filter(|v| !v.is_empty())
             .or_else(|| {
-                crate::prefix::named_after_file_tag(self.tag(n))?;
-                self.attr_sym(n, s.file).and_then(crate::prefix::file_stem)
+                crate::document::prefix::named_after_file_tag(self.tag(n))?;
+                self.attr_sym(n, s.file)
+                    .and_then(crate::document::prefix::file_stem)
             })
     }
 
@@ -1532,8 +1537,10 @@ impl Document {
         let mine: Vec<Node> = part.elements(theirs).collect();
         let mut wanted: AHashMap<(Sym, &str), usize> = AHashMap::with_capacity(mine.len());
         for (i, &a) in mine.iter().enumerate() {
-            if let (Some(tag), Some(name)) = (crate::names::known(part.tag(a)), part.asset_name(a))
-            {
+            if let (Some(tag), Some(name)) = (
+                crate::document::names::known(part.tag(a)),
+                part.asset_name(a),
+            ) {
                 wanted.entry((tag, name)).or_insert(i);
             }
         }

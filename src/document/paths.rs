@@ -21,11 +21,11 @@
 use std::path::{Component, Path, PathBuf};
 
 use crate::document::Document;
+use crate::document::names::{Sym, sym};
+use crate::document::schema::Kind;
+use crate::document::tree::{Node, Tree};
+use crate::document::vocab::AttrKind;
 use crate::error::Errors;
-use crate::names::{Sym, sym};
-use crate::schema::Kind;
-use crate::tree::{Node, Tree};
-use crate::vocab::AttrKind;
 
 #[derive(Default)]
 struct Dirs {

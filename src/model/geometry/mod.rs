@@ -40,7 +40,7 @@ pub use frame::{Angles, Pose, body_relative_pose, element_pose, euler_to_quat};
 pub use mesh::{find_mesh, mesh_vertices};
 
 use crate::document::Document;
-use crate::tree::Node;
+use crate::document::tree::Node;
 
 /// An error about `node`, ending with its source position (house style).
 fn err_at(doc: &Document, node: Node, msg: impl std::fmt::Display) -> String {
