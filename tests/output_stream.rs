@@ -24,7 +24,7 @@ fn relocated(store: &AssetStore) -> Vec<String> {
         .par_iter()
         .map(|m| {
             let mut doc = Document::load(root().join(m)).unwrap();
-            store.relocate(&mut doc).unwrap();
+            doc.relocate_assets(store).unwrap();
             doc.to_pretty_string()
         })
         .collect()
@@ -52,7 +52,7 @@ fn a_webdataset_stream_is_read_by_python_and_every_sample_compiles() {
     let again = AssetStore::new();
     for m in MODELS.iter().rev() {
         let mut doc = Document::load(root().join(m)).unwrap();
-        again.relocate(&mut doc).unwrap();
+        doc.relocate_assets(&again).unwrap();
     }
     assert_eq!(
         stream(&again, &xmls),

@@ -59,7 +59,7 @@ fn prepare(
         super::validate(&doc)?;
     }
     let store = AssetStore::new();
-    store.relocate(&mut doc).map_err(|e| e.to_string())?;
+    doc.relocate_assets(&store).map_err(|e| e.to_string())?;
     let text = render(
         &doc,
         WriteOptions {

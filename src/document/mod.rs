@@ -23,6 +23,7 @@ pub(crate) mod names;
 pub(crate) mod paths;
 pub(crate) mod prefix;
 pub(crate) mod read;
+mod relocate;
 pub(crate) mod schema;
 pub(crate) mod skin;
 pub(crate) mod tree;

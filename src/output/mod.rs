@@ -3,6 +3,10 @@
 //! can be moved ([`AssetStore`]), a tar stream of a whole output folder
 //! ([`TarWriter`]), and things made in parallel but consumed in order, in bounded memory
 //! ([`for_each_ordered`]).
+//!
+//! The bottom tier, below whatever writes: it may use `crate::error` only and knows no
+//! documents (the document tier rewrites a document's file references with an
+//! [`AssetStore`]; the batch tier and the command line drive the rest).
 
 mod assets;
 mod files;

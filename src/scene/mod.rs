@@ -296,10 +296,10 @@ impl Scene {
     /// of randomizers) to the store's relocatable names, so that variants written into the
     /// store's folder compile wherever the folder goes.
     pub fn relocate_assets(&mut self, store: &crate::output::AssetStore) -> Result<(), Errors> {
-        store.relocate(&mut self.template)?;
+        self.template.relocate_assets(store)?;
         for group in &mut self.groups {
             for model in &mut group.pool {
-                store.relocate(&mut model.doc)?;
+                model.doc.relocate_assets(store)?;
             }
             // Instances made before were made from the models as they were.
             for slot in &mut group.instances {
