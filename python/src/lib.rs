@@ -3,13 +3,18 @@
 //! Each Python type converts its arguments at the edge, does the work in Rust with the GIL
 //! released (see `errors::run`), and turns `Errors` and panics into `MjcfError`. The
 //! library crate knows nothing of Python.
+//!
+//! The files mirror the library's tiers: `document.rs` (the document tier), `model.rs`
+//! (instances), `scene/` (the batch tier: scenes, variants, the stream, the superset);
+//! `errors.rs` is the edge where Rust errors and panics become `MjcfError`. The compiled
+//! tier's face, `ModelCache`, is Python (`mjcf_forge/_cache.py`), over the user's own
+//! `mujoco` package.
 #![forbid(unsafe_code)]
 
 mod document;
 mod errors;
 mod model;
 mod scene;
-mod superset;
 
 use pyo3::prelude::*;
 
@@ -47,7 +52,7 @@ fn _mjcf_forge(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::PyScene>()?;
     m.add_class::<scene::PyVariant>()?;
     m.add_class::<scene::PyVariantIter>()?;
-    m.add_class::<superset::PySuperset>()?;
+    m.add_class::<scene::PySuperset>()?;
     m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

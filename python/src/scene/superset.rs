@@ -6,8 +6,8 @@ use mjcf_forge::scene::{Scene, Superset};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
+use super::patch::patch_list;
 use crate::errors::run;
-use crate::scene::patch_list;
 
 /// A scene's superset: the template with every object any slot can hold, so that every
 /// variant (which objects stand where included) is a patch of one compiled model, as

@@ -1,0 +1,83 @@
+//! Patches as Python holds them: `(object, name or id, field, value)` tuples.
+
+use mjcf_forge::scene::{PatchEntry, PatchValue};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyList, PyTuple};
+
+/// A patch entry as Python holds it: `(object, name or id, field, value)`.
+pub(super) type PatchTuple<'py> = (String, Bound<'py, PyAny>, String, Bound<'py, PyAny>);
+
+/// A patch as Python tuples (see `Variant.patch`).
+pub(super) fn patch_list<'py>(
+    py: Python<'py>,
+    entries: &[PatchEntry],
+) -> PyResult<Bound<'py, PyList>> {
+    let items = entries
+        .iter()
+        .map(|e| {
+            let value = match &e.value {
+                PatchValue::Numbers(v) => PyTuple::new(py, v)?.into_any(),
+                PatchValue::Id { name, .. } => name.as_str().into_pyobject(py)?.into_any(),
+            };
+            let name = match e.id {
+                Some(id) => id.into_pyobject(py)?.into_any(),
+                None => e.name.as_str().into_pyobject(py)?.into_any(),
+            };
+            (e.object, name, e.field, value).into_pyobject(py)
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    PyList::new(py, items)
+}
+
+/// A patch entry back from its Python tuple (an unpickled variant's): the object and
+/// field names are the library's own, matched against its table.
+pub(super) fn patch_entry(
+    object: String,
+    name: &Bound<'_, PyAny>,
+    field: String,
+    value: &Bound<'_, PyAny>,
+) -> PyResult<PatchEntry> {
+    let (name, id) = match name.extract::<usize>() {
+        Ok(id) => (String::new(), Some(id)),
+        Err(_) => (name.extract::<String>()?, None),
+    };
+    const OBJECTS: [&str; 7] = [
+        "body", "joint", "geom", "site", "camera", "light", "material",
+    ];
+    let unknown =
+        || PyValueError::new_err(format!("not a patch entry: ({object}, {name}, {field})"));
+    let object = *OBJECTS.iter().find(|o| **o == object).ok_or_else(unknown)?;
+    let field = if field == "matid" {
+        "matid"
+    } else {
+        mjcf_forge::scene::PATCHABLE
+            .iter()
+            .map(|p| p.2)
+            .chain([
+                "qpos0",
+                "qpos_spring",
+                "ipos",
+                "iquat",
+                "gravcomp",
+                "contype",
+                "conaffinity",
+            ])
+            .find(|f| *f == field)
+            .ok_or_else(unknown)?
+    };
+    let value = match value.extract::<String>() {
+        Ok(target) => PatchValue::Id {
+            object: "material",
+            name: target,
+        },
+        Err(_) => PatchValue::Numbers(value.extract::<Vec<f64>>()?),
+    };
+    Ok(PatchEntry {
+        object,
+        name,
+        id,
+        field,
+        value,
+    })
+}
