@@ -1,0 +1,403 @@
+//! From a scene description to a [`Scene`]: models loaded once, the template assembled,
+//! every name, body, attribute and distribution checked, with the scene file's positions.
+//! An object group is checked in `group.rs`, a randomizer in `randomizer.rs`.
+
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, OnceLock};
+
+use toml::Spanned;
+
+use crate::document::Document;
+use crate::document::tree::{Node, Tree};
+use crate::error::{Error, ErrorKind, Errors, Location};
+use crate::model::geometry::{Angles, Pose};
+use crate::model::merge::MergeOptions;
+use crate::model::{XmlModel, XmlModelOptions};
+
+use super::place::{self};
+use super::randomize::{self};
+use super::spec::SceneSpec;
+use super::{Group, Instance, Scene, splice};
+
+mod group;
+mod randomizer;
+
+/// The largest count a group, and all groups together, may ask for per variant (each slot
+/// keeps its prefixed instances; placement compares every object with the ones before).
+pub(super) const MAX_COUNT: u32 = 10_000;
+
+/// Where model files come from: the disk, or the demo's built-in texts.
+pub(crate) trait ModelSource: Sync {
+    /// Loads `file` (as the scene names it) relative to `dir`; also returns its absolute
+    /// path when it is a file on disk.
+    fn load(&self, dir: &Path, file: &str) -> Result<(Document, Option<PathBuf>), Errors>;
+}
+
+/// Model files on disk.
+pub(crate) struct Files;
+
+impl ModelSource for Files {
+    fn load(&self, dir: &Path, file: &str) -> Result<(Document, Option<PathBuf>), Errors> {
+        let path = dir.join(file);
+        let doc = Document::load(&path)?;
+        let abs = std::path::absolute(&path).unwrap_or(path);
+        Ok((doc, Some(abs)))
+    }
+}
+
+/// The scene file's text, to turn byte spans into positions.
+pub(super) struct Source<'a> {
+    text: &'a str,
+    file: Arc<Path>,
+}
+
+impl Source<'_> {
+    pub(super) fn location(&self, span: std::ops::Range<usize>) -> Location {
+        let upto = &self.text[..span.start.min(self.text.len())];
+        let line = upto.matches('\n').count() as u32 + 1;
+        let col = (upto.len() - upto.rfind('\n').map_or(0, |i| i + 1)) as u32 + 1;
+        Location::new(self.file.clone(), line, col)
+    }
+
+    pub(super) fn error<T>(&self, at: &Spanned<T>, msg: impl Into<String>) -> Error {
+        Error::at(self.location(at.span()), ErrorKind::Invalid(msg.into()))
+    }
+
+    /// A model's own errors pass through (they point into the model); a model file that
+    /// cannot be read at all is reported where the scene names it.
+    pub(super) fn model_errors(&self, at: &Spanned<String>, errors: Errors) -> Errors {
+        Errors(
+            errors
+                .0
+                .into_iter()
+                .map(|e| match e.location {
+                    None => Error::at(self.location(at.span()), e.kind),
+                    Some(_) => e,
+                })
+                .collect(),
+        )
+    }
+}
+
+/// Builds a scene from TOML text named `file` (its folder holds the models). Problems in
+/// the scene file come in the order of their positions.
+pub(crate) fn from_toml(
+    text: &str,
+    file: Arc<Path>,
+    models: &dyn ModelSource,
+) -> Result<Scene, Errors> {
+    build(text, file.clone(), models).map_err(|mut e| {
+        e.0.sort_by_key(|e| match &e.location {
+            Some(l) if l.file == file => (0, l.line, l.col),
+            _ => (1, 0, 0),
+        });
+        e
+    })
+}
+
+fn build(text: &str, file: Arc<Path>, models: &dyn ModelSource) -> Result<Scene, Errors> {
+    let src = Source {
+        text,
+        file: file.clone(),
+    };
+    let spec: SceneSpec = toml::from_str(text).map_err(|e| {
+        let location = src.location(e.span().unwrap_or(0..0));
+        Error::at(location, ErrorKind::Invalid(e.message().trim().to_string()))
+    })?;
+    let dir = file.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let mut files = Vec::new();
+    let mut errors = Vec::new();
+
+    // The template: the base, then each fixture where it goes.
+    let (mut template, base_file) = models
+        .load(&dir, spec.base.as_ref())
+        .map_err(|e| src.model_errors(&spec.base, e))?;
+    files.extend(base_file);
+    // Parts of the template by arena slot: [start, end) of each, with label and prefix.
+    let mut parts: Vec<(usize, usize, Arc<str>, Arc<str>)> = Vec::new();
+    let base_end = slot_end(&template);
+    parts.push((0, base_end, Arc::from("base"), Arc::from("")));
+    let mut prefixes: Vec<&str> = Vec::new();
+    for f in &spec.fixture {
+        let (doc, path) = match models.load(&dir, f.model.as_ref()) {
+            Ok(x) => x,
+            Err(e) => {
+                errors.extend(src.model_errors(&f.model, e).0);
+                continue;
+            }
+        };
+        files.extend(path);
+        if prefixes.contains(&f.prefix.as_ref().as_str()) {
+            errors.push(src.error(
+                &f.prefix,
+                format!(
+                    "prefix '{}' is already used by another fixture",
+                    f.prefix.as_ref()
+                ),
+            ));
+            continue;
+        }
+        prefixes.push(f.prefix.as_ref());
+        let options = model_options(f.collision_rgba, f.name_unnamed_geoms);
+        let mut model = match XmlModel::with_prefix(doc, f.prefix.as_ref(), options) {
+            Ok(m) => m,
+            Err(e) => {
+                errors.extend(e.0);
+                continue;
+            }
+        };
+        if f.pos.is_some() || f.quat.is_some() {
+            let doc = model.document_mut();
+            let root = root_body(doc).expect("an XmlModel has one root body");
+            if let Some(pos) = f.pos {
+                doc.set_attr(root, "pos", &place::join(&pos));
+            }
+            if let Some(q) = &f.quat {
+                let n = q.as_ref().iter().map(|x| x * x).sum::<f64>().sqrt();
+                if !(n > 0.0 && n.is_finite()) {
+                    errors.push(src.error(q, "quat must be a non-zero quaternion (w x y z)"));
+                    continue;
+                }
+                let quat = q.as_ref().map(|x| x / n);
+                place::write_pose(
+                    doc,
+                    root,
+                    &Pose {
+                        pos: f.pos.unwrap_or_else(|| {
+                            doc.attr(root, "pos")
+                                .and_then(randomize::parse_numbers)
+                                .and_then(|v| v.try_into().ok())
+                                .unwrap_or([0.0; 3])
+                        }),
+                        quat,
+                    },
+                );
+            }
+        }
+        let into = f.into.as_ref().map(|s| s.as_ref().as_str());
+        if let Some(name) = &f.into
+            && template.find_body(name.as_ref()).is_none()
+        {
+            errors.push(src.error(
+                name,
+                format!(
+                    "no body '{}' in the scene so far (the base and the fixtures above)",
+                    name.as_ref()
+                ),
+            ));
+            continue;
+        }
+        let start = slot_end(&template);
+        let options = MergeOptions {
+            fuse_keys: false,
+            part_prefix: f.prefix.as_ref().clone(),
+        };
+        if let Err(e) = template.merge(model.document(), into, &options) {
+            errors.extend(e.0);
+            continue;
+        }
+        let label: Arc<str> = Arc::from(f.prefix.as_ref().as_str());
+        parts.push((start, slot_end(&template), label.clone(), label));
+    }
+    if !errors.is_empty() {
+        return Err(Errors(errors));
+    }
+
+    // Randomizers (checked before the groups, which select their elements).
+    let group_names: Vec<&str> = spec
+        .objects
+        .iter()
+        .map(|g| g.name.as_ref().as_str())
+        .collect();
+    let mut randomizers = Vec::new();
+    for (k, r) in spec.randomize.iter().enumerate() {
+        match randomizer::load(&src, &dir, k, r, &prefixes, &group_names) {
+            Ok(x) => randomizers.push(x),
+            Err(e) => errors.push(e),
+        }
+    }
+
+    // Groups.
+    let angles = Angles::of(&template)
+        .map_err(|e| Error::at(src.location(spec.base.span()), ErrorKind::Invalid(e)))?;
+    let mut groups: Vec<Group> = Vec::new();
+    for g in &spec.objects {
+        match group::load(
+            &src, &dir, g, &groups, &template, &angles, models, &mut files,
+        ) {
+            Ok(x) => groups.push(x),
+            Err(e) => errors.extend(e.0),
+        }
+    }
+    if !errors.is_empty() {
+        return Err(Errors(errors));
+    }
+
+    // What each randomizer selects in the template.
+    let mut selected = vec![0usize; randomizers.len()];
+    let mut template_targets = Vec::with_capacity(randomizers.len());
+    for (k, r) in randomizers.iter().enumerate() {
+        let mut targets = Vec::new();
+        for (start, end, label, prefix) in &parts {
+            if !r.applies_to_part(label) {
+                continue;
+            }
+            let nodes = template
+                .descendants(template.root())
+                .filter(|&n| (*start..*end).contains(&Tree::index(n)));
+            match r.select(&template, nodes, prefix, label) {
+                Ok(t) => targets.extend(t),
+                Err(e) => errors.extend(e.0),
+            }
+        }
+        selected[k] += targets.len();
+        template_targets.push(targets);
+    }
+    let prefixes_apart = prefixes_apart(&groups);
+    // The template as variants are written: with `discardvisual` when the scene asks
+    // (set on the written text only: merging compares parts' settings with the template's).
+    let splice = if spec.discard_visual {
+        let mut written = template.clone();
+        super::set_discard_visual(&mut written);
+        splice::Template::build(&written, &template_targets, &randomizers)
+    } else {
+        splice::Template::build(&template, &template_targets, &randomizers)
+    };
+    let mut scene = Scene {
+        splice,
+        structure: OnceLock::new(),
+        discard_visual: spec.discard_visual,
+        prefixes_apart,
+        seed: spec.seed,
+        file,
+        template,
+        template_targets,
+        groups,
+        randomizers,
+        model_files: files,
+    };
+    // Every pool model made once for slot 0: checks that it makes an instance and what
+    // each randomizer selects in it.
+    for group in &scene.groups {
+        for m in 0..group.pool.len() {
+            match make_instance(&scene, group, 0, m) {
+                Ok(inst) => {
+                    for (k, t) in &inst.targets {
+                        selected[*k] += t.len();
+                    }
+                    let _ = group.instances[m].set(Ok(inst));
+                }
+                Err(e) => errors.extend(e.0),
+            }
+        }
+    }
+    for (r, spec) in scene.randomizers.iter().zip(&spec.randomize) {
+        if selected[r.index] == 0 && errors.is_empty() {
+            errors.push(src.error(
+                &spec.kind,
+                format!(
+                    "this randomizer selects no element (kind '{}'{}{})",
+                    r.kind,
+                    r.name.as_ref().map_or(String::new(), |n| format!(", name '{n}'")),
+                    r.part.as_ref().map_or(String::new(), |p| format!(", part '{p}'"))
+                ),
+            ));
+        }
+    }
+    if !errors.is_empty() {
+        return Err(Errors(errors));
+    }
+    scene.model_files.sort();
+    scene.model_files.dedup();
+    Ok(scene)
+}
+
+/// Whether no prefix that an instance of any group can get begins another one (then two
+/// names with different prefixes always differ).
+fn prefixes_apart(groups: &[Group]) -> bool {
+    let mut all: Vec<String> = groups
+        .iter()
+        .flat_map(|g| (0..g.count.1).map(move |i| g.prefix_pattern.replace("{i}", &i.to_string())))
+        .collect();
+    all.sort();
+    // Sorted, a prefix of another string comes right before some string it begins.
+    all.windows(2).all(|w| !w[1].starts_with(w[0].as_str()))
+}
+
+/// One past the largest arena slot in use.
+fn slot_end(doc: &Document) -> usize {
+    doc.descendants(doc.root())
+        .map(Tree::index)
+        .max()
+        .unwrap_or(0)
+        + 1
+}
+
+pub(super) fn model_options(
+    collision_rgba: Option<[f64; 4]>,
+    name_unnamed_geoms: bool,
+) -> XmlModelOptions {
+    XmlModelOptions {
+        name: None,
+        contact_geom_rgba: collision_rgba,
+        name_unnamed_geoms,
+        exclude_from_prefixing: Vec::new(),
+    }
+}
+
+pub(super) fn root_body(doc: &Document) -> Option<Node> {
+    let world = doc.worldbody()?;
+    let roots = doc.top_level_bodies(world);
+    (roots.len() == 1).then(|| roots[0])
+}
+
+/// Pool model `m` of `group` prefixed for `slot`, with what each randomizer selects in it.
+pub(crate) fn make_instance(
+    scene: &Scene,
+    group: &super::Group,
+    slot: u32,
+    m: usize,
+) -> Result<Instance, Errors> {
+    let prefix = group.prefix_pattern.replace("{i}", &slot.to_string());
+    let model = XmlModel::with_prefix(group.pool[m].doc.clone(), &prefix, group.options.clone())?;
+    let mut doc = model.into_document();
+    // Brought to the template's compiler settings once, so merging a variant converts
+    // nothing; randomized angles are then written in the template's units.
+    let mut errors = Vec::new();
+    if let Some(converted) = scene.template.prepared_part(&doc, &mut errors) {
+        doc = converted;
+    }
+    if !errors.is_empty() {
+        return Err(Errors(errors));
+    }
+    let root = root_body(&doc).expect("pool models have one root body");
+    let root_name = doc.attr(root, "name").unwrap_or_default().to_string();
+    let part: Arc<str> = Arc::from(group.name.as_str());
+    let mut targets = Vec::new();
+    for r in &scene.randomizers {
+        if !r.applies_to_part(&group.name) {
+            continue;
+        }
+        match r.select(&doc, doc.descendants(doc.root()), &prefix, &part) {
+            Ok(t) if !t.is_empty() => targets.push((r.index, t)),
+            Ok(_) => {}
+            Err(e) => errors.extend(e.0),
+        }
+    }
+    // Instances are merged into copies of the template without a name check: check once.
+    errors.extend(scene.template.name_clashes(&[&doc]));
+    if !errors.is_empty() {
+        return Err(Errors(errors));
+    }
+    let fragments = scene.splice.as_ref().and_then(|t| {
+        splice::Fragments::build(&doc, root, &targets, &scene.randomizers, &scene.template, t)
+    });
+    Ok(Instance {
+        doc,
+        prefix,
+        root,
+        root_name,
+        targets,
+        fragments,
+    })
+}
