@@ -1,4 +1,6 @@
 //! Errors: one type, positioned at `file:line:col`, with the include chain that led there.
+//!
+//! Below every tier (each reports through it), so it uses nothing of the crate.
 
 use std::fmt;
 use std::path::{Path, PathBuf};

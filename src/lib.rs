@@ -1,5 +1,20 @@
 //! mjcf-forge: an arena-allocated MJCF (MuJoCo XML) document engine.
 //!
+//! The crate is built in tiers, one folder each, every tier using only those below it:
+//!
+//! | tier | what it is |
+//! | --- | --- |
+//! | `error.rs` | the one error type, `file:line:col` with the include chain |
+//! | `output/` | atomic files, the content-named asset store, tar, the ordered pipeline |
+//! | `document/` | one model in an arena: read, inline defaults, prefix, validate, write |
+//! | `mujoco/` | the MuJoCo FFI (builds with the `mujoco` feature): compile, inertias |
+//! | `model/` | instances with a prefix, merging, geometry and placement offsets |
+//! | `scene/` | the batch tier: a scene file in, seeded variants out |
+//! | `compiled/` | compiled variants at patch cost (builds with the `mujoco` feature) |
+//!
+//! The faces sit on top: the command line (`src/main.rs`, `src/cli/`) and the Python
+//! package (`python/`), both through the public API only.
+//!
 //! The document tier: [`Document::load`] reads a model exactly as MuJoCo reads it
 //! (`<include>` expanded, default classes inlined into explicit attributes, file references
 //! absolute) into an arena with interned names, so that cloning, renaming and merging are
@@ -23,7 +38,7 @@
 #![cfg_attr(mjcf_mujoco, deny(unsafe_code))]
 #![warn(missing_docs)]
 
-// The tiers, from the bottom up; each `mod.rs` says what its tier may use.
+// The tiers (see the table above); each `mod.rs` says what its tier may use.
 mod document;
 mod error;
 #[doc(hidden)]

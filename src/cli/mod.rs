@@ -1,5 +1,7 @@
 //! The subcommands, one file each (`Args` for clap and `run`), and what they share: how a
 //! finished document is written, how problems are reported, and `--validate`.
+//!
+//! A face, on top of every tier: it uses the library's public API only (`mjcf_forge::...`).
 
 pub mod compile;
 pub mod export;

@@ -21,8 +21,17 @@
 //! # Ok::<(), mjcf_forge::Errors>(())
 //! ```
 //!
-//! The scene file is TOML; `corpora/scenes/demo/demo.toml` is a commented example and the
-//! README describes every key.
+//! The scene file is TOML; `corpora/scenes/demo/demo.toml` is a commented example and
+//! `docs/scenes.md` describes every key.
+//!
+//! Files: `spec.rs` (the scene file), `load/` (checks, template, instances), `place.rs`,
+//! `randomize.rs`, `rng.rs`, `splice.rs` (variants as text), `params.rs` (the manifest),
+//! `patch.rs` (structure keys and patches), `superset.rs` (one model for every variant),
+//! `check.rs` (MuJoCo validation), `demo.rs` (the built-in scene).
+//!
+//! May use: the model and document tiers, `crate::output` (asset store, ordered pipeline),
+//! `crate::error`, and the MuJoCo FFI (`check.rs`, in builds with MuJoCo). Knows nothing of
+//! the compiled-model cache or the faces above.
 
 #[cfg(mjcf_mujoco)]
 mod check;
