@@ -45,7 +45,10 @@ fn pages() -> Vec<PathBuf> {
 }
 
 fn shown(page: &Path) -> String {
-    page.strip_prefix(root()).unwrap_or(page).display().to_string()
+    page.strip_prefix(root())
+        .unwrap_or(page)
+        .display()
+        .to_string()
 }
 
 struct Block {
@@ -92,7 +95,11 @@ fn parse(page: &Path) -> (Vec<Block>, Vec<(usize, String)>) {
             }
             // Blocks inside list items are indented: take the fence's indentation off.
             let cut = l.len().min(indent);
-            code.push_str(if l[..cut].trim().is_empty() { &l[cut..] } else { l });
+            code.push_str(if l[..cut].trim().is_empty() {
+                &l[cut..]
+            } else {
+                l
+            });
             code.push('\n');
             i += 1;
         }
@@ -118,7 +125,11 @@ fn every_block_has_a_known_language() {
         .filter(|b| !LANGUAGES.contains(&b.lang.as_str()))
         .map(|b| format!("{}:{}: ```{}", shown(&b.page), b.line - 1, b.lang))
         .collect();
-    assert!(bad.is_empty(), "blocks without one of {LANGUAGES:?}:\n{}", bad.join("\n"));
+    assert!(
+        bad.is_empty(),
+        "blocks without one of {LANGUAGES:?}:\n{}",
+        bad.join("\n")
+    );
 }
 
 /// A folder that links what the blocks read, for them to run in.
@@ -141,11 +152,18 @@ fn shell_blocks_run() {
         forge.parent().unwrap().display(),
         std::env::var("PATH").unwrap_or_default()
     );
-    let blocks: Vec<Block> = all_blocks().into_iter().filter(|b| b.lang == "sh").collect();
+    let blocks: Vec<Block> = all_blocks()
+        .into_iter()
+        .filter(|b| b.lang == "sh")
+        .collect();
     assert!(blocks.len() >= 4, "only {} sh blocks", blocks.len());
     let mut ran = 0;
     for b in &blocks {
-        let needs_mujoco = b.code.lines().next().is_some_and(|l| l.trim() == NEEDS_MUJOCO);
+        let needs_mujoco = b
+            .code
+            .lines()
+            .next()
+            .is_some_and(|l| l.trim() == NEEDS_MUJOCO);
         if needs_mujoco && !cfg!(feature = "mujoco") {
             continue;
         }
@@ -174,7 +192,10 @@ fn shell_blocks_run() {
 #[test]
 fn toml_blocks_are_scenes_that_make_variants() {
     let demo = root().join("corpora/scenes/demo");
-    let blocks: Vec<Block> = all_blocks().into_iter().filter(|b| b.lang == "toml").collect();
+    let blocks: Vec<Block> = all_blocks()
+        .into_iter()
+        .filter(|b| b.lang == "toml")
+        .collect();
     assert!(!blocks.is_empty(), "no toml block");
     for b in &blocks {
         let at = format!("{}:{}", shown(&b.page), b.line);
@@ -292,8 +313,16 @@ fn the_readme_stays_short_and_names_what_exists() {
     let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
     let lines = readme.lines().count();
     assert!(lines <= 200, "README.md has {lines} lines (at most 200)");
-    for path in ["scripts/run-example.sh", "scripts/test.sh", ".ci/run", "corpora/scenes/demo/demo.toml"] {
+    for path in [
+        "scripts/run-example.sh",
+        "scripts/test.sh",
+        ".ci/run",
+        "corpora/scenes/demo/demo.toml",
+    ] {
         assert!(readme.contains(path), "README.md no longer names {path}");
-        assert!(root().join(path).exists(), "README.md names {path}, which is gone");
+        assert!(
+            root().join(path).exists(),
+            "README.md names {path}, which is gone"
+        );
     }
 }
