@@ -39,6 +39,8 @@
 #![warn(missing_docs)]
 
 // The tiers (see the table above); each `mod.rs` says what its tier may use.
+#[cfg(doctest)]
+mod doc_pages;
 mod document;
 mod error;
 #[doc(hidden)]
