@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Generate src/vocab.rs: the MJCF vocabulary table of mjcf-forge.
+"""Generate src/document/vocab.rs: the MJCF vocabulary table of mjcf-forge.
 
 Inputs (both required, neither is committed):
 
@@ -16,7 +16,7 @@ Usage::
     python3 -m venv /tmp/vv && /tmp/vv/bin/pip install mujoco==3.17.0
     python3 scripts/gen_vocab.py --schema /tmp/mjcf.schema \\
         --schema-rev <mujoco commit of the schema copy> \\
-        --python /tmp/vv/bin/python [--out src/vocab.rs]
+        --python /tmp/vv/bin/python [--out src/document/vocab.rs]
 
 The script prints a report (differences between the two inputs, counts) on
 stderr and formats the output with rustfmt when it is on PATH.
@@ -534,7 +534,7 @@ def emit(b: Builder, namespaces: list[str], args, schema_sha: str) -> str:
     w(f"//   python3 -m venv /tmp/vv && /tmp/vv/bin/pip install mujoco=={PINNED_MUJOCO}")
     w("//   # save mjcf.schema of that revision to /tmp/mjcf.schema, then:")
     w("//   python3 scripts/gen_vocab.py --schema /tmp/mjcf.schema --schema-rev <rev> \\")
-    w("//       --python /tmp/vv/bin/python --out src/vocab.rs")
+    w("//       --python /tmp/vv/bin/python --out src/document/vocab.rs")
     w("")
     w("//! The MJCF vocabulary: every element kind and attribute MuJoCo")
     w(f"//! {PINNED_MUJOCO} accepts, with what each attribute holds as far as names and files go.")
@@ -875,7 +875,7 @@ def main() -> None:
     ap.add_argument("--python", default=sys.executable,
                     help=f"a Python with mujoco=={PINNED_MUJOCO} (default: this one)")
     ap.add_argument("--out", type=Path,
-                    default=Path(__file__).resolve().parent.parent / "src" / "vocab.rs")
+                    default=Path(__file__).resolve().parent.parent / "src" / "document" / "vocab.rs")
     ap.add_argument("--no-rustfmt", action="store_true")
     args = ap.parse_args()
 

@@ -16,7 +16,7 @@ use std::process::ExitCode;
 
 /// mimalloc rather than the system's malloc: `generate` makes about 145 small allocations
 /// per variant of a robot scene, a fifth of its time with glibc's; with mimalloc a lift5
-/// variant costs about 15% less CPU, on one thread or two (README, "Batch tier").
+/// variant costs about 15% less CPU, on one thread or two (`docs/speed.md`, "Thread scaling").
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 

@@ -155,7 +155,7 @@ fn collect(
 /// fields and skins, and the main file's folder for flexcomp files, although both are
 /// then read from `meshdir`; for `<model file>`, the name as it stands, which the
 /// operating system takes from the working directory (of this process, as MuJoCo run
-/// here would). 3.17.0 and 4.0.0 agree on each (experiments in the README).
+/// here would). 3.17.0 and 4.0.0 agree on each (experiments in `docs/fidelity.md`).
 fn main_side_probe(tag: &str, file: &str, dirs: &Dirs, model_dir: &Path) -> PathBuf {
     let folder = match tag {
         "mesh" => dirs.mesh.as_deref(),

@@ -10,7 +10,7 @@
 //   python3 -m venv /tmp/vv && /tmp/vv/bin/pip install mujoco==3.17.0
 //   # save mjcf.schema of that revision to /tmp/mjcf.schema, then:
 //   python3 scripts/gen_vocab.py --schema /tmp/mjcf.schema --schema-rev <rev> \
-//       --python /tmp/vv/bin/python --out src/vocab.rs
+//       --python /tmp/vv/bin/python --out src/document/vocab.rs
 
 //! The MJCF vocabulary: every element kind and attribute MuJoCo
 //! 3.17.0 accepts, with what each attribute holds as far as names and files go.
