@@ -10,8 +10,6 @@
 //! bodies, each part's values landing on its own objects and everything else taking its
 //! default; keys of the same name can be fused into one.
 
-use ahash::AHashMap;
-
 use crate::document::names::Sym;
 use crate::document::tree::Node;
 use crate::document::{Document, Section};
@@ -22,9 +20,12 @@ use import::Import;
 use keys::{implicit_keys, keys_of};
 use layout::Layout;
 
+mod assets;
+mod defaults;
 mod import;
 mod keys;
 mod layout;
+mod settings;
 
 /// How to merge.
 #[derive(Clone, Debug, Default)]
@@ -1098,113 +1099,6 @@ impl Document {
         }
     }
 
-    /// `option`/`size`/`visual`/`statistic` of a part: the base's values win; every part
-    /// setting the base does not share is reported. `size` user-data widths take the larger.
-    fn settings_from_part(&mut self, part: &Document, section: Node, report: &mut MergeReport) {
-        let tag = part.tag(section).to_string();
-        let base = self.elements(self.root).find(|&n| self.tag(n) == tag);
-        let mut items: Vec<(Node, Option<Node>)> = vec![(section, base)];
-        while let Some((p, b)) = items.pop() {
-            for (k, v) in part.attrs(p) {
-                let bv = b.and_then(|b| self.attr(b, k)).map(str::to_string);
-                if tag == "size" && k.starts_with("nuser_") {
-                    let pv: i64 = v.trim().parse().unwrap_or(-1);
-                    let cur: i64 = bv
-                        .as_deref()
-                        .and_then(|x| x.trim().parse().ok())
-                        .unwrap_or(-1);
-                    if pv > cur {
-                        let b = match b {
-                            Some(b) => b,
-                            None => {
-                                let n = self.append_element(self.root, "size", &[]);
-                                items.retain(|_| true);
-                                n
-                            }
-                        };
-                        self.set_attr(b, k, v);
-                        report.warnings.push(format!(
-                            "{}: <size {k}=\"{v}\"> of the part is used (the larger user-data width)",
-                            part.location(p)
-                        ));
-                    }
-                    continue;
-                }
-                if bv.as_deref().is_some_and(|bv| same_value(bv, v)) {
-                    continue;
-                }
-                report.warnings.push(format!(
-                    "{}: the part's <{} {k}=\"{v}\"> is ignored: the base's {} wins",
-                    part.location(p),
-                    part.tag(p),
-                    bv.map(|x| format!("\"{x}\""))
-                        .unwrap_or_else(|| "value (MuJoCo's default)".into())
-                ));
-            }
-            for pk in part.elements(p) {
-                let t = part.tag(pk);
-                let bk = b.and_then(|b| self.elements(b).find(|&x| self.tag(x) == t));
-                items.push((pk, bk));
-            }
-        }
-    }
-
-    /// Residual default classes of a part (see `defaults`): the same name must mean the same.
-    fn check_residual_defaults(&self, part: &Document, errors: &mut Vec<Error>) {
-        let Some(ours) = self.elements(self.root).find(|&n| self.tag(n) == "default") else {
-            return;
-        };
-        for section in part
-            .elements(part.root)
-            .filter(|&n| part.tag(n) == "default")
-        {
-            for class in part.elements(section) {
-                let name = part.attr(class, "class").unwrap_or_default();
-                if let Some(c) = self
-                    .elements(ours)
-                    .find(|&c| self.attr(c, "class") == Some(name))
-                    && !self.same_subtree(c, part, class)
-                {
-                    errors.push(part.error_at(
-                        class,
-                        ErrorKind::Invalid(format!(
-                            "default class '{name}' differs from the base's at {}",
-                            self.location(c)
-                        )),
-                    ));
-                }
-            }
-        }
-    }
-
-    /// Adds the part's residual classes the base does not have (checked beforehand).
-    fn merge_residual_defaults(&mut self, part: &Document, section: Node, file_offset: u32) {
-        let existing = self.elements(self.root).find(|&n| self.tag(n) == "default");
-        let dest = match existing {
-            Some(d) => d,
-            None => {
-                let sym = self.intern("default");
-                let d = self.new_element(sym, None);
-                match self.tree.first_child(self.root) {
-                    Some(f) => self.tree.insert_before(f, d),
-                    None => self.tree.append(self.root, d),
-                }
-                d
-            }
-        };
-        let mut imp = Import::new(file_offset, false);
-        for class in part.elements(section).collect::<Vec<_>>() {
-            let name = part.attr(class, "class").unwrap_or_default();
-            if self
-                .elements(dest)
-                .any(|c| self.attr(c, "class") == Some(name))
-            {
-                continue;
-            }
-            self.import(part, class, dest, &mut imp);
-        }
-    }
-
     /// Whether two elements (here and in `other`) have the same tag, attributes (in any
     /// order) and children.
     fn same_subtree(&self, a: Node, other: &Document, b: Node) -> bool {
@@ -1230,70 +1124,5 @@ impl Document {
             }
         }
         true
-    }
-
-    /// The name of an asset: its `name`, else the one MuJoCo derives from its file.
-    fn asset_name(&self, n: Node) -> Option<&str> {
-        let s = syms();
-        // An empty name is no name: MuJoCo names such an asset after its file.
-        self.attr_sym(n, s.name)
-            .filter(|v| !v.is_empty())
-            .or_else(|| {
-                crate::document::prefix::named_after_file_tag(self.tag(n))?;
-                self.attr_sym(n, s.file)
-                    .and_then(crate::document::prefix::file_stem)
-            })
-    }
-
-    /// For each asset of the part, in order: whether the base already has it (same tag,
-    /// name and content); an asset with a base name but other content is an error naming both.
-    pub(crate) fn asset_decisions(&self, part: &Document, errors: &mut Vec<Error>) -> Vec<bool> {
-        let Some(theirs) = part.find_section(Section::Asset) else {
-            return Vec::new();
-        };
-        // Index the part's assets (usually a handful) and look each base asset up in that,
-        // so a whole scene's assets are walked once per merge without building a map of them.
-        let mine: Vec<Node> = part.elements(theirs).collect();
-        let mut wanted: AHashMap<(Sym, &str), usize> = AHashMap::with_capacity(mine.len());
-        for (i, &a) in mine.iter().enumerate() {
-            if let (Some(tag), Some(name)) = (
-                crate::document::names::known(part.tag(a)),
-                part.asset_name(a),
-            ) {
-                wanted.entry((tag, name)).or_insert(i);
-            }
-        }
-        let mut same: Vec<Option<Node>> = vec![None; mine.len()];
-        if !wanted.is_empty()
-            && let Some(assets) = self.find_section(Section::Asset)
-        {
-            for n in self.elements(assets) {
-                if let (Some(tag), Some(name)) = (self.tag_sym(n), self.asset_name(n))
-                    && let Some(&i) = wanted.get(&(tag, name))
-                    && same[i].is_none()
-                {
-                    same[i] = Some(n);
-                }
-            }
-        }
-        mine.iter()
-            .zip(same)
-            .map(|(&a, found)| match found {
-                None => false,
-                Some(n) if self.same_subtree(n, part, a) => true,
-                Some(n) => {
-                    let tag = part.tag(a);
-                    let name = part.asset_name(a).unwrap_or_default();
-                    errors.push(part.error_at(
-                        a,
-                        ErrorKind::Invalid(format!(
-                            "asset <{tag}> '{name}' differs from the base's <{tag}> '{name}' at {}",
-                            self.location(n)
-                        )),
-                    ));
-                    false
-                }
-            })
-            .collect()
     }
 }
