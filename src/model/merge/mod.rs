@@ -22,7 +22,9 @@ use layout::Layout;
 
 mod assets;
 mod defaults;
+mod free_joints;
 mod import;
+mod inertia;
 mod keys;
 mod layout;
 mod settings;
@@ -537,13 +539,6 @@ impl Document {
         self.descendants(world)
             .find(|&n| self.tag_sym(n) == Some(body) && self.attr_sym(n, name_sym) == Some(name))
     }
-
-    fn has_free_joint(&self, node: Node) -> bool {
-        self.descendants(node).any(|n| {
-            self.tag(n) == "freejoint"
-                || (self.tag(n) == "joint" && self.attr(n, "type").map(str::trim) == Some("free"))
-        })
-    }
 }
 
 impl Document {
@@ -874,118 +869,6 @@ impl Document {
         if ba != pa {
             part.make_limits_explicit(pa == "true");
         }
-    }
-
-    /// Whether `node` is a `<joint type="free">` (a `<freejoint>` is not) whose body
-    /// `alignfree` would align.
-    fn is_free_joint_element(&self, node: Node) -> bool {
-        self.tag(node) == "joint"
-            && self.attr(node, "type").is_some_and(|t| t.trim() == "free")
-            && self.joint_body_is_a_leaf(node)
-    }
-
-    /// Whether the body of `joint` has no child bodies: MuJoCo aligns only such free bodies
-    /// with their inertial frames (`freejoint/align` in its reference; seen in 3.17.0 and
-    /// 4.0.0).
-    fn joint_body_is_a_leaf(&self, joint: Node) -> bool {
-        let mut body = self.parent(joint);
-        while let Some(b) = body
-            && self.tag(b) != "body"
-        {
-            body = self.parent(b);
-        }
-        body.is_none_or(|b| !self.descendants(b).skip(1).any(|n| self.tag(n) == "body"))
-    }
-
-    /// Whether MuJoCo aligns the body of the free joint `joint` (a `<freejoint>` or a
-    /// `<joint type="free">`) with its inertial frame: `align="true"` on a `<freejoint>`,
-    /// or the compiler's `alignfree="true"` where the joint does not say (a
-    /// `<joint type="free">` never does), for a body without child bodies. Its frame and
-    /// `qpos0` are then the inertial frame's, which only MuJoCo's compiler knows exactly.
-    pub(crate) fn aligns_free_body(&self, joint: Node) -> bool {
-        let free = match self.tag(joint) {
-            "freejoint" => true,
-            "joint" => self.attr(joint, "type").is_some_and(|t| t.trim() == "free"),
-            _ => false,
-        };
-        if !free {
-            return false;
-        }
-        let global = || {
-            compiler_settings(self)
-                .get("alignfree")
-                .is_some_and(|(v, _)| v == "true")
-        };
-        let on = match self.attr(joint, "align").map(str::trim) {
-            Some("true") if self.tag(joint) == "freejoint" => true,
-            Some("false") if self.tag(joint) == "freejoint" => false,
-            _ => global(),
-        };
-        on && self.joint_body_is_a_leaf(joint)
-    }
-
-    /// Whether `body` has a geom (directly or in a `<frame>` inside it) in the compiler's
-    /// `inertiagrouprange` ("lo hi") whose mass is not zero (`mass="0"`, or `density="0"`
-    /// without `mass`). Under inertiafromgeom="true" such a body takes its inertia from its
-    /// geoms; a body without one keeps its `<inertial>` (MuJoCo 3.17.0 and 4.0.0: a body with
-    /// no geom, only geoms of other groups, or only massless ones).
-    fn has_massive_geom_in_range(&self, body: Node, range: &str) -> bool {
-        let bounds: Vec<i64> = range
-            .split_ascii_whitespace()
-            .filter_map(|t| t.parse().ok())
-            .collect();
-        let (lo, hi) = match bounds[..] {
-            [lo, hi] => (lo, hi),
-            _ => (0, 5),
-        };
-        let zero = |n: Node, k: &str| {
-            self.attr(n, k)
-                .and_then(|v| v.trim().parse::<f64>().ok())
-                .is_some_and(|x| x == 0.0)
-        };
-        let mut stack: Vec<Node> = self.elements(body).collect();
-        while let Some(n) = stack.pop() {
-            match self.tag(n) {
-                "geom" => {
-                    let group = self
-                        .attr(n, "group")
-                        .and_then(|v| v.trim().parse::<i64>().ok())
-                        .unwrap_or(0);
-                    let massless = match self.attr(n, "mass") {
-                        Some(_) => zero(n, "mass"),
-                        None => zero(n, "density"),
-                    };
-                    if (lo..=hi).contains(&group) && !massless {
-                        return true;
-                    }
-                }
-                "frame" => stack.extend(self.elements(n)),
-                _ => {}
-            }
-        }
-        false
-    }
-
-    /// The bodies whose mass and inertia MuJoCo infers from their geoms (under
-    /// `inertiafromgeom="auto"`): those without an `<inertial>` that have a geom, directly or
-    /// in a `<frame>` (or `<replicate>`) inside them.
-    pub(crate) fn bodies_inferring_inertia(&self) -> Vec<Node> {
-        let has_geom = |body: Node| {
-            let mut stack: Vec<Node> = self.elements(body).collect();
-            while let Some(n) = stack.pop() {
-                match self.tag(n) {
-                    "geom" => return true,
-                    "frame" | "replicate" => stack.extend(self.elements(n)),
-                    _ => {}
-                }
-            }
-            false
-        };
-        self.descendants(self.root)
-            .filter(|&n| self.tag(n) == "body")
-            .filter(|&b| !self.elements(b).any(|c| self.tag(c) == "inertial"))
-            .filter(|&b| has_geom(b))
-            .collect()
     }
 
     /// Every `euler` becomes the `quat` it means under `angles` (for a base with another
