@@ -1,7 +1,7 @@
 //! Free joints: which elements hold one, and which free bodies MuJoCo aligns with their
 //! inertial frames (`alignfree`, or a `<freejoint>`'s own `align`).
 
-use super::compiler_settings;
+use super::compiler::compiler_settings;
 use crate::document::Document;
 use crate::document::tree::Node;
 

@@ -5,8 +5,9 @@
 use ahash::AHashMap;
 
 use super::MergeOptions;
+use super::angles::angles_checked;
+use super::fmt_num;
 use super::layout::{Layout, Offsets, actuator_states, joint_widths};
-use super::{angles_checked, fmt_num};
 use crate::document::tree::{Node, Tree};
 use crate::document::{Document, Section};
 use crate::error::{ErrorKind, Errors};
