@@ -9,15 +9,25 @@
 //! warnings). Keyframes are remapped onto the merged model's joints, actuators and mocap
 //! bodies, each part's values landing on its own objects and everything else taking its
 //! default; keys of the same name can be fused into one.
-
-use crate::document::names::Sym;
-use crate::document::tree::Node;
-use crate::document::{Document, Section};
-use crate::error::{Error, ErrorKind, Errors};
-
-use import::Import;
-use keys::{implicit_keys, keys_of};
-use layout::Layout;
+//!
+//! Its files:
+//!
+//! - [`compiler`]: the part's `compiler` settings against the base's: which must agree, the
+//!   rewrites of the part that stand in for the others, and why the rest cannot be converted;
+//! - [`angles`]: angle units and Euler sequences (the part converted, or the base when it is
+//!   the smaller);
+//! - [`inertia`]: where a body's mass and inertia come from, what the inertia settings act on;
+//! - [`free_joints`]: free joints, and which free bodies MuJoCo aligns with their inertial
+//!   frames;
+//! - [`assets`]: the part's assets the base already has, shared rather than copied;
+//! - [`defaults`]: the part's residual default classes;
+//! - [`settings`]: `option`, `size`, `visual` and `statistic`, the base's winning;
+//! - [`import`]: the part's nodes copied into the base's arena;
+//! - [`layout`]: what fills the state vectors a keyframe gives, and where;
+//! - [`keys`]: keyframes remapped onto the merged model, and fused by name.
+//!
+//! Here: the public types, the entry points ([`Document::merge`], [`Document::merge_all`] and
+//! `merge_unchecked` for the batch tier) and the few helpers several files share.
 
 mod angles;
 mod assets;
@@ -29,6 +39,15 @@ mod inertia;
 mod keys;
 mod layout;
 mod settings;
+
+use crate::document::names::Sym;
+use crate::document::tree::Node;
+use crate::document::{Document, Section};
+use crate::error::{Error, ErrorKind, Errors};
+
+use import::Import;
+use keys::{implicit_keys, keys_of};
+use layout::Layout;
 
 /// How to merge.
 #[derive(Clone, Debug, Default)]
@@ -59,75 +78,6 @@ pub struct MergeReport {
     pub warnings: Vec<String>,
     /// How many of the part's assets were already in the base (same tag, name, content).
     pub shared_assets: usize,
-}
-
-fn same_value(a: &str, b: &str) -> bool {
-    let ta: Vec<&str> = a.split_ascii_whitespace().collect();
-    let tb: Vec<&str> = b.split_ascii_whitespace().collect();
-    ta.len() == tb.len()
-        && ta
-            .iter()
-            .zip(&tb)
-            .all(|(x, y)| match (x.parse::<f64>(), y.parse::<f64>()) {
-                (Ok(p), Ok(q)) => p == q,
-                _ => x == y,
-            })
-}
-
-/// The shortest text that reads back as `x` (plain or with an exponent).
-pub(crate) fn fmt_num(x: f64) -> String {
-    let plain = format!("{x}");
-    let exp = format!("{x:e}");
-    if exp.len() < plain.len() { exp } else { plain }
-}
-
-/// Names this module looks up often, interned once.
-struct Syms {
-    name: Sym,
-    file: Sym,
-    euler: Sym,
-    axisangle: Sym,
-    joint: Sym,
-    ty: Sym,
-    range: Sym,
-    reference: Sym,
-    springref: Sym,
-}
-
-fn syms() -> &'static Syms {
-    static SYMS: std::sync::OnceLock<Syms> = std::sync::OnceLock::new();
-    SYMS.get_or_init(|| {
-        let s = crate::document::names::sym;
-        Syms {
-            name: s("name"),
-            file: s("file"),
-            euler: s("euler"),
-            axisangle: s("axisangle"),
-            joint: s("joint"),
-            ty: s("type"),
-            range: s("range"),
-            reference: s("ref"),
-            springref: s("springref"),
-        }
-    })
-}
-
-impl Document {
-    /// The level of `node` (the root is level 1).
-    fn depth_of(&self, node: Node) -> usize {
-        std::iter::successors(Some(node), |&n| self.parent(n)).count()
-    }
-
-    /// How many levels the deepest element below `node` is under it (0 for a leaf).
-    fn depth_below(&self, node: Node) -> usize {
-        let mut deepest = 0;
-        let mut stack = vec![(node, 0)];
-        while let Some((n, d)) = stack.pop() {
-            deepest = deepest.max(d);
-            stack.extend(self.children(n).map(|k| (k, d + 1)));
-        }
-        deepest
-    }
 }
 
 impl Document {
@@ -404,6 +354,75 @@ impl Document {
         self.descendants(world)
             .find(|&n| self.tag_sym(n) == Some(body) && self.attr_sym(n, name_sym) == Some(name))
     }
+
+    /// The level of `node` (the root is level 1).
+    fn depth_of(&self, node: Node) -> usize {
+        std::iter::successors(Some(node), |&n| self.parent(n)).count()
+    }
+
+    /// How many levels the deepest element below `node` is under it (0 for a leaf).
+    fn depth_below(&self, node: Node) -> usize {
+        let mut deepest = 0;
+        let mut stack = vec![(node, 0)];
+        while let Some((n, d)) = stack.pop() {
+            deepest = deepest.max(d);
+            stack.extend(self.children(n).map(|k| (k, d + 1)));
+        }
+        deepest
+    }
+}
+
+/// Whether two attribute values are the same, number tokens compared as numbers ("0" and
+/// "0.0" are the same value to MuJoCo).
+fn same_value(a: &str, b: &str) -> bool {
+    let ta: Vec<&str> = a.split_ascii_whitespace().collect();
+    let tb: Vec<&str> = b.split_ascii_whitespace().collect();
+    ta.len() == tb.len()
+        && ta
+            .iter()
+            .zip(&tb)
+            .all(|(x, y)| match (x.parse::<f64>(), y.parse::<f64>()) {
+                (Ok(p), Ok(q)) => p == q,
+                _ => x == y,
+            })
+}
+
+/// The shortest text that reads back as `x` (plain or with an exponent).
+pub(crate) fn fmt_num(x: f64) -> String {
+    let plain = format!("{x}");
+    let exp = format!("{x:e}");
+    if exp.len() < plain.len() { exp } else { plain }
+}
+
+/// Names this module looks up often, interned once.
+struct Syms {
+    name: Sym,
+    file: Sym,
+    euler: Sym,
+    axisangle: Sym,
+    joint: Sym,
+    ty: Sym,
+    range: Sym,
+    reference: Sym,
+    springref: Sym,
+}
+
+fn syms() -> &'static Syms {
+    static SYMS: std::sync::OnceLock<Syms> = std::sync::OnceLock::new();
+    SYMS.get_or_init(|| {
+        let s = crate::document::names::sym;
+        Syms {
+            name: s("name"),
+            file: s("file"),
+            euler: s("euler"),
+            axisangle: s("axisangle"),
+            joint: s("joint"),
+            ty: s("type"),
+            range: s("range"),
+            reference: s("ref"),
+            springref: s("springref"),
+        }
+    })
 }
 
 impl Document {
