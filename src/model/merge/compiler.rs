@@ -98,8 +98,6 @@ fn no_conversion_reason(attr: &str, base: &str, default: &str) -> &'static str {
 }
 
 impl Document {
-    /// The part brought to this document's compiler settings (`None`: it already is), or
-    /// the reasons it cannot be.
     /// `part` converted as [`Document::merge`] converts it, carrying this document's
     /// `<compiler>` settings instead of its own, so that merging it here later converts
     /// nothing more (the batch tier prepares each object once and merges it into every
@@ -135,6 +133,8 @@ impl Document {
         Some(conv)
     }
 
+    /// The part brought to this document's compiler settings (`None`: it already is), or
+    /// the reasons it cannot be.
     pub(super) fn converted_part(
         &self,
         part: &Document,

@@ -69,8 +69,6 @@ impl Document {
         offset
     }
 
-    /// Copies a subtree of another document into this arena as the last child of
-    /// `parent`, through `imp`. Nodes are created in place (no detached copy to re-link).
     /// Copies one node of `other` (without its children) under `parent` here.
     fn import_one(&mut self, other: &Document, node: Node, parent: Node, imp: &mut Import) -> Node {
         let data = match *other.tree.data(node) {
@@ -106,8 +104,9 @@ impl Document {
         new
     }
 
-    /// Copies `node` of `other` and everything below it under `parent` here (in document
-    /// order, from a stack: parts nest without bound); returns the copy of `node`.
+    /// Copies `node` of `other` and everything below it into this arena as the last child of
+    /// `parent`, through `imp` (in document order, from a stack: parts nest without bound);
+    /// returns the copy of `node`. Nodes are created in place (no detached copy to re-link).
     pub(super) fn import(
         &mut self,
         other: &Document,
