@@ -10,7 +10,7 @@
 //!   [`schema`] (which attributes declare names and which refer to them);
 //! - editing and checking: [`prefix`] (renaming every name and reference), [`validate`]
 //!   (duplicate names, dangling references);
-//! - writing: [`write`] (compact and pretty XML; files through `output`);
+//! - writing: [`write`](mod@write) (compact and pretty XML; files through `output`);
 //! - [`limits`]: the input limits every reader honours.
 //!
 //! May use: `crate::error` and `crate::output` (atomic files). Knows nothing of models,
