@@ -4,7 +4,7 @@
 use quick_xml::Reader;
 use quick_xml::events::{BytesStart, Event};
 
-use super::Builder;
+use super::builder::Builder;
 use super::bytes::{is_blank, is_xml_space};
 use super::checks::{clip, expand_refs, first_forbidden_char, is_utf16};
 use super::lines::Lines;

@@ -1,7 +1,7 @@
 //! The fast reader: one pass over the bytes for the markup well-formed MJCF uses, building
 //! the nodes quick-xml's events would build; anything else hands the load back.
 
-use super::Builder;
+use super::builder::Builder;
 use super::bytes::{find_any, is_blank, is_xml_space};
 use super::checks::first_forbidden_char;
 use super::lines::LineCursor;

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use super::Builder;
+use super::builder::Builder;
 use crate::document::limits::read_regular_file;
 use crate::document::paths::join_by_name;
 use crate::document::tree::Node;
