@@ -310,6 +310,28 @@ fn residual_class(i: usize) -> String {
 }
 
 impl Resolver<'_> {
+    /// The name of the residual class holding `residual` for `slot` (see
+    /// [`Resolver::residuals`]): elements left with the same values share one class.
+    fn residual_class_name(&mut self, slot: DefaultSlot, residual: Vec<(Sym, StrRef)>) -> StrRef {
+        let key: Vec<(Sym, String)> = residual
+            .iter()
+            .map(|&(n, v)| (n, self.doc.str(v).to_string()))
+            .collect();
+        let found = self.residuals.iter().position(|(s, attrs)| {
+            *s == slot
+                && attrs.len() == key.len()
+                && attrs
+                    .iter()
+                    .zip(&key)
+                    .all(|(a, k)| a.0 == k.0 && self.doc.str(a.1) == k.1)
+        });
+        let i = found.unwrap_or_else(|| {
+            self.residuals.push((slot, residual));
+            self.residuals.len() - 1
+        });
+        self.doc.push_str(&residual_class(i))
+    }
+
     /// Writes the residual classes as the only `<default>` left (see [`Resolver::residuals`]).
     fn write_residuals(&mut self) {
         if self.residuals.is_empty() {
@@ -651,23 +673,7 @@ impl Resolver<'_> {
             out.push(crate::document::tree::Attr { name, value });
         }
         if !residual.is_empty() {
-            let key: Vec<(Sym, String)> = residual
-                .iter()
-                .map(|&(n, v)| (n, self.doc.str(v).to_string()))
-                .collect();
-            let found = self.residuals.iter().position(|(s, attrs)| {
-                *s == slot
-                    && attrs.len() == key.len()
-                    && attrs
-                        .iter()
-                        .zip(&key)
-                        .all(|(a, k)| a.0 == k.0 && self.doc.str(a.1) == k.1)
-            });
-            let i = found.unwrap_or_else(|| {
-                self.residuals.push((slot, residual));
-                self.residuals.len() - 1
-            });
-            let value = self.doc.push_str(&residual_class(i));
+            let value = self.residual_class_name(slot, residual);
             out.push(crate::document::tree::Attr {
                 name: self.syms.class,
                 value,
