@@ -22,6 +22,8 @@
 //! material of that class inherits them. MuJoCo keeps a material's textures as one name per
 //! role, so they are inherited role by role; see [`Layers`].
 
+mod layers;
+
 use ahash::AHashMap;
 
 use crate::document::Document;
@@ -30,6 +32,7 @@ use crate::document::schema::Kind;
 use crate::document::tree::{Node, StrRef};
 use crate::document::vocab::{self, DefaultSlot, ElementSpec};
 use crate::error::{Error, ErrorKind, Errors};
+use layers::{Layers, RGB};
 
 /// Attributes that together give one orientation: a new one replaces all of them.
 const ORIENTATION: [&str; 5] = ["quat", "axisangle", "xyaxes", "zaxis", "euler"];
@@ -63,50 +66,6 @@ const SLOTS: [DefaultSlot; 11] = [
     DefaultSlot::Equality,
     DefaultSlot::Tendon,
 ];
-
-/// The texture roles a `<layer role=...>` may name, in MuJoCo's `mjtTextureRole` order. The
-/// first role there, `user`, is refused by the reader of MuJoCo 3.17.0 and 4.0.0 (`unknown
-/// layer role 'user'`), as is any other word, even with white space around a known one.
-const TEXTURE_ROLES: [&str; 9] = [
-    "rgb",
-    "occlusion",
-    "roughness",
-    "metallic",
-    "normal",
-    "opacity",
-    "emissive",
-    "rgba",
-    "orm",
-];
-/// The role a material's `texture` attribute sets.
-const RGB: usize = 0;
-
-/// A material's textures by role, as MuJoCo keeps them (one name per role) and as a class's
-/// material passes them on. Checked with MuJoCo 3.17.0 and 4.0.0
-/// (corpora/features/default_material_layers.xml):
-/// - a material starts from its class's textures, a nested class from its parent's (taken
-///   when the parent's own rows have been read, like every other default value);
-/// - its `texture` attribute sets the `rgb` role, then each `<layer>` sets its role, a later
-///   one replacing an earlier one; roles it does not name keep the class's textures, so its
-///   own layers add to the class's, role by role;
-/// - an empty name (`texture=""`) leaves that role without a texture;
-/// - one element with both a `texture` attribute and `<layer>` children is refused (in a
-///   class too), but a class's `texture` and an element's layers combine, and the reverse.
-///
-/// `None`: the role was never given.
-#[derive(Clone, Copy, Debug, Default)]
-struct Layers([Option<StrRef>; TEXTURE_ROLES.len()]);
-
-impl Layers {
-    fn is_empty(&self) -> bool {
-        self.0.iter().all(Option::is_none)
-    }
-
-    /// Whether no role but `rgb` was given (so the `texture` attribute can say it all).
-    fn only_rgb(&self) -> bool {
-        self.0[RGB + 1..].iter().all(Option::is_none)
-    }
-}
 
 fn slot_index(slot: DefaultSlot) -> Option<usize> {
     SLOTS.iter().position(|s| *s == slot)
@@ -689,98 +648,6 @@ impl Resolver<'_> {
             out,
             text: std::mem::take(&mut self.scratch.text),
         };
-    }
-
-    /// Moves the `texture` attribute out of a material's attribute set into its `rgb` role.
-    fn take_texture(&self, set: &mut AttrSet, layers: &mut Layers) {
-        if let Some(t) = set.get(self.syms.texture) {
-            set.remove(self.syms.texture);
-            layers.0[RGB] = Some(t);
-        }
-    }
-
-    /// Reads the `<layer>` children of a material (or of a class's material row) onto
-    /// `layers`, in order; returns whether it has any. `own` are its attributes. What MuJoCo
-    /// 3.17.0 and 4.0.0 refuse is reported (a `texture` attribute next to layers, an unknown
-    /// or missing role, a missing texture): inlined into a material that is valid on its
-    /// own, such a row would no longer be refused.
-    fn read_layers(&mut self, node: Node, own: &[(Sym, StrRef)], layers: &mut Layers) -> bool {
-        let texture_attr = own.iter().any(|(n, _)| *n == self.syms.texture);
-        let mut any = false;
-        let kids: Vec<Node> = self
-            .doc
-            .elements(node)
-            .filter(|&k| self.doc.tag_sym(k) == Some(self.syms.layer))
-            .collect();
-        for layer in kids {
-            if texture_attr && !any {
-                let e = self.doc.error_at(
-                    layer,
-                    ErrorKind::Invalid(
-                        "a material with a 'texture' attribute cannot have <layer> children".into(),
-                    ),
-                );
-                self.errors.push(e);
-            }
-            any = true;
-            let role = self.doc.attr_sym(layer, self.syms.role);
-            let texture = self
-                .doc
-                .attr_slice(layer)
-                .iter()
-                .find(|a| a.name == self.syms.texture)
-                .map(|a| a.value);
-            let problem = match (role, texture) {
-                (None, _) => Some("<layer> needs a 'role'".to_string()),
-                (_, None) => Some("<layer> needs a 'texture'".to_string()),
-                (Some(r), Some(t)) => match TEXTURE_ROLES.iter().position(|k| *k == r) {
-                    Some(i) => {
-                        layers.0[i] = Some(t);
-                        None
-                    }
-                    None => Some(format!("unknown layer role '{r}'")),
-                },
-            };
-            if let Some(msg) = problem {
-                let e = self.doc.error_at(layer, ErrorKind::Invalid(msg));
-                self.errors.push(e);
-            }
-        }
-        any
-    }
-
-    /// Replaces a material's `<layer>` children with one per role that has a texture, in
-    /// role order (an empty name is no texture: nothing to write).
-    fn write_layers(&mut self, node: Node, layers: &Layers) {
-        let old: Vec<Node> = self
-            .doc
-            .elements(node)
-            .filter(|&k| self.doc.tag_sym(k) == Some(self.syms.layer))
-            .collect();
-        for k in old {
-            self.doc.remove(k);
-        }
-        for (role, texture) in TEXTURE_ROLES.iter().zip(layers.0) {
-            let Some(texture) = texture.filter(|t| !self.doc.str(*t).is_empty()) else {
-                continue;
-            };
-            let layer = self.doc.new_element(self.syms.layer, Some(node));
-            let role = self.doc.push_str(role);
-            self.doc.replace_attrs(
-                layer,
-                &[
-                    crate::document::tree::Attr {
-                        name: self.syms.role,
-                        value: role,
-                    },
-                    crate::document::tree::Attr {
-                        name: self.syms.texture,
-                        value: texture,
-                    },
-                ],
-            );
-            self.doc.tree.append(node, layer);
-        }
     }
 
     /// A texture that writes its own `gridsize`, other than its class's, does not take the
