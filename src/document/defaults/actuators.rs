@@ -1,8 +1,8 @@
 //! Actuators: the one dummy per class that every actuator element writes, whichever shortcut
 //! it is, and the tag a resolved actuator is written with.
 
-use super::AttrSet;
 use super::Resolver;
+use super::classes::AttrSet;
 use crate::document::Document;
 use crate::document::names::Sym;
 use crate::document::schema::Kind;

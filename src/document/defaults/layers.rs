@@ -1,8 +1,8 @@
 //! A material's textures by role: what a class's `<material>` row and its `<layer>` children
 //! pass on, and the `<layer>` children a resolved material is written with.
 
-use super::AttrSet;
 use super::Resolver;
+use super::classes::AttrSet;
 use crate::document::names::Sym;
 use crate::document::tree::{Node, StrRef};
 use crate::error::ErrorKind;

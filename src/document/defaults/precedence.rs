@@ -2,8 +2,8 @@
 //! nearer one wins, numeric arrays overlaid, orientations replaced whole), and the case where
 //! a class's value is not taken at all.
 
-use super::AttrSet;
 use super::Resolver;
+use super::classes::AttrSet;
 use crate::document::names::Sym;
 use crate::document::tree::StrRef;
 use crate::document::vocab::ElementSpec;

@@ -2,8 +2,8 @@
 //! shortcut's parameters spelled out as its documented table, and read back off a `general`
 //! dummy the way MuJoCo pre-reads them.
 
-use super::AttrSet;
 use super::Resolver;
+use super::classes::AttrSet;
 use crate::document::Document;
 use crate::document::tree::Node;
 use crate::error::{Error, ErrorKind};
