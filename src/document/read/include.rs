@@ -56,6 +56,8 @@ impl Builder {
     ///
     /// Reading an included file recurses (on include depth only), so that depth is checked
     /// before anything else: a chain of includes cannot exhaust the stack.
+    ///
+    /// [`Limits::max_depth`]: crate::document::limits::Limits::max_depth
     pub(super) fn expand_include(
         &mut self,
         node: Node,

@@ -66,6 +66,8 @@ fn count_newlines(text: &[u8]) -> usize {
 
 /// The line of the reading position in [`Builder::parse_fast`], kept up to date as the
 /// reader passes over newlines.
+///
+/// [`Builder::parse_fast`]: super::builder::Builder::parse_fast
 pub(super) struct LineCursor {
     pub(super) line: u32,
     /// Offset of the line's first byte.

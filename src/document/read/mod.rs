@@ -16,7 +16,7 @@
 //! The files, by what they do:
 //! - [`fast`]: the fast reader, one pass over the bytes;
 //! - [`events`]: the full reader, on quick-xml's events;
-//! - [`include`]: `<include>` expanded (the file found, cycles refused) for either reader;
+//! - [`mod@include`]: `<include>` expanded (the file found, cycles refused) for either reader;
 //! - [`builder`]: what both readers write through: the document's tables, names checked
 //!   when first met, character data joined;
 //! - [`tags`]: start tags and their attributes scanned from the bytes (by the fast reader,
