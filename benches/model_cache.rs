@@ -8,8 +8,9 @@
 //! - `model_cache/compile`: the same variant's XML made and compiled by MuJoCo, what a
 //!   new scene costs without the cache.
 //!
-//! Needs MuJoCo: `cargo bench --features mujoco --bench model_cache` (3.17.0) or
-//! `--features mujoco-c` (4.0.0). Without either it prints how to run it.
+//! Needs MuJoCo: `cargo bench --features mujoco --bench model_cache` (the MuJoCo build.rs
+//! finds: 3.17.0 in the repository, or the one in `MJCF_FORGE_MUJOCO_DIR`). Without the
+//! feature it prints how to run it.
 
 #[cfg(mjcf_mujoco)]
 mod with_mujoco {
@@ -63,8 +64,5 @@ criterion::criterion_main!(benches);
 
 #[cfg(not(mjcf_mujoco))]
 fn main() {
-    eprintln!(
-        "model_cache: needs MuJoCo: cargo bench --features mujoco --bench model_cache \
-         (or --features mujoco-c)"
-    );
+    eprintln!("model_cache: needs MuJoCo: cargo bench --features mujoco --bench model_cache");
 }

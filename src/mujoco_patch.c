@@ -1,7 +1,7 @@
-// The MuJoCo side of patching a compiled model (src/model_cache.rs), for both cargo
-// features that link MuJoCo (`mujoco`: the 3.17.0 wheel's headers; `mujoco-c`: the chosen
-// MuJoCo's). Compiled against that MuJoCo's own headers, so mjModel's and mjData's layouts
-// are never copied into Rust: arrays are found by name through MuJoCo's X-macro table.
+// The MuJoCo side of patching a compiled model (src/mujoco/cache.rs). Compiled by build.rs
+// against the linked MuJoCo's own headers, as the FFI's shim is, so mjModel's and mjData's
+// layouts are never copied into Rust: arrays are found by name through MuJoCo's X-macro
+// table.
 #include <math.h>
 #include <stddef.h>
 #include <string.h>

@@ -1,4 +1,4 @@
-//! The Rust `ModelCache` (features `mujoco` and `mujoco-c`): every patched model equals,
+//! The Rust `ModelCache` (feature `mujoco`): every patched model equals,
 //! bit for bit in every array and statistic, MuJoCo compiling the variant's XML.
 
 #![cfg(mjcf_mujoco)]

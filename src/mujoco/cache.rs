@@ -6,7 +6,7 @@
 //! (`tests/model_cache.rs` compares every array bit for bit).
 //!
 //! The C side (`src/mujoco_patch.c`) is compiled against the linked MuJoCo's headers, as
-//! the rest of this module's FFI is; arrays are found by name through MuJoCo's X-macro
+//! the FFI's shim is; arrays are found by name through MuJoCo's X-macro
 //! table, so no Rust copy of `mjModel`'s layout is needed.
 
 use std::collections::HashMap;

@@ -5,21 +5,12 @@
 //! `mjModel`, or a [`CompileError`] carrying MuJoCo's own message and, when MuJoCo names
 //! one, the line of the offending element.
 //!
-//! Two builds, chosen by cargo feature (see `build.rs` and the README):
-//!
-//! - `mujoco`: MuJoCo 3.17.0 from the PyPI wheel that `scripts/setup.sh` installs; the FFI
-//!   declarations come from the `mujoco-rs` crate (`mujoco_rs::mujoco_c`), which was
-//!   generated from the 3.17.0 headers.
-//! - `mujoco-c`: the MuJoCo a user has (4.0.0 from `.cache/venv-mj4` by default, or the
-//!   folder in `MJCF_FORGE_MUJOCO_DIR`), through our own shim (`src/mujoco_shim.c`), which
-//!   `build.rs` compiles against that MuJoCo's own headers: no Rust copy of `mjModel`'s
-//!   layout exists in that build; fields are read by name through MuJoCo's X-macro tables.
-//!
-//! Both go through the small private module `sys` below; everything else is shared. This
-//! module calls
-//! `mj_loadXML` itself instead of `mujoco_rs::prelude::MjModel::from_xml*`, because those
-//! read MuJoCo's error into a 100-byte buffer, which cuts longer messages short, often
-//! before the `line N` part.
+//! One binding for any MuJoCo from 3.17.0 on: `build.rs` compiles our small C shim
+//! (`src/mujoco_shim.c`) against the headers of the MuJoCo it links, so no Rust copy of
+//! `mjModel`'s layout exists; fields are read by name through MuJoCo's X-macro tables. The
+//! calls into C go through the small private module `sys` below. This module calls
+//! `mj_loadXML` itself, with a 4 KiB error buffer: MuJoCo's messages name the offending
+//! element's line at their end, which a short buffer would cut off.
 //!
 //! # Thread safety
 //!
@@ -58,9 +49,6 @@ use std::fmt;
 use std::path::Path;
 use std::ptr::NonNull;
 use std::sync::OnceLock;
-
-#[cfg(feature = "mujoco")]
-use mujoco_rs::mujoco_c as ffi;
 
 use sys::{model_array, model_size};
 
@@ -471,8 +459,8 @@ fn load_xml(path: &CStr, vfs: Option<&sys::Vfs>) -> Result<CompiledModel, Compil
     }
 }
 
-/// Refuses to call into a MuJoCo other than the one the FFI declarations were made for
-/// (mujoco-rs itself would panic there).
+/// Refuses to call into a MuJoCo other than the one whose headers the shim was compiled
+/// with (a library swapped after the build): the layouts the shim reads would be wrong.
 fn check_version() -> Result<(), CompileError> {
     static LINKED: OnceLock<c_int> = OnceLock::new();
     let linked = *LINKED.get_or_init(sys::linked_version);
@@ -791,12 +779,6 @@ macro_rules! model_arrays {
     };
 }
 
-/// A size field of `mjModel` as `usize` (they are never negative).
-#[cfg(feature = "mujoco")]
-fn n(size: ffi::mjtSize) -> usize {
-    usize::try_from(size).unwrap_or(0)
-}
-
 model_arrays! {
     /// Body positions relative to the parent body, 3 per body (`nbody x 3`).
     body_pos: f64, |m| model_size!(m, nbody) * 3;
@@ -837,9 +819,9 @@ model_arrays! {
     /// Site positions relative to their body (`nsite x 3`).
     site_pos: f64, |m| model_size!(m, nsite) * 3;
     /// Actuator gain parameters, `mjNGAIN` (10) per actuator (`nactuator x 10`).
-    actuator_gainprm: f64, |m| model_size!(m, nactuator) * sys::NGAIN;
+    actuator_gainprm: f64, |m| model_size!(m, nactuator) * sys::ngain();
     /// Actuator bias parameters, `mjNBIAS` (10) per actuator (`nactuator x 10`).
-    actuator_biasprm: f64, |m| model_size!(m, nactuator) * sys::NBIAS;
+    actuator_biasprm: f64, |m| model_size!(m, nactuator) * sys::nbias();
     /// Default pose (`nq`).
     qpos0: f64, |m| model_size!(m, nq);
     /// Keyframe times (`nkey`).
@@ -977,21 +959,6 @@ impl CompiledModel {
     pub fn warnings(&self) -> Option<&str> {
         self.warnings.as_deref()
     }
-
-    /// The raw `mjModel`, read-only, for fields without an accessor here (builds with the
-    /// feature `mujoco` only: with `mujoco-c`, no Rust copy of the layout exists).
-    ///
-    /// ```no_run
-    /// use std::path::Path;
-    /// use mjcf_forge::mujoco::compile_file;
-    ///
-    /// let model = compile_file(Path::new("arm.xml")).unwrap();
-    /// println!("timestep {}", model.ffi().opt.timestep);
-    /// ```
-    #[cfg(feature = "mujoco")]
-    pub fn ffi(&self) -> &ffi::mjModel {
-        self.raw()
-    }
 }
 
 #[cfg(test)]
@@ -1045,133 +1012,9 @@ mod tests {
     }
 }
 
-/// MuJoCo 3.17.0 through mujoco-rs (feature `mujoco`).
-#[cfg(feature = "mujoco")]
-mod sys {
-    use std::ffi::{CStr, c_char, c_int};
-
-    use mujoco_rs::mujoco_c as ffi;
-    use mujoco_rs::wrappers::MjVfs;
-
-    use super::{Contact, ObjType};
-
-    pub(super) type Model = ffi::mjModel;
-    pub(super) const NGAIN: usize = ffi::mjNGAIN as usize;
-    pub(super) const NBIAS: usize = ffi::mjNBIAS as usize;
-
-    /// A size field of `mjModel` as `usize`.
-    macro_rules! model_size {
-        ($m:expr, $field:ident) => {
-            crate::mujoco::n($m.$field)
-        };
-    }
-    /// An array field of `mjModel` as a pointer to `$ty`.
-    macro_rules! model_array {
-        ($m:expr, $field:ident, $ty:ty) => {
-            $m.$field.cast_const()
-        };
-    }
-    pub(super) use {model_array, model_size};
-
-    pub(super) struct Vfs(MjVfs);
-
-    impl Vfs {
-        pub(super) fn new() -> Option<Vfs> {
-            Some(Vfs(MjVfs::new()))
-        }
-
-        /// Adds `bytes` (`len` of them) under `name`; MuJoCo's return code.
-        pub(super) fn add_buffer(&mut self, name: &CStr, bytes: &[u8], len: c_int) -> c_int {
-            // SAFETY: the VFS is live (made by `mj_defaultVFS` in `MjVfs::new`); `name` is
-            // NUL-terminated; MuJoCo copies `len` (= `bytes.len()`) bytes before returning.
-            unsafe {
-                ffi::mj_addBufferVFS(self.0.ffi_mut(), name.as_ptr(), bytes.as_ptr().cast(), len)
-            }
-        }
-    }
-
-    /// # Safety
-    /// As `mj_loadXML`: `err` holds `err_len` writable bytes.
-    pub(super) unsafe fn load_xml(
-        path: &CStr,
-        vfs: Option<&Vfs>,
-        err: *mut c_char,
-        err_len: c_int,
-    ) -> *mut Model {
-        let vfs = vfs.map_or(std::ptr::null(), |v| std::ptr::from_ref(v.0.ffi()));
-        // SAFETY: see the caller's contract; `vfs` is null or live.
-        unsafe { ffi::mj_loadXML(path.as_ptr(), vfs, err, err_len) }
-    }
-
-    /// # Safety
-    /// `m` came from [`load_xml`] and is not used afterwards.
-    pub(super) unsafe fn delete_model(m: *mut Model) {
-        // SAFETY: see the contract.
-        unsafe { ffi::mj_deleteModel(m) }
-    }
-
-    pub(super) fn linked_version() -> c_int {
-        // SAFETY: `mj_version` only returns a constant.
-        unsafe { ffi::mj_version() }
-    }
-
-    pub(super) fn header_version() -> c_int {
-        ffi::mjVERSION_HEADER as c_int
-    }
-
-    /// # Safety
-    /// `id` is in range for `obj` in the live model `m`.
-    pub(super) unsafe fn id2name(m: &Model, obj: ObjType, id: c_int) -> *const c_char {
-        use ffi::mjtObj::*;
-        let kind = match obj {
-            ObjType::Body => mjOBJ_BODY,
-            ObjType::Joint => mjOBJ_JOINT,
-            ObjType::Geom => mjOBJ_GEOM,
-            ObjType::Site => mjOBJ_SITE,
-            ObjType::Camera => mjOBJ_CAMERA,
-            ObjType::Light => mjOBJ_LIGHT,
-            ObjType::Mesh => mjOBJ_MESH,
-            ObjType::Material => mjOBJ_MATERIAL,
-            ObjType::Texture => mjOBJ_TEXTURE,
-            ObjType::Tendon => mjOBJ_TENDON,
-            ObjType::Actuator => mjOBJ_ACTUATOR,
-            ObjType::Sensor => mjOBJ_SENSOR,
-            ObjType::Equality => mjOBJ_EQUALITY,
-            ObjType::Key => mjOBJ_KEY,
-        };
-        // SAFETY: see the contract.
-        unsafe { ffi::mj_id2name(std::ptr::from_ref(m), kind as c_int, id) }
-    }
-
-    pub(super) fn initial_contacts(m: &Model) -> Vec<Contact> {
-        let m = std::ptr::from_ref(m);
-        // SAFETY: `m` is a live compiled model; `mj_makeData` returns null or data sized
-        // for it, which `mj_forward` fills and we free before returning. `contact` holds
-        // `ncon` entries after `mj_forward`.
-        unsafe {
-            let d = ffi::mj_makeData(m);
-            if d.is_null() {
-                return Vec::new();
-            }
-            ffi::mj_forward(m, d);
-            let n = usize::try_from((*d).ncon).unwrap_or(0);
-            let contacts = super::slice_or_empty((*d).contact, n)
-                .iter()
-                .map(|c| Contact {
-                    geom1: usize::try_from(c.geom[0]).unwrap_or(usize::MAX),
-                    geom2: usize::try_from(c.geom[1]).unwrap_or(usize::MAX),
-                    dist: c.dist,
-                })
-                .collect();
-            ffi::mj_deleteData(d);
-            contacts
-        }
-    }
-}
-
-/// The MuJoCo a user has, through src/mujoco_shim.c (feature `mujoco-c`): the shim is
-/// compiled against that MuJoCo's headers, so nothing here knows a struct layout.
-#[cfg(feature = "mujoco-c")]
+/// The calls into C: MuJoCo's own entry points whose signatures are plain C types, and
+/// src/mujoco_shim.c for everything that needs a struct layout, a constant or an enum, which
+/// build.rs compiles against the linked MuJoCo's headers, so nothing here knows a layout.
 mod sys {
     use std::ffi::{CStr, c_char, c_int, c_void};
     use std::ptr::NonNull;
@@ -1190,10 +1033,6 @@ mod sys {
         _opaque: [u8; 0],
     }
 
-    /// `mjNGAIN` and `mjNBIAS` (10 in every MuJoCo 3.x and 4.0.0 header).
-    pub(super) const NGAIN: usize = 10;
-    pub(super) const NBIAS: usize = 10;
-
     unsafe extern "C" {
         fn mj_version() -> c_int;
         fn mj_loadXML(
@@ -1211,6 +1050,8 @@ mod sys {
         ) -> c_int;
         fn mj_id2name(m: *const Model, kind: c_int, id: c_int) -> *const c_char;
         fn mjf_header_version() -> c_int;
+        fn mjf_ngain() -> c_int;
+        fn mjf_nbias() -> c_int;
         fn mjf_model_size(m: *const Model, name: *const c_char) -> i64;
         fn mjf_model_array(
             m: *const Model,
@@ -1270,6 +1111,18 @@ mod sys {
             "mjModel.{field}: element size in MuJoCo's headers differs from ours"
         );
         ptr.cast()
+    }
+
+    /// `mjNGAIN`, the gain parameters per actuator, as the headers define it.
+    pub(super) fn ngain() -> usize {
+        // SAFETY: returns a constant of the headers the shim was compiled with.
+        usize::try_from(unsafe { mjf_ngain() }).unwrap_or(0)
+    }
+
+    /// `mjNBIAS`, the bias parameters per actuator, as the headers define it.
+    pub(super) fn nbias() -> usize {
+        // SAFETY: returns a constant of the headers the shim was compiled with.
+        usize::try_from(unsafe { mjf_nbias() }).unwrap_or(0)
     }
 
     /// A VFS owned by us, freed with `mj_deleteVFS`.
