@@ -1,7 +1,7 @@
 //! Build script: does something only with the cargo feature `mujoco`, which links MuJoCo's C
 //! library (3.17.0 or later) through our own C shim.
 //!
-//! No Rust copy of MuJoCo's headers exists: `src/mujoco_shim.c` (the FFI) and
+//! No Rust copy of MuJoCo's headers exists: `src/mujoco/shim.c` (the FFI) and
 //! `src/mujoco_patch.c` (the model cache) are compiled against the headers of the very
 //! MuJoCo the build links, so struct layouts and constants always match the library. The
 //! MuJoCo is a folder laid out like the PyPI wheel's `mujoco/` package
@@ -91,7 +91,7 @@ mod mujoco {
         println!("cargo::rustc-cfg=mjcf_mujoco");
         println!("cargo::rerun-if-env-changed={DIR_VAR}");
         println!("cargo::rerun-if-env-changed={PYTHON_VAR}");
-        println!("cargo::rerun-if-changed=src/mujoco_shim.c");
+        println!("cargo::rerun-if-changed=src/mujoco/shim.c");
         println!("cargo::rerun-if-changed=src/mujoco_patch.c");
 
         let mujoco = find().unwrap_or_else(|tried| stop(&not_found(&tried)));
@@ -116,7 +116,7 @@ mod mujoco {
         );
         println!("cargo::rustc-env={VERSION_VAR}={}", mujoco.version);
 
-        compile_c("src/mujoco_shim.c", &include, "mjcf_forge_mujoco_shim");
+        compile_c("src/mujoco/shim.c", &include, "mjcf_forge_mujoco_shim");
         compile_c("src/mujoco_patch.c", &include, "mjcf_forge_mujoco_patch");
         // After the C libraries, which need its symbols. By file name: the wheel ships the
         // versioned file only, no `libmujoco.so` for `-lmujoco` to find.

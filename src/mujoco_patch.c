@@ -48,8 +48,6 @@ mjData* mjf_patch_make_data(const mjModel* m) { return mj_makeData(m); }
 
 void mjf_patch_delete_data(mjData* d) { mj_deleteData(d); }
 
-mjModel* mjf_patch_copy_model(const mjModel* m) { return mj_copyModel(NULL, m); }
-
 // Bytes of a model's buffer and, when given, a data's buffer and arena.
 long long mjf_patch_nbytes(const mjModel* m, const mjData* d) {
   long long n = (long long)m->nbuffer;

@@ -1,4 +1,4 @@
-// The MuJoCo side of the FFI (src/mujoco/mod.rs declares these functions).
+// The MuJoCo side of the FFI (src/mujoco/sys.rs declares these functions).
 //
 // Compiled by build.rs against the headers of the MuJoCo that the build links, whichever
 // version from 3.17.0 on, so the layouts of mjModel, mjData and mjVFS and MuJoCo's constants
@@ -16,6 +16,9 @@ int mjf_header_version(void) { return mjVERSION_HEADER; }
 int mjf_ngain(void) { return mjNGAIN; }
 
 int mjf_nbias(void) { return mjNBIAS; }
+
+// A deep copy into a new model (mj_copyModel allocates it), or NULL.
+mjModel* mjf_copy_model(const mjModel* m) { return mj_copyModel(NULL, m); }
 
 // A size field of mjModel (MJMODEL_SIZES); -1 when `name` is not one.
 long long mjf_model_size(const mjModel* m, const char* name) {
