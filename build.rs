@@ -2,7 +2,7 @@
 //! library (3.17.0 or later) through our own C shim.
 //!
 //! No Rust copy of MuJoCo's headers exists: `src/mujoco/shim.c` (the FFI) and
-//! `src/mujoco_patch.c` (the model cache) are compiled against the headers of the very
+//! `src/compiled/patch.c` (the model cache) are compiled against the headers of the very
 //! MuJoCo the build links, so struct layouts and constants always match the library. The
 //! MuJoCo is a folder laid out like the PyPI wheel's `mujoco/` package
 //! (`include/mujoco/mujoco.h` beside `libmujoco.so.X.Y.Z`), looked for in this order:
@@ -92,7 +92,7 @@ mod mujoco {
         println!("cargo::rerun-if-env-changed={DIR_VAR}");
         println!("cargo::rerun-if-env-changed={PYTHON_VAR}");
         println!("cargo::rerun-if-changed=src/mujoco/shim.c");
-        println!("cargo::rerun-if-changed=src/mujoco_patch.c");
+        println!("cargo::rerun-if-changed=src/compiled/patch.c");
 
         let mujoco = find().unwrap_or_else(|tried| stop(&not_found(&tried)));
         if mujoco.version < OLDEST {
@@ -117,7 +117,11 @@ mod mujoco {
         println!("cargo::rustc-env={VERSION_VAR}={}", mujoco.version);
 
         compile_c("src/mujoco/shim.c", &include, "mjcf_forge_mujoco_shim");
-        compile_c("src/mujoco_patch.c", &include, "mjcf_forge_mujoco_patch");
+        compile_c(
+            "src/compiled/patch.c",
+            &include,
+            "mjcf_forge_compiled_patch",
+        );
         // After the C libraries, which need its symbols. By file name: the wheel ships the
         // versioned file only, no `libmujoco.so` for `-lmujoco` to find.
         println!("cargo::rustc-link-search=native={}", mujoco.dir.display());

@@ -19,7 +19,8 @@ mod with_mujoco {
     use std::time::Duration;
 
     use criterion::{Criterion, Throughput};
-    use mjcf_forge::mujoco::{ModelCache, compile_str};
+    use mjcf_forge::compiled::ModelCache;
+    use mjcf_forge::mujoco::compile_str;
     use mjcf_forge::scene::Scene;
 
     fn lift5_fixed() -> Scene {

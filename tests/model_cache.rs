@@ -6,7 +6,8 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use mjcf_forge::mujoco::{CompiledModel, ModelCache, compile_str};
+use mjcf_forge::compiled::ModelCache;
+use mjcf_forge::mujoco::{CompiledModel, compile_str};
 use mjcf_forge::scene::Scene;
 
 fn root() -> PathBuf {

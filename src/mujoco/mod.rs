@@ -14,12 +14,11 @@
 //! - `model.rs`: [`CompiledModel`] and what it reads ([`Sizes`], [`ObjType`], arrays,
 //!   [`Contact`]s);
 //! - `inertia.rs`: compiled inertias written back into a document;
-//! - `sys.rs`: the extern declarations (MuJoCo's and the shim's) and their wrappers;
-//! - `cache.rs`: the model cache, which builds on scenes and is to move up to a tier of its
-//!   own; it already gets what it needs from the FFI through `pub(crate)` items only.
+//! - `sys.rs`: the extern declarations (MuJoCo's and the shim's) and their wrappers.
 //!
-//! May use: the document tier and `crate::error`. Knows nothing of models, scenes (but for
-//! `cache.rs`) or the faces above.
+//! May use: the document tier and `crate::error`. Knows nothing of models, scenes, the
+//! compiled tier (whose model cache gets what it needs from here through `pub(crate)`
+//! items) or the faces above.
 //!
 //! # Thread safety
 //!
@@ -53,13 +52,11 @@
 // denies unsafe code elsewhere (it must use `deny`, not `forbid`, in builds with MuJoCo).
 #![allow(unsafe_code)]
 
-mod cache;
 mod compile;
 mod inertia;
 mod model;
 mod sys;
 
-pub use cache::ModelCache;
 pub use compile::{CompileError, compile_file, compile_str};
 pub(crate) use inertia::{free_joint_qpos0, write_all_inertials_from_geoms};
 pub use inertia::{write_all_inertials, write_inertials};

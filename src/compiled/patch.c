@@ -1,4 +1,4 @@
-// The MuJoCo side of patching a compiled model (src/mujoco/cache.rs). Compiled by build.rs
+// The MuJoCo side of patching a compiled model (src/compiled/cache.rs). Compiled by build.rs
 // against the linked MuJoCo's own headers, as the FFI's shim is, so mjModel's and mjData's
 // layouts are never copied into Rust: arrays are found by name through MuJoCo's X-macro
 // table.

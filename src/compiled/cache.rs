@@ -5,8 +5,8 @@
 //! of 3.17 and 4.0 leaves): exactly the model MuJoCo compiles from the variant's XML
 //! (`tests/model_cache.rs` compares every array bit for bit).
 //!
-//! The C side (`src/mujoco_patch.c`) is compiled against the linked MuJoCo's headers, as
-//! the FFI's shim is; arrays are found by name through MuJoCo's X-macro table, so no Rust copy of
+//! The C side (`patch.c`) is compiled against the linked MuJoCo's headers, as the FFI's
+//! shim is; arrays are found by name through MuJoCo's X-macro table, so no Rust copy of
 //! `mjModel`'s layout is needed. Models come from the FFI ([`crate::mujoco`]), which hands
 //! over the raw model, its serial number and the writable pointer through `pub(crate)` items.
 
@@ -178,7 +178,7 @@ impl Signature {
 /// bounded in count and bytes (models and their scratch data), least recently used out.
 ///
 /// ```no_run
-/// use mjcf_forge::mujoco::ModelCache;
+/// use mjcf_forge::compiled::ModelCache;
 /// use mjcf_forge::scene::Scene;
 ///
 /// let scene = Scene::demo().unwrap();
