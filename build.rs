@@ -1,209 +1,273 @@
-//! Build script: only does something with the cargo feature `mujoco` or `mujoco-c`.
+//! Build script: does something only with the cargo feature `mujoco`, which links MuJoCo's C
+//! library (3.17.0 or later) through our own C shim.
 //!
-//! With `mujoco` (MuJoCo 3.17.0), the crate links MuJoCo's C library through `mujoco-rs`,
-//! taking the library from the PyPI wheel `mujoco==3.17.0` that `scripts/setup.sh` installs
-//! into the repository's `.cache/venv`. The wheel ships the versioned file
-//! `libmujoco.so.3.17.0` only; `.cargo/config.toml` points mujoco-rs
-//! (`MUJOCO_DYNAMIC_LINK_DIR`) at a committed linker script named `libmujoco.so` that
-//! redirects `-lmujoco` to that versioned name. This script:
+//! No Rust copy of MuJoCo's headers exists: `src/mujoco/shim.c` (the FFI) and
+//! `src/compiled/patch.c` (the model cache) are compiled against the headers of the very
+//! MuJoCo the build links, so struct layouts and constants always match the library. The
+//! MuJoCo is a folder laid out like the PyPI wheel's `mujoco/` package
+//! (`include/mujoco/mujoco.h` beside `libmujoco.so.X.Y.Z`), looked for in this order:
 //!
-//! 1. finds the wheel's directory (or `MJCF_FORGE_MUJOCO_LIB_DIR` when set),
-//! 2. stops the build with a message naming `scripts/setup.sh` when the library is missing,
-//! 3. puts the directory on the linker's search path, so the linker script resolves, and
-//! 4. embeds it as an rpath in every binary, test and example of this package, so they run
-//!    without `LD_LIBRARY_PATH`.
+//! 1. `MJCF_FORGE_MUJOCO_DIR`, when set: that folder, and nothing else;
+//! 2. the `mujoco` package of the Python in `MJCF_FORGE_PYTHON`, when that file exists
+//!    (`.cargo/config.toml` names the repository's `.cache/venv`, MuJoCo 3.17.0, so builds
+//!    inside the repository use what `scripts/setup.sh` installed);
+//! 3. the `mujoco` package of `python3` on `PATH` (what `cargo install` elsewhere finds).
 //!
-//! With `mujoco-c` (the MuJoCo a user has; MuJoCo 4.0.0 by default), there is no mujoco-rs:
-//! `src/mujoco_shim.c` is compiled against the headers of a MuJoCo directory laid out like
-//! the wheel's `mujoco/` package (`include/mujoco/mujoco.h` and one `libmujoco.so.X.Y.Z`):
-//! `MJCF_FORGE_MUJOCO_DIR` when set, else the 4.0.0 wheel that `scripts/setup.sh` installs
-//! into `.cache/venv-mj4`. That library is linked by its file name, with an rpath.
+//! A Python's package may span several folders (from 4.0 on, the wheel `mujoco` is a
+//! pkgutil namespace whose library and headers come from the wheel `mujoco-core`), so every
+//! folder of `mujoco.__path__` is tried. The library is linked by its file name, with an
+//! rpath to its folder, so binaries, tests and examples run without `LD_LIBRARY_PATH`; its
+//! version becomes the compile-time variable `MJCF_FORGE_MUJOCO_VERSION` (tests pick the
+//! judge of that version by it). A missing MuJoCo, or one older than 3.17.0, stops the
+//! build with a message naming what was tried and how to fix it.
 //!
-//! Either feature sets the cfg `mjcf_mujoco`, which the code tests for "built with MuJoCo".
-//! Without them it prints nothing but its own rerun conditions, so the default build
-//! neither needs nor looks for MuJoCo.
-
-use std::env;
-use std::path::{Path, PathBuf};
-
-/// The MuJoCo version that the `mujoco-rs` dependency binds and the wheel provides.
-const MUJOCO_VERSION: &str = "3.17.0";
-
-/// Overrides the directory that holds `libmujoco.so.<MUJOCO_VERSION>`.
-const LIB_DIR_VAR: &str = "MJCF_FORGE_MUJOCO_LIB_DIR";
-
-/// `mujoco-c`: the MuJoCo directory (headers in `include/`, the library beside them).
-const MUJOCO_DIR_VAR: &str = "MJCF_FORGE_MUJOCO_DIR";
+//! The cfg `mjcf_mujoco` means "built with MuJoCo" to the code. Without the feature this
+//! script prints nothing but its own rerun conditions, so the default build neither needs
+//! nor looks for MuJoCo.
 
 fn main() {
     println!("cargo::rerun-if-changed=build.rs");
     println!("cargo::rustc-check-cfg=cfg(mjcf_mujoco)");
-    let with_rs = env::var_os("CARGO_FEATURE_MUJOCO").is_some();
-    let with_c = env::var_os("CARGO_FEATURE_MUJOCO_C").is_some();
-    if with_rs && with_c {
-        eprintln!(
-            "\nerror: the cargo features `mujoco` (MuJoCo 3.17.0 through mujoco-rs) and `mujoco-c` \
-             (the MuJoCo in {MUJOCO_DIR_VAR}, 4.0.0 by default) each link a MuJoCo library; \
-             enable one of them.\n"
-        );
-        std::process::exit(1);
-    }
-    if with_c {
-        println!("cargo::rustc-cfg=mjcf_mujoco");
-        #[cfg(feature = "mujoco-c")]
-        build_shim();
-        return;
-    }
-    if !with_rs {
-        return;
-    }
-    println!("cargo::rustc-cfg=mjcf_mujoco");
-    println!("cargo::rerun-if-env-changed={LIB_DIR_VAR}");
-
-    let manifest_dir = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").expect("set by cargo"));
-    let lib_name = format!("libmujoco.so.{MUJOCO_VERSION}");
-    let lib_dir = match env::var_os(LIB_DIR_VAR) {
-        Some(dir) => Some(PathBuf::from(dir)),
-        None => find_wheel_dir(&manifest_dir, &lib_name),
-    };
-    let lib_dir = match lib_dir {
-        Some(dir) if dir.join(&lib_name).is_file() => dir,
-        found => missing_library(&manifest_dir, &lib_name, found.as_deref()),
-    };
-    // An absolute path, so the rpath works from wherever a binary is started.
-    let lib_dir = lib_dir.canonicalize().unwrap_or(lib_dir);
-
-    println!(
-        "cargo::rerun-if-changed={}",
-        lib_dir.join(&lib_name).display()
-    );
-    println!(
-        "cargo::rerun-if-changed={}",
-        manifest_dir
-            .join(".cargo/mujoco-link/libmujoco.so")
-            .display()
-    );
-    println!("cargo::rustc-link-search=native={}", lib_dir.display());
-    let target_os = env::var("CARGO_CFG_TARGET_OS").unwrap_or_default();
-    if target_os != "windows" {
-        println!("cargo::rustc-link-arg=-Wl,-rpath,{}", lib_dir.display());
-    }
-    // The model cache's C side, against the wheel's own 3.17.0 headers.
     #[cfg(feature = "mujoco")]
-    build_patch(&lib_dir.join("include"));
+    mujoco::build();
 }
 
-/// Compiles `src/mujoco_patch.c` (the model cache's C side) against MuJoCo's headers in
-/// `include`.
-#[cfg(any(feature = "mujoco", feature = "mujoco-c"))]
-fn build_patch(include: &Path) {
-    println!("cargo::rerun-if-changed=src/mujoco_patch.c");
-    cc::Build::new()
-        .file("src/mujoco_patch.c")
-        .include(include)
-        .warnings(true)
-        .compile("mjcf_forge_mujoco_patch");
-}
+#[cfg(feature = "mujoco")]
+mod mujoco {
+    use std::env;
+    use std::fmt;
+    use std::path::{Path, PathBuf};
+    use std::process::Command;
 
-/// `<repo>/.cache/venv/lib/python3.*/site-packages/mujoco`, the first that holds the library.
-fn find_wheel_dir(manifest_dir: &Path, lib_name: &str) -> Option<PathBuf> {
-    let venv_lib = manifest_dir.join(".cache/venv/lib");
-    let mut candidates: Vec<PathBuf> = std::fs::read_dir(&venv_lib)
-        .ok()?
-        .filter_map(Result::ok)
-        .filter(|entry| entry.file_name().to_string_lossy().starts_with("python3"))
-        .map(|entry| entry.path().join("site-packages/mujoco"))
-        .collect();
-    candidates.sort();
-    candidates
-        .into_iter()
-        .find(|dir| dir.join(lib_name).is_file())
-}
+    /// The folder of one MuJoCo (headers in `include/`, the library beside them).
+    const DIR_VAR: &str = "MJCF_FORGE_MUJOCO_DIR";
+    /// A Python whose `mujoco` package is the MuJoCo to link.
+    const PYTHON_VAR: &str = "MJCF_FORGE_PYTHON";
+    /// The compile-time variable that names the linked MuJoCo's version.
+    const VERSION_VAR: &str = "MJCF_FORGE_MUJOCO_VERSION";
+    /// The oldest MuJoCo the shim and the model cache are known to work with.
+    const OLDEST: Version = Version(3, 17, 0);
 
-fn missing_library(manifest_dir: &Path, lib_name: &str, looked_in: Option<&Path>) -> ! {
-    let looked_in = looked_in.map_or_else(
-        || {
-            manifest_dir
-                .join(".cache/venv/lib/python3.*/site-packages/mujoco")
-                .display()
-                .to_string()
-        },
-        |dir| dir.display().to_string(),
-    );
-    eprintln!(
-        "\nerror: the cargo feature `mujoco` needs MuJoCo {MUJOCO_VERSION}'s C library, and {lib_name} \
-         was not found in {looked_in}.\n\
-         Run `scripts/setup.sh` in the repository root: it installs the PyPI wheel \
-         mujoco=={MUJOCO_VERSION} into .cache/venv, which ships the library.\n\
-         (Or set {LIB_DIR_VAR} to a directory that holds {lib_name}.)\n"
-    );
-    std::process::exit(1);
-}
+    /// Prints every folder of the `mujoco` package, the one of `__init__.py` first.
+    const PYTHON_QUERY: &str = "import mujoco, os\n\
+        print(os.path.dirname(mujoco.__file__))\n\
+        for p in mujoco.__path__: print(p)";
 
-/// `mujoco-c`: compiles the shim against the chosen MuJoCo's headers and links its library.
-#[cfg(feature = "mujoco-c")]
-fn build_shim() {
-    println!("cargo::rerun-if-env-changed={MUJOCO_DIR_VAR}");
-    println!("cargo::rerun-if-changed=src/mujoco_shim.c");
-    let manifest_dir = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").expect("set by cargo"));
-    let dir = match env::var_os(MUJOCO_DIR_VAR) {
-        Some(dir) => PathBuf::from(dir),
-        None => {
-            let venv_lib = manifest_dir.join(".cache/venv-mj4/lib");
-            let mut candidates: Vec<PathBuf> = std::fs::read_dir(&venv_lib)
-                .map(|rd| {
-                    rd.filter_map(Result::ok)
-                        .filter(|e| e.file_name().to_string_lossy().starts_with("python3"))
-                        .map(|e| e.path().join("site-packages/mujoco"))
-                        .collect()
-                })
-                .unwrap_or_default();
-            candidates.sort();
-            candidates
-                .into_iter()
-                .find(|d| d.join("include/mujoco/mujoco.h").is_file())
-                .unwrap_or_else(|| {
-                    manifest_dir.join(".cache/venv-mj4/lib/python3.*/site-packages/mujoco")
-                })
+    #[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+    struct Version(u32, u32, u32);
+
+    impl Version {
+        /// `"3.17.0"`.
+        fn parse(text: &str) -> Option<Version> {
+            let mut parts = text.split('.').map(|p| p.parse::<u32>().ok());
+            let v = Version(parts.next()??, parts.next()??, parts.next()??);
+            parts.next().is_none().then_some(v)
         }
-    };
-    let dir = dir.canonicalize().unwrap_or(dir);
-    let include = dir.join("include");
-    // The versioned library (`libmujoco.so.4.0.0`), else a plain `libmujoco.so`.
-    let mut libs: Vec<String> = std::fs::read_dir(&dir)
-        .map(|rd| {
-            rd.filter_map(Result::ok)
-                .map(|e| e.file_name().to_string_lossy().into_owned())
-                .filter(|n| n.starts_with("libmujoco.so"))
-                .collect()
-        })
-        .unwrap_or_default();
-    libs.sort_by_key(|n| std::cmp::Reverse(n.len()));
-    let (true, Some(lib)) = (include.join("mujoco/mujoco.h").is_file(), libs.first()) else {
-        eprintln!(
-            "\nerror: the cargo feature `mujoco-c` needs a MuJoCo directory with \
-             include/mujoco/mujoco.h and libmujoco.so.X.Y.Z; {} has not both.\n\
-             Run `scripts/setup.sh` in the repository root (it installs the PyPI wheel \
-             mujoco==4.0.0 into .cache/venv-mj4), or set {MUJOCO_DIR_VAR} to the `mujoco` \
-             folder of your installation (e.g. .../site-packages/mujoco).\n",
-            dir.display()
+
+        /// `mjVERSION_HEADER`: 3017000 is 3.17.0; before 3.0 it had a digit a part (232).
+        fn from_code(code: u32) -> Version {
+            if code < 1_000_000 {
+                Version(code / 100, code / 10 % 10, code % 10)
+            } else {
+                Version(code / 1_000_000, code / 1000 % 1000, code % 1000)
+            }
+        }
+    }
+
+    impl fmt::Display for Version {
+        fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+            write!(f, "{}.{}.{}", self.0, self.1, self.2)
+        }
+    }
+
+    /// A MuJoCo found: its folder, the library's file name there, and its version.
+    struct Mujoco {
+        dir: PathBuf,
+        lib: String,
+        version: Version,
+    }
+
+    pub fn build() {
+        println!("cargo::rustc-cfg=mjcf_mujoco");
+        println!("cargo::rerun-if-env-changed={DIR_VAR}");
+        println!("cargo::rerun-if-env-changed={PYTHON_VAR}");
+        println!("cargo::rerun-if-changed=src/mujoco/shim.c");
+        println!("cargo::rerun-if-changed=src/compiled/patch.c");
+
+        let mujoco = find().unwrap_or_else(|tried| stop(&not_found(&tried)));
+        if mujoco.version < OLDEST {
+            stop(&format!(
+                "the cargo feature `mujoco` needs MuJoCo {OLDEST} or later, and the MuJoCo found \
+                 in {} is {}.\n\
+                 Upgrade it (`pip install -U mujoco`), or set {DIR_VAR} to the `mujoco` folder \
+                 of a newer one.",
+                mujoco.dir.display(),
+                mujoco.version
+            ));
+        }
+        let include = mujoco.dir.join("include");
+        println!(
+            "cargo::rerun-if-changed={}",
+            mujoco.dir.join(&mujoco.lib).display()
         );
+        println!(
+            "cargo::rerun-if-changed={}",
+            include.join("mujoco/mujoco.h").display()
+        );
+        println!("cargo::rustc-env={VERSION_VAR}={}", mujoco.version);
+
+        compile_c("src/mujoco/shim.c", &include, "mjcf_forge_mujoco_shim");
+        compile_c(
+            "src/compiled/patch.c",
+            &include,
+            "mjcf_forge_compiled_patch",
+        );
+        // After the C libraries, which need its symbols. By file name: the wheel ships the
+        // versioned file only, no `libmujoco.so` for `-lmujoco` to find.
+        println!("cargo::rustc-link-search=native={}", mujoco.dir.display());
+        println!("cargo::rustc-link-lib=dylib:+verbatim={}", mujoco.lib);
+        if env::var("CARGO_CFG_TARGET_OS").unwrap_or_default() != "windows" {
+            println!("cargo::rustc-link-arg=-Wl,-rpath,{}", mujoco.dir.display());
+        }
+    }
+
+    fn compile_c(file: &str, include: &Path, name: &str) {
+        cc::Build::new()
+            .file(file)
+            .include(include)
+            .warnings(true)
+            .compile(name);
+    }
+
+    /// The MuJoCo to link, or what was tried (one line each) when none was found.
+    fn find() -> Result<Mujoco, Vec<String>> {
+        if let Some(dir) = env::var_os(DIR_VAR).filter(|d| !d.is_empty()) {
+            // Set on purpose: a wrong folder is an error, not a reason to look elsewhere.
+            let dir = PathBuf::from(dir);
+            return in_folder(&dir).map_err(|why| {
+                vec![format!(
+                    "{DIR_VAR}={}: {why} (being set, it is the only place looked in)",
+                    dir.display()
+                )]
+            });
+        }
+        let mut tried = vec![format!("{DIR_VAR}: not set")];
+        if let Some(python) = env::var_os(PYTHON_VAR).filter(|p| !p.is_empty()) {
+            let python = PathBuf::from(python);
+            let label = format!("{PYTHON_VAR}={}", python.display());
+            if python.is_file() {
+                match from_python(&python) {
+                    Ok(found) => return Ok(found),
+                    Err(why) => tried.push(format!("{label}: {why}")),
+                }
+            } else {
+                tried.push(format!("{label}: no such file"));
+            }
+        } else {
+            tried.push(format!("{PYTHON_VAR}: not set"));
+        }
+        // Only now does PATH decide, so only now is it a reason to look again.
+        println!("cargo::rerun-if-env-changed=PATH");
+        match from_python(Path::new("python3")) {
+            Ok(found) => Ok(found),
+            Err(why) => {
+                tried.push(format!("python3 on PATH: {why}"));
+                Err(tried)
+            }
+        }
+    }
+
+    /// The MuJoCo of `python`'s `mujoco` package: the first of its folders that holds one.
+    fn from_python(python: &Path) -> Result<Mujoco, String> {
+        let out = Command::new(python)
+            .args(["-c", PYTHON_QUERY])
+            .output()
+            .map_err(|e| format!("cannot run it ({e})"))?;
+        if !out.status.success() {
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            let last = stderr.lines().rev().find(|l| !l.trim().is_empty());
+            return Err(format!(
+                "cannot import mujoco ({})",
+                last.unwrap_or("no message").trim()
+            ));
+        }
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        let mut reasons = Vec::new();
+        for dir in stdout.lines().map(str::trim).filter(|l| !l.is_empty()) {
+            match in_folder(Path::new(dir)) {
+                Ok(found) => return Ok(found),
+                Err(why) => reasons.push(format!("{dir}: {why}")),
+            }
+        }
+        Err(format!(
+            "its mujoco package has no C library: {}",
+            reasons.join("; ")
+        ))
+    }
+
+    /// The MuJoCo in `dir`: `include/mujoco/mujoco.h` and the library, whose version the
+    /// file name gives (`libmujoco.so.3.17.0`; a plain `libmujoco.so` takes the headers').
+    fn in_folder(dir: &Path) -> Result<Mujoco, String> {
+        let header = dir.join("include/mujoco/mujoco.h");
+        let text = std::fs::read_to_string(&header)
+            .map_err(|_| "no include/mujoco/mujoco.h".to_string())?;
+        let code = text
+            .lines()
+            .find_map(|l| l.trim().strip_prefix("#define mjVERSION_HEADER"))
+            .and_then(|v| v.trim().parse::<u32>().ok())
+            .ok_or_else(|| "include/mujoco/mujoco.h defines no mjVERSION_HEADER".to_string())?;
+        let headers = Version::from_code(code);
+        let names: Vec<String> = std::fs::read_dir(dir)
+            .map_err(|e| format!("cannot list it ({e})"))?
+            .filter_map(Result::ok)
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .filter(|n| n.starts_with("libmujoco.so"))
+            .collect();
+        let versioned: Vec<(String, Version)> = names
+            .iter()
+            .filter_map(|n| Some((n.clone(), Version::parse(n.strip_prefix("libmujoco.so.")?)?)))
+            .collect();
+        // The file of the headers' version; else any versioned one (refused just below);
+        // else a plain `libmujoco.so`.
+        let (lib, version) = versioned
+            .iter()
+            .find(|(_, v)| *v == headers)
+            .or_else(|| versioned.iter().max_by_key(|(_, v)| *v))
+            .cloned()
+            .or_else(|| {
+                names
+                    .iter()
+                    .find(|n| *n == "libmujoco.so")
+                    .map(|n| (n.clone(), headers))
+            })
+            .ok_or_else(|| "no libmujoco.so.X.Y.Z".to_string())?;
+        if version != headers {
+            return Err(format!(
+                "{lib} is MuJoCo {version}, but its headers are {headers}'s"
+            ));
+        }
+        // An absolute path, so the rpath works from wherever a binary is started.
+        let dir = dir.canonicalize().unwrap_or_else(|_| dir.to_path_buf());
+        Ok(Mujoco { dir, lib, version })
+    }
+
+    fn not_found(tried: &[String]) -> String {
+        let tried: String = tried.iter().map(|t| format!("  - {t}\n")).collect();
+        format!(
+            "the cargo feature `mujoco` needs MuJoCo's C library ({OLDEST} or later), and none \
+             was found. Tried, in order:\n{tried}\
+             To fix it, either:\n\
+             \x20 - `pip install mujoco` into the Python that `python3` runs (or set {PYTHON_VAR} \
+             to a Python that has it), or\n\
+             \x20 - set {DIR_VAR} to a folder with include/mujoco/mujoco.h and \
+             libmujoco.so.X.Y.Z (the `mujoco` folder of an installed wheel).\n\
+             In a checkout of mjcf-forge, `scripts/setup.sh` installs MuJoCo 3.17.0 into \
+             .cache/venv, which {PYTHON_VAR} names by default."
+        )
+    }
+
+    fn stop(message: &str) -> ! {
+        eprintln!("\nerror: {message}\n");
         std::process::exit(1);
-    };
-    println!("cargo::rerun-if-changed={}", dir.join(lib).display());
-    println!(
-        "cargo::rerun-if-changed={}",
-        include.join("mujoco/mujoco.h").display()
-    );
-    cc::Build::new()
-        .file("src/mujoco_shim.c")
-        .include(&include)
-        .warnings(true)
-        .compile("mjcf_forge_mujoco_shim");
-    build_patch(&include);
-    println!("cargo::rustc-link-search=native={}", dir.display());
-    println!("cargo::rustc-link-lib=dylib:+verbatim={lib}");
-    if env::var("CARGO_CFG_TARGET_OS").unwrap_or_default() != "windows" {
-        println!("cargo::rustc-link-arg=-Wl,-rpath,{}", dir.display());
     }
 }

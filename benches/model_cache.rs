@@ -8,8 +8,9 @@
 //! - `model_cache/compile`: the same variant's XML made and compiled by MuJoCo, what a
 //!   new scene costs without the cache.
 //!
-//! Needs MuJoCo: `cargo bench --features mujoco --bench model_cache` (3.17.0) or
-//! `--features mujoco-c` (4.0.0). Without either it prints how to run it.
+//! Needs MuJoCo: `cargo bench --features mujoco --bench model_cache` (the MuJoCo build.rs
+//! finds: 3.17.0 in the repository, or the one in `MJCF_FORGE_MUJOCO_DIR`). Without the
+//! feature it prints how to run it.
 
 #[cfg(mjcf_mujoco)]
 mod with_mujoco {
@@ -18,7 +19,8 @@ mod with_mujoco {
     use std::time::Duration;
 
     use criterion::{Criterion, Throughput};
-    use mjcf_forge::mujoco::{ModelCache, compile_str};
+    use mjcf_forge::compiled::ModelCache;
+    use mjcf_forge::mujoco::compile_str;
     use mjcf_forge::scene::Scene;
 
     fn lift5_fixed() -> Scene {
@@ -63,8 +65,5 @@ criterion::criterion_main!(benches);
 
 #[cfg(not(mjcf_mujoco))]
 fn main() {
-    eprintln!(
-        "model_cache: needs MuJoCo: cargo bench --features mujoco --bench model_cache \
-         (or --features mujoco-c)"
-    );
+    eprintln!("model_cache: needs MuJoCo: cargo bench --features mujoco --bench model_cache");
 }

@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Runs every test of mjcf-forge (the README's test command; .ci/run calls it):
-# formatting, clippy, the Rust tests with and without the `mujoco` feature (real MuJoCo
-# 3.17.0 and 4.0.0 judge every output), the `mujoco-c` build against MuJoCo 4.0.0, the
-# judge's own tests under both versions, the Python package's tests (setup has built and
-# installed it into .cache/venv) and a short run of each fuzz target. Sets up first
-# (idempotent).
+# formatting, clippy, the Rust tests without the `mujoco` feature and once with it per
+# MuJoCo version the feature links (3.17.0 from .cache/venv, as .cargo/config.toml sets
+# MJCF_FORGE_PYTHON, and 4.0.0 from .cache/venv-mj4 through MJCF_FORGE_MUJOCO_DIR; real
+# MuJoCo 3.17.0 and 4.0.0 judge every output in each run), the judge's own tests under both
+# versions, the Python package's tests (setup has built and installed it into .cache/venv)
+# and a short run of each fuzz target. Sets up first (idempotent).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
@@ -15,17 +16,18 @@ cargo fmt --all -- --check
 echo "== cargo clippy"
 cargo clippy --all-targets -- -D warnings
 cargo clippy --all-targets --features mujoco -- -D warnings
-# The `mujoco-c` build (MuJoCo 4.0.0 through our own shim) in its own target folder, so
-# the two MuJoCo builds do not evict each other's artifacts.
-CARGO_TARGET_DIR=target/mujoco-c cargo clippy --all-targets --features mujoco-c -- -D warnings
 # The Python bindings crate (the workspace's other member; not built by the commands above).
 PYO3_PYTHON="$PWD/.cache/venv/bin/python" cargo clippy -p mjcf-forge-python --all-targets -- -D warnings
 echo "== cargo test (default features)"
 cargo test --all-targets
-echo "== cargo test --features mujoco (with doctests)"
+echo "== cargo test --features mujoco, MuJoCo 3.17.0 (with doctests)"
 cargo test --features mujoco
-echo "== cargo test --features mujoco-c (MuJoCo 4.0.0: the FFI and compile --json against Python 4.0.0)"
-CARGO_TARGET_DIR=target/mujoco-c cargo test --features mujoco-c --lib --test mujoco_compile --test cli_compile --test model_cache
+# From 4.0 on the wheel `mujoco` depends on `mujoco-core`, which puts libmujoco.so.4.0.0 and
+# include/ into the same `mujoco` folder; the venv's Python says where that is. Its own
+# target folder, so the two MuJoCo builds do not evict each other's artifacts.
+echo "== cargo test --features mujoco, MuJoCo 4.0.0 (with doctests)"
+MJ4_DIR="$(.cache/venv-mj4/bin/python -c 'import mujoco, os; print(os.path.dirname(mujoco.__file__))')"
+MJCF_FORGE_MUJOCO_DIR="$MJ4_DIR" CARGO_TARGET_DIR=target/mujoco-4 cargo test --features mujoco
 echo "== judge self-tests (MuJoCo 3.17.0 and 4.0.0)"
 .cache/venv/bin/python -m pytest tests/judge -q -p no:cacheprovider
 .cache/venv-mj4/bin/python -m pytest tests/judge -q -p no:cacheprovider

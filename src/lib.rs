@@ -34,7 +34,8 @@
 //! # Ok::<(), mjcf_forge::Errors>(())
 //! ```
 #![cfg_attr(not(mjcf_mujoco), forbid(unsafe_code))]
-// The one FFI module, `mujoco`, opts back in; everything else stays safe.
+// The two tiers that call into MuJoCo's C, `mujoco` (the FFI) and `compiled` (the model
+// cache), opt back in; everything else stays safe.
 #![cfg_attr(mjcf_mujoco, deny(unsafe_code))]
 #![warn(missing_docs)]
 
@@ -50,6 +51,10 @@ mod model;
 pub mod mujoco;
 pub mod output;
 pub mod scene;
+
+// Above both the scene tier and the FFI: compiled variants.
+#[cfg(mjcf_mujoco)]
+pub mod compiled;
 
 pub use document::limits::Limits;
 pub use document::tree::Node;

@@ -1,4 +1,4 @@
-//! The Rust `ModelCache` (features `mujoco` and `mujoco-c`): every patched model equals,
+//! The Rust `ModelCache` (feature `mujoco`): every patched model equals,
 //! bit for bit in every array and statistic, MuJoCo compiling the variant's XML.
 
 #![cfg(mjcf_mujoco)]
@@ -6,7 +6,8 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use mjcf_forge::mujoco::{CompiledModel, ModelCache, compile_str};
+use mjcf_forge::compiled::ModelCache;
+use mjcf_forge::mujoco::{CompiledModel, compile_str};
 use mjcf_forge::scene::Scene;
 
 fn root() -> PathBuf {

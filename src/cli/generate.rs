@@ -383,10 +383,10 @@ fn make_one(
 }
 
 /// `--validate`: per worker thread a model cache (each structure compiled once per thread,
-/// its other variants patched: the same models, see `mjcf_forge::mujoco::ModelCache`),
+/// its other variants patched: the same models, see `mjcf_forge::compiled::ModelCache`),
 /// then the interpenetration check on the variant's model.
 #[cfg(mjcf_mujoco)]
-struct Validators<'s>(Vec<std::sync::Mutex<mjcf_forge::mujoco::ModelCache<'s>>>);
+struct Validators<'s>(Vec<std::sync::Mutex<mjcf_forge::compiled::ModelCache<'s>>>);
 
 /// Without MuJoCo `--validate` is refused before anything runs.
 #[cfg(not(mjcf_mujoco))]
@@ -404,7 +404,7 @@ impl<'s> Validators<'s> {
             (0..threads)
                 .map(|_| {
                     let cache =
-                        mjcf_forge::mujoco::ModelCache::new(scene, 8, Some(VALIDATE_CACHE_BYTES))
+                        mjcf_forge::compiled::ModelCache::new(scene, 8, Some(VALIDATE_CACHE_BYTES))
                             .compiling_in(dir);
                     std::sync::Mutex::new(cache)
                 })

@@ -32,10 +32,10 @@ pub fn check_variant(
 }
 
 /// [`check_variant`] on a model already compiled (or patched by a
-/// [`crate::mujoco::ModelCache`]) for variant `index`.
+/// [`crate::compiled::ModelCache`]) for variant `index`.
 ///
 /// ```
-/// use mjcf_forge::mujoco::ModelCache;
+/// use mjcf_forge::compiled::ModelCache;
 /// let scene = mjcf_forge::scene::Scene::demo()?;
 /// let mut cache = ModelCache::new(&scene, 4, None);
 /// let params = scene.variant(2)?.params;

@@ -17,19 +17,30 @@ pub fn python() -> PathBuf {
     JUDGES[0].python()
 }
 
-/// The Python whose MuJoCo is the one this test build links: 4.0.0's venv with the feature
-/// `mujoco-c` (its default library), else 3.17.0's.
+/// The Python whose MuJoCo is the version this test build links (see [`linked_judge`]).
+#[cfg(mjcf_mujoco)]
 pub fn python_linked() -> PathBuf {
     linked_judge().python()
 }
 
-/// The judge of the MuJoCo version this test build links (see [`python_linked`]).
+/// The judge of the MuJoCo version this test build links: build.rs names it in
+/// `MJCF_FORGE_MUJOCO_VERSION`, so a build against 4.0.0 (`MJCF_FORGE_MUJOCO_DIR`) is judged
+/// by 4.0.0's venv. A version no judge has fails here rather than being judged by another.
+#[cfg(mjcf_mujoco)]
 pub fn linked_judge() -> &'static Judge {
-    if cfg!(feature = "mujoco-c") {
-        &JUDGES[1]
-    } else {
-        &JUDGES[0]
-    }
+    let linked = env!("MJCF_FORGE_MUJOCO_VERSION");
+    JUDGES
+        .iter()
+        .find(|j| j.version == linked)
+        .unwrap_or_else(|| {
+            let known: Vec<&str> = JUDGES.iter().map(|j| j.version).collect();
+            panic!(
+                "this test build links MuJoCo {linked}, and no judge has that version (the \
+                 judges, from scripts/setup.sh: {}): build against one of them \
+                 (MJCF_FORGE_MUJOCO_DIR or MJCF_FORGE_PYTHON)",
+                known.join(", ")
+            )
+        })
 }
 
 /// One MuJoCo version that judges outputs: its venv (made by scripts/setup.sh) and the list

@@ -1,7 +1,7 @@
-// The MuJoCo side of patching a compiled model (src/model_cache.rs), for both cargo
-// features that link MuJoCo (`mujoco`: the 3.17.0 wheel's headers; `mujoco-c`: the chosen
-// MuJoCo's). Compiled against that MuJoCo's own headers, so mjModel's and mjData's layouts
-// are never copied into Rust: arrays are found by name through MuJoCo's X-macro table.
+// The MuJoCo side of patching a compiled model (src/compiled/cache.rs). Compiled by build.rs
+// against the linked MuJoCo's own headers, as the FFI's shim is, so mjModel's and mjData's
+// layouts are never copied into Rust: arrays are found by name through MuJoCo's X-macro
+// table.
 #include <math.h>
 #include <stddef.h>
 #include <string.h>
@@ -47,8 +47,6 @@ int mjf_patch_name2id(const mjModel* m, const char* kind, const char* name) {
 mjData* mjf_patch_make_data(const mjModel* m) { return mj_makeData(m); }
 
 void mjf_patch_delete_data(mjData* d) { mj_deleteData(d); }
-
-mjModel* mjf_patch_copy_model(const mjModel* m) { return mj_copyModel(NULL, m); }
 
 // Bytes of a model's buffer and, when given, a data's buffer and arena.
 long long mjf_patch_nbytes(const mjModel* m, const mjData* d) {

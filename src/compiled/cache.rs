@@ -5,40 +5,39 @@
 //! of 3.17 and 4.0 leaves): exactly the model MuJoCo compiles from the variant's XML
 //! (`tests/model_cache.rs` compares every array bit for bit).
 //!
-//! The C side (`src/mujoco_patch.c`) is compiled against the linked MuJoCo's headers, as
-//! the rest of this module's FFI is; arrays are found by name through MuJoCo's X-macro
-//! table, so no Rust copy of `mjModel`'s layout is needed.
+//! The C side (`patch.c`) is compiled against the linked MuJoCo's headers, as the FFI's
+//! shim is; arrays are found by name through MuJoCo's X-macro table, so no Rust copy of
+//! `mjModel`'s layout is needed. Models come from the FFI ([`crate::mujoco`]), which hands
+//! over the raw model, its serial number and the writable pointer through `pub(crate)` items.
 
 use std::collections::HashMap;
 use std::ffi::{CString, c_char, c_int, c_void};
 use std::ptr::NonNull;
-use std::sync::atomic::{AtomicU64, Ordering};
 
-use super::{CompileError, CompiledModel, ObjType, Sizes, compile_str, sys};
+use crate::mujoco::{CompileError, CompiledModel, MjModel, ObjType, Sizes, compile_str};
 use crate::scene::{PatchEntry, PatchValue, Scene, Superset, VariantPatch};
 
 /// mjData, opaque here: only the C side reads it.
 #[repr(C)]
-pub(super) struct RawData {
+struct RawData {
     _private: [u8; 0],
 }
 
 unsafe extern "C" {
     fn mjf_patch_array(
-        m: *mut sys::Model,
+        m: *mut MjModel,
         name: *const c_char,
         elem: *mut usize,
         count: *mut usize,
     ) -> *mut c_void;
-    fn mjf_patch_name2id(m: *const sys::Model, kind: *const c_char, name: *const c_char) -> c_int;
-    fn mjf_patch_make_data(m: *const sys::Model) -> *mut RawData;
+    fn mjf_patch_name2id(m: *const MjModel, kind: *const c_char, name: *const c_char) -> c_int;
+    fn mjf_patch_make_data(m: *const MjModel) -> *mut RawData;
     fn mjf_patch_delete_data(d: *mut RawData);
-    pub(super) fn mjf_patch_copy_model(m: *const sys::Model) -> *mut sys::Model;
-    fn mjf_patch_nbytes(m: *const sys::Model, d: *const RawData) -> i64;
-    fn mjf_patch_get_stat(m: *const sys::Model, out: *mut f64);
-    fn mjf_patch_finish(m: *mut sys::Model, d: *mut RawData, fixed: c_int, values: *const f64);
+    fn mjf_patch_nbytes(m: *const MjModel, d: *const RawData) -> i64;
+    fn mjf_patch_get_stat(m: *const MjModel, out: *mut f64);
+    fn mjf_patch_finish(m: *mut MjModel, d: *mut RawData, fixed: c_int, values: *const f64);
     fn mjf_patch_array_name(i: c_int) -> *const c_char;
-    fn mjf_patch_meaninertia(m: *mut sys::Model, d: *const RawData, keep: *const c_int, n: c_int);
+    fn mjf_patch_meaninertia(m: *mut MjModel, d: *const RawData, keep: *const c_int, n: c_int);
 }
 
 impl CompiledModel {
@@ -67,10 +66,12 @@ impl CompiledModel {
             }
             let bytes = |m: &CompiledModel| -> &[u8] {
                 let (mut elem, mut count) = (0usize, 0usize);
+                // The C side hands back a writable pointer; nothing is written through it here.
+                let raw = std::ptr::from_ref(m.raw()).cast_mut();
                 // SAFETY: the model is live (only read here); `name` is NUL-terminated.
-                let p = unsafe { mjf_patch_array(m.ptr.as_ptr(), name, &mut elem, &mut count) };
+                let p = unsafe { mjf_patch_array(raw, name, &mut elem, &mut count) };
                 // SAFETY: `elem * count` bytes at `p` belong to the live model.
-                unsafe { super::slice_or_empty(p.cast::<u8>().cast_const(), elem * count) }
+                unsafe { crate::mujoco::slice_or_empty(p.cast::<u8>().cast_const(), elem * count) }
             };
             let (a, b) = (bytes(self), bytes(other));
             if a != b {
@@ -104,13 +105,6 @@ impl CompiledModel {
         }
         out
     }
-}
-
-/// Serial numbers of compiled models: a plan made for one model is never used for another.
-static SERIAL: AtomicU64 = AtomicU64::new(1);
-
-pub(super) fn next_serial() -> u64 {
-    SERIAL.fetch_add(1, Ordering::Relaxed)
 }
 
 /// Scratch mjData for `mj_setConst` (which overwrites the qpos of the data it is given).
@@ -184,7 +178,7 @@ impl Signature {
 /// bounded in count and bytes (models and their scratch data), least recently used out.
 ///
 /// ```no_run
-/// use mjcf_forge::mujoco::ModelCache;
+/// use mjcf_forge::compiled::ModelCache;
 /// use mjcf_forge::scene::Scene;
 ///
 /// let scene = Scene::demo().unwrap();
@@ -350,7 +344,7 @@ impl<'s> ModelCache<'s> {
     pub fn apply(&mut self, index: u64, model: &mut CompiledModel) -> Result<(), String> {
         let patch = self.patch_of(index)?;
         let key = patch.structure_key;
-        let known = self.state.plans.iter().find(|p| p.serial == model.serial);
+        let known = self.state.plans.iter().find(|p| p.serial == model.serial());
         match known {
             Some(p) if p.key != key => {
                 return Err(format!(
@@ -424,10 +418,10 @@ impl State {
                 || self.max_bytes.is_some_and(|b| self.nbytes() > b))
         {
             let (_, gone) = entries.remove(0);
-            self.plans.retain(|p| p.serial != gone.serial);
+            self.plans.retain(|p| p.serial != gone.serial());
         }
         // Plans of callers' models: as many as cached models are allowed.
-        let cached: Vec<u64> = entries.iter().map(|(_, m)| m.serial).collect();
+        let cached: Vec<u64> = entries.iter().map(|(_, m)| m.serial()).collect();
         let mut extra = self
             .plans
             .iter()
@@ -445,14 +439,14 @@ impl State {
 
     /// The index of `model`'s plan, made on first sight.
     fn plan_of(&mut self, model: &CompiledModel, key: &str) -> Result<usize, String> {
-        if let Some(at) = self.plans.iter().position(|p| p.serial == model.serial) {
+        if let Some(at) = self.plans.iter().position(|p| p.serial == model.serial()) {
             return Ok(at);
         }
         let scratch = Scratch::new(model)?;
         // SAFETY: model and data are live.
         let nbytes = unsafe { mjf_patch_nbytes(model.raw(), scratch.0.as_ptr()) };
         self.plans.push(Plan {
-            serial: model.serial,
+            serial: model.serial(),
             key: key.to_string(),
             scratch,
             fields: Vec::new(),
@@ -482,7 +476,7 @@ impl State {
                 .map(|e| (e.object, e.name.clone(), e.id, e.field))
                 .collect();
         }
-        let ptr = model.ptr.as_ptr();
+        let ptr = model.as_mut_ptr();
         for (t, e) in plan.targets.iter().zip(entries) {
             write(ptr, t, &e.value)?;
         }
@@ -527,14 +521,14 @@ fn patch_variant(
         sup.kept_dofs.insert(roots.clone(), keep);
     }
     let keep = &sup.kept_dofs[&roots];
-    let Some(plan) = state.plans.iter().find(|p| p.serial == model.serial) else {
+    let Some(plan) = state.plans.iter().find(|p| p.serial == model.serial()) else {
         return Ok(());
     };
     // SAFETY: live model and its scratch data (left at qpos0 by the statistics); `keep`
     // holds valid dof indices of this structure.
     unsafe {
         mjf_patch_meaninertia(
-            model.ptr.as_ptr(),
+            model.as_mut_ptr(),
             plan.scratch.0.as_ptr(),
             keep.as_ptr(),
             keep.len() as c_int,
@@ -552,7 +546,7 @@ fn kept_dofs(model: &mut CompiledModel, parked: &[String]) -> Result<Vec<c_int>,
         let c = CString::new(name).map_err(|e| e.to_string())?;
         let (mut elem, mut count) = (0usize, 0usize);
         // SAFETY: live model; NUL-terminated name.
-        let p = unsafe { mjf_patch_array(model.ptr.as_ptr(), c.as_ptr(), &mut elem, &mut count) };
+        let p = unsafe { mjf_patch_array(model.as_mut_ptr(), c.as_ptr(), &mut elem, &mut count) };
         if elem != 4 || p.is_null() {
             return Err(format!("this MuJoCo's mjModel has no int array {name}"));
         }
@@ -566,7 +560,7 @@ fn kept_dofs(model: &mut CompiledModel, parked: &[String]) -> Result<Vec<c_int>,
         let kind = CString::new("body").map_err(|e| e.to_string())?;
         let name = CString::new(root.as_str()).map_err(|e| e.to_string())?;
         // SAFETY: live model; NUL-terminated strings.
-        let id = unsafe { mjf_patch_name2id(model.ptr.as_ptr(), kind.as_ptr(), name.as_ptr()) };
+        let id = unsafe { mjf_patch_name2id(model.as_mut_ptr(), kind.as_ptr(), name.as_ptr()) };
         let id = usize::try_from(id).map_err(|_| format!("the superset has no body '{root}'"))?;
         out_of[id] = true;
     }
@@ -588,7 +582,7 @@ fn kept_dofs(model: &mut CompiledModel, parked: &[String]) -> Result<Vec<c_int>,
 }
 
 /// Writes one entry's value at its target.
-fn write(model: *mut sys::Model, t: &Target, value: &PatchValue) -> Result<(), String> {
+fn write(model: *mut MjModel, t: &Target, value: &PatchValue) -> Result<(), String> {
     match value {
         PatchValue::Id { object, name } => {
             let kind = CString::new(*object).map_err(|e| e.to_string())?;
@@ -621,7 +615,7 @@ fn write(model: *mut sys::Model, t: &Target, value: &PatchValue) -> Result<(), S
 
 /// Where every entry lands in `model`.
 fn resolve(model: &mut CompiledModel, entries: &[PatchEntry]) -> Result<Vec<Target>, String> {
-    let ptr = model.ptr.as_ptr();
+    let ptr = model.as_mut_ptr();
     let array = |name: &str| -> Result<(*mut u8, usize, usize), String> {
         let c = CString::new(name).map_err(|e| e.to_string())?;
         let (mut elem, mut count) = (0usize, 0usize);

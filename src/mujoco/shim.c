@@ -1,16 +1,24 @@
-// The few MuJoCo entry points that src/mujoco.rs needs, for the cargo feature `mujoco-4`.
+// The MuJoCo side of the FFI (src/mujoco/sys.rs declares these functions).
 //
-// Compiled by build.rs against the headers of the MuJoCo that the build links (the 4.0.0
-// wheel's `mujoco/include`), so the layout of mjModel, mjData and mjVFS comes from those
-// headers, never from a Rust copy of them. Fields are looked up by name through MuJoCo's own
-// X-macro tables (mjxmacro.h: MJMODEL_SIZES, MJMODEL_POINTERS), which MuJoCo keeps in step
-// with mjModel; Rust names the fields it reads and checks the element size it expects.
+// Compiled by build.rs against the headers of the MuJoCo that the build links, whichever
+// version from 3.17.0 on, so the layouts of mjModel, mjData and mjVFS and MuJoCo's constants
+// come from those headers, never from a Rust copy of them. Fields are looked up by name
+// through MuJoCo's own X-macro tables (mjxmacro.h: MJMODEL_SIZES, MJMODEL_POINTERS), which
+// MuJoCo keeps in step with mjModel; Rust names the fields it reads and checks the element
+// size it expects.
 #include <stdlib.h>
 #include <string.h>
 
 #include <mujoco/mujoco.h>
 
 int mjf_header_version(void) { return mjVERSION_HEADER; }
+
+int mjf_ngain(void) { return mjNGAIN; }
+
+int mjf_nbias(void) { return mjNBIAS; }
+
+// A deep copy into a new model (mj_copyModel allocates it), or NULL.
+mjModel* mjf_copy_model(const mjModel* m) { return mj_copyModel(NULL, m); }
 
 // A size field of mjModel (MJMODEL_SIZES); -1 when `name` is not one.
 long long mjf_model_size(const mjModel* m, const char* name) {

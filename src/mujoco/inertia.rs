@@ -1,0 +1,251 @@
+//! Inertias as MuJoCo compiles them, written back into a document: what lets the merge (in
+//! the model tier, which calls these) join a part whose compiler settings for masses and
+//! inertias differ from the base's, and place a free body exactly where MuJoCo does.
+
+use crate::document::tree::Node;
+use crate::document::{Document, Section};
+
+use super::compile::{CompileError, compile_str};
+use super::model::ObjType;
+
+/// Writes an explicit `<inertial>` (mass, pos, quat, diaginertia, at full precision, as
+/// MuJoCo compiles `doc` alone) into every body that infers its inertia from its geoms, so
+/// that the document compiles to the same masses and inertias whatever the compiler's
+/// `inertiagrouprange`: what lets [`Document::merge`](crate::Document::merge) take a part
+/// whose range differs from the base's. Returns how many bodies got one.
+///
+/// Refuses documents whose compiled bodies are not their `<body>` elements one to one
+/// (`<replicate>`, `<attach>`, `<composite>`, `<flexcomp>`, `fusestatic`), and documents
+/// with `inertiafromgeom="true"` (which ignores `<inertial>`).
+///
+/// ```
+/// use mjcf_forge::Document;
+/// use mjcf_forge::mujoco::write_inertials;
+///
+/// let mut doc = Document::from_str(r#"<mujoco><compiler inertiagrouprange="1 5"/><worldbody>
+///   <body name="b"><freejoint/><geom size="0.1" group="1"/><geom size="0.5" group="0"/></body>
+///   </worldbody></mujoco>"#, ".")?;
+/// assert_eq!(write_inertials(&mut doc)?, 1);
+/// assert!(doc.to_xml_string().contains("<inertial "));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn write_inertials(doc: &mut Document) -> Result<usize, CompileError> {
+    write_inertials_of(doc, false)
+}
+
+/// Like [`write_inertials`], but for every body whose compiled mass or inertia is not zero or
+/// that has geoms or an `<inertial>` of its own (which is replaced): afterwards the compiler's
+/// mass settings (`settotalmass`, `boundmass`, `boundinertia`, `balanceinertia`,
+/// `inertiafromgeom="false"`) have nothing left to change when left at MuJoCo's defaults, so
+/// a part authored with them merges exactly into a base without them.
+///
+/// ```
+/// use mjcf_forge::Document;
+/// use mjcf_forge::mujoco::write_all_inertials;
+///
+/// let mut doc = Document::from_str(r#"<mujoco><compiler settotalmass="3"/><worldbody>
+///   <body name="b"><freejoint/><geom size="0.1"/></body></worldbody></mujoco>"#, ".")?;
+/// assert_eq!(write_all_inertials(&mut doc)?, 1);
+/// assert!(doc.to_xml_string().contains(r#"mass="3.0""#));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn write_all_inertials(doc: &mut Document) -> Result<usize, CompileError> {
+    write_inertials_of(doc, true)
+}
+
+/// `qpos0` of the free joint `joint` of `doc` (7 numbers) as MuJoCo compiles `doc` alone:
+/// for a free body MuJoCo aligns with its inertial frame, the only exact source. Joints
+/// are matched to `doc`'s joint elements in document order, which must be one to one.
+pub(crate) fn free_joint_qpos0(doc: &Document, joint: Node) -> Result<[f64; 7], CompileError> {
+    let joints: Vec<Node> = doc
+        .find_section(Section::Worldbody)
+        .map(|w| {
+            doc.descendants(w)
+                .filter(|&n| matches!(doc.tag(n), "joint" | "freejoint"))
+                .collect()
+        })
+        .unwrap_or_default();
+    let model = compile_str(&doc.to_xml_string(), doc.model_dir())?;
+    let types = model.jnt_type();
+    if types.len() != joints.len() {
+        return Err(CompileError::local(format!(
+            "MuJoCo compiled {} joints from {} joint elements",
+            types.len(),
+            joints.len()
+        )));
+    }
+    let k = joints
+        .iter()
+        .position(|&n| n == joint)
+        .ok_or_else(|| CompileError::local("not a joint of the model's bodies".to_string()))?;
+    if types[k] != 0 {
+        return Err(CompileError::local("not a free joint".to_string()));
+    }
+    // qpos widths by joint type: free 7, ball 4, slide and hinge 1.
+    let at: usize = types[..k]
+        .iter()
+        .map(|&t| match t {
+            0 => 7,
+            1 => 4,
+            _ => 1,
+        })
+        .sum();
+    let mut q = [0.0; 7];
+    q.copy_from_slice(&model.qpos0()[at..at + 7]);
+    Ok(q)
+}
+
+/// For a document with `compiler inertiafromgeom="true"`: every body's compiled inertia
+/// written out as by [`write_all_inertials`] (compiled under "true", whatever the body's
+/// `<inertial>` says), then the setting made `"auto"`, under which every written `<inertial>`
+/// counts: the same masses and inertias, and no mass setting left with anything to change.
+pub(crate) fn write_all_inertials_from_geoms(doc: &mut Document) -> Result<usize, CompileError> {
+    let n = write_inertials_checked(doc, true, false)?;
+    let compilers: Vec<Node> = doc
+        .elements(doc.root())
+        .filter(|&c| doc.tag(c) == "compiler" && doc.attr(c, "inertiafromgeom").is_some())
+        .collect();
+    for c in compilers {
+        doc.set_attr(c, "inertiafromgeom", "auto");
+    }
+    Ok(n)
+}
+
+fn write_inertials_of(doc: &mut Document, all: bool) -> Result<usize, CompileError> {
+    write_inertials_checked(doc, all, true)
+}
+
+/// `from_geoms_refused`: refuse inertiafromgeom="true", under which the written inertials
+/// would be ignored (callers that then make the setting "auto" pass false).
+fn write_inertials_checked(
+    doc: &mut Document,
+    all: bool,
+    from_geoms_refused: bool,
+) -> Result<usize, CompileError> {
+    let refused = ["replicate", "attach", "composite", "flexcomp"];
+    if let Some(n) = doc
+        .descendants(doc.root())
+        .find(|&n| refused.contains(&doc.tag(n)))
+    {
+        return Err(CompileError::local(format!(
+            "{}: <{}> makes bodies when MuJoCo compiles; explicit inertials are written for \
+             plain <body> elements only",
+            doc.location(n),
+            doc.tag(n)
+        )));
+    }
+    for c in doc
+        .elements(doc.root())
+        .filter(|&c| doc.tag(c) == "compiler")
+    {
+        let setting = |k: &str, bad: &str| doc.attr(c, k).is_some_and(|v| v.trim() == bad);
+        if (from_geoms_refused && setting("inertiafromgeom", "true"))
+            || setting("fusestatic", "true")
+        {
+            return Err(CompileError::local(format!(
+                "{}: compiler inertiafromgeom=\"true\" or fusestatic=\"true\": explicit \
+                 inertials would not carry the compiled inertia",
+                doc.location(c)
+            )));
+        }
+    }
+    let inferring = bodies_inferring_inertia(doc);
+    if inferring.is_empty() && !all {
+        return Ok(0);
+    }
+    let model = compile_str(&doc.to_xml_string(), doc.model_dir())?;
+    // MuJoCo numbers bodies depth first in document order, the world body first.
+    let bodies: Vec<Node> = doc
+        .descendants(doc.root())
+        .filter(|&n| doc.tag(n) == "body")
+        .collect();
+    let names = model.names(ObjType::Body);
+    if names.len() != bodies.len() + 1 {
+        return Err(CompileError::local(format!(
+            "MuJoCo compiled {} bodies from {} <body> elements",
+            names.len() - 1,
+            bodies.len()
+        )));
+    }
+    for (i, &b) in bodies.iter().enumerate() {
+        if doc.attr(b, "name").is_some_and(|n| n != names[i + 1]) {
+            return Err(CompileError::local(format!(
+                "{}: body {:?} compiled as {:?}: bodies do not match one to one",
+                doc.location(b),
+                doc.attr(b, "name").unwrap_or(""),
+                names[i + 1]
+            )));
+        }
+    }
+    let (mass, ipos, iquat, inertia) = (
+        model.body_mass(),
+        model.body_ipos(),
+        model.body_iquat(),
+        model.body_inertia(),
+    );
+    let list = |v: &[f64]| {
+        v.iter()
+            .map(|x| format!("{x:?}"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let own_inertial = |doc: &Document, b| doc.elements(b).find(|&c| doc.tag(c) == "inertial");
+    let targets: Vec<Node> = if all {
+        bodies
+            .iter()
+            .enumerate()
+            .filter(|&(i, &b)| {
+                let id = i + 1;
+                let nonzero =
+                    mass[id] != 0.0 || inertia[3 * id..3 * id + 3].iter().any(|&x| x != 0.0);
+                nonzero || inferring.contains(&b) || own_inertial(doc, b).is_some()
+            })
+            .map(|(_, &b)| b)
+            .collect()
+    } else {
+        inferring
+    };
+    for &b in &targets {
+        if let Some(old) = own_inertial(doc, b) {
+            doc.remove(old);
+        }
+        let id = 1 + bodies
+            .iter()
+            .position(|&n| n == b)
+            .expect("a body of the document");
+        let attrs = [
+            ("pos", list(&ipos[3 * id..3 * id + 3])),
+            ("quat", list(&iquat[4 * id..4 * id + 4])),
+            ("mass", list(&mass[id..id + 1])),
+            ("diaginertia", list(&inertia[3 * id..3 * id + 3])),
+        ];
+        let attrs: Vec<(&str, &str)> = attrs.iter().map(|(k, v)| (*k, v.as_str())).collect();
+        doc.append_element(b, "inertial", &attrs);
+    }
+    Ok(targets.len())
+}
+
+/// The bodies whose mass and inertia MuJoCo infers from their geoms (under
+/// `inertiafromgeom="auto"`): those without an `<inertial>` that have a geom, directly or in
+/// a `<frame>` (or `<replicate>`) inside them.
+///
+/// The same rule as the merge's `Document::bodies_inferring_inertia`, kept here because this
+/// tier may not use the model tier above it.
+fn bodies_inferring_inertia(doc: &Document) -> Vec<Node> {
+    let has_geom = |body: Node| {
+        let mut stack: Vec<Node> = doc.elements(body).collect();
+        while let Some(n) = stack.pop() {
+            match doc.tag(n) {
+                "geom" => return true,
+                "frame" | "replicate" => stack.extend(doc.elements(n)),
+                _ => {}
+            }
+        }
+        false
+    };
+    doc.descendants(doc.root())
+        .filter(|&n| doc.tag(n) == "body")
+        .filter(|&b| !doc.elements(b).any(|c| doc.tag(c) == "inertial"))
+        .filter(|&b| has_geom(b))
+        .collect()
+}
