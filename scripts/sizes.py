@@ -21,7 +21,7 @@ from __future__ import annotations
 import json
 import sys
 
-# Same order as the Rust `Sizes` (src/mujoco.rs): the required nine first.
+# Same order as the Rust `Sizes` (src/mujoco/model.rs): the required nine first.
 KEYS = [
     "nbody", "njnt", "ngeom", "nsite", "nu", "nsensor", "nq", "nv", "nmesh",
     "na", "nactuator", "ncam", "nlight", "ntex", "nmat", "ntendon", "nwrap", "neq",

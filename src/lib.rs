@@ -40,6 +40,8 @@
 #![warn(missing_docs)]
 
 // The tiers (see the table above); each `mod.rs` says what its tier may use.
+#[cfg(mjcf_mujoco)]
+pub mod compiled;
 #[cfg(doctest)]
 mod doc_pages;
 mod document;
@@ -51,10 +53,6 @@ mod model;
 pub mod mujoco;
 pub mod output;
 pub mod scene;
-
-// Above both the scene tier and the FFI: compiled variants.
-#[cfg(mjcf_mujoco)]
-pub mod compiled;
 
 pub use document::limits::Limits;
 pub use document::tree::Node;

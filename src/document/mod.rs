@@ -9,7 +9,8 @@
 //! - the MJCF vocabulary: [`vocab`] (generated from MuJoCo's schema) and its index
 //!   [`schema`] (which attributes declare names and which refer to them);
 //! - editing and checking: [`prefix`] (renaming every name and reference), [`validate`]
-//!   (duplicate names, dangling references);
+//!   (duplicate names, dangling references), [`relocate`](mod@relocate) (file references
+//!   to content-named assets), [`inertia`] (which bodies take their inertia from geoms);
 //! - writing: [`write`](mod@write) (compact and pretty XML; files through `output`);
 //! - [`limits`]: the input limits every reader honours.
 //!
@@ -17,6 +18,7 @@
 //! MuJoCo, scenes or the faces above.
 
 pub(crate) mod defaults;
+pub(crate) mod inertia;
 pub(crate) mod limits;
 pub(crate) mod load;
 pub(crate) mod names;

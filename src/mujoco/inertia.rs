@@ -149,7 +149,7 @@ fn write_inertials_checked(
             )));
         }
     }
-    let inferring = bodies_inferring_inertia(doc);
+    let inferring = doc.bodies_inferring_inertia();
     if inferring.is_empty() && !all {
         return Ok(0);
     }
@@ -223,29 +223,4 @@ fn write_inertials_checked(
         doc.append_element(b, "inertial", &attrs);
     }
     Ok(targets.len())
-}
-
-/// The bodies whose mass and inertia MuJoCo infers from their geoms (under
-/// `inertiafromgeom="auto"`): those without an `<inertial>` that have a geom, directly or in
-/// a `<frame>` (or `<replicate>`) inside them.
-///
-/// The same rule as the merge's `Document::bodies_inferring_inertia`, kept here because this
-/// tier may not use the model tier above it.
-fn bodies_inferring_inertia(doc: &Document) -> Vec<Node> {
-    let has_geom = |body: Node| {
-        let mut stack: Vec<Node> = doc.elements(body).collect();
-        while let Some(n) = stack.pop() {
-            match doc.tag(n) {
-                "geom" => return true,
-                "frame" | "replicate" => stack.extend(doc.elements(n)),
-                _ => {}
-            }
-        }
-        false
-    };
-    doc.descendants(doc.root())
-        .filter(|&n| doc.tag(n) == "body")
-        .filter(|&b| !doc.elements(b).any(|c| doc.tag(c) == "inertial"))
-        .filter(|&b| has_geom(b))
-        .collect()
 }

@@ -16,7 +16,8 @@
 //!   rewrites of the part that stand in for the others, and why the rest cannot be converted;
 //! - [`angles`]: angle units and Euler sequences (the part converted, or the base when it is
 //!   the smaller);
-//! - [`inertia`]: where a body's mass and inertia come from, what the inertia settings act on;
+//! - where a body's mass and inertia come from (its `<inertial>` or its geoms) is the
+//!   document tier's rule (`document/inertia.rs`), shared with the MuJoCo FFI;
 //! - [`free_joints`]: free joints, and which free bodies MuJoCo aligns with their inertial
 //!   frames;
 //! - [`assets`]: the part's assets the base already has, shared rather than copied;
@@ -35,7 +36,6 @@ mod compiler;
 mod defaults;
 mod free_joints;
 mod import;
-mod inertia;
 mod keys;
 mod layout;
 mod settings;

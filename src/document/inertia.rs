@@ -10,7 +10,7 @@ impl Document {
     /// without `mass`). Under inertiafromgeom="true" such a body takes its inertia from its
     /// geoms; a body without one keeps its `<inertial>` (MuJoCo 3.17.0 and 4.0.0: a body with
     /// no geom, only geoms of other groups, or only massless ones).
-    pub(super) fn has_massive_geom_in_range(&self, body: Node, range: &str) -> bool {
+    pub(crate) fn has_massive_geom_in_range(&self, body: Node, range: &str) -> bool {
         let bounds: Vec<i64> = range
             .split_ascii_whitespace()
             .filter_map(|t| t.parse().ok())
