@@ -10,6 +10,10 @@
 //!   [`schema`] (which attributes declare names and which refer to them);
 //! - editing and checking: [`prefix`] (renaming every name and reference), [`validate`]
 //!   (duplicate names, dangling references);
+//! - editing as ElementTree code does: [`edit`] (elements moved, taken out, cleared,
+//!   copied between documents or into one of their own), [`text`] (text and tail),
+//!   [`import`] (nodes copied between arenas, and the [`NodeMap`](import::NodeMap) of where
+//!   they went);
 //! - writing: [`write`](mod@write) (compact and pretty XML; files through `output`);
 //! - [`limits`]: the input limits every reader honours.
 //!
@@ -17,6 +21,8 @@
 //! MuJoCo, scenes or the faces above.
 
 pub(crate) mod defaults;
+pub(crate) mod edit;
+pub(crate) mod import;
 pub(crate) mod limits;
 pub(crate) mod load;
 pub(crate) mod names;
@@ -26,6 +32,7 @@ pub(crate) mod read;
 mod relocate;
 pub(crate) mod schema;
 pub(crate) mod skin;
+pub(crate) mod text;
 pub(crate) mod tree;
 pub(crate) mod validate;
 pub mod vocab;

@@ -22,7 +22,6 @@
 //! - [`assets`]: the part's assets the base already has, shared rather than copied;
 //! - [`defaults`]: the part's residual default classes;
 //! - [`settings`]: `option`, `size`, `visual` and `statistic`, the base's winning;
-//! - [`import`]: the part's nodes copied into the base's arena;
 //! - [`layout`]: what fills the state vectors a keyframe gives, and where;
 //! - [`keys`]: keyframes remapped onto the merged model, and fused by name.
 //!
@@ -34,18 +33,17 @@ mod assets;
 mod compiler;
 mod defaults;
 mod free_joints;
-mod import;
 mod inertia;
 mod keys;
 mod layout;
 mod settings;
 
+use crate::document::import::Import;
 use crate::document::names::Sym;
 use crate::document::tree::Node;
 use crate::document::{Document, Section};
 use crate::error::{Error, ErrorKind, Errors};
 
-use import::Import;
 use keys::{implicit_keys, keys_of};
 use layout::Layout;
 
@@ -301,13 +299,13 @@ impl Document {
                         if *shared {
                             report.shared_assets += 1;
                         } else {
-                            self.import(part, a, dest, imp);
+                            self.import(part, a, Some(dest), imp);
                         }
                     }
                 }
                 "worldbody" => {
                     for child in part.elements(section).collect::<Vec<_>>() {
-                        self.import(part, child, target, imp);
+                        self.import(part, child, Some(target), imp);
                     }
                 }
                 "keyframe" => {}
@@ -316,12 +314,12 @@ impl Document {
                         Some(s) => self.section(s),
                         None => {
                             let root = self.root;
-                            self.import(part, section, root, imp);
+                            self.import(part, section, Some(root), imp);
                             continue;
                         }
                     };
                     for child in part.elements(section).collect::<Vec<_>>() {
-                        self.import(part, child, dest, imp);
+                        self.import(part, child, Some(dest), imp);
                     }
                 }
             }
