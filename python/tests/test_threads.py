@@ -29,7 +29,7 @@ def test_threads_sharing_one_scene_get_what_one_thread_gets():
 
 def test_threads_sharing_one_document_read_and_edit_safely():
     doc = Document.load(PANDA)
-    bodies = [b.name for b in doc.find_all("body") if b.name]
+    bodies = [b.name for b in doc.find_all_named("body") if b.name]
     original = doc.to_xml()
     errors = []
 
@@ -38,9 +38,9 @@ def test_threads_sharing_one_document_read_and_edit_safely():
             for _ in range(30):
                 text = doc.to_xml()
                 assert text.startswith("<mujoco")
-                el = doc.find("body", bodies[k])
+                el = doc.find_named("body", bodies[k])
                 el.set("user", [k])  # each thread edits its own body
-                assert doc.find("body", bodies[k])["user"] == str(k)
+                assert doc.find_named("body", bodies[k])["user"] == str(k)
                 doc.copy()
         except Exception as e:  # noqa: BLE001 - reported below
             errors.append(e)
@@ -51,7 +51,7 @@ def test_threads_sharing_one_document_read_and_edit_safely():
     for t in threads:
         t.join()
     assert not errors, errors
-    assert all(doc.find("body", bodies[k])["user"] == str(k) for k in range(8))
+    assert all(doc.find_named("body", bodies[k])["user"] == str(k) for k in range(8))
     assert doc.to_xml() != original
 
 
