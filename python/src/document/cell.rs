@@ -195,11 +195,25 @@ impl DocCell {
             .and_then(|o| o.cast_into::<PyElement>().ok())
     }
 
-    /// Records `proxy` as the proxy of `node`.
-    fn register(&self, py: Python<'_>, node: Node, proxy: &Bound<'_, PyElement>) -> PyResult<()> {
-        let weak = PyWeakrefReference::new(proxy)?.unbind();
+    /// Records `proxy` as the proxy of `node`, unless another one got there first (making
+    /// a Python object may run other threads' code): then that one is the proxy.
+    fn register<'py>(
+        &self,
+        py: Python<'py>,
+        node: Node,
+        proxy: Bound<'py, PyElement>,
+    ) -> PyResult<Bound<'py, PyElement>> {
+        let weak = PyWeakrefReference::new(&proxy)?.unbind();
         let serial = proxy.get().serial();
         let mut reg = self.registry(py);
+        if let Some(first) = reg
+            .proxies
+            .get(&node)
+            .and_then(|e| e.proxy.bind(py).upgrade())
+        {
+            drop(reg);
+            return Ok(first.cast_into::<PyElement>()?);
+        }
         let old = reg.proxies.insert(
             node,
             Entry {
@@ -207,15 +221,14 @@ impl DocCell {
                 serial,
             },
         );
-        let sweep = reg.proxies.len() > reg.sweep_at;
-        if sweep {
+        if reg.proxies.len() > reg.sweep_at {
             reg.proxies
                 .retain(|_, e| e.proxy.bind(py).upgrade().is_some());
             reg.sweep_at = (2 * reg.proxies.len()).max(1024);
         }
         drop(reg);
         drop(old);
-        Ok(())
+        Ok(proxy)
     }
 
     /// Forgets the entry of `node` if it is the proxy `serial`'s. Called while a proxy is
@@ -243,17 +256,38 @@ pub(crate) fn proxy<'py>(
         return Ok(p);
     }
     let p = Bound::new(py, PyElement::at(cell.clone(), node))?;
-    cell.register(py, node, &p)?;
-    Ok(p)
+    cell.register(py, node, p)
 }
 
-/// Proxies of several nodes, in order.
+/// Proxies of several nodes, in order: the live ones found under one lock, the others made
+/// (what `findall` and iteration return, so the common path).
 pub(crate) fn proxies<'py>(
     py: Python<'py>,
     cell: &Arc<DocCell>,
     nodes: impl IntoIterator<Item = Node>,
 ) -> PyResult<Vec<Bound<'py, PyElement>>> {
-    nodes.into_iter().map(|n| proxy(py, cell, n)).collect()
+    let nodes: Vec<Node> = nodes.into_iter().collect();
+    let found: Vec<Option<Bound<'py, PyAny>>> = {
+        let reg = cell.registry(py);
+        // Upgrading makes a strong reference, which frees nothing: safe under the lock.
+        nodes
+            .iter()
+            .map(|n| reg.proxies.get(n).and_then(|e| e.proxy.bind(py).upgrade()))
+            .collect()
+    };
+    nodes
+        .into_iter()
+        .zip(found)
+        .map(
+            |(n, f)| match f.and_then(|o| o.cast_into::<PyElement>().ok()) {
+                Some(p) => Ok(p),
+                None => {
+                    let p = Bound::new(py, PyElement::at(cell.clone(), n))?;
+                    cell.register(py, n, p)
+                }
+            },
+        )
+        .collect()
 }
 
 /// Points the live proxies of `from`'s nodes that `map` copied into `to` at their copies.
