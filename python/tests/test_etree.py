@@ -114,6 +114,16 @@ def test_element_path_selects_what_xml_etree_selects(both, path):
     tree = ET.ElementTree(theirs)
     if not path.startswith(".."):
         assert shape(ours.findall(path)) == shape(tree.findall(path))
+        assert shape(ours.iterfind(path)) == shape(tree.iterfind(path))
+        assert ours.findtext(path) == tree.findtext(path)
+
+
+def test_absolute_paths_from_a_document_warn_as_element_tree_does(both):
+    ours, theirs = both
+    with pytest.warns(FutureWarning):
+        expected = shape(ET.ElementTree(theirs).findall("/worldbody"))
+    with pytest.warns(FutureWarning):
+        assert shape(ours.findall("/worldbody")) == expected
 
 
 def test_paths_from_inner_elements_and_iter(both):

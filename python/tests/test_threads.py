@@ -55,6 +55,34 @@ def test_threads_sharing_one_document_read_and_edit_safely():
     assert doc.to_xml() != original
 
 
+def test_threads_moving_elements_between_two_documents_in_both_directions_finish():
+    # Copying between documents locks both; threads copying A->B and B->A at once must not
+    # each hold one lock and wait for the other. Handles are shared between the threads.
+    a, b = Document.load(PANDA), Document.load(PANDA)
+    errors = []
+
+    def work(k):
+        try:
+            src, dst = (a, b) if k % 2 else (b, a)
+            for i in range(40):
+                el = src.find(".//body[@name='link3']")
+                dst.worldbody.append(el)  # copied in; the handle follows the copy
+                assert el.parent is dst.worldbody
+                dst.worldbody.remove(el)
+                src.worldbody[0].set("user", [k, i])
+                dst.findall(".//geom")
+        except Exception as e:  # noqa: BLE001 - reported below
+            errors.append(e)
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in range(6)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(timeout=120)
+    assert not any(t.is_alive() for t in threads), "deadlock"
+    assert not errors, errors
+
+
 def _longest_pause_while(call) -> tuple[float, float]:
     """Runs `call` in a thread; returns (its duration, the longest gap between two ticks
     of this thread meanwhile). With the GIL held for the whole call, the gap is the call."""
