@@ -54,6 +54,7 @@ pub mod mujoco;
 pub mod output;
 pub mod scene;
 
+pub use document::import::NodeMap;
 pub use document::limits::Limits;
 pub use document::tree::Node;
 pub use document::vocab;

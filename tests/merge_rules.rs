@@ -205,3 +205,47 @@ fn mass_settings_of_the_base_are_never_converted() {
         "corpora/errors/merge/part_settotalmass.xml:2:3: cannot merge: compiler settotalmass=\"2\" differs from the base's \"5\" and has no exact conversion: the base's own setting would also change the part's masses and inertias"
     );
 }
+
+#[test]
+fn merge_maps_tell_where_each_part_node_went() {
+    use mjcf_forge::MergePart;
+    let mut base = Document::from_str(
+        r#"<mujoco><asset><texture name="t" type="2d" builtin="checker" width="8" height="8"/></asset>
+           <worldbody><body name="b"><joint name="bj"/><geom size="1"/></body></worldbody>
+           <keyframe><key name="home" qpos="0.5"/></keyframe></mujoco>"#,
+        ".",
+    )
+    .unwrap();
+    let part = Document::from_str(
+        r#"<mujoco><compiler angle="radian"/>
+           <asset><texture name="t" type="2d" builtin="checker" width="8" height="8"/></asset>
+           <worldbody><body name="p"><joint name="pj"/><geom size="1"/></body></worldbody>
+           <keyframe><key name="p_home" qpos="0.25"/></keyframe></mujoco>"#,
+        ".",
+    )
+    .unwrap();
+    let of = |doc: &Document, tag: &str| {
+        doc.descendants(doc.root())
+            .filter(|&n| doc.tag(n) == tag)
+            .collect::<Vec<_>>()
+    };
+    let (base_body, base_texture) = (base.find_body("b").unwrap(), of(&base, "texture")[0]);
+    let (part_body, part_joint) = (part.find_body("p").unwrap(), of(&part, "joint")[0]);
+    let parts = [MergePart {
+        doc: &part,
+        into: None,
+        prefix: "p_",
+    }];
+    let (_, maps) = base.merge_all_mapped(&parts, true).unwrap();
+    let map = &maps[0];
+    // Copied nodes map to their copies; the shared asset to the base's own.
+    assert_eq!(map.get(part_body), base.find_body("p"));
+    assert_eq!(base.attr(map.get(part_joint).unwrap(), "name"), Some("pj"));
+    assert_eq!(map.get(of(&part, "texture")[0]), Some(base_texture));
+    // What a merge folds in is not copied: the part's compiler and keys.
+    assert_eq!(map.get(of(&part, "compiler")[0]), None);
+    assert_eq!(map.get(of(&part, "key")[0]), None);
+    // The base's handles are still its elements (the merge worked on a copy).
+    assert_eq!(base.attr(base_body, "name"), Some("b"));
+    assert_eq!(base.find_body("b"), Some(base_body));
+}

@@ -96,16 +96,16 @@ def build_lift_with_models() -> tuple[str, dict[str, Model]]:
     world = Document.load(ASSETS / "arenas" / "table_arena.xml")
     # robosuite's set_base_xpos: the robot base behind the table.
     robot_doc = robot.document
-    robot_doc.find("body", robot.root_body).set("pos", [-0.56, 0, 0.912])
+    robot_doc.find_named("body", robot.root_body).set("pos", [-0.56, 0, 0.912])
     world.merge(robot_doc)
     objects = {}
     # The table's top surface, in the world: the table body's position plus its site's.
-    table, top_site = world.find("body", "table"), world.find("site", "table_top")
+    table, top_site = world.find_named("body", "table"), world.find_named("site", "table_top")
     table_top = float(table["pos"].split()[2]) + float(top_site["pos"].split()[2])
     for i, name in enumerate(["can", "milk", "bread", "cereal", "lemon"]):
         obj = Model(ASSETS / "objects" / f"{name}.xml", f"object{i}")
         doc = obj.document
-        root = doc.worldbody.children()[0]
+        root = doc.worldbody[0]
         # Rest on the table by the object's own bottom offset (robosuite's placement rule),
         # free to move, as robosuite's objects are.
         root.set("pos", [-0.2 + 0.1 * i, 0.0, table_top - obj.bottom_offset[2]])

@@ -1,7 +1,9 @@
 """mjcf_forge: MuJoCo MJCF models loaded exactly as MuJoCo reads them, in Rust.
 
 - :class:`Document`: a model with its includes expanded, default classes inlined and
-  asset paths absolute; prefix, merge, validate, edit elements, write.
+  asset paths absolute; prefix, merge, validate, write; its :class:`Element` s behave as
+  ``xml.etree.ElementTree`` elements (ElementPath, live ``attrib``, ``append``, ...), and
+  :mod:`mjcf_forge.etree` mirrors ``xml.etree.ElementTree``'s functions over them.
 - :class:`Model`: one instance of a model with its own name prefix and robosuite's
   vocabulary (``bodies``, ``joints``, ``contact_geoms``, ``bottom_offset``, ...).
 - :class:`Scene`: a randomized scene description; ``scene.variant(i)`` is variant ``i``
@@ -13,6 +15,7 @@
 """
 
 from ._mjcf_forge import (
+    Attrib,
     Document,
     Element,
     MergeReport,
@@ -25,8 +28,10 @@ from ._mjcf_forge import (
     __version__,
 )
 from ._cache import ModelCache
+from . import etree
 
 __all__ = [
+    "Attrib",
     "Document",
     "Element",
     "MergeReport",

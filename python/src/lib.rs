@@ -4,7 +4,8 @@
 //! released (see `errors::run`), and turns `Errors` and panics into `MjcfError`. The
 //! library crate knows nothing of Python.
 //!
-//! The files mirror the library's tiers: `document.rs` (the document tier), `model.rs`
+//! The files mirror the library's tiers: `document/` (the document tier, with elements that
+//! behave as `xml.etree` elements), `model.rs`
 //! (instances), `scene/` (the batch tier: scenes, variants, the stream, the superset);
 //! `errors.rs` is the edge where Rust errors and panics become `MjcfError`. The compiled
 //! tier's face, `ModelCache`, is Python (`mjcf_forge/_cache.py`), over the user's own
@@ -47,6 +48,12 @@ fn _mjcf_forge(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MjcfError", m.py().get_type::<errors::MjcfError>())?;
     m.add_class::<document::PyDocument>()?;
     m.add_class::<document::PyElement>()?;
+    m.add_class::<document::PyAttrib>()?;
+    // `attrib` is a mapping to isinstance() and to code that checks for one.
+    m.py()
+        .import("collections.abc")?
+        .getattr("MutableMapping")?
+        .call_method1("register", (m.py().get_type::<document::PyAttrib>(),))?;
     m.add_class::<document::PyMergeReport>()?;
     m.add_class::<model::PyModel>()?;
     m.add_class::<scene::PyScene>()?;

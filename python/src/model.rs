@@ -7,9 +7,10 @@ use std::sync::{Arc, RwLock};
 use mjcf_forge::{Document, MujocoModel, XmlModel, XmlModelOptions};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
+use pyo3::sync::RwLockExt;
 use pyo3::types::{PyDict, PyList, PyString};
 
-use crate::document::PyDocument;
+use crate::document::{DocCell, PyDocument, retarget};
 use crate::errors::{Failure, read, run, write};
 
 /// One instance of an MJCF model, with every name prefixed and its parts sorted by role:
@@ -36,6 +37,33 @@ use crate::errors::{Failure, read, run, write};
 #[pyclass(name = "Model", module = "mjcf_forge", frozen)]
 pub(crate) struct PyModel {
     model: Arc<RwLock<XmlModel>>,
+    /// The model's document as a `Document` shares it: one cell, so that its elements keep
+    /// one proxy each however often `document` is asked for.
+    cell: Arc<DocCell>,
+}
+
+impl PyModel {
+    /// The model, read with the GIL held (waiting without it, see `document::cell`).
+    fn lock(&self, py: Python<'_>) -> std::sync::RwLockReadGuard<'_, XmlModel> {
+        self.model
+            .read_py_attached(py)
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
+    /// The model, changed with the GIL held.
+    fn lock_mut(&self, py: Python<'_>) -> std::sync::RwLockWriteGuard<'_, XmlModel> {
+        self.model
+            .write_py_attached(py)
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
+    fn with(model: XmlModel) -> PyModel {
+        let model = Arc::new(RwLock::new(model));
+        PyModel {
+            cell: DocCell::of_model(model.clone()),
+            model,
+        }
+    }
 }
 
 /// The geometry-derived numbers, raising instead of returning NaN.
@@ -92,7 +120,7 @@ impl PyModel {
             Path(PathBuf),
         }
         let source = if let Ok(doc) = source.cast::<PyDocument>() {
-            Source::Doc(Box::new(doc.get().snapshot()))
+            Source::Doc(Box::new(doc.get().snapshot(source.py())))
         } else {
             Source::Path(source.extract::<PathBuf>().map_err(|_| {
                 PyTypeError::new_err("Model(source, ...): source is a Document or a path")
@@ -111,88 +139,86 @@ impl PyModel {
             };
             Ok(XmlModel::with_prefix(doc, &prefix, options)?)
         })?;
-        Ok(PyModel {
-            model: Arc::new(RwLock::new(model)),
-        })
+        Ok(PyModel::with(model))
     }
 
     /// The model's name: ``name=`` if given, else the ``model`` attribute, else the root
     /// body's name.
     #[getter]
-    fn name(&self) -> String {
-        read(&self.model).name().to_owned()
+    fn name(&self, py: Python<'_>) -> String {
+        self.lock(py).name().to_owned()
     }
 
     /// The prefix every name of this instance carries (``"robot0_"``).
     #[getter]
-    fn naming_prefix(&self) -> String {
-        read(&self.model).naming_prefix().to_owned()
+    fn naming_prefix(&self, py: Python<'_>) -> String {
+        self.lock(py).naming_prefix().to_owned()
     }
 
     /// The one top-level body (prefixed name).
     #[getter]
-    fn root_body(&self) -> String {
-        read(&self.model).root_body().to_owned()
+    fn root_body(&self, py: Python<'_>) -> String {
+        self.lock(py).root_body().to_owned()
     }
 
     /// Every named body, the root first.
     #[getter]
-    fn bodies(&self) -> Vec<String> {
-        read(&self.model).bodies().to_vec()
+    fn bodies(&self, py: Python<'_>) -> Vec<String> {
+        self.lock(py).bodies().to_vec()
     }
 
     /// Every named joint (free joints included).
     #[getter]
-    fn joints(&self) -> Vec<String> {
-        read(&self.model).joints().to_vec()
+    fn joints(&self, py: Python<'_>) -> Vec<String> {
+        self.lock(py).joints().to_vec()
     }
 
     /// Every named actuator.
     #[getter]
-    fn actuators(&self) -> Vec<String> {
-        read(&self.model).actuators().to_vec()
+    fn actuators(&self, py: Python<'_>) -> Vec<String> {
+        self.lock(py).actuators().to_vec()
     }
 
     /// Every named site of the kinematic tree.
     #[getter]
-    fn sites(&self) -> Vec<String> {
-        read(&self.model).sites().to_vec()
+    fn sites(&self, py: Python<'_>) -> Vec<String> {
+        self.lock(py).sites().to_vec()
     }
 
     /// Every named sensor.
     #[getter]
-    fn sensors(&self) -> Vec<String> {
-        read(&self.model).sensors().to_vec()
+    fn sensors(&self, py: Python<'_>) -> Vec<String> {
+        self.lock(py).sensors().to_vec()
     }
 
     /// Collision geoms: group 0 (MuJoCo's default group).
     #[getter]
-    fn contact_geoms(&self) -> Vec<String> {
-        read(&self.model).contact_geoms().to_vec()
+    fn contact_geoms(&self, py: Python<'_>) -> Vec<String> {
+        self.lock(py).contact_geoms().to_vec()
     }
 
     /// Visual geoms: group 1.
     #[getter]
-    fn visual_geoms(&self) -> Vec<String> {
-        read(&self.model).visual_geoms().to_vec()
+    fn visual_geoms(&self, py: Python<'_>) -> Vec<String> {
+        self.lock(py).visual_geoms().to_vec()
     }
 
     /// Geoms that matter to a task, by role (set with :meth:`set_important`).
     #[getter]
-    fn important_geoms(&self) -> BTreeMap<String, Vec<String>> {
-        read(&self.model).important_geoms().clone()
+    fn important_geoms(&self, py: Python<'_>) -> BTreeMap<String, Vec<String>> {
+        self.lock(py).important_geoms().clone()
     }
 
     /// Sites that matter to a task, by role.
     #[getter]
-    fn important_sites(&self) -> BTreeMap<String, String> {
-        read(&self.model).important_sites().clone()
+    fn important_sites(&self, py: Python<'_>) -> BTreeMap<String, String> {
+        self.lock(py).important_sites().clone()
     }
 
     /// Sensors that matter to a task, by role.
     #[getter]
-    fn important_sensors(&self) -> BTreeMap<String, String> {
-        read(&self.model).important_sensors().clone()
+    fn important_sensors(&self, py: Python<'_>) -> BTreeMap<String, String> {
+        self.lock(py).important_sensors().clone()
     }
 
     /// Sets the important geoms, sites and sensors by role, with raw (unprefixed) names,
@@ -200,11 +226,12 @@ impl PyModel {
     #[pyo3(signature = (*, geoms = None, sites = None, sensors = None))]
     fn set_important(
         &self,
+        py: Python<'_>,
         geoms: Option<BTreeMap<String, Vec<String>>>,
         sites: Option<BTreeMap<String, String>>,
         sensors: Option<BTreeMap<String, String>>,
     ) {
-        let mut model = write(&self.model);
+        let mut model = self.lock_mut(py);
         if let Some(g) = geoms {
             model.set_important_geoms(g);
         }
@@ -250,12 +277,13 @@ impl PyModel {
     #[pyo3(signature = (*, bottom = None, top = None, base = None, horizontal_radius = None))]
     fn set_offsets(
         &self,
+        py: Python<'_>,
         bottom: Option<[f64; 3]>,
         top: Option<[f64; 3]>,
         base: Option<[f64; 3]>,
         horizontal_radius: Option<f64>,
     ) {
-        let mut model = write(&self.model);
+        let mut model = self.lock_mut(py);
         if let Some(v) = bottom {
             model.set_bottom_offset(v);
         }
@@ -277,7 +305,7 @@ impl PyModel {
         py: Python<'py>,
         names: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let model = read(&self.model);
+        let model = self.lock(py);
         if let Ok(s) = names.cast::<PyString>() {
             return Ok(PyString::new(py, &model.correct_naming(&s.to_cow()?)).into_any());
         }
@@ -305,37 +333,44 @@ impl PyModel {
         body: Option<String>,
         fuse_keys: bool,
     ) -> PyResult<crate::document::PyMergeReport> {
-        let others: Vec<XmlModel> = if let Ok(m) = other.cast::<PyModel>() {
-            vec![read(&m.get().model).clone()]
+        let others: Vec<Bound<'_, PyModel>> = if let Ok(m) = other.cast::<PyModel>() {
+            vec![m.clone()]
         } else {
             let list: Vec<Bound<'_, PyAny>> = other.extract().map_err(|_| {
                 PyTypeError::new_err("merge(other, ...): other is a Model or a list of Models")
             })?;
-            list.iter()
+            list.into_iter()
                 .map(|m| {
-                    m.cast::<PyModel>()
-                        .map(|m| read(&m.get().model).clone())
+                    m.cast_into::<PyModel>()
                         .map_err(|_| PyTypeError::new_err("merge: every part must be a Model"))
                 })
                 .collect::<PyResult<_>>()?
         };
-        run(py, || {
+        let copies: Vec<XmlModel> = others.iter().map(|m| m.get().lock(py).clone()).collect();
+        let (report, maps) = run(py, || {
             let mut model = write(&self.model);
             let mut merged = model.clone();
             let parts: Vec<(&XmlModel, Option<&str>)> =
-                others.iter().map(|m| (m, body.as_deref())).collect();
-            let report = merged.merge_all(&parts, fuse_keys)?;
+                copies.iter().map(|m| (m, body.as_deref())).collect();
+            let out = merged.merge_all_mapped(&parts, fuse_keys)?;
             *model = merged;
-            Ok(report)
-        })
-        .map(Into::into)
+            Ok(out)
+        })?;
+        // Elements of the parts in hand now stand for their copies in this model.
+        for (part, map) in others.iter().zip(&maps) {
+            retarget(py, &part.get().cell, &self.cell, map);
+        }
+        Ok(report.into())
     }
 
-    /// A copy of the instance's document (names prefixed): a :class:`Document`, so
-    /// changes to it do not reach the model.
+    /// The instance's own document (names prefixed), live: changes made through it (its
+    /// elements' attributes, appended or removed elements) are the model's, and what
+    /// :meth:`to_xml` writes. The name lists and offsets are read from it on first use.
     #[getter]
-    fn document(&self, py: Python<'_>) -> PyResult<PyDocument> {
-        run(py, || Ok(read(&self.model).document().clone())).map(PyDocument::new)
+    fn document(&self) -> PyDocument {
+        PyDocument {
+            doc: self.cell.clone(),
+        }
     }
 
     /// The instance as XML text (see :meth:`Document.to_xml`); robosuite calls this
@@ -358,8 +393,8 @@ impl PyModel {
         run(py, || Ok(read(&self.model).info_json()))
     }
 
-    fn __repr__(&self) -> String {
-        let model = read(&self.model);
+    fn __repr__(&self, py: Python<'_>) -> String {
+        let model = self.lock(py);
         format!(
             "<mjcf_forge.Model name={:?} prefix={:?} root_body={:?}>",
             model.name(),

@@ -90,24 +90,24 @@ def test_defaults_are_inlined_into_elements():
         '</default></default><worldbody><body name="b"><joint name="j"/>'
         '<geom name="g" class="c" size="0.1"/></body></worldbody></mujoco>'
     )
-    assert doc.find("joint", "j")["damping"] == "2"
-    assert doc.find("geom", "g").get("rgba") == "1 0 0 1"
-    assert doc.find("default") is None
+    assert doc.find_named("joint", "j")["damping"] == "2"
+    assert doc.find_named("geom", "g").get("rgba") == "1 0 0 1"
+    assert doc.find_named("default") is None
 
 
 def test_element_access_reads_and_sets_attributes():
     doc = Document.load(PANDA)
-    hand = doc.find("body", "right_hand")
+    hand = doc.find_named("body", "right_hand")
     assert hand is not None and hand.tag == "body" and hand.name == "right_hand"
     assert hand.parent.tag == "body"
-    assert doc.find("body", "no_such_body") is None
-    assert [b.name for b in doc.find_all("body")][:2] == ["base", "link0"]
-    joints = doc.worldbody.find_all("joint")
+    assert doc.find_named("body", "no_such_body") is None
+    assert [b.name for b in doc.find_all_named("body")][:2] == ["base", "link0"]
+    joints = doc.worldbody.find_all_named("joint")
     assert [j.name for j in joints] == [f"joint{i}" for i in range(1, 8)]
     assert all(isinstance(j, mjcf_forge.Element) for j in doc.root.iter("joint"))
-    assert len(doc.root.iter()) == len(doc.find_all())
+    assert len(list(doc.root.iter())) == len(doc.find_all_named())
 
-    link1 = doc.find("body", "link1")
+    link1 = doc.find_named("body", "link1")
     link1.set("pos", [0, 0, 0.5])
     link1["quat"] = np.array([1.0, 0.0, 0.0, 0.0])
     link1.set("mocap", False)
@@ -120,7 +120,7 @@ def test_element_access_reads_and_sets_attributes():
     with pytest.raises(TypeError):
         link1.set("pos", {"x": 1})
     assert link1.location.startswith(f"{PANDA}:")
-    assert link1 == doc.find("body", "link1") and len({link1, doc.find("body", "link1")}) == 1
+    assert link1 is doc.find_named("body", "link1") and len({link1, doc.find_named("body", "link1")}) == 1
 
     # The edit is in the document, and MuJoCo sees it.
     m = mujoco.MjModel.from_xml_string(doc.to_xml())
@@ -132,7 +132,7 @@ def test_element_access_reads_and_sets_attributes():
     m = mujoco.MjModel.from_xml_string(doc.to_xml())
     assert np.allclose(m.site("tip").size[0], 0.01)
     site.remove()
-    assert doc.find("site", "tip") is None
+    assert doc.find_named("site", "tip") is None
     with pytest.raises(MjcfError):
         doc.section("nonsense")
     assert doc.section("sensor").tag == "sensor"
@@ -167,8 +167,8 @@ def test_copy_and_pickle_are_independent_and_equal():
     doc = Document.load(PANDA)
     for other in (doc.copy(), copy.copy(doc), copy.deepcopy(doc), pickle.loads(pickle.dumps(doc))):
         assert other.to_xml() == doc.to_xml()
-        other.find("body", "link1").set("pos", "1 2 3")
-        assert doc.find("body", "link1")["pos"] != "1 2 3"
+        other.find_named("body", "link1").set("pos", "1 2 3")
+        assert doc.find_named("body", "link1")["pos"] != "1 2 3"
 
 
 def test_write_is_atomic_and_reports_failures(tmp_path):
@@ -254,7 +254,7 @@ def test_prefix_and_merge_equal_the_command_lines_bytes(forge_cli, tmp_path):
 
 def test_names_and_text_xml_cannot_carry_are_refused():
     doc = Document.from_string('<mujoco><worldbody><body name="b"/></worldbody></mujoco>')
-    body = doc.find("body", "b")
+    body = doc.find_named("body", "b")
     before = doc.to_xml()
     for bad in [
         lambda: body.set("a b", 1),
@@ -270,4 +270,4 @@ def test_names_and_text_xml_cannot_carry_are_refused():
         assert "XML" in str(err.value) and len(err.value.errors) == 1
     assert doc.to_xml() == before
     body.set("user", "tab\tand\nnewline")  # allowed in XML, escaped when written
-    assert Document.from_string(doc.to_xml()).find("body", "b")["user"] == "tab\tand\nnewline"
+    assert Document.from_string(doc.to_xml()).find_named("body", "b")["user"] == "tab\tand\nnewline"

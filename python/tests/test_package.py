@@ -10,7 +10,7 @@ from pathlib import Path
 import mjcf_forge
 
 STUB = Path(mjcf_forge.__file__).with_name("_mjcf_forge.pyi")
-PUBLIC_CLASSES = ["Document", "Element", "MergeReport", "Model", "Scene", "Variant", "VariantIterator"]
+PUBLIC_CLASSES = ["Attrib", "Document", "Element", "MergeReport", "Model", "Scene", "Variant", "VariantIterator"]
 
 
 def stub_members() -> dict[str, set[str]]:

@@ -68,7 +68,7 @@ def test_every_variant_compiles_with_its_objects_where_params_say(demo):
         doc = v.document
         for r in v.params["randomized"]:
             if r.get("name"):
-                el = doc.find(r["kind"], r["name"])
+                el = doc.find_named(r["kind"], r["name"])
                 assert el is not None, r
 
 

@@ -29,7 +29,7 @@ def test_threads_sharing_one_scene_get_what_one_thread_gets():
 
 def test_threads_sharing_one_document_read_and_edit_safely():
     doc = Document.load(PANDA)
-    bodies = [b.name for b in doc.find_all("body") if b.name]
+    bodies = [b.name for b in doc.find_all_named("body") if b.name]
     original = doc.to_xml()
     errors = []
 
@@ -38,9 +38,9 @@ def test_threads_sharing_one_document_read_and_edit_safely():
             for _ in range(30):
                 text = doc.to_xml()
                 assert text.startswith("<mujoco")
-                el = doc.find("body", bodies[k])
+                el = doc.find_named("body", bodies[k])
                 el.set("user", [k])  # each thread edits its own body
-                assert doc.find("body", bodies[k])["user"] == str(k)
+                assert doc.find_named("body", bodies[k])["user"] == str(k)
                 doc.copy()
         except Exception as e:  # noqa: BLE001 - reported below
             errors.append(e)
@@ -51,8 +51,36 @@ def test_threads_sharing_one_document_read_and_edit_safely():
     for t in threads:
         t.join()
     assert not errors, errors
-    assert all(doc.find("body", bodies[k])["user"] == str(k) for k in range(8))
+    assert all(doc.find_named("body", bodies[k])["user"] == str(k) for k in range(8))
     assert doc.to_xml() != original
+
+
+def test_threads_moving_elements_between_two_documents_in_both_directions_finish():
+    # Copying between documents locks both; threads copying A->B and B->A at once must not
+    # each hold one lock and wait for the other. Handles are shared between the threads.
+    a, b = Document.load(PANDA), Document.load(PANDA)
+    errors = []
+
+    def work(k):
+        try:
+            src, dst = (a, b) if k % 2 else (b, a)
+            for i in range(40):
+                el = src.find(".//body[@name='link3']")
+                dst.worldbody.append(el)  # copied in; the handle follows the copy
+                assert el.parent is dst.worldbody
+                dst.worldbody.remove(el)
+                src.worldbody[0].set("user", [k, i])
+                dst.findall(".//geom")
+        except Exception as e:  # noqa: BLE001 - reported below
+            errors.append(e)
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in range(6)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(timeout=120)
+    assert not any(t.is_alive() for t in threads), "deadlock"
+    assert not errors, errors
 
 
 def _longest_pause_while(call) -> tuple[float, float]:

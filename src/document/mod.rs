@@ -11,6 +11,10 @@
 //! - editing and checking: [`prefix`] (renaming every name and reference), [`validate`]
 //!   (duplicate names, dangling references), [`relocate`](mod@relocate) (file references
 //!   to content-named assets), [`inertia`] (which bodies take their inertia from geoms);
+//! - editing as ElementTree code does: [`edit`] (elements moved, taken out, cleared,
+//!   copied between documents or into one of their own), [`text`] (text and tail),
+//!   [`import`] (nodes copied between arenas, and the [`NodeMap`](import::NodeMap) of where
+//!   they went);
 //! - writing: [`write`](mod@write) (compact and pretty XML; files through `output`);
 //! - [`limits`]: the input limits every reader honours.
 //!
@@ -18,6 +22,8 @@
 //! MuJoCo, scenes or the faces above.
 
 pub(crate) mod defaults;
+pub(crate) mod edit;
+pub(crate) mod import;
 pub(crate) mod inertia;
 pub(crate) mod limits;
 pub(crate) mod load;
@@ -28,6 +34,7 @@ pub(crate) mod read;
 mod relocate;
 pub(crate) mod schema;
 pub(crate) mod skin;
+pub(crate) mod text;
 pub(crate) mod tree;
 pub(crate) mod validate;
 pub mod vocab;

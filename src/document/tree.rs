@@ -103,6 +103,14 @@ impl Tree {
         sibling.0.insert_before(new.0, &mut self.arena);
     }
 
+    pub(crate) fn insert_after(&mut self, sibling: Node, new: Node) {
+        sibling.0.insert_after(new.0, &mut self.arena);
+    }
+
+    pub(crate) fn prepend(&mut self, parent: Node, child: Node) {
+        parent.0.prepend(child.0, &mut self.arena);
+    }
+
     pub(crate) fn detach(&mut self, node: Node) {
         node.0.detach(&mut self.arena);
     }
@@ -125,6 +133,11 @@ impl Tree {
     #[inline]
     pub(crate) fn next_sibling(&self, node: Node) -> Option<Node> {
         self.arena[node.0].next_sibling().map(Node)
+    }
+
+    #[inline]
+    pub(crate) fn previous_sibling(&self, node: Node) -> Option<Node> {
+        self.arena[node.0].previous_sibling().map(Node)
     }
 
     pub(crate) fn children(&self, node: Node) -> impl Iterator<Item = Node> + '_ {

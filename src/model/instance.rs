@@ -4,6 +4,7 @@
 use std::collections::BTreeMap;
 use std::sync::OnceLock;
 
+use crate::document::import::NodeMap;
 use crate::document::names::{Sym, sym};
 use crate::document::tree::Node;
 use crate::document::vocab::Ns;
@@ -454,6 +455,26 @@ impl XmlModel {
         others: &[(&XmlModel, Option<&str>)],
         fuse_keys: bool,
     ) -> Result<MergeReport, Errors> {
+        self.merge_with(others, fuse_keys, false)
+            .map(|(report, _)| report)
+    }
+
+    /// [`XmlModel::merge_all`], also telling where each other model's nodes went (see
+    /// [`Document::merge_all_mapped`]).
+    pub fn merge_all_mapped(
+        &mut self,
+        others: &[(&XmlModel, Option<&str>)],
+        fuse_keys: bool,
+    ) -> Result<(MergeReport, Vec<NodeMap>), Errors> {
+        self.merge_with(others, fuse_keys, true)
+    }
+
+    fn merge_with(
+        &mut self,
+        others: &[(&XmlModel, Option<&str>)],
+        fuse_keys: bool,
+        keep_maps: bool,
+    ) -> Result<(MergeReport, Vec<NodeMap>), Errors> {
         let parts: Vec<crate::model::merge::MergePart<'_>> = others
             .iter()
             .map(|(m, into)| crate::model::merge::MergePart {
@@ -462,11 +483,11 @@ impl XmlModel {
                 prefix: &m.prefix,
             })
             .collect();
-        let report = self.doc.merge_all(&parts, fuse_keys)?;
+        let out = self.doc.merge_checked(&parts, fuse_keys, keep_maps)?;
         // The model's extent and lists changed with the merge.
         self.offsets = OnceLock::new();
         self.lists = OnceLock::new();
-        Ok(report)
+        Ok(out)
     }
 }
 

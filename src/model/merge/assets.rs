@@ -26,6 +26,18 @@ impl Document {
     /// For each asset of the part, in order: whether the base already has it (same tag,
     /// name and content); an asset with a base name but other content is an error naming both.
     pub(crate) fn asset_decisions(&self, part: &Document, errors: &mut Vec<Error>) -> Vec<bool> {
+        self.asset_matches(part, errors)
+            .iter()
+            .map(Option::is_some)
+            .collect()
+    }
+
+    /// [`Document::asset_decisions`], with this document's asset each shared one matches.
+    pub(crate) fn asset_matches(
+        &self,
+        part: &Document,
+        errors: &mut Vec<Error>,
+    ) -> Vec<Option<Node>> {
         let Some(theirs) = part.find_section(Section::Asset) else {
             return Vec::new();
         };
@@ -57,8 +69,8 @@ impl Document {
         mine.iter()
             .zip(same)
             .map(|(&a, found)| match found {
-                None => false,
-                Some(n) if self.same_subtree(n, part, a) => true,
+                None => None,
+                Some(n) if self.same_subtree(n, part, a) => Some(n),
                 Some(n) => {
                     let tag = part.tag(a);
                     let name = part.asset_name(a).unwrap_or_default();
@@ -69,7 +81,7 @@ impl Document {
                             self.location(n)
                         )),
                     ));
-                    false
+                    None
                 }
             })
             .collect()

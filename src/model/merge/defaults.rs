@@ -2,8 +2,8 @@
 //! MJCF has no attribute for them on the element itself): carried over, a class of the same
 //! name having to mean the same in base and part.
 
-use super::import::Import;
 use crate::document::Document;
+use crate::document::import::Import;
 use crate::document::tree::Node;
 use crate::error::{Error, ErrorKind};
 
@@ -65,7 +65,7 @@ impl Document {
             {
                 continue;
             }
-            self.import(part, class, dest, &mut imp);
+            self.import(part, class, Some(dest), &mut imp);
         }
     }
 }

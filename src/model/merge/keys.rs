@@ -8,6 +8,7 @@ use super::MergeOptions;
 use super::angles::angles_checked;
 use super::fmt_num;
 use super::layout::{Layout, Offsets, actuator_states, joint_widths};
+use crate::document::import::NodeMap;
 use crate::document::tree::{Node, Tree};
 use crate::document::{Document, Section};
 use crate::error::{ErrorKind, Errors};
@@ -185,7 +186,7 @@ impl Document {
         part: &Document,
         part_layout: &Layout,
         part_keys: &[Key],
-        map: &AHashMap<Node, Node>,
+        map: &NodeMap,
         options: &MergeOptions,
     ) -> Result<(), Errors> {
         for (doc, layout) in [(&*self, base_layout), (part, part_layout)] {
@@ -259,7 +260,7 @@ impl Document {
             &part_layout.mocap,
         ] {
             for (j, n) in items.iter().enumerate() {
-                if let Some(&m) = map.get(n) {
+                if let Some(m) = map.get(*n) {
                     from_part.insert(m, j);
                 }
             }

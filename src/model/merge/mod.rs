@@ -23,29 +23,29 @@
 //! - [`assets`]: the part's assets the base already has, shared rather than copied;
 //! - [`defaults`]: the part's residual default classes;
 //! - [`settings`]: `option`, `size`, `visual` and `statistic`, the base's winning;
-//! - [`import`]: the part's nodes copied into the base's arena;
 //! - [`layout`]: what fills the state vectors a keyframe gives, and where;
-//! - [`keys`]: keyframes remapped onto the merged model, and fused by name.
+//! - [`keys`]: keyframes remapped onto the merged model, and fused by name;
+//! - copying a part's nodes into the base's arena is the document tier's
+//!   (`document/import.rs`), which also records where each node went.
 //!
-//! Here: the public types, the entry points ([`Document::merge`], [`Document::merge_all`] and
-//! `merge_unchecked` for the batch tier) and the few helpers several files share.
+//! Here: the public types, the entry points ([`Document::merge`], [`Document::merge_all`],
+//! [`Document::merge_all_mapped`] and `merge_unchecked` for the batch tier) and the few helpers several files share.
 
 mod angles;
 mod assets;
 mod compiler;
 mod defaults;
 mod free_joints;
-mod import;
 mod keys;
 mod layout;
 mod settings;
 
+use crate::document::import::{Import, NodeMap};
 use crate::document::names::Sym;
 use crate::document::tree::Node;
 use crate::document::{Document, Section};
 use crate::error::{Error, ErrorKind, Errors};
 
-use import::Import;
 use keys::{implicit_keys, keys_of};
 use layout::Layout;
 
@@ -135,23 +135,60 @@ impl Document {
         parts: &[MergePart<'_>],
         fuse_keys: bool,
     ) -> Result<MergeReport, Errors> {
+        self.merge_checked(parts, fuse_keys, false)
+            .map(|(report, _)| report)
+    }
+
+    /// [`Document::merge_all`], also telling where each part's nodes went: one [`NodeMap`]
+    /// per part, from the part's nodes to this document's copies of them (what a caller
+    /// holding handles to a part's elements follows). A part's asset that this document
+    /// already had maps to that asset; what a merge folds in rather than copies (a part's
+    /// `<compiler>`, `<option>`, keyframes) is not in the map.
+    ///
+    /// ```
+    /// use mjcf_forge::{Document, MergePart};
+    /// let mut scene = Document::from_str("<mujoco><worldbody/></mujoco>", ".")?;
+    /// let cube = Document::from_str(r#"<mujoco><worldbody><body name="cube"><geom size="1"/></body></worldbody></mujoco>"#, ".")?;
+    /// let body = cube.descendants(cube.root()).find(|&n| cube.tag(n) == "body").unwrap();
+    /// let part = MergePart { doc: &cube, into: None, prefix: "" };
+    /// let (_, maps) = scene.merge_all_mapped(&[part], false)?;
+    /// assert_eq!(maps[0].get(body), scene.find_body("cube"));
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn merge_all_mapped(
+        &mut self,
+        parts: &[MergePart<'_>],
+        fuse_keys: bool,
+    ) -> Result<(MergeReport, Vec<NodeMap>), Errors> {
+        self.merge_checked(parts, fuse_keys, true)
+    }
+
+    /// The merge behind [`Document::merge_all`] and [`Document::merge_all_mapped`]: the
+    /// maps are kept when `keep_maps`.
+    pub(crate) fn merge_checked(
+        &mut self,
+        parts: &[MergePart<'_>],
+        fuse_keys: bool,
+        keep_maps: bool,
+    ) -> Result<(MergeReport, Vec<NodeMap>), Errors> {
         let clashes = self.name_clashes(&parts.iter().map(|p| p.doc).collect::<Vec<_>>());
         if !clashes.is_empty() {
             return Err(Errors(clashes));
         }
         // Every check runs before the document changes, except keyframe remapping: with
         // keys, or with several parts, work on a copy so that a failure changes nothing.
+        // (A copy keeps every node's handle: the maps and the caller's handles stay good.)
         let has_keys = |d: &Document| !keys_of(d).is_empty() || implicit_keys(d) > 0;
         let keys = has_keys(self) || parts.iter().any(|p| has_keys(p.doc));
         // A base smaller than its part may adopt the part's angle unit before the checks
         // (`adopt_angle_unit_if_smaller`): then it too works on a copy (a small one).
         if !keys && parts.len() == 1 && self.node_count() >= parts[0].doc.node_count() {
-            self.merge_unchecked(parts, fuse_keys)
+            self.merge_parts(parts, fuse_keys, keep_maps)
         } else {
             let mut merged = self.clone();
-            let report = merged.merge_unchecked(parts, fuse_keys)?;
+            let out = merged.merge_parts(parts, fuse_keys, keep_maps)?;
             *self = merged;
-            Ok(report)
+            Ok(out)
         }
     }
 
@@ -164,6 +201,16 @@ impl Document {
         parts: &[MergePart<'_>],
         fuse_keys: bool,
     ) -> Result<MergeReport, Errors> {
+        self.merge_parts(parts, fuse_keys, false)
+            .map(|(report, _)| report)
+    }
+
+    fn merge_parts(
+        &mut self,
+        parts: &[MergePart<'_>],
+        fuse_keys: bool,
+        keep_maps: bool,
+    ) -> Result<(MergeReport, Vec<NodeMap>), Errors> {
         // Room for every part at once: reserving per part would reallocate (and copy) the
         // whole scene once per part.
         let nodes: usize = parts.iter().map(|p| p.doc.node_count()).sum();
@@ -174,16 +221,20 @@ impl Document {
             .reserve(parts.iter().map(|p| p.doc.strings.len()).sum());
         self.spans.reserve(nodes);
         let mut report = MergeReport::default();
+        let mut maps = Vec::new();
         for p in parts {
             let options = MergeOptions {
                 fuse_keys,
                 part_prefix: p.prefix.to_string(),
             };
-            let r = self.merge_in_place(p.doc, p.into, &options)?;
+            let (r, map) = self.merge_in_place(p.doc, p.into, &options, keep_maps)?;
             report.warnings.extend(r.warnings);
             report.shared_assets += r.shared_assets;
+            if keep_maps {
+                maps.push(map);
+            }
         }
-        Ok(report)
+        Ok((report, maps))
     }
 
     fn merge_in_place(
@@ -191,7 +242,8 @@ impl Document {
         part: &Document,
         into: Option<&str>,
         options: &MergeOptions,
-    ) -> Result<MergeReport, Errors> {
+        keep_map: bool,
+    ) -> Result<(MergeReport, NodeMap), Errors> {
         let mut report = MergeReport::default();
         let mut errors: Vec<Error> = Vec::new();
         self.adopt_angle_unit_if_smaller(part);
@@ -241,7 +293,7 @@ impl Document {
         };
 
         // Checks before changes: free bodies, assets, residual classes.
-        let assets = self.asset_decisions(part, &mut errors);
+        let assets = self.asset_matches(part, &mut errors);
         if let (Some(into), Some(world)) = (into, part.find_section(Section::Worldbody)) {
             for child in part.elements(world) {
                 if part.has_free_joint(child) {
@@ -284,7 +336,7 @@ impl Document {
         self.strings.reserve(part.strings.len());
         self.spans.reserve(part.node_count());
         let file_offset = self.adopt_files(part);
-        let mut imp = Import::new(file_offset, has_keys);
+        let mut imp = Import::new(file_offset, has_keys || keep_map);
         let top: Vec<Node> = part.elements(part.root).collect();
         for section in top {
             let tag = part.tag(section).to_string();
@@ -298,16 +350,19 @@ impl Document {
                 "asset" => {
                     let dest = self.section(Section::Asset);
                     for (a, shared) in part.elements(section).zip(assets.iter()) {
-                        if *shared {
+                        if let Some(same) = *shared {
                             report.shared_assets += 1;
+                            if let Some(map) = imp.map.as_mut() {
+                                map.insert(a, same);
+                            }
                         } else {
-                            self.import(part, a, dest, imp);
+                            self.import(part, a, Some(dest), imp);
                         }
                     }
                 }
                 "worldbody" => {
                     for child in part.elements(section).collect::<Vec<_>>() {
-                        self.import(part, child, target, imp);
+                        self.import(part, child, Some(target), imp);
                     }
                 }
                 "keyframe" => {}
@@ -316,18 +371,18 @@ impl Document {
                         Some(s) => self.section(s),
                         None => {
                             let root = self.root;
-                            self.import(part, section, root, imp);
+                            self.import(part, section, Some(root), imp);
                             continue;
                         }
                     };
                     for child in part.elements(section).collect::<Vec<_>>() {
-                        self.import(part, child, dest, imp);
+                        self.import(part, child, Some(dest), imp);
                     }
                 }
             }
         }
+        let map = imp.map.take().unwrap_or_default();
         if has_keys {
-            let map = imp.map.take().unwrap_or_default();
             self.remap_keys(
                 &base_layout,
                 &base_keys,
@@ -338,7 +393,7 @@ impl Document {
                 options,
             )?;
         }
-        Ok(report)
+        Ok((report, map))
     }
 
     /// The body named `name` anywhere in the kinematic tree.

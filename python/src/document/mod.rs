@@ -1,0 +1,401 @@
+//! `Document`, `Element` and `Attrib`: the document tier, with elements that behave as
+//! `xml.etree.ElementTree` elements over the arena (see STYLE.md, "ElementTree over a
+//! native tree").
+//!
+//! - `cell.rs`: the shared, lockable document and the registry of one proxy per node;
+//! - `element.rs`: `Element`, the proxy; `children.rs`, `path.rs`, `attrib.rs` its child
+//!   edits, ElementPath and live attribute mapping;
+//! - `values.rs`: attribute values from Python, and the checks of what XML can carry.
+//!
+//! A `Document` is one cell: Python threads may share it, readers run at once, and an
+//! `Element` keeps its document alive by holding the cell. Locks are only held by Rust
+//! code that never waits for the GIL while holding one.
+
+mod attrib;
+mod cell;
+mod children;
+mod element;
+mod path;
+mod values;
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use mjcf_forge::{Document, MergePart, Node, Section};
+use pyo3::exceptions::PyFutureWarning;
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+
+use crate::errors::{Failure, run};
+
+pub(crate) use attrib::PyAttrib;
+pub(crate) use cell::{DocCell, retarget};
+pub(crate) use element::PyElement;
+pub(crate) use values::check_xml_text;
+
+/// A shared, lockable document.
+pub(crate) type SharedDoc = Arc<DocCell>;
+
+/// An MJCF model as MuJoCo reads it: ``<include>`` expanded, default classes inlined
+/// into explicit attributes, asset file paths absolute.
+///
+/// Load one with :meth:`Document.load` or :meth:`Document.from_string`; edit it in place
+/// (:meth:`prefix`, :meth:`merge`, element attributes); write it with :meth:`to_xml` or
+/// :meth:`write`. Safe to share between threads; loading, writing, prefixing, merging and
+/// validating release the GIL.
+///
+/// Example::
+///
+///     doc = Document.load("panda.xml")
+///     doc.prefix("robot0_")
+///     hand = doc.find_named("body", "robot0_right_hand")
+///     hand.attrib["pos"] = "0 0 0.1"
+///     joints = doc.findall(".//joint")
+///     doc.write("out.xml")
+#[pyclass(name = "Document", module = "mjcf_forge", frozen)]
+pub(crate) struct PyDocument {
+    pub(crate) doc: SharedDoc,
+}
+
+impl PyDocument {
+    pub(crate) fn new(doc: Document) -> PyDocument {
+        PyDocument {
+            doc: DocCell::new(doc),
+        }
+    }
+
+    /// A copy of the Rust document (for parts that are merged or wrapped by a model).
+    pub(crate) fn snapshot(&self, py: Python<'_>) -> Document {
+        self.doc.read(py).clone()
+    }
+}
+
+/// What a merge did besides merging.
+#[pyclass(name = "MergeReport", module = "mjcf_forge", frozen, get_all)]
+pub(crate) struct PyMergeReport {
+    /// One line per part setting the base overrode or adjusted (``option``, ``size``,
+    /// ``visual``, ``statistic`` conflicts), each with its position in the part.
+    warnings: Vec<String>,
+    /// How many of the part's assets were already in the base (same tag, name and
+    /// content) and are shared rather than copied.
+    shared_assets: usize,
+}
+
+#[pymethods]
+impl PyMergeReport {
+    fn __repr__(&self) -> String {
+        format!(
+            "MergeReport(warnings={:?}, shared_assets={})",
+            self.warnings, self.shared_assets
+        )
+    }
+}
+
+impl From<mjcf_forge::MergeReport> for PyMergeReport {
+    fn from(report: mjcf_forge::MergeReport) -> PyMergeReport {
+        PyMergeReport {
+            warnings: report.warnings,
+            shared_assets: report.shared_assets,
+        }
+    }
+}
+
+#[pymethods]
+impl PyDocument {
+    /// Loads an MJCF file (``str`` or path-like) as MuJoCo reads it.
+    ///
+    /// Raises :class:`MjcfError` with every problem found (``file:line:col: message``).
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<PyDocument> {
+        run(py, || Ok(Document::load(&path)?)).map(PyDocument::new)
+    }
+
+    /// Reads MJCF text. ``base_dir`` plays the part of the main file's folder: includes
+    /// and asset files are found from there (default: the current folder). Positions in
+    /// errors name ``<string>``.
+    #[staticmethod]
+    #[pyo3(signature = (xml, base_dir = None))]
+    fn from_string(py: Python<'_>, xml: &str, base_dir: Option<PathBuf>) -> PyResult<PyDocument> {
+        let xml = xml.to_owned();
+        let base_dir = base_dir.unwrap_or_else(|| PathBuf::from("."));
+        run(py, move || Ok(Document::from_str(&xml, &base_dir)?)).map(PyDocument::new)
+    }
+
+    /// The document as XML text: compact (no white space between elements) by default,
+    /// indented by two spaces a level with ``pretty=True`` (what :meth:`write` writes and
+    /// what ``mjcf-forge inline`` prints).
+    #[pyo3(signature = (pretty = false))]
+    fn to_xml(&self, py: Python<'_>, pretty: bool) -> PyResult<String> {
+        run(py, || {
+            let doc = self.doc.read_detached();
+            Ok(if pretty {
+                doc.to_pretty_string()
+            } else {
+                doc.to_xml_string()
+            })
+        })
+    }
+
+    /// Writes the indented XML to ``path`` atomically: through a temporary file in the
+    /// same folder and a rename, so a failure never leaves a partial or clobbered file.
+    fn write(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        run(py, || Ok(self.doc.read_detached().write_file(&path)?))
+    }
+
+    /// Prefixes every name in place (bodies, joints, geoms, assets, classes, ...) and every
+    /// reference to it, following MuJoCo's schema; references to ``world`` stay.
+    fn prefix(&self, py: Python<'_>, prefix: &str) -> PyResult<()> {
+        check_xml_text("prefix", prefix)?;
+        let prefix = prefix.to_owned();
+        run(py, || {
+            Ok(self.doc.write_detached().apply_prefix(&prefix)?)
+        })
+    }
+
+    /// Merges ``other`` into this document, in place: its worldbody children into the
+    /// world (``body=None``) or into the body named ``body``, every other section carried
+    /// over (identical assets shared, compiler settings converted where exact).
+    ///
+    /// Handles to the part's elements follow them: afterwards they stand for (read and
+    /// change) their copies in this document, as if the elements had moved; the part
+    /// itself is left as it was.
+    ///
+    /// ``fuse_keys`` makes the part's keyframe ``part_prefix + N`` one with this
+    /// document's key ``N`` (``part_prefix``: the prefix the part's names carry). Returns a :class:`MergeReport`; raises :class:`MjcfError`
+    /// (all name clashes at once, with positions), leaving this document unchanged.
+    #[pyo3(signature = (other, body = None, *, fuse_keys = false, part_prefix = None))]
+    fn merge(
+        &self,
+        py: Python<'_>,
+        other: &PyDocument,
+        body: Option<String>,
+        fuse_keys: bool,
+        part_prefix: Option<String>,
+    ) -> PyResult<PyMergeReport> {
+        let prefix = part_prefix.unwrap_or_default();
+        let from = other.doc.clone();
+        let map = run(py, || {
+            // A copy of the part first: it may be this very document (merging a model with
+            // itself), and two locks on one RwLock would deadlock.
+            let part = from.read_detached().clone();
+            let mut doc = self.doc.write_detached();
+            // Merge into a copy so that a refused merge leaves the document as it was (a
+            // copy keeps every node's handle, so elements of this document stay valid).
+            let mut merged = doc.clone();
+            let parts = [MergePart {
+                doc: &part,
+                into: body.as_deref(),
+                prefix: &prefix,
+            }];
+            let (report, mut maps) = merged.merge_all_mapped(&parts, fuse_keys)?;
+            *doc = merged;
+            Ok((report, maps.pop().unwrap_or_default()))
+        });
+        let (report, map) = map?;
+        // The part's elements in hand now stand for their copies, as if moved.
+        retarget(py, &other.doc, &self.doc, &map);
+        Ok(report.into())
+    }
+
+    /// Checks names: duplicates within a namespace and references to nothing. Raises
+    /// :class:`MjcfError` listing every problem with its position.
+    fn validate(&self, py: Python<'_>) -> PyResult<()> {
+        run(py, || Ok(self.doc.read_detached().validate()?))
+    }
+
+    /// An independent copy (cheap: a few flat buffers).
+    fn copy(&self, py: Python<'_>) -> PyResult<PyDocument> {
+        run(py, || Ok(self.doc.read_detached().clone())).map(PyDocument::new)
+    }
+
+    fn __copy__(&self, py: Python<'_>) -> PyResult<PyDocument> {
+        self.copy(py)
+    }
+
+    fn __deepcopy__(&self, py: Python<'_>, _memo: &Bound<'_, PyAny>) -> PyResult<PyDocument> {
+        self.copy(py)
+    }
+
+    /// Pickling (Ray, multiprocessing) goes through the XML text and the model folder: the
+    /// text is already inlined with absolute paths, so reading it back gives the same model.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let (xml, dir) = run(py, || {
+            let doc = self.doc.read_detached();
+            Ok((doc.to_xml_string(), doc.model_dir().to_path_buf()))
+        })?;
+        let from_string = py.get_type::<PyDocument>().getattr("from_string")?;
+        PyTuple::new(
+            py,
+            [
+                from_string,
+                PyTuple::new(
+                    py,
+                    [
+                        xml.into_pyobject(py)?.into_any(),
+                        dir.into_pyobject(py)?.into_any(),
+                    ],
+                )?
+                .into_any(),
+            ],
+        )
+    }
+
+    /// The ``model`` attribute of ``<mujoco>``, or ``None``.
+    #[getter]
+    fn model_name(&self, py: Python<'_>) -> Option<String> {
+        self.doc.read(py).model_name().map(str::to_owned)
+    }
+
+    /// The folder of the main file (includes and relative asset paths were resolved from it).
+    #[getter]
+    fn model_dir(&self, py: Python<'_>) -> PathBuf {
+        self.doc.read(py).model_dir().to_path_buf()
+    }
+
+    /// The root ``<mujoco>`` element.
+    #[getter]
+    fn root<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyElement>> {
+        let root = self.doc.read(py).root();
+        cell::proxy(py, &self.doc, root)
+    }
+
+    /// The root ``<mujoco>`` element (``ElementTree.getroot``).
+    fn getroot<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyElement>> {
+        self.root(py)
+    }
+
+    /// The ``<worldbody>`` element (created, empty, when the model has none).
+    #[getter]
+    fn worldbody<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyElement>> {
+        self.section(py, "worldbody")
+    }
+
+    /// The top-level section with this tag (``"asset"``, ``"actuator"``, ``"sensor"``, ...),
+    /// created empty at the end when the model has none. Repeated sections were already
+    /// merged into one at load, as MuJoCo reads them all in order.
+    fn section<'py>(&self, py: Python<'py>, tag: &str) -> PyResult<Bound<'py, PyElement>> {
+        let section = Section::from_tag(tag).ok_or_else(|| {
+            Failure(vec![format!(
+                "'{tag}' is not a section of an MJCF model (asset, worldbody, actuator, ...)"
+            )])
+        })?;
+        let node = self.doc.write(py).section(section);
+        cell::proxy(py, &self.doc, node)
+    }
+
+    /// The first element matching the ElementPath ``path`` from the root, as
+    /// ``ElementTree.find`` (``"worldbody/body"``, ``".//joint"``, ``".//body[@name='b']"``).
+    #[pyo3(signature = (path, namespaces = None))]
+    fn find<'py>(
+        &self,
+        py: Python<'py>,
+        path: &str,
+        namespaces: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let path = tree_path(py, path)?;
+        path::find(&self.root(py)?, &path, namespaces)
+    }
+
+    /// Every element matching the ElementPath ``path`` from the root (``ElementTree.findall``).
+    #[pyo3(signature = (path, namespaces = None))]
+    fn findall<'py>(
+        &self,
+        py: Python<'py>,
+        path: &str,
+        namespaces: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let path = tree_path(py, path)?;
+        path::findall(&self.root(py)?, &path, namespaces)
+    }
+
+    /// An iterator over the elements matching ``path`` from the root (``ElementTree.iterfind``).
+    #[pyo3(signature = (path, namespaces = None))]
+    fn iterfind<'py>(
+        &self,
+        py: Python<'py>,
+        path: &str,
+        namespaces: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let path = tree_path(py, path)?;
+        path::iterfind(&self.root(py)?, &path, namespaces)
+    }
+
+    /// The text of the first element matching ``path`` from the root (``ElementTree.findtext``).
+    #[pyo3(signature = (path, default = None, namespaces = None))]
+    fn findtext<'py>(
+        &self,
+        py: Python<'py>,
+        path: &str,
+        default: Option<Bound<'py, PyAny>>,
+        namespaces: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Option<Bound<'py, PyAny>>> {
+        let path = tree_path(py, path)?;
+        path::findtext(&self.root(py)?, &path, default, namespaces)
+    }
+
+    /// An iterator over every element (document order), only those tagged ``tag`` when
+    /// given (``ElementTree.iter``).
+    #[pyo3(signature = (tag = None))]
+    fn iter<'py>(&self, py: Python<'py>, tag: Option<&str>) -> PyResult<Bound<'py, PyAny>> {
+        path::iter(self.root(py)?.get(), py, tag)
+    }
+
+    /// The first element (document order) whose tag is ``kind`` (``"body"``, ``"geom"``,
+    /// ``"joint"``, ``"mesh"``, ...) and, when given, whose ``name`` is ``name``; ``None``
+    /// when there is none.
+    #[pyo3(signature = (kind, name = None))]
+    fn find_named<'py>(
+        &self,
+        py: Python<'py>,
+        kind: &str,
+        name: Option<&str>,
+    ) -> PyResult<Option<Bound<'py, PyElement>>> {
+        let found = {
+            let doc = self.doc.read(py);
+            path::named(&doc, doc.root(), Some(kind), name).next()
+        };
+        found.map(|n| cell::proxy(py, &self.doc, n)).transpose()
+    }
+
+    /// Every element (document order) whose tag is ``kind`` (any tag when ``None``) and,
+    /// when given, whose ``name`` is ``name``.
+    #[pyo3(signature = (kind = None, name = None))]
+    fn find_all_named<'py>(
+        &self,
+        py: Python<'py>,
+        kind: Option<&str>,
+        name: Option<&str>,
+    ) -> PyResult<Vec<Bound<'py, PyElement>>> {
+        let nodes: Vec<Node> = {
+            let doc = self.doc.read(py);
+            path::named(&doc, doc.root(), kind, name).collect()
+        };
+        cell::proxies(py, &self.doc, nodes)
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> String {
+        let doc = self.doc.read(py);
+        format!(
+            "<mjcf_forge.Document model={:?} dir={:?} nodes={}>",
+            doc.model_name().unwrap_or(""),
+            doc.model_dir().display().to_string(),
+            doc.node_count()
+        )
+    }
+}
+
+/// A path of ``ElementTree.find`` and friends, from the tree: an absolute path is taken
+/// from the root, with the warning ElementTree gives.
+fn tree_path(py: Python<'_>, path: &str) -> PyResult<String> {
+    if !path.starts_with('/') {
+        return Ok(path.to_owned());
+    }
+    let message = format!(
+        "This search is broken in 1.3 and earlier, and will be fixed in a future version.  \
+         If you rely on the current behaviour, change it to {:?}",
+        format!(".{path}")
+    );
+    let message = std::ffi::CString::new(message).unwrap_or_default();
+    PyErr::warn(py, &py.get_type::<PyFutureWarning>(), &message, 1)?;
+    Ok(format!(".{path}"))
+}
