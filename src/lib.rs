@@ -55,6 +55,7 @@ pub mod output;
 pub mod scene;
 
 pub use document::import::NodeMap;
+pub use document::inertia::{CompiledInertia, InertiaCompiler};
 pub use document::limits::Limits;
 pub use document::tree::Node;
 pub use document::vocab;

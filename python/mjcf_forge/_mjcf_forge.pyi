@@ -3,7 +3,7 @@ against the module's own signatures by python/tests/test_stubs.py)."""
 
 import os
 from pathlib import Path
-from collections.abc import Iterable, Iterator, Mapping, MutableMapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, MutableMapping, Sequence
 from typing import Any, Optional, TypeVar, Union, overload
 
 import numpy as np
@@ -149,15 +149,25 @@ class Document:
     def from_string(xml: str, base_dir: Optional[_Path] = None) -> Document: ...
     def to_xml(self, pretty: bool = False) -> str: ...
     def write(self, path: _Path) -> None: ...
-    def prefix(self, prefix: str) -> None: ...
+    def prefix(
+        self, prefix: str, *, exclude: Union[Iterable[str], Callable[[str], bool], None] = None
+    ) -> None:
+        """Every name and reference prefixed; ``exclude`` (names, or ``name -> bool``) keeps some."""
     def merge(
         self,
-        other: Document,
+        other: Union[Document, Sequence[Document]],
         body: Optional[str] = None,
         *,
         fuse_keys: bool = False,
         part_prefix: Optional[str] = None,
-    ) -> MergeReport: ...
+        worldbody: bool = True,
+        compile_inertia: Optional[
+            Callable[[str, Path], tuple[Sequence[str], Sequence[float], Sequence[float], Sequence[float], Sequence[float]]]
+        ] = None,
+    ) -> MergeReport:
+        """``compile_inertia(xml, model_dir)`` -> (body names, body_mass, body_ipos, body_iquat,
+        body_inertia) as MuJoCo compiles ``xml`` alone: converts parts whose compiler mass
+        settings differ from this document's."""
     def validate(self) -> None: ...
     def copy(self) -> Document: ...
     def __copy__(self) -> Document: ...

@@ -271,3 +271,62 @@ def test_names_and_text_xml_cannot_carry_are_refused():
     assert doc.to_xml() == before
     body.set("user", "tab\tand\nnewline")  # allowed in XML, escaped when written
     assert Document.from_string(doc.to_xml()).find_named("body", "b")["user"] == "tab\tand\nnewline"
+
+
+def test_prefix_keeps_excluded_names_where_declared_and_referenced():
+    xml = ('<mujoco><asset><material name="shared"/><material name="own"/></asset><worldbody>'
+           '<body name="b"><geom name="g" material="shared" size="1"/><geom material="own" size="1"/>'
+           '</body></worldbody></mujoco>')
+    asked = []
+    doc = Document.from_string(xml)
+    doc.prefix("p_", exclude=lambda name: asked.append(name) or name == "shared")
+    assert asked == ["b", "g", "own", "shared"]  # each name once, sorted
+    assert doc.to_xml() == xml.replace('"b"', '"p_b"').replace('"g"', '"p_g"').replace('"own"', '"p_own"')
+    doc = Document.from_string(xml)
+    doc.prefix("p_", exclude={"shared", "own"})
+    assert 'name="p_b"' in doc.to_xml() and 'material="own"' in doc.to_xml()
+    with pytest.raises(TypeError):
+        doc.prefix("p_", exclude="own")  # a str is a name, not a collection of names
+    # The callable may read the document: it runs with no lock held.
+    doc = Document.from_string(xml)
+    doc.prefix("p_", exclude=lambda name: doc.find_named("material", name) is not None)
+    assert 'name="p_b"' in doc.to_xml() and 'material="shared"' in doc.to_xml()
+
+
+def test_merge_takes_lists_leaves_worldbodies_out_and_converts_inertia_with_a_callable():
+    base = Document.from_string('<mujoco><compiler inertiagrouprange="0 0"/><worldbody/></mujoco>')
+    a = Document.from_string('<mujoco><worldbody><body name="a"><geom size="0.1"/></body></worldbody></mujoco>')
+    b = Document.from_string('<mujoco><worldbody><body name="b"/></worldbody><sensor><clock name="c"/></sensor></mujoco>')
+    b_body = b.find(".//body")
+    # Without MuJoCo this build refuses a part whose inertiagrouprange differs.
+    with pytest.raises(MjcfError, match="inertiagrouprange"):
+        base.merge([b, a])
+    assert base.to_xml() == '<mujoco><compiler inertiagrouprange="0 0"/><worldbody/></mujoco>'
+    calls = []
+
+    def compile_inertia(xml, model_dir):
+        calls.append(xml)
+        m = mujoco.MjModel.from_xml_string(xml)
+        names = [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, i) or "" for i in range(m.nbody)]
+        return names, m.body_mass, m.body_ipos.ravel(), m.body_iquat.ravel(), m.body_inertia.ravel()
+
+    base.merge([b, a], worldbody=False, compile_inertia=compile_inertia)
+    assert calls == [] and base.find(".//body") is None and base.find(".//clock") is not None
+    assert b_body.parent is b.find("worldbody")  # not merged: still the part's
+    base = Document.from_string('<mujoco><compiler inertiagrouprange="0 0"/><worldbody/></mujoco>')
+    base.merge([b, a], compile_inertia=compile_inertia)
+    assert len(calls) == 1 and b_body.parent is base.worldbody
+    merged = mujoco.MjModel.from_xml_string(base.to_xml())
+    alone = mujoco.MjModel.from_xml_string(a.to_xml())
+    assert merged.body("a").mass == alone.body("a").mass and merged.body("a").mass > 0
+    with pytest.raises(MjcfError, match="compile_inertia: RuntimeError: no MuJoCo here"):
+        base2 = Document.from_string('<mujoco><compiler inertiagrouprange="0 0"/><worldbody/></mujoco>')
+
+        def broken(xml, model_dir):
+            raise RuntimeError("no MuJoCo here")
+
+        base2.merge(a, compile_inertia=broken)
+    with pytest.raises(TypeError):
+        base.merge(a, compile_inertia=3)
+    with pytest.raises(TypeError):
+        base.merge([a, 3])

@@ -10,7 +10,8 @@
 //!   [`schema`] (which attributes declare names and which refer to them);
 //! - editing and checking: [`prefix`] (renaming every name and reference), [`validate`]
 //!   (duplicate names, dangling references), [`relocate`](mod@relocate) (file references
-//!   to content-named assets), [`inertia`] (which bodies take their inertia from geoms);
+//!   to content-named assets), [`inertia`] (which bodies take their inertia from geoms, and compiled inertias
+//!   written back as `<inertial>`s);
 //! - editing as ElementTree code does: [`edit`] (elements moved, taken out, cleared,
 //!   copied between documents or into one of their own), [`text`] (text and tail),
 //!   [`import`] (nodes copied between arenas, and the [`NodeMap`](import::NodeMap) of where

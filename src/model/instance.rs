@@ -483,7 +483,7 @@ impl XmlModel {
                 prefix: &m.prefix,
             })
             .collect();
-        let out = self.doc.merge_checked(&parts, fuse_keys, keep_maps)?;
+        let out = self.doc.merge_checked(&parts, fuse_keys, keep_maps, None)?;
         // The model's extent and lists changed with the merge.
         self.offsets = OnceLock::new();
         self.lists = OnceLock::new();

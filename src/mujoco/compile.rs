@@ -81,6 +81,14 @@ impl fmt::Display for CompileError {
 
 impl std::error::Error for CompileError {}
 
+/// A local error (no line) from a message: what the document tier's checks report when it
+/// writes compiled inertials back ([`Document::write_compiled_inertials`](crate::Document::write_compiled_inertials)).
+impl From<String> for CompileError {
+    fn from(message: String) -> Self {
+        Self::local(message)
+    }
+}
+
 /// The line number in a MuJoCo error message: MuJoCo's `", line N"` (it ends the
 /// `Element ...` line of its messages), else tinyxml2's `"Line number=N"`.
 fn parse_line(message: &str) -> Option<u32> {

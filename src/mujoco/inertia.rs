@@ -2,6 +2,7 @@
 //! the model tier, which calls these) join a part whose compiler settings for masses and
 //! inertias differ from the base's, and place a free body exactly where MuJoCo does.
 
+use crate::document::inertia::CompiledInertia;
 use crate::document::tree::Node;
 use crate::document::{Document, Section};
 
@@ -95,22 +96,6 @@ pub(crate) fn free_joint_qpos0(doc: &Document, joint: Node) -> Result<[f64; 7], 
     Ok(q)
 }
 
-/// For a document with `compiler inertiafromgeom="true"`: every body's compiled inertia
-/// written out as by [`write_all_inertials`] (compiled under "true", whatever the body's
-/// `<inertial>` says), then the setting made `"auto"`, under which every written `<inertial>`
-/// counts: the same masses and inertias, and no mass setting left with anything to change.
-pub(crate) fn write_all_inertials_from_geoms(doc: &mut Document) -> Result<usize, CompileError> {
-    let n = write_inertials_checked(doc, true, false)?;
-    let compilers: Vec<Node> = doc
-        .elements(doc.root())
-        .filter(|&c| doc.tag(c) == "compiler" && doc.attr(c, "inertiafromgeom").is_some())
-        .collect();
-    for c in compilers {
-        doc.set_attr(c, "inertiafromgeom", "auto");
-    }
-    Ok(n)
-}
-
 fn write_inertials_of(doc: &mut Document, all: bool) -> Result<usize, CompileError> {
     write_inertials_checked(doc, all, true)
 }
@@ -122,105 +107,18 @@ fn write_inertials_checked(
     all: bool,
     from_geoms_refused: bool,
 ) -> Result<usize, CompileError> {
-    let refused = ["replicate", "attach", "composite", "flexcomp"];
-    if let Some(n) = doc
-        .descendants(doc.root())
-        .find(|&n| refused.contains(&doc.tag(n)))
-    {
-        return Err(CompileError::local(format!(
-            "{}: <{}> makes bodies when MuJoCo compiles; explicit inertials are written for \
-             plain <body> elements only",
-            doc.location(n),
-            doc.tag(n)
-        )));
-    }
-    for c in doc
-        .elements(doc.root())
-        .filter(|&c| doc.tag(c) == "compiler")
-    {
-        let setting = |k: &str, bad: &str| doc.attr(c, k).is_some_and(|v| v.trim() == bad);
-        if (from_geoms_refused && setting("inertiafromgeom", "true"))
-            || setting("fusestatic", "true")
-        {
-            return Err(CompileError::local(format!(
-                "{}: compiler inertiafromgeom=\"true\" or fusestatic=\"true\": explicit \
-                 inertials would not carry the compiled inertia",
-                doc.location(c)
-            )));
-        }
-    }
-    let inferring = doc.bodies_inferring_inertia();
-    if inferring.is_empty() && !all {
-        return Ok(0);
-    }
+    doc.write_compiled_inertials(all, from_geoms_refused, &mut compiled_inertia)
+}
+
+/// The bodies' masses and inertias as MuJoCo compiles `doc` alone: what the merge writes
+/// back into a part (through [`Document::write_compiled_inertials`]) in builds with MuJoCo.
+pub(crate) fn compiled_inertia(doc: &Document) -> Result<CompiledInertia, CompileError> {
     let model = compile_str(&doc.to_xml_string(), doc.model_dir())?;
-    // MuJoCo numbers bodies depth first in document order, the world body first.
-    let bodies: Vec<Node> = doc
-        .descendants(doc.root())
-        .filter(|&n| doc.tag(n) == "body")
-        .collect();
-    let names = model.names(ObjType::Body);
-    if names.len() != bodies.len() + 1 {
-        return Err(CompileError::local(format!(
-            "MuJoCo compiled {} bodies from {} <body> elements",
-            names.len() - 1,
-            bodies.len()
-        )));
-    }
-    for (i, &b) in bodies.iter().enumerate() {
-        if doc.attr(b, "name").is_some_and(|n| n != names[i + 1]) {
-            return Err(CompileError::local(format!(
-                "{}: body {:?} compiled as {:?}: bodies do not match one to one",
-                doc.location(b),
-                doc.attr(b, "name").unwrap_or(""),
-                names[i + 1]
-            )));
-        }
-    }
-    let (mass, ipos, iquat, inertia) = (
-        model.body_mass(),
-        model.body_ipos(),
-        model.body_iquat(),
-        model.body_inertia(),
-    );
-    let list = |v: &[f64]| {
-        v.iter()
-            .map(|x| format!("{x:?}"))
-            .collect::<Vec<_>>()
-            .join(" ")
-    };
-    let own_inertial = |doc: &Document, b| doc.elements(b).find(|&c| doc.tag(c) == "inertial");
-    let targets: Vec<Node> = if all {
-        bodies
-            .iter()
-            .enumerate()
-            .filter(|&(i, &b)| {
-                let id = i + 1;
-                let nonzero =
-                    mass[id] != 0.0 || inertia[3 * id..3 * id + 3].iter().any(|&x| x != 0.0);
-                nonzero || inferring.contains(&b) || own_inertial(doc, b).is_some()
-            })
-            .map(|(_, &b)| b)
-            .collect()
-    } else {
-        inferring
-    };
-    for &b in &targets {
-        if let Some(old) = own_inertial(doc, b) {
-            doc.remove(old);
-        }
-        let id = 1 + bodies
-            .iter()
-            .position(|&n| n == b)
-            .expect("a body of the document");
-        let attrs = [
-            ("pos", list(&ipos[3 * id..3 * id + 3])),
-            ("quat", list(&iquat[4 * id..4 * id + 4])),
-            ("mass", list(&mass[id..id + 1])),
-            ("diaginertia", list(&inertia[3 * id..3 * id + 3])),
-        ];
-        let attrs: Vec<(&str, &str)> = attrs.iter().map(|(k, v)| (*k, v.as_str())).collect();
-        doc.append_element(b, "inertial", &attrs);
-    }
-    Ok(targets.len())
+    Ok(CompiledInertia {
+        body_names: model.names(ObjType::Body),
+        mass: model.body_mass().to_vec(),
+        ipos: model.body_ipos().to_vec(),
+        iquat: model.body_iquat().to_vec(),
+        inertia: model.body_inertia().to_vec(),
+    })
 }

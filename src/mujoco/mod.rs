@@ -58,7 +58,7 @@ mod model;
 mod sys;
 
 pub use compile::{CompileError, compile_file, compile_str};
-pub(crate) use inertia::{free_joint_qpos0, write_all_inertials_from_geoms};
+pub(crate) use inertia::{compiled_inertia, free_joint_qpos0};
 pub use inertia::{write_all_inertials, write_inertials};
 pub use model::{CompiledModel, Contact, ObjType, Sizes};
 // For the compiled tier's model cache, which patches models in place through its own C.

@@ -21,10 +21,11 @@ mod values;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use mjcf_forge::{Document, MergePart, Node, Section};
-use pyo3::exceptions::PyFutureWarning;
+use ahash::AHashSet;
+use mjcf_forge::{CompiledInertia, Document, MergePart, Node, Section};
+use pyo3::exceptions::{PyFutureWarning, PyTypeError};
 use pyo3::prelude::*;
-use pyo3::types::PyTuple;
+use pyo3::types::{PyString, PyTuple};
 
 use crate::errors::{Failure, run};
 
@@ -144,56 +145,177 @@ impl PyDocument {
 
     /// Prefixes every name in place (bodies, joints, geoms, assets, classes, ...) and every
     /// reference to it, following MuJoCo's schema; references to ``world`` stay.
-    fn prefix(&self, py: Python<'_>, prefix: &str) -> PyResult<()> {
+    ///
+    /// ``exclude`` keeps names as they are, where declared and wherever referenced (in
+    /// every namespace): a collection of names, or a callable ``exclude(name) -> bool``,
+    /// asked once for each distinct name the prefix would rename, in sorted order (with no
+    /// lock held, so it may read this document).
+    #[pyo3(signature = (prefix, *, exclude = None))]
+    fn prefix(
+        &self,
+        py: Python<'_>,
+        prefix: &str,
+        exclude: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
         check_xml_text("prefix", prefix)?;
         let prefix = prefix.to_owned();
+        let keep: AHashSet<String> = match exclude {
+            None => AHashSet::new(),
+            Some(f) if f.is_callable() => {
+                // The names the prefix would rename, found on a copy (so that the callable
+                // runs with no lock of ours held), then asked about one by one.
+                let names = run(py, || {
+                    let mut copy = self.doc.read_detached().clone();
+                    let seen = std::cell::RefCell::new(AHashSet::new());
+                    copy.apply_prefix_except(&prefix, |_, name| {
+                        seen.borrow_mut().insert(name.to_owned());
+                        false
+                    })?;
+                    let mut names: Vec<String> = seen.into_inner().into_iter().collect();
+                    // Asked in a fixed order: the callable may have side effects.
+                    names.sort_unstable();
+                    Ok(names)
+                })?;
+                let mut keep = AHashSet::new();
+                for name in names {
+                    if f.call1((name.as_str(),))?.is_truthy()? {
+                        keep.insert(name);
+                    }
+                }
+                keep
+            }
+            Some(names) => {
+                if names.is_instance_of::<PyString>() {
+                    return Err(PyTypeError::new_err(
+                        "prefix(..., exclude=...): a collection of names or a callable, not a str",
+                    ));
+                }
+                names
+                    .try_iter()?
+                    .map(|n| n?.extract::<String>())
+                    .collect::<PyResult<_>>()?
+            }
+        };
         run(py, || {
-            Ok(self.doc.write_detached().apply_prefix(&prefix)?)
+            Ok(self
+                .doc
+                .write_detached()
+                .apply_prefix_except(&prefix, |_, name| keep.contains(name))?)
         })
     }
 
     /// Merges ``other`` into this document, in place: its worldbody children into the
     /// world (``body=None``) or into the body named ``body``, every other section carried
-    /// over (identical assets shared, compiler settings converted where exact).
+    /// over (identical assets shared, compiler settings converted where exact). ``other``
+    /// may be a list of documents, merged in order with every name checked once.
     ///
-    /// Handles to the part's elements follow them: afterwards they stand for (read and
-    /// change) their copies in this document, as if the elements had moved; the part
-    /// itself is left as it was.
+    /// Handles to the parts' elements follow them: afterwards they stand for (read and
+    /// change) their copies in this document, as if the elements had moved; the parts
+    /// themselves are left as they were.
     ///
-    /// ``fuse_keys`` makes the part's keyframe ``part_prefix + N`` one with this
-    /// document's key ``N`` (``part_prefix``: the prefix the part's names carry). Returns a :class:`MergeReport`; raises :class:`MjcfError`
-    /// (all name clashes at once, with positions), leaving this document unchanged.
-    #[pyo3(signature = (other, body = None, *, fuse_keys = false, part_prefix = None))]
+    /// ``worldbody=False`` leaves the parts' worldbody children out (every other section is
+    /// merged). ``fuse_keys`` makes a part's keyframe ``part_prefix + N`` one with this
+    /// document's key ``N`` (``part_prefix``: the prefix the parts' names carry).
+    ///
+    /// ``compile_inertia``: a callable ``compile_inertia(xml, model_dir)`` returning
+    /// ``(body_names, body_mass, body_ipos, body_iquat, body_inertia)`` (the arrays
+    /// flattened, by body id, the world body first) as MuJoCo compiles the MJCF text
+    /// ``xml`` alone. A part whose compiler settings for masses and inertias
+    /// (``inertiagrouprange``, ``settotalmass``, ...) differ from this document's is then
+    /// converted exactly: each body's compiled inertia is written out as an explicit
+    /// ``<inertial>`` before the merge. Without it such a part is refused. It is called
+    /// only for such parts, while this document is locked: it must not use this document.
+    ///
+    /// Returns a :class:`MergeReport`; raises :class:`MjcfError` (all name clashes at
+    /// once, with positions), leaving this document unchanged.
+    #[pyo3(signature = (
+        other,
+        body = None,
+        *,
+        fuse_keys = false,
+        part_prefix = None,
+        worldbody = true,
+        compile_inertia = None,
+    ))]
+    #[allow(clippy::too_many_arguments)]
     fn merge(
         &self,
         py: Python<'_>,
-        other: &PyDocument,
+        other: &Bound<'_, PyAny>,
         body: Option<String>,
         fuse_keys: bool,
         part_prefix: Option<String>,
+        worldbody: bool,
+        compile_inertia: Option<Py<PyAny>>,
     ) -> PyResult<PyMergeReport> {
+        let others: Vec<Bound<'_, PyDocument>> = if let Ok(d) = other.cast::<PyDocument>() {
+            vec![d.clone()]
+        } else {
+            let list: Vec<Bound<'_, PyAny>> = other.extract().map_err(|_| {
+                PyTypeError::new_err(
+                    "merge(other, ...): other is a Document or a list of Documents",
+                )
+            })?;
+            list.into_iter()
+                .map(|d| {
+                    d.cast_into::<PyDocument>()
+                        .map_err(|_| PyTypeError::new_err("merge: every part must be a Document"))
+                })
+                .collect::<PyResult<_>>()?
+        };
+        if let Some(f) = &compile_inertia
+            && !f.bind(py).is_callable()
+        {
+            return Err(PyTypeError::new_err(
+                "merge(..., compile_inertia=...): a callable",
+            ));
+        }
         let prefix = part_prefix.unwrap_or_default();
-        let from = other.doc.clone();
-        let map = run(py, || {
-            // A copy of the part first: it may be this very document (merging a model with
-            // itself), and two locks on one RwLock would deadlock.
-            let part = from.read_detached().clone();
+        let cells: Vec<SharedDoc> = others.iter().map(|d| d.get().doc.clone()).collect();
+        let out = run(py, || {
+            // Copies of the parts first: one may be this very document (merging a model
+            // with itself), and two locks on one RwLock would deadlock. A copy keeps every
+            // node's handle, so the maps name the parts' own nodes.
+            let parts: Vec<Document> = cells
+                .iter()
+                .map(|c| {
+                    let mut part = c.read_detached().clone();
+                    if !worldbody && let Some(world) = part.find_section(Section::Worldbody) {
+                        let children: Vec<Node> = part.elements(world).collect();
+                        for child in children {
+                            part.remove(child);
+                        }
+                    }
+                    part
+                })
+                .collect();
+            let parts: Vec<MergePart<'_>> = parts
+                .iter()
+                .map(|part| MergePart {
+                    doc: part,
+                    into: body.as_deref(),
+                    prefix: &prefix,
+                })
+                .collect();
             let mut doc = self.doc.write_detached();
             // Merge into a copy so that a refused merge leaves the document as it was (a
             // copy keeps every node's handle, so elements of this document stay valid).
             let mut merged = doc.clone();
-            let parts = [MergePart {
-                doc: &part,
-                into: body.as_deref(),
-                prefix: &prefix,
-            }];
-            let (report, mut maps) = merged.merge_all_mapped(&parts, fuse_keys)?;
+            let out = match &compile_inertia {
+                None => merged.merge_all_mapped(&parts, fuse_keys)?,
+                Some(f) => {
+                    let mut compile = |part: &Document| python_inertia(f, part);
+                    merged.merge_all_mapped_with(&parts, fuse_keys, &mut compile)?
+                }
+            };
             *doc = merged;
-            Ok((report, maps.pop().unwrap_or_default()))
+            Ok(out)
         });
-        let (report, map) = map?;
-        // The part's elements in hand now stand for their copies, as if moved.
-        retarget(py, &other.doc, &self.doc, &map);
+        let (report, maps) = out?;
+        // The parts' elements in hand now stand for their copies, as if moved.
+        for (cell, map) in cells.iter().zip(&maps) {
+            retarget(py, cell, &self.doc, map);
+        }
         Ok(report.into())
     }
 
@@ -398,4 +520,24 @@ fn tree_path(py: Python<'_>, path: &str) -> PyResult<String> {
     let message = std::ffi::CString::new(message).unwrap_or_default();
     PyErr::warn(py, &py.get_type::<PyFutureWarning>(), &message, 1)?;
     Ok(format!(".{path}"))
+}
+
+/// The inertias of `part` as the Python callable `compile` says MuJoCo compiles it alone
+/// (`Document.merge`'s `compile_inertia`), called with the GIL taken for the call.
+fn python_inertia(compile: &Py<PyAny>, part: &Document) -> Result<CompiledInertia, String> {
+    let xml = part.to_xml_string();
+    let dir = part.model_dir().to_path_buf();
+    type Arrays = (Vec<String>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>);
+    Python::attach(|py| {
+        let (body_names, mass, ipos, iquat, inertia): Arrays =
+            compile.bind(py).call1((xml, dir))?.extract()?;
+        Ok::<_, PyErr>(CompiledInertia {
+            body_names,
+            mass,
+            ipos,
+            iquat,
+            inertia,
+        })
+    })
+    .map_err(|e| format!("compile_inertia: {e}"))
 }

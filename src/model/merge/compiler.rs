@@ -5,6 +5,7 @@
 use super::angles::angles_checked;
 use super::same_value;
 use crate::document::Document;
+use crate::document::inertia::{CompiledInertia, InertiaCompiler};
 use crate::document::tree::Node;
 use crate::error::{Error, ErrorKind};
 
@@ -29,7 +30,6 @@ pub(super) const MUST_AGREE: [(&str, &str); 11] = [
 
 /// Compiler mass settings whose whole effect is the compiled bodies' masses and inertias,
 /// with MuJoCo's default (under which they change nothing).
-#[cfg(mjcf_mujoco)]
 const INERTIA_ONLY: [(&str, &str); 4] = [
     ("boundmass", "0"),
     ("boundinertia", "0"),
@@ -68,14 +68,15 @@ impl<'a> Compiler<'a> {
 
 /// Why a compiler setting that differs between a part and the base cannot be converted
 /// (the text after "has no exact conversion"): each of these applies to the whole merged
-/// model, and nothing on the part's own elements can stand in for it.
-fn no_conversion_reason(attr: &str, base: &str, default: &str) -> &'static str {
+/// model, and nothing on the part's own elements can stand in for it. `compiles`: whether
+/// the merge had a MuJoCo to write the part's inertias out with.
+fn no_conversion_reason(attr: &str, base: &str, default: &str, compiles: bool) -> &'static str {
     match attr {
         "boundmass" | "boundinertia" | "settotalmass" | "balanceinertia" | "inertiafromgeom"
         | "inertiagrouprange" => {
             if !same_value(base, default) {
                 ": the base's own setting would also change the part's masses and inertias"
-            } else if cfg!(mjcf_mujoco) {
+            } else if compiles {
                 ": the part's inertias could not be written out"
             } else {
                 ": writing the part's inertias out needs a build with the `mujoco` feature"
@@ -97,6 +98,21 @@ fn no_conversion_reason(attr: &str, base: &str, default: &str) -> &'static str {
     }
 }
 
+/// An [`InertiaCompiler`] that is a plain function.
+type CompileFn = fn(&Document) -> Result<CompiledInertia, String>;
+
+/// The build's own MuJoCo as an [`InertiaCompiler`], if it has one (the `mujoco` feature).
+pub(super) fn builtin_compiler() -> Option<CompileFn> {
+    #[cfg(mjcf_mujoco)]
+    {
+        Some(|doc: &Document| crate::mujoco::compiled_inertia(doc).map_err(|e| e.to_string()))
+    }
+    #[cfg(not(mjcf_mujoco))]
+    {
+        None
+    }
+}
+
 impl Document {
     /// `part` converted as [`Document::merge`] converts it, carrying this document's
     /// `<compiler>` settings instead of its own, so that merging it here later converts
@@ -107,7 +123,7 @@ impl Document {
         part: &Document,
         errors: &mut Vec<Error>,
     ) -> Option<Document> {
-        let mut conv = self.converted_part(part, errors)?;
+        let mut conv = self.converted_part(part, errors, None)?;
         let compiler = crate::document::names::sym("compiler");
         let theirs: Vec<Node> = conv
             .elements(conv.root)
@@ -134,11 +150,13 @@ impl Document {
     }
 
     /// The part brought to this document's compiler settings (`None`: it already is), or
-    /// the reasons it cannot be.
+    /// the reasons it cannot be. Inertias that only MuJoCo knows come from `compile`, else
+    /// from the build's own MuJoCo if it has one.
     pub(super) fn converted_part(
         &self,
         part: &Document,
         errors: &mut Vec<Error>,
+        compile: Option<&mut InertiaCompiler<'_>>,
     ) -> Option<Document> {
         let ours = compiler_settings(self);
         let theirs = compiler_settings(part);
@@ -149,22 +167,34 @@ impl Document {
             return None;
         }
         let mut part = part.clone();
-        self.convert_compiler(&mut part, errors);
+        let mut builtin = builtin_compiler();
+        let compile = match compile {
+            Some(c) => Some(c),
+            None => builtin.as_mut().map(|f| f as &mut InertiaCompiler<'_>),
+        };
+        self.convert_compiler(&mut part, errors, compile);
         Some(part)
     }
 
     /// Brings `part` to this document's compiler settings, or reports why it cannot be.
-    fn convert_compiler(&self, part: &mut Document, errors: &mut Vec<Error>) {
+    /// The mass settings are converted only with a `compile` (MuJoCo) to write the part's
+    /// inertias out with.
+    fn convert_compiler(
+        &self,
+        part: &mut Document,
+        errors: &mut Vec<Error>,
+        mut compile: Option<&mut InertiaCompiler<'_>>,
+    ) {
+        let compiles = compile.is_some();
         // A part's inertiafromgeom="true" alone becomes "auto" below, in every build, by
         // dropping the <inertial>s that "true" overrides. With mass settings, another
-        // inertiagrouprange or a base with "false" as well, builds with MuJoCo first make it
-        // "auto" with every body's compiled inertia written out
-        // (`mujoco::write_all_inertials_from_geoms`), after which those settings have nothing
+        // inertiagrouprange or a base with "false" as well, a merge with MuJoCo (the build's,
+        // or the caller's `compile`) first makes it "auto" with every body's compiled inertia
+        // written out (`write_compiled_inertials_from_geoms`), after which those settings have nothing
         // left to change: a locomotion model with `inertiafromgeom="true"
         // settotalmass="14"` (Gymnasium's half_cheetah) merges exactly into a base with
         // MuJoCo's defaults.
-        #[cfg(mjcf_mujoco)]
-        {
+        if let Some(compile) = compile.as_deref_mut() {
             let (ours, theirs) = (compiler_settings(self), compiler_settings(part));
             let setting = |m: &Compiler<'_>, k: &str, d: &str| {
                 m.get(k)
@@ -182,7 +212,7 @@ impl Document {
             drop((ours, theirs));
             if pi == "true" && bi != "true" && more {
                 let at = part.location(part.root);
-                if let Err(e) = crate::mujoco::write_all_inertials_from_geoms(part) {
+                if let Err(e) = part.write_compiled_inertials_from_geoms(compile) {
                     errors.push(Error::at(
                         at,
                         ErrorKind::Invalid(format!(
@@ -207,15 +237,17 @@ impl Document {
             value(&theirs, "inertiafromgeom", "auto"),
         );
         let drop_inertials = pi == "true" && bi == "auto";
-        // Builds with MuJoCo convert mass settings: each body's inertia is written out as
+        // With MuJoCo, mass settings are converted: each body's inertia is written out as
         // MuJoCo compiles the part alone, after which the setting changes nothing. That is
         // exact when the merged model reads <inertial> (inertiafromgeom not "true") and the
         // base leaves the setting at MuJoCo's default (no bound, no rescaling of its own).
-        #[cfg(mjcf_mujoco)]
-        let converted: Vec<&str> = {
+        let mut converted: Vec<&str> = {
             let mut all = Vec::new();
             let mut converted = Vec::new();
-            if bi != "true" && pi != "true" {
+            if let Some(compile) = compile
+                && bi != "true"
+                && pi != "true"
+            {
                 for (attr, default) in INERTIA_ONLY {
                     let (b, p) = (value(&base, attr, default), value(&theirs, attr, default));
                     if !same_value(&b, &p) && same_value(&b, default) {
@@ -240,11 +272,7 @@ impl Document {
                         .chain(auto_to_false.then_some("inertiafromgeom"))
                         .collect::<Vec<_>>();
                     let at = part.location(theirs.get(names[0]).map_or(part.root, |(_, n)| n));
-                    let written = if all.is_empty() {
-                        crate::mujoco::write_inertials(part)
-                    } else {
-                        crate::mujoco::write_all_inertials(part)
-                    };
+                    let written = part.write_compiled_inertials(!all.is_empty(), true, compile);
                     if let Err(e) = written {
                         errors.push(Error::at(
                             at,
@@ -261,10 +289,6 @@ impl Document {
             }
             converted
         };
-        #[cfg(not(mjcf_mujoco))]
-        let mut converted: Vec<&str> = Vec::new();
-        #[cfg(mjcf_mujoco)]
-        let mut converted = converted;
         let theirs = compiler_settings(part);
         // alignfree is the default of each <freejoint>'s own `align`: a part's free joints
         // keep its setting when they say it themselves. A <joint type="free"> has no
@@ -319,7 +343,7 @@ impl Document {
                             )
                         })
                         .unwrap_or_default(),
-                    _ => no_conversion_reason(attr, &b, default).to_string(),
+                    _ => no_conversion_reason(attr, &b, default, compiles).to_string(),
                 };
                 errors.push(part.error_at(
                     at,

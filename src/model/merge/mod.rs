@@ -41,6 +41,7 @@ mod layout;
 mod settings;
 
 use crate::document::import::{Import, NodeMap};
+use crate::document::inertia::InertiaCompiler;
 use crate::document::names::Sym;
 use crate::document::tree::Node;
 use crate::document::{Document, Section};
@@ -135,7 +136,7 @@ impl Document {
         parts: &[MergePart<'_>],
         fuse_keys: bool,
     ) -> Result<MergeReport, Errors> {
-        self.merge_checked(parts, fuse_keys, false)
+        self.merge_checked(parts, fuse_keys, false, None)
             .map(|(report, _)| report)
     }
 
@@ -160,16 +161,60 @@ impl Document {
         parts: &[MergePart<'_>],
         fuse_keys: bool,
     ) -> Result<(MergeReport, Vec<NodeMap>), Errors> {
-        self.merge_checked(parts, fuse_keys, true)
+        self.merge_checked(parts, fuse_keys, true, None)
+    }
+
+    /// [`Document::merge_all_mapped`], with the inertias only MuJoCo knows coming from
+    /// `compile` rather than from the build's own MuJoCo: a part whose compiler settings for
+    /// masses and inertias (`inertiagrouprange`, `settotalmass`, `boundmass`,
+    /// `boundinertia`, `balanceinertia`, `inertiafromgeom`) differ from this document's is
+    /// converted by writing out, as explicit `<inertial>`s, what `compile` says MuJoCo
+    /// compiles it to alone ([`Document::write_compiled_inertials`]). `compile` is called
+    /// only for such parts. This is how the Python package merges with the user's own
+    /// `mujoco` in builds without the `mujoco` feature.
+    ///
+    /// ```
+    /// use mjcf_forge::{CompiledInertia, Document, MergePart};
+    ///
+    /// let mut world = Document::from_str(
+    ///     r#"<mujoco><compiler inertiagrouprange="0 0"/><worldbody/></mujoco>"#, ".")?;
+    /// let table = Document::from_str(
+    ///     r#"<mujoco><worldbody><body name="t"><geom size="0.1"/><geom size="0.1" group="1"/></body></worldbody></mujoco>"#,
+    ///     ".",
+    /// )?;
+    /// let mut compile = |_: &Document| -> Result<CompiledInertia, String> {
+    ///     // What MuJoCo compiles the table to alone: both spheres count under "0 5".
+    ///     Ok(CompiledInertia {
+    ///         body_names: vec!["world".into(), "t".into()],
+    ///         mass: vec![0.0, 8.377580409572781],
+    ///         ipos: vec![0.0; 6],
+    ///         iquat: vec![1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0],
+    ///         inertia: vec![0.0, 0.0, 0.0, 0.033510321638291124, 0.033510321638291124, 0.033510321638291124],
+    ///     })
+    /// };
+    /// let part = MergePart { doc: &table, into: None, prefix: "" };
+    /// world.merge_all_mapped_with(&[part], false, &mut compile)?;
+    /// assert!(world.to_xml_string().contains(r#"mass="8.377580409572781""#));
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn merge_all_mapped_with(
+        &mut self,
+        parts: &[MergePart<'_>],
+        fuse_keys: bool,
+        compile: &mut InertiaCompiler<'_>,
+    ) -> Result<(MergeReport, Vec<NodeMap>), Errors> {
+        self.merge_checked(parts, fuse_keys, true, Some(compile))
     }
 
     /// The merge behind [`Document::merge_all`] and [`Document::merge_all_mapped`]: the
-    /// maps are kept when `keep_maps`.
+    /// maps are kept when `keep_maps`; inertias come from `compile`, else from the build's
+    /// MuJoCo if it has one.
     pub(crate) fn merge_checked(
         &mut self,
         parts: &[MergePart<'_>],
         fuse_keys: bool,
         keep_maps: bool,
+        compile: Option<&mut InertiaCompiler<'_>>,
     ) -> Result<(MergeReport, Vec<NodeMap>), Errors> {
         let clashes = self.name_clashes(&parts.iter().map(|p| p.doc).collect::<Vec<_>>());
         if !clashes.is_empty() {
@@ -183,10 +228,10 @@ impl Document {
         // A base smaller than its part may adopt the part's angle unit before the checks
         // (`adopt_angle_unit_if_smaller`): then it too works on a copy (a small one).
         if !keys && parts.len() == 1 && self.node_count() >= parts[0].doc.node_count() {
-            self.merge_parts(parts, fuse_keys, keep_maps)
+            self.merge_parts(parts, fuse_keys, keep_maps, compile)
         } else {
             let mut merged = self.clone();
-            let out = merged.merge_parts(parts, fuse_keys, keep_maps)?;
+            let out = merged.merge_parts(parts, fuse_keys, keep_maps, compile)?;
             *self = merged;
             Ok(out)
         }
@@ -201,7 +246,7 @@ impl Document {
         parts: &[MergePart<'_>],
         fuse_keys: bool,
     ) -> Result<MergeReport, Errors> {
-        self.merge_parts(parts, fuse_keys, false)
+        self.merge_parts(parts, fuse_keys, false, None)
             .map(|(report, _)| report)
     }
 
@@ -210,6 +255,7 @@ impl Document {
         parts: &[MergePart<'_>],
         fuse_keys: bool,
         keep_maps: bool,
+        mut compile: Option<&mut InertiaCompiler<'_>>,
     ) -> Result<(MergeReport, Vec<NodeMap>), Errors> {
         // Room for every part at once: reserving per part would reallocate (and copy) the
         // whole scene once per part.
@@ -227,7 +273,8 @@ impl Document {
                 fuse_keys,
                 part_prefix: p.prefix.to_string(),
             };
-            let (r, map) = self.merge_in_place(p.doc, p.into, &options, keep_maps)?;
+            let (r, map) =
+                self.merge_in_place(p.doc, p.into, &options, keep_maps, compile.as_deref_mut())?;
             report.warnings.extend(r.warnings);
             report.shared_assets += r.shared_assets;
             if keep_maps {
@@ -243,11 +290,12 @@ impl Document {
         into: Option<&str>,
         options: &MergeOptions,
         keep_map: bool,
+        compile: Option<&mut InertiaCompiler<'_>>,
     ) -> Result<(MergeReport, NodeMap), Errors> {
         let mut report = MergeReport::default();
         let mut errors: Vec<Error> = Vec::new();
         self.adopt_angle_unit_if_smaller(part);
-        let converted = self.converted_part(part, &mut errors);
+        let converted = self.converted_part(part, &mut errors, compile);
         if !errors.is_empty() {
             return Err(Errors(errors));
         }
