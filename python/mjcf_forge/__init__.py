@@ -12,6 +12,9 @@
 - :class:`ModelCache`: compiled models of a scene's variants at patch cost: one compile
   per structure (``variant.structure_key``), then ``variant.patch`` written into it.
 - :class:`MjcfError`: the one exception type (a ``ValueError``), with ``.errors``.
+- :mod:`mjcf_forge.base`: robosuite's ``MujocoXML``, ``MujocoModel`` and
+  ``MujocoXMLModel`` (``robosuite.models.base``) over documents, for code written for
+  robosuite (its ``XMLError`` is an :class:`MjcfError`).
 """
 
 from ._mjcf_forge import (
@@ -29,6 +32,7 @@ from ._mjcf_forge import (
 )
 from ._cache import ModelCache
 from . import etree
+from . import base
 
 __all__ = [
     "Attrib",
