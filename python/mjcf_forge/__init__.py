@@ -14,7 +14,8 @@
 - :class:`MjcfError`: the one exception type (a ``ValueError``), with ``.errors``.
 - :mod:`mjcf_forge.base`: robosuite's ``MujocoXML``, ``MujocoModel`` and
   ``MujocoXMLModel`` (``robosuite.models.base``) over documents, for code written for
-  robosuite (its ``XMLError`` is an :class:`MjcfError`).
+  robosuite (its ``XMLError`` is an :class:`MjcfError`); ``mjcf_forge.robosuite.use()``,
+  called before robosuite is imported, makes robosuite's own classes build on them.
 """
 
 from ._mjcf_forge import (
