@@ -729,17 +729,20 @@ class MujocoXMLModel(MujocoXML, MujocoModel):
         a name it returns True for, and the name of an element it returns True for, stay
         as they are where declared and wherever referenced."""
         exclude = self.exclude_from_prefixing
-        if type(self).exclude_from_prefixing is MujocoXMLModel.exclude_from_prefixing:
-            self.document.prefix(prefix)
-            return
         kept = set()
-        for element in self.root.iter():
-            if exclude(element):
-                name = element.get("name")
-                if name is not None:
-                    kept.add(name)
+        keep = None
+        if type(self).exclude_from_prefixing is not MujocoXMLModel.exclude_from_prefixing:
+            for element in self.root.iter():
+                if exclude(element):
+                    name = element.get("name")
+                    if name is not None:
+                        kept.add(name)
+
+            def keep(name):
+                return name in kept or bool(exclude(name))
+
         try:
-            self.document.prefix(prefix, exclude=lambda name: name in kept or bool(exclude(name)))
+            self.document.prefix(prefix, exclude=keep)
         except MjcfError as e:
             raise _reraised(e) from None
 

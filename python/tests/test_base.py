@@ -365,6 +365,9 @@ def test_load_errors_are_xml_errors(tmp_path):
     with pytest.raises(XMLError) as err:
         MujocoXML(str(tmp_path / "missing.xml"))
     assert "missing.xml" in str(err.value) and err.value.errors
+    # A prefix MuJoCo would read as two names.
+    with pytest.raises(XMLError, match="prefix 'a b_' holds white space"):
+        MyModel(idn="a b")
 
 
 # ------------------------------------------------------------------------------------
