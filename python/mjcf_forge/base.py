@@ -235,6 +235,12 @@ def _instance_randomization() -> bool:
     return bool(USING_INSTANCE_RANDOMIZATION)
 
 
+def _named(names: list) -> list:
+    """The names of a raw list (robosuite's ``_joints`` and friends) without the ``None``
+    of unnamed elements, which no name can refer to."""
+    return [n for n in names if n is not None]
+
+
 def _same_subtree(a: Any, b: Any) -> bool:
     """Same tag, attributes (any order), text and children, recursively."""
     if a.tag != b.tag or dict(a.items()) != dict(b.items()):
@@ -698,8 +704,10 @@ class MujocoXMLModel(MujocoXML, MujocoModel):
             else [self._elements["root_body"]]
         )
 
+        # As robosuite: None for an unnamed element (so that len(self._joints), robosuite's
+        # RobotModel.dof, counts the joint elements); the public lists leave them out.
         def names(key):
-            return [e.get("name") for e in self._elements.get(key, []) if e.get("name") is not None]
+            return [e.get("name") for e in self._elements.get(key, [])]
 
         self._root_body = self._elements["root_body"].get("name")
         self._bodies = names("bodies")
@@ -792,37 +800,37 @@ class MujocoXMLModel(MujocoXML, MujocoModel):
     @property
     def bodies(self):
         """Names of the named bodies (prefixed), the root first."""
-        return self.correct_naming(self._bodies)
+        return self.correct_naming(_named(self._bodies))
 
     @property
     def joints(self):
         """Names of the named ``<joint>`` s of the tree (prefixed)."""
-        return self.correct_naming(self._joints)
+        return self.correct_naming(_named(self._joints))
 
     @property
     def actuators(self):
         """Names of the named actuators (prefixed)."""
-        return self.correct_naming(self._actuators)
+        return self.correct_naming(_named(self._actuators))
 
     @property
     def sites(self):
         """Names of the named sites of the tree (prefixed)."""
-        return self.correct_naming(self._sites)
+        return self.correct_naming(_named(self._sites))
 
     @property
     def sensors(self):
         """Names of the named sensors (prefixed)."""
-        return self.correct_naming(self._sensors)
+        return self.correct_naming(_named(self._sensors))
 
     @property
     def contact_geoms(self):
         """Names of the geoms of group 0 (prefixed)."""
-        return self.correct_naming(self._contact_geoms)
+        return self.correct_naming(_named(self._contact_geoms))
 
     @property
     def visual_geoms(self):
         """Names of the geoms of group 1 (prefixed)."""
-        return self.correct_naming(self._visual_geoms)
+        return self.correct_naming(_named(self._visual_geoms))
 
     @property
     def important_sites(self):

@@ -177,6 +177,7 @@ def test_models_compile_and_list_as_robosuites(rs, path):
     for attr in ["bodies", "joints", "actuators", "sites", "sensors", "contact_geoms",
                  "visual_geoms"]:
         # robosuite lists an unnamed element as None, which its correct_naming refuses.
+        assert getattr(ours, "_" + attr) == getattr(theirs, "_" + attr), attr
         named = [n for n in getattr(theirs, "_" + attr) if n is not None]
         assert getattr(ours, attr) == theirs.correct_naming(named), attr
     if theirs._root_body is not None:
@@ -379,6 +380,7 @@ def test_mujoco_xml_model_attributes():
     can = MyModel(idn=7)
     assert (can.idn, can.mount, can.name, can.naming_prefix) == (7, None, "MyModel7", "7_")
     assert can.root_body is None  # can.xml's root body has no name
+    assert can._bodies == [None, "object"]  # robosuite's raw list; the public one is named
     assert can.bodies == ["7_object"] and can.joints == [] and can.actuators == []
     assert can.sites == ["7_bottom_site", "7_top_site", "7_horizontal_radius_site"]
     assert can.sensors == [] and can.contact_geoms == ["7_g0_col"] and can.visual_geoms == []
