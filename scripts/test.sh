@@ -10,6 +10,9 @@ set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
 bash scripts/setup.sh
+# robosuite 1.5.2 with MuJoCo 3.9.0, where python/tests/test_robosuite_use.py builds
+# robosuite's own classes both ways (idempotent; about 300 MB of wheels the first time).
+bash scripts/setup_robosuite_env.sh
 
 echo "== cargo fmt --check"
 cargo fmt --all -- --check

@@ -3,7 +3,8 @@
 The hook itself is checked here on robosuite's unpacked wheel (its light modules only).
 The comparison builds robosuite's arenas, grippers, mount, objects, robots and a Lift task
 both ways in the robosuite venv (.cache/venv-robosuite-env: robosuite 1.5.2 with MuJoCo
-3.9.0, made by scripts/setup_robosuite_env.sh; skipped without it), in two processes
+3.9.0, made by scripts/setup_robosuite_env.sh, which scripts/test.sh runs; a missing venv
+is a failure, not a skip), in two processes
 (robosuite_build.py), and compares what MuJoCo compiles from each.
 """
 from __future__ import annotations
@@ -108,8 +109,7 @@ INERTIA_ARRAYS = {
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
     """robosuite_build.py's output, robosuite's way and ours."""
-    if not RS_ENV.exists():
-        pytest.skip(f"{RS_ENV} missing: run scripts/setup_robosuite_env.sh")
+    assert RS_ENV.exists(), f"{RS_ENV} missing: run scripts/setup_robosuite_env.sh"
     tmp = tmp_path_factory.mktemp("robosuite_use")
     # The robosuite venv imports this checkout's mjcf_forge (the package of this test run).
     env = dict(os.environ, PYTHONPATH=str(Path(mjcf_forge.__file__).resolve().parents[1]))
