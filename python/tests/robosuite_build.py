@@ -15,6 +15,11 @@ import sys
 import traceback
 
 mode, out_path = sys.argv[1], sys.argv[2]
+import mujoco  # noqa: E402
+
+# robosuite 1.5.2's environments run on MuJoCo 3.9.0 only (see
+# scripts/requirements-robosuite-env.txt): another MuJoCo here means a path shadowed it.
+assert mujoco.__version__ == "3.9.0", (mujoco.__version__, mujoco.__file__)
 if mode == "forge":
     import mjcf_forge.robosuite
 

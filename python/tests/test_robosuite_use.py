@@ -111,8 +111,13 @@ def built(tmp_path_factory):
     """robosuite_build.py's output, robosuite's way and ours."""
     assert RS_ENV.exists(), f"{RS_ENV} missing: run scripts/setup_robosuite_env.sh"
     tmp = tmp_path_factory.mktemp("robosuite_use")
-    # The robosuite venv imports this checkout's mjcf_forge (the package of this test run).
-    env = dict(os.environ, PYTHONPATH=str(Path(mjcf_forge.__file__).resolve().parents[1]))
+    # The robosuite venv imports this test run's mjcf_forge, and only it: the package's
+    # folder is linked alone into a folder of its own, since the folder it is installed in
+    # holds another MuJoCo, which would shadow the robosuite venv's.
+    only = tmp / "path"
+    only.mkdir()
+    (only / "mjcf_forge").symlink_to(Path(mjcf_forge.__file__).resolve().parent)
+    env = dict(os.environ, PYTHONPATH=str(only))
     out = {}
     for mode in ("robosuite", "forge"):
         path = tmp / f"{mode}.json"
