@@ -201,6 +201,17 @@ def sort_elements(
     return _elements_dict
 
 
+# The module's own sorting functions: while they are the ones in use (not replaced on the
+# module), MujocoXMLModel sorts its elements natively (Document._sort_elements), with the
+# same result; a replaced one is honoured through the Python path.
+_SORTING = None
+
+
+def _native_sorting() -> bool:
+    module = sys.modules[__name__]
+    return all(getattr(module, name) is fn for name, fn in _SORTING)
+
+
 def _find_elements(root: Any, tags: Any, attribs: Optional[dict] = None) -> Optional[Any]:
     """The first element under ``root`` (itself included) with one of ``tags`` and the
     given attribute values (robosuite's ``find_elements(..., return_first=True)``)."""
@@ -269,6 +280,10 @@ def _asset_name(asset: Any) -> Optional[str]:
 # MujocoXML
 # --------------------------------------------------------------------------------------
 
+# The sections MujocoXML holds, in robosuite's order (created in that order when missing).
+_SECTIONS = ["worldbody", "actuator", "sensor", "asset", "tendon", "equality", "contact"]
+
+
 
 class MujocoXML(object):
     """A MuJoCo model read from an MJCF file, to merge other models into (robosuite's
@@ -299,16 +314,23 @@ class MujocoXML(object):
             raise _reraised(e) from None
         self.root = self.document.root
         self.tree = ET.ElementTree(self.root)
-        self.worldbody = self.create_default_element("worldbody")
-        self.actuator = self.create_default_element("actuator")
-        self.sensor = self.create_default_element("sensor")
-        self.asset = self.create_default_element("asset")
-        self.tendon = self.create_default_element("tendon")
-        self.equality = self.create_default_element("equality")
-        self.contact = self.create_default_element("contact")
+        if type(self).create_default_element is MujocoXML.create_default_element:
+            # The hook's own work, in one native call (the same elements, created in order).
+            (self.worldbody, self.actuator, self.sensor, self.asset, self.tendon,
+             self.equality, self.contact) = self.document._sections(_SECTIONS)
+        else:
+            self.worldbody = self.create_default_element("worldbody")
+            self.actuator = self.create_default_element("actuator")
+            self.sensor = self.create_default_element("sensor")
+            self.asset = self.create_default_element("asset")
+            self.tendon = self.create_default_element("tendon")
+            self.equality = self.create_default_element("equality")
+            self.contact = self.create_default_element("contact")
         # Default classes are already inlined (exactly) by Document.load, and file paths
-        # made absolute; this hook stays for subclasses that extend it.
-        self.resolve_asset_dependency()
+        # made absolute, which is what the hook does: it is called only when a subclass
+        # overrides it (and stays callable).
+        if type(self).resolve_asset_dependency is not MujocoXML.resolve_asset_dependency:
+            self.resolve_asset_dependency()
 
     def resolve_asset_dependency(self):
         """Makes every asset's ``file`` absolute (robosuite's hook; already so after
@@ -679,19 +701,24 @@ class MujocoXMLModel(MujocoXML, MujocoModel):
         self.idn = idn
         self.mount = None
 
-        group_mapping = {0: "col", 1: "vis"}
-        ctr_mapping = {"col": 0, "vis": 0}
+        if _native_sorting():
+            # One native pass: the same sorting, naming and lists as the Python path below.
+            self._elements, raw = self.document._sort_elements(name_geoms=True)
+        else:
+            raw = None
+            group_mapping = {0: "col", 1: "vis"}
+            ctr_mapping = {"col": 0, "vis": 0}
 
-        def _add_default_name_filter(element, parent):
-            filter_key = _element_filter(element=element, parent=parent)
-            # Geoms of the tree only: a tendon's <geom> wrap takes no name.
-            if filter_key in ("contact_geoms", "visual_geoms") and element.get("name") is None:
-                group = group_mapping[_group(element)]
-                element.set("name", f"g{ctr_mapping[group]}_{group}")
-                ctr_mapping[group] += 1
-            return filter_key
+            def _add_default_name_filter(element, parent):
+                filter_key = _element_filter(element=element, parent=parent)
+                # Geoms of the tree only: a tendon's <geom> wrap takes no name.
+                if filter_key in ("contact_geoms", "visual_geoms") and element.get("name") is None:
+                    group = group_mapping[_group(element)]
+                    element.set("name", f"g{ctr_mapping[group]}_{group}")
+                    ctr_mapping[group] += 1
+                return filter_key
 
-        self._elements = sort_elements(root=self.root, element_filter=_add_default_name_filter)
+            self._elements = sort_elements(root=self.root, element_filter=_add_default_name_filter)
         roots = self._elements.get("root_body", [])
         if len(roots) != 1:
             raise xml_error(
@@ -706,10 +733,17 @@ class MujocoXMLModel(MujocoXML, MujocoModel):
 
         # As robosuite: None for an unnamed element (so that len(self._joints), robosuite's
         # RobotModel.dof, counts the joint elements); the public lists leave them out.
-        def names(key):
-            return [e.get("name") for e in self._elements.get(key, [])]
+        if raw is not None:
+            raw["bodies"] = raw["root_body"] + raw.get("bodies", [])
 
-        self._root_body = self._elements["root_body"].get("name")
+            def names(key):
+                return list(raw.get(key, ()))
+        else:
+
+            def names(key):
+                return [e.get("name") for e in self._elements.get(key, [])]
+
+        self._root_body = raw["root_body"][0] if raw is not None else self._elements["root_body"].get("name")
         self._bodies = names("bodies")
         self._joints = names("joints")
         self._actuators = names("actuators")
@@ -724,9 +758,7 @@ class MujocoXMLModel(MujocoXML, MujocoModel):
         rgba = self.contact_geom_rgba
         if rgba is not None:
             value = array_to_string(rgba)
-            for geom in self._elements.get("contact_geoms", []):
-                geom.set("rgba", value)
-                geom.attrib.pop("material", None)
+            self.document._set_all(self._elements.get("contact_geoms", []), "rgba", value, "material")
 
         if _instance_randomization():
             self._add_default_material()
@@ -882,3 +914,8 @@ class MujocoXMLModel(MujocoXML, MujocoModel):
     def horizontal_radius(self):
         """Defined by subclasses."""
         raise NotImplementedError
+
+
+_SORTING = tuple(
+    (fn.__name__, fn) for fn in (sort_elements, _element_filter, _group, _tree_parent)
+)

@@ -16,6 +16,7 @@ mod cell;
 mod children;
 mod element;
 mod path;
+mod sort;
 mod values;
 
 use std::path::PathBuf;
@@ -25,7 +26,7 @@ use ahash::AHashSet;
 use mjcf_forge::{CompiledInertia, Document, MergePart, Node, Section};
 use pyo3::exceptions::{PyFutureWarning, PyTypeError};
 use pyo3::prelude::*;
-use pyo3::types::{PyString, PyTuple};
+use pyo3::types::{PyDict, PyString, PyTuple};
 
 use crate::errors::{Failure, run};
 
@@ -384,6 +385,94 @@ impl PyDocument {
     /// The root ``<mujoco>`` element (``ElementTree.getroot``).
     fn getroot<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyElement>> {
         self.root(py)
+    }
+
+    /// ``mjcf_forge.base``'s element sorting in one native pass (robosuite's
+    /// ``sort_elements(root, element_filter=_element_filter)``, naming unnamed geoms of
+    /// groups 0 and 1 ``g{n}_col`` / ``g{n}_vis`` first when ``name_geoms``): a dict of
+    /// the keys, in the order they first appear, to their elements in document order, and
+    /// a dict of the same keys to those elements' names (None for an unnamed one).
+    #[pyo3(signature = (name_geoms = true))]
+    fn _sort_elements<'py>(
+        &self,
+        py: Python<'py>,
+        name_geoms: bool,
+    ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
+        let sorted = {
+            let mut doc = self.doc.write(py);
+            sort::sort(py, &mut doc, name_geoms)?
+        };
+        let elements = PyDict::new(py);
+        let names = PyDict::new(py);
+        for (key, nodes, found) in sorted {
+            elements.set_item(key, cell::proxies(py, &self.doc, nodes)?)?;
+            names.set_item(key, found)?;
+        }
+        Ok((elements, names))
+    }
+
+    /// Sets ``key`` to ``value`` (as :meth:`Element.set`) on every element of
+    /// ``elements`` and removes the attribute ``remove`` from each (if given): what
+    /// ``mjcf_forge.base`` does to the collision geoms, under one lock for the elements of
+    /// this document.
+    #[pyo3(signature = (elements, key, value, remove = None))]
+    fn _set_all(
+        &self,
+        py: Python<'_>,
+        elements: Vec<Bound<'_, PyElement>>,
+        key: &str,
+        value: &Bound<'_, PyAny>,
+        remove: Option<&str>,
+    ) -> PyResult<()> {
+        let (key, text) = values::checked_attr(key, value)?;
+        let mut here = Vec::with_capacity(elements.len());
+        let mut elsewhere = Vec::new();
+        for e in &elements {
+            let (cell, node) = e.get().target();
+            if Arc::ptr_eq(&cell, &self.doc) {
+                here.push(node);
+            } else {
+                elsewhere.push((cell, node));
+            }
+        }
+        let apply = |doc: &mut Document, node: Node| {
+            doc.set_attr(node, &key, &text);
+            if let Some(r) = remove {
+                doc.remove_attr(node, r);
+            }
+        };
+        {
+            let mut doc = self.doc.write(py);
+            for node in here {
+                apply(&mut doc, node);
+            }
+        }
+        for (cell, node) in elsewhere {
+            apply(&mut cell.write(py), node);
+        }
+        Ok(())
+    }
+
+    /// The top-level sections with these tags, each created empty at the end when
+    /// missing, in the order given (:meth:`section` of each).
+    fn _sections<'py>(
+        &self,
+        py: Python<'py>,
+        tags: Vec<String>,
+    ) -> PyResult<Vec<Bound<'py, PyElement>>> {
+        let mut sections = Vec::with_capacity(tags.len());
+        for tag in &tags {
+            sections.push(Section::from_tag(tag).ok_or_else(|| {
+                Failure(vec![format!(
+                    "'{tag}' is not a section of an MJCF model (asset, worldbody, actuator, ...)"
+                )])
+            })?);
+        }
+        let nodes: Vec<Node> = {
+            let mut doc = self.doc.write(py);
+            sections.into_iter().map(|s| doc.section(s)).collect()
+        };
+        cell::proxies(py, &self.doc, nodes)
     }
 
     /// The ``<worldbody>`` element (created, empty, when the model has none).
