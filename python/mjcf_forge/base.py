@@ -208,8 +208,11 @@ _SORTING = None
 
 
 def _native_sorting() -> bool:
-    module = sys.modules[__name__]
-    return all(getattr(module, name) is fn for name, fn in _SORTING)
+    g = globals()
+    for name, fn in _SORTING:
+        if g[name] is not fn:
+            return False
+    return True
 
 
 def _find_elements(root: Any, tags: Any, attribs: Optional[dict] = None) -> Optional[Any]:
@@ -387,8 +390,9 @@ class MujocoXML(object):
         body = None
         if merge_body is not None and merge_body != "default":
             body = merge_body
-            names = [b.get("name") for b in self.worldbody.iter("body") if b.get("name") is not None]
-            if not isinstance(body, str) or body not in names:
+            # A body of that name found natively; the names listed only for the error.
+            if not isinstance(body, str) or self.worldbody.find_named("body", body) is None:
+                names = [b.get("name") for b in self.worldbody.iter("body") if b.get("name") is not None]
                 close = difflib.get_close_matches(str(body), names, n=3)
                 hint = " (did you mean {}?)".format(" or ".join(repr(c) for c in close)) if close else ""
                 raise xml_error(
@@ -735,22 +739,21 @@ class MujocoXMLModel(MujocoXML, MujocoModel):
         # RobotModel.dof, counts the joint elements); the public lists leave them out.
         if raw is not None:
             raw["bodies"] = raw["root_body"] + raw.get("bodies", [])
-
-            def names(key):
-                return list(raw.get(key, ()))
+            names = raw.get  # fresh lists of the native call, owned here
         else:
+            raw = {key: [e.get("name") for e in elements] for key, elements in self._elements.items()
+                   if key != "root_body"}
+            raw["root_body"] = [self._elements["root_body"].get("name")]
+            names = raw.get
 
-            def names(key):
-                return [e.get("name") for e in self._elements.get(key, [])]
-
-        self._root_body = raw["root_body"][0] if raw is not None else self._elements["root_body"].get("name")
+        self._root_body = raw["root_body"][0]
         self._bodies = names("bodies")
-        self._joints = names("joints")
-        self._actuators = names("actuators")
-        self._sites = names("sites")
-        self._sensors = names("sensors")
-        self._contact_geoms = names("contact_geoms")
-        self._visual_geoms = names("visual_geoms")
+        self._joints = names("joints", [])
+        self._actuators = names("actuators", [])
+        self._sites = names("sites", [])
+        self._sensors = names("sensors", [])
+        self._contact_geoms = names("contact_geoms", [])
+        self._visual_geoms = names("visual_geoms", [])
         self._base_offset = string_to_array(self._elements["root_body"].get("pos", "0 0 0"))
 
         self._add_prefix(self.naming_prefix)
