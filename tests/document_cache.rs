@@ -355,3 +355,105 @@ fn the_cache_is_bounded_least_recently_used_out() {
     }
     assert_eq!(small.len(), 1);
 }
+
+/// One model with every kind of value the document split adds to `PATCHABLE`'s: option
+/// values, actuator gains (named and unnamed, `kv` given or not), an unnamed free joint's
+/// pose, a body with neither inertial nor geoms.
+fn rules_model(v: &[&str; 8]) -> String {
+    format!(
+        "<mujoco><option timestep='{}' gravity='0 0 {}' density='{}' viscosity='0'/>\
+         <worldbody>\
+         <body name='arm' pos='0 0 1'><joint name='j1'/><geom size='.1' pos='.2 0 0' mass='1'/>\
+           <body name='tip' pos='{} 0 0'><joint name='j2'/><geom size='.05'/></body></body>\
+         <body name='free' pos='0 1 {}'><freejoint/><geom size='.1' rgba='{}'/></body>\
+         <body name='empty' pos='1 1 1'/>\
+         </worldbody><actuator>\
+         <position name='p' joint='j1' kp='{}'/>\
+         <position joint='j2' kp='{}' kv='2'/>\
+         <velocity joint='j1' kv='3'/>\
+         <general joint='j2' gainprm='4 1' biasprm='0 -4 -1' dynprm='1 2'/>\
+         </actuator></mujoco>",
+        v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]
+    )
+}
+
+#[test]
+fn option_values_actuator_gains_and_unnamed_elements_are_patched_exactly() {
+    let dir = Path::new(".");
+    let a = ["0.002", "-9.81", "0", "0.3", "0.5", "1 0 0 1", "10", "20"];
+    let b = ["0.004", "-3", "1.2", "0.35", "0.7", "0 1 0 1", "15", "0"];
+    let (da, db) = (
+        Document::from_str(&rules_model(&a), dir).unwrap(),
+        Document::from_str(&rules_model(&b), dir).unwrap(),
+    );
+    let (sa, sb) = (split_document(&da), split_document(&db));
+    assert_eq!(sa.structure_key, sb.structure_key);
+    let fields: Vec<(&str, &str)> = sa.entries.iter().map(|e| (e.object, e.field)).collect();
+    for want in [
+        ("option", "timestep"),
+        ("option", "gravity"),
+        ("option", "density"),
+        ("actuator", "gainprm"),
+        ("actuator", "biasprm"),
+        ("actuator", "dynprm"),
+        ("joint", "qpos0"),
+        ("body", "ipos"),
+    ] {
+        assert!(fields.contains(&want), "{want:?} not in {fields:?}");
+    }
+    // Unnamed actuators by their ids.
+    assert!(
+        sa.entries
+            .iter()
+            .any(|e| e.object == "actuator" && e.id == Some(3))
+    );
+    let mut cache = DocumentCache::new(4, None);
+    for doc in [&da, &db, &da] {
+        exact(&mut cache, doc, "rules model");
+    }
+    assert_eq!((cache.compiles(), cache.patches()), (1, 2));
+}
+
+#[test]
+fn derived_values_mujoco_set_const_leaves_stay_structure() {
+    let dir = Path::new(".");
+    let key = |xml: String| split_document(&Document::from_str(&xml, dir).unwrap()).structure_key;
+    // A damping ratio is turned into a damping from the masses at compile time.
+    let dampratio = |mass: &str| {
+        format!(
+            "<mujoco><worldbody><body name='b'><joint name='j'/>\
+             <inertial pos='0 0 0' mass='{mass}' diaginertia='1 1 1'/></body></worldbody>\
+             <actuator><position joint='j' kp='10' dampratio='1'/></actuator></mujoco>"
+        )
+    };
+    assert_ne!(key(dampratio("1")), key(dampratio("2")));
+    // A spatial tendon's spring length is its length at qpos0.
+    let tendon = |x: &str| {
+        format!(
+            "<mujoco><worldbody><site name='s0'/><body name='b' pos='{x} 0 0'><freejoint/>\
+             <geom size='.1'/><site name='s1'/></body></worldbody>\
+             <tendon><spatial stiffness='1'><site site='s0'/><site site='s1'/></spatial></tendon>\
+             </mujoco>"
+        )
+    };
+    assert_ne!(key(tendon("1")), key(tendon("2")));
+    // A muscle's length range is simulated from every dynamic value; colours still patch.
+    let muscle = |damping: &str, rgba: &str| {
+        format!(
+            "<mujoco><worldbody><body name='b'><joint name='j' damping='{damping}'/>\
+             <geom name='g' size='.1' pos='.2 0 0' rgba='{rgba}'/></body></worldbody>\
+             <actuator><muscle joint='j'/></actuator></mujoco>"
+        )
+    };
+    assert_ne!(key(muscle("1", "1 0 0 1")), key(muscle("2", "1 0 0 1")));
+    assert_eq!(key(muscle("1", "1 0 0 1")), key(muscle("1", "0 1 0 1")));
+    // Values MuJoCo checks are patched only where it takes them as written.
+    let inertia = |d: &str| {
+        format!(
+            "<mujoco><worldbody><body name='b'><freejoint/>\
+             <inertial pos='0 0 0' mass='1' diaginertia='{d}'/></body></worldbody></mujoco>"
+        )
+    };
+    assert_eq!(key(inertia("1 1 1")), key(inertia("1 2 2")));
+    assert_ne!(key(inertia("1 1 1")), key(inertia("1 1 3")));
+}
