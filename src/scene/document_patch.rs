@@ -16,6 +16,8 @@
 //! a spatial tendon's spring length at `qpos0`) keeps what it feeds into the key. So a
 //! key never promises more than MuJoCo's own compile gives.
 
+use std::path::Path;
+
 use super::patch::{
     self, PatchEntry, PatchValue, Rules, derives_damping, entry, numbers, owner, setting,
 };
@@ -186,8 +188,17 @@ impl Key {
     fn new(doc: &Document) -> Key {
         let mut key = Key(Vec::with_capacity(1 << 16));
         key.str("mjcf-forge document key 1");
-        // Relative file names resolve from here.
-        key.str(&doc.model_dir().to_string_lossy());
+        // Relative file names resolve from the model's folder (loading makes them
+        // absolute; a document edited afterwards may have some).
+        let relative = doc.descendants(doc.root()).any(|n| {
+            doc.attrs(n).any(|(a, v)| {
+                (a.starts_with("file") || matches!(a, "meshdir" | "texturedir" | "assetdir"))
+                    && Path::new(v.trim()).is_relative()
+            })
+        });
+        if relative {
+            key.str(&doc.model_dir().to_string_lossy());
+        }
         key
     }
 
