@@ -6,7 +6,11 @@
 //!   environment's own model, with `mj_setConst` and the compiler's statistics
 //!   (`ModelCache::apply`): a variant ready to step;
 //! - `model_cache/compile`: the same variant's XML made and compiled by MuJoCo, what a
-//!   new scene costs without the cache.
+//!   new scene costs without the cache;
+//! - `document_cache/split`: a variant taken as a plain document, split into its
+//!   structure key and patch (`split_document`, no MuJoCo);
+//! - `document_cache/hit`: `DocumentCache::model` on such a document of a cached
+//!   structure: the split, the patch written, `mj_setConst` and the statistics.
 //!
 //! Needs MuJoCo: `cargo bench --features mujoco --bench model_cache` (the MuJoCo build.rs
 //! finds: 3.17.0 in the repository, or the one in `MJCF_FORGE_MUJOCO_DIR`). Without the
@@ -19,9 +23,9 @@ mod with_mujoco {
     use std::time::Duration;
 
     use criterion::{Criterion, Throughput};
-    use mjcf_forge::compiled::ModelCache;
+    use mjcf_forge::compiled::{DocumentCache, ModelCache};
     use mjcf_forge::mujoco::compile_str;
-    use mjcf_forge::scene::Scene;
+    use mjcf_forge::scene::{Scene, split_document};
 
     fn lift5_fixed() -> Scene {
         Scene::load(concat!(
@@ -56,10 +60,41 @@ mod with_mujoco {
         });
         group.finish();
     }
+
+    pub fn document_cache(c: &mut Criterion) {
+        let scene = lift5_fixed();
+        // Documents made before timing: the cache is what is measured.
+        let docs: Vec<_> = (0..32)
+            .map(|i| scene.variant(i).expect("variant").document)
+            .collect();
+        let mut cache = DocumentCache::new(4, None);
+        cache.model(&docs[0]).expect("compiles");
+        let mut group = c.benchmark_group("document_cache");
+        group.throughput(Throughput::Elements(1));
+        let mut next = 1usize;
+        group.bench_function("split", |b| {
+            b.iter(|| {
+                black_box(split_document(&docs[next % docs.len()]));
+                next += 1;
+            });
+        });
+        group.bench_function("hit", |b| {
+            b.iter(|| {
+                black_box(cache.model(&docs[next % docs.len()]).expect("patched"));
+                next += 1;
+            });
+        });
+        group.finish();
+        assert_eq!(cache.compiles(), 1, "lift5_fixed has one structure");
+    }
 }
 
 #[cfg(mjcf_mujoco)]
-criterion::criterion_group!(benches, with_mujoco::model_cache);
+criterion::criterion_group!(
+    benches,
+    with_mujoco::model_cache,
+    with_mujoco::document_cache
+);
 #[cfg(mjcf_mujoco)]
 criterion::criterion_main!(benches);
 

@@ -36,7 +36,7 @@ echo "== judge self-tests (MuJoCo 3.17.0 and 4.0.0)"
 .cache/venv-mj4/bin/python -m pytest tests/judge -q -p no:cacheprovider
 echo "== python package (pytest: API, errors, threads, MuJoCo judge, Gymnasium, Ray)"
 .cache/venv/bin/python -m pytest python/tests -q -p no:cacheprovider
-echo "== ModelCache under MuJoCo 4.0.0 (patched models judged against 4.0.0's compile)"
-.cache/venv-mj4/bin/python -m pytest python/tests/test_model_cache.py -q -p no:cacheprovider
+echo "== ModelCache and DocumentCache under MuJoCo 4.0.0 (patched models judged against 4.0.0's compile)"
+.cache/venv-mj4/bin/python -m pytest python/tests/test_model_cache.py python/tests/test_document_cache.py -q -p no:cacheprovider
 echo "== fuzz smoke run (5 s per target; long campaigns: bash scripts/fuzz.sh SECONDS)"
 bash scripts/fuzz.sh 5

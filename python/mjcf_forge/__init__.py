@@ -11,6 +11,8 @@
   ``scene.variants(indices, threads=...)`` generates many on Rust threads.
 - :class:`ModelCache`: compiled models of a scene's variants at patch cost: one compile
   per structure (``variant.structure_key``), then ``variant.patch`` written into it.
+- :class:`DocumentCache`: the same for any document or MJCF text: its structure
+  (``doc.structure_key``) and patch (``doc.patch``) found by reading it.
 - :class:`MjcfError`: the one exception type (a ``ValueError``), with ``.errors``.
 - :mod:`mjcf_forge.base`: robosuite's ``MujocoXML``, ``MujocoModel`` and
   ``MujocoXMLModel`` (``robosuite.models.base``) over documents, for code written for
@@ -32,12 +34,14 @@ from ._mjcf_forge import (
     __version__,
 )
 from ._cache import ModelCache
+from ._doc_cache import DocumentCache
 from . import etree
 from . import base
 
 __all__ = [
     "Attrib",
     "Document",
+    "DocumentCache",
     "Element",
     "MergeReport",
     "MjcfError",

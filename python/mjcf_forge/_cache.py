@@ -15,7 +15,7 @@ from __future__ import annotations
 import collections
 import copy
 import itertools
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -66,6 +66,23 @@ _STATIC_PREFIXES = (
 )
 
 
+def _evict(
+    entries: "collections.OrderedDict[str, Any]",
+    max_models: int,
+    max_bytes: int | None,
+    nbytes: Callable[[], int],
+    dropped: Callable[[str, Any], None],
+) -> None:
+    """The bound both caches keep: the least recently used entries out (``dropped`` is
+    told of each) while there are more than ``max_models`` or ``nbytes()`` is above
+    ``max_bytes``; the most recent one always stays."""
+    while len(entries) > 1 and (
+        len(entries) > max_models or (max_bytes is not None and nbytes() > max_bytes)
+    ):
+        key, gone = entries.popitem(last=False)
+        dropped(key, gone)
+
+
 def _copy(value: Any) -> Any:
     return value.copy() if hasattr(value, "copy") else value
 
@@ -79,6 +96,7 @@ _PREFIX = {
     "camera": "cam_",
     "light": "light_",
     "material": "mat_",
+    "actuator": "actuator_",
 }
 _OBJ = {
     "body": "mjOBJ_BODY",
@@ -88,6 +106,7 @@ _OBJ = {
     "camera": "mjOBJ_CAMERA",
     "light": "mjOBJ_LIGHT",
     "material": "mjOBJ_MATERIAL",
+    "actuator": "mjOBJ_ACTUATOR",
 }
 _COUNT = {
     "body": "nbody",
@@ -97,6 +116,7 @@ _COUNT = {
     "camera": "ncam",
     "light": "nlight",
     "material": "nmat",
+    "actuator": "nu",
 }
 # Joint fields that are per degree of freedom or per qpos coordinate.
 _DOF_FIELDS = ("damping", "armature", "frictionloss")
@@ -133,7 +153,10 @@ class _Plan:
         self.nbytes = model.nbuffer + data.nbuffer + data.narena
         self.fields: list[tuple[Any, Any, str]] | None = None
         self.groups: list[tuple[Any, np.ndarray, np.ndarray]] = []
+        # (flat array, index, which material name of the patch) per matid entry.
         self.matids: list[tuple[Any, int, int]] = []
+        # (field of model.opt, first of its numbers, how many) per option entry.
+        self.options: list[tuple[str, int, int]] = []
         # The <statistic> values the scene sets: MuJoCo keeps them over what it computes.
         self.fixed = fixed
         # Views (fetching one from the bindings costs microseconds) and constants.
@@ -178,8 +201,15 @@ class _Plan:
         mujoco, model = self.mujoco, self.model
         groups: dict[str, tuple[Any, list[int], list[int]]] = {}
         matids: list[tuple[Any, int, int]] = []
+        options: list[tuple[str, int, int]] = []
         numbers = 0
-        for k, (obj, name, field, value) in enumerate(patch):
+        for obj, name, field, value in patch:
+            if obj == "option":
+                if isinstance(value, str) or not hasattr(model.opt, field):
+                    raise _error(f"this MuJoCo's mjOption has no field {field}")
+                options.append((field, numbers, len(value)))
+                numbers += len(value)
+                continue
             if isinstance(name, int):
                 i = name if name < getattr(model, _COUNT[obj]) else -1
             else:
@@ -205,7 +235,7 @@ class _Plan:
             if not np.shares_memory(flat, whole):
                 raise _error(f"mjModel.{array} is not one contiguous array here")
             if isinstance(value, str):
-                matids.append((flat, rows[0], k))
+                matids.append((flat, rows[0], len(matids)))
                 continue
             _, targets, sources = groups.setdefault(array, (flat, [], []))
             targets.extend(rows)
@@ -215,6 +245,7 @@ class _Plan:
             numbers += len(value)
         self.groups = [(flat, np.array(t), np.array(s)) for flat, t, s in groups.values()]
         self.matids = matids
+        self.options = options
         self.fields = [tuple(e[:3]) for e in patch]
 
     def apply(self, patch: list) -> None:
@@ -230,13 +261,30 @@ class _Plan:
             itertools.chain.from_iterable(e[3] for e in patch if not isinstance(e[3], str)),
             dtype=np.float64,
         )
+        self.write(values, [e[3] for e in patch if isinstance(e[3], str)])
+        self.finish()
+
+    def write(self, values: np.ndarray, materials: list) -> None:
+        """Writes a patch of the resolved layout: its numbers end to end (``values``) and
+        the names of its materials in order."""
         for flat, targets, sources in self.groups:
             # A float32 array takes the numbers rounded as MuJoCo rounds them (they are).
             flat[targets] = values[sources]
         for flat, index, k in self.matids:
-            flat[index] = self.mujoco.mj_name2id(
-                self.model, self.mujoco.mjtObj.mjOBJ_MATERIAL, patch[k][3]
-            )
+            i = self.mujoco.mj_name2id(self.model, self.mujoco.mjtObj.mjOBJ_MATERIAL, materials[k])
+            if i < 0:
+                raise _error(f"no material named '{materials[k]}'")
+            flat[index] = i
+        opt = self.model.opt
+        for field, first, n in self.options:
+            if n == 1:
+                setattr(opt, field, float(values[first]))
+            else:
+                getattr(opt, field)[:] = values[first : first + n]
+
+    def finish(self) -> None:
+        """What follows the values: ``mj_setConst``, the compiler's statistics, and the
+        statistics the document fixes."""
         self.mujoco.mj_setConst(self.model, self.data)
         self.statistics()
         for stat, value in self.fixed:
@@ -364,13 +412,12 @@ class ModelCache:
 
     def _trim(self) -> None:
         cached = {id(m) for m in self._entries.values()}
-        while len(self._entries) > 1 and (
-            len(self._entries) > self._max_models
-            or (self._max_bytes is not None and self.nbytes > self._max_bytes)
-        ):
-            _, gone = self._entries.popitem(last=False)
+
+        def dropped(_key: str, gone: Any) -> None:
             self._plans.pop(id(gone), None)
             cached.discard(id(gone))
+
+        _evict(self._entries, self._max_models, self._max_bytes, lambda: self.nbytes, dropped)
         # Plans of the caller's models: as many as cached models are allowed.
         extra = [k for k in self._plans if k not in cached]
         for k in extra[: max(0, len(extra) - self._max_models)]:

@@ -3,42 +3,19 @@
 //! ([`crate::scene::Scene::patch`]) into its arrays, then running MuJoCo's `mj_setConst`
 //! and the statistics the compiler derives from the model at `qpos0` (which `mj_setConst`
 //! of 3.17 and 4.0 leaves): exactly the model MuJoCo compiles from the variant's XML
-//! (`tests/model_cache.rs` compares every array bit for bit).
-//!
-//! The C side (`patch.c`) is compiled against the linked MuJoCo's headers, as the FFI's
-//! shim is; arrays are found by name through MuJoCo's X-macro table, so no Rust copy of
-//! `mjModel`'s layout is needed. Models come from the FFI ([`crate::mujoco`]), which hands
-//! over the raw model, its serial number and the writable pointer through `pub(crate)` items.
+//! (`tests/model_cache.rs` compares every array bit for bit). The mechanism (models kept by
+//! key, least recently used out; plans; the C side) is `store.rs`, which
+//! [`super::DocumentCache`] shares.
 
 use std::collections::HashMap;
-use std::ffi::{CString, c_char, c_int, c_void};
-use std::ptr::NonNull;
+use std::ffi::{CString, c_int};
 
-use crate::mujoco::{CompileError, CompiledModel, MjModel, ObjType, Sizes, compile_str};
-use crate::scene::{PatchEntry, PatchValue, Scene, Superset, VariantPatch};
-
-/// mjData, opaque here: only the C side reads it.
-#[repr(C)]
-struct RawData {
-    _private: [u8; 0],
-}
-
-unsafe extern "C" {
-    fn mjf_patch_array(
-        m: *mut MjModel,
-        name: *const c_char,
-        elem: *mut usize,
-        count: *mut usize,
-    ) -> *mut c_void;
-    fn mjf_patch_name2id(m: *const MjModel, kind: *const c_char, name: *const c_char) -> c_int;
-    fn mjf_patch_make_data(m: *const MjModel) -> *mut RawData;
-    fn mjf_patch_delete_data(d: *mut RawData);
-    fn mjf_patch_nbytes(m: *const MjModel, d: *const RawData) -> i64;
-    fn mjf_patch_get_stat(m: *const MjModel, out: *mut f64);
-    fn mjf_patch_finish(m: *mut MjModel, d: *mut RawData, fixed: c_int, values: *const f64);
-    fn mjf_patch_array_name(i: c_int) -> *const c_char;
-    fn mjf_patch_meaninertia(m: *mut MjModel, d: *const RawData, keep: *const c_int, n: c_int);
-}
+use super::store::{
+    Signature, State, Store, mjf_patch_array, mjf_patch_array_name, mjf_patch_get_stat,
+    mjf_patch_meaninertia, mjf_patch_name2id,
+};
+use crate::mujoco::{CompileError, CompiledModel, compile_str};
+use crate::scene::{PatchEntry, Scene, Superset, VariantPatch};
 
 impl CompiledModel {
     /// Where `other` differs from this model: every array of `mjModel` compared bit for
@@ -107,73 +84,6 @@ impl CompiledModel {
     }
 }
 
-/// Scratch mjData for `mj_setConst` (which overwrites the qpos of the data it is given).
-struct Scratch(NonNull<RawData>);
-
-// SAFETY: exclusively owned heap data without thread affinity.
-unsafe impl Send for Scratch {}
-
-impl Scratch {
-    fn new(model: &CompiledModel) -> Result<Scratch, String> {
-        // SAFETY: the model is live.
-        let d = unsafe { mjf_patch_make_data(model.raw()) };
-        NonNull::new(d)
-            .map(Scratch)
-            .ok_or_else(|| "MuJoCo could not allocate mjData for the model".to_string())
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        // SAFETY: made by mj_makeData, owned here alone.
-        unsafe { mjf_patch_delete_data(self.0.as_ptr()) }
-    }
-}
-
-/// Where one patch entry lands: `n` elements at `ptr` (`elem` bytes each; a one-value
-/// entry fills all `n`, as a joint's damping fills each of its dofs).
-struct Target {
-    ptr: *mut u8,
-    elem: usize,
-    n: usize,
-    /// The field holds integers: an id (`geom_matid`, the value a material's name) or
-    /// collision bits (`geom_contype`, `geom_conaffinity`).
-    int: bool,
-}
-
-/// How to patch one model: its structure key, scratch data and resolved targets.
-struct Plan {
-    serial: u64,
-    key: String,
-    scratch: Scratch,
-    fields: Vec<(&'static str, String, Option<usize>, &'static str)>,
-    targets: Vec<Target>,
-    nbytes: usize,
-}
-
-// SAFETY: the raw pointers point into the model the plan belongs to, which is only
-// written through `&mut` of that model.
-unsafe impl Send for Plan {}
-
-/// What a structure is: the sizes and names of its model, to refuse a model of another.
-#[derive(PartialEq)]
-struct Signature {
-    sizes: Sizes,
-    names: Vec<Vec<String>>,
-}
-
-impl Signature {
-    fn of(m: &CompiledModel) -> Signature {
-        Signature {
-            sizes: m.sizes(),
-            names: [ObjType::Body, ObjType::Joint, ObjType::Geom, ObjType::Site]
-                .into_iter()
-                .map(|o| m.names(o))
-                .collect(),
-        }
-    }
-}
-
 /// Compiled models of a [`Scene`]'s variants, one per structure, patched per variant;
 /// bounded in count and bytes (models and their scratch data), least recently used out.
 ///
@@ -198,56 +108,21 @@ pub struct ModelCache<'s> {
     dir: Option<std::path::PathBuf>,
     /// With [`ModelCache::with_superset`]: the scene's superset.
     superset: Option<SupersetState>,
-    /// Cached models by structure key, least recently used first.
-    entries: Vec<(String, CompiledModel)>,
-    state: State,
-}
-
-/// Everything but the cached models (so that a cached model and the plans can be borrowed
-/// at once).
-struct State {
-    max_models: usize,
-    max_bytes: Option<usize>,
-    /// Plans by model serial (cached models' and callers'), least recently used first.
-    plans: Vec<Plan>,
-    signatures: HashMap<String, Signature>,
-    /// Per structure, the statistics the scene fixes (see `Scene::fixed_statistics`).
-    stats: HashMap<String, [f64; 7]>,
+    /// The statistics the scene's `<statistic>` fixes, as bits (see `Store::insert`).
     fixed: c_int,
-    compiles: u64,
-    patches: u64,
+    store: Store,
 }
 
 impl<'s> ModelCache<'s> {
     /// A cache for `scene` holding at most `max_models` compiled models (at least one)
     /// and, when given, about `max_bytes` of models and scratch data.
     pub fn new(scene: &'s Scene, max_models: usize, max_bytes: Option<usize>) -> Self {
-        let fixed = scene
-            .fixed_statistics()
-            .iter()
-            .map(|s| match *s {
-                "meaninertia" => 1,
-                "meanmass" => 2,
-                "meansize" => 4,
-                "extent" => 8,
-                _ => 16,
-            })
-            .fold(0, |a, b| a | b);
         ModelCache {
             scene,
             dir: None,
             superset: None,
-            entries: Vec::new(),
-            state: State {
-                max_models: max_models.max(1),
-                max_bytes,
-                plans: Vec::new(),
-                signatures: HashMap::new(),
-                stats: HashMap::new(),
-                fixed,
-                compiles: 0,
-                patches: 0,
-            },
+            fixed: super::fixed_bits(&scene.fixed_statistics()),
+            store: Store::new(max_models, max_bytes),
         }
     }
 
@@ -282,27 +157,27 @@ impl<'s> ModelCache<'s> {
 
     /// Models compiled so far (misses).
     pub fn compiles(&self) -> u64 {
-        self.state.compiles
+        self.store.state.compiles
     }
 
     /// Patches applied so far.
     pub fn patches(&self) -> u64 {
-        self.state.patches
+        self.store.state.patches
     }
 
     /// How many compiled models the cache holds.
     pub fn len(&self) -> usize {
-        self.entries.len()
+        self.store.entries.len()
     }
 
     /// Whether the cache holds none.
     pub fn is_empty(&self) -> bool {
-        self.entries.is_empty()
+        self.store.entries.is_empty()
     }
 
     /// Bytes held: the cached models and every plan's scratch data.
     pub fn nbytes(&self) -> usize {
-        self.state.nbytes()
+        self.store.nbytes()
     }
 
     /// Variant `index` as MuJoCo compiles it from its XML: the cached model of its
@@ -311,32 +186,31 @@ impl<'s> ModelCache<'s> {
     pub fn model(&mut self, index: u64) -> Result<&CompiledModel, String> {
         let patch = self.patch_of(index)?;
         let key = patch.structure_key;
-        let at = match self.entries.iter().position(|(k, _)| *k == key) {
-            None => {
-                self.compile(index, &key)?;
-                // The superset as compiled parks every object: place the variant's.
-                self.superset.is_some()
-            }
-            Some(at) => {
-                let entry = self.entries.remove(at);
-                self.entries.push(entry);
-                true
-            }
+        let patch_it = if self.store.touch(&key) {
+            true
+        } else {
+            self.compile(index, &key)?;
+            // The superset as compiled parks every object: place the variant's.
+            self.superset.is_some()
         };
-        let last = self.entries.len() - 1;
-        if at {
-            let model = &mut self.entries[last].1;
+        let store = &mut self.store;
+        let Some((_, model)) = store.entries.last_mut() else {
+            return Err("the cache holds no model".to_string());
+        };
+        if patch_it {
             let target = (index, key.as_str(), patch.entries.as_slice());
             patch_variant(
                 self.scene,
                 &mut self.superset,
-                &mut self.state,
+                &mut store.state,
                 target,
                 model,
             )?;
-            self.state.trim(&mut self.entries);
+            store.trim();
         }
-        Ok(&self.entries[self.entries.len() - 1].1)
+        store
+            .last()
+            .ok_or_else(|| "the cache holds no model".to_string())
     }
 
     /// Patches `model`, a model of variant `index`'s structure, in place into variant
@@ -344,7 +218,12 @@ impl<'s> ModelCache<'s> {
     pub fn apply(&mut self, index: u64, model: &mut CompiledModel) -> Result<(), String> {
         let patch = self.patch_of(index)?;
         let key = patch.structure_key;
-        let known = self.state.plans.iter().find(|p| p.serial == model.serial());
+        let known = self
+            .store
+            .state
+            .plans
+            .iter()
+            .find(|p| p.serial == model.serial());
         match known {
             Some(p) if p.key != key => {
                 return Err(format!(
@@ -355,10 +234,10 @@ impl<'s> ModelCache<'s> {
             }
             Some(_) => {}
             None => {
-                if !self.state.signatures.contains_key(&key) {
+                if !self.store.state.signatures.contains_key(&key) {
                     self.compile(index, &key)?;
                 }
-                if self.state.signatures.get(&key) != Some(&Signature::of(model)) {
+                if self.store.state.signatures.get(&key) != Some(&Signature::of(model)) {
                     return Err(format!(
                         "the model does not have the structure of variant {index} (key \
                          {key}): its sizes or names differ"
@@ -367,14 +246,9 @@ impl<'s> ModelCache<'s> {
             }
         }
         let target = (index, key.as_str(), patch.entries.as_slice());
-        patch_variant(
-            self.scene,
-            &mut self.superset,
-            &mut self.state,
-            target,
-            model,
-        )?;
-        self.state.trim(&mut self.entries);
+        let state = &mut self.store.state;
+        patch_variant(self.scene, &mut self.superset, state, target, model)?;
+        self.store.trim();
         Ok(())
     }
 
@@ -389,104 +263,7 @@ impl<'s> ModelCache<'s> {
             .unwrap_or_else(|| self.scene.template().model_dir());
         let model = compile_str(&xml, dir)
             .map_err(|e: CompileError| format!("variant {index}: MuJoCo: {e}"))?;
-        let state = &mut self.state;
-        state.compiles += 1;
-        let mut stat = [0.0; 7];
-        // SAFETY: the model is live; `stat` holds 7 values.
-        unsafe { mjf_patch_get_stat(model.raw(), stat.as_mut_ptr()) };
-        state.stats.insert(key.to_string(), stat);
-        state
-            .signatures
-            .insert(key.to_string(), Signature::of(&model));
-        // Its plan now, so that its bytes count.
-        state.plan_of(&model, key)?;
-        self.entries.push((key.to_string(), model));
-        self.state.trim(&mut self.entries);
-        Ok(())
-    }
-}
-
-impl State {
-    fn nbytes(&self) -> usize {
-        self.plans.iter().map(|p| p.nbytes).sum()
-    }
-
-    /// Drops the least recently used models (and plans) beyond the bounds.
-    fn trim(&mut self, entries: &mut Vec<(String, CompiledModel)>) {
-        while entries.len() > 1
-            && (entries.len() > self.max_models
-                || self.max_bytes.is_some_and(|b| self.nbytes() > b))
-        {
-            let (_, gone) = entries.remove(0);
-            self.plans.retain(|p| p.serial != gone.serial());
-        }
-        // Plans of callers' models: as many as cached models are allowed.
-        let cached: Vec<u64> = entries.iter().map(|(_, m)| m.serial()).collect();
-        let mut extra = self
-            .plans
-            .iter()
-            .filter(|p| !cached.contains(&p.serial))
-            .count();
-        self.plans.retain(|p| {
-            if extra > self.max_models && !cached.contains(&p.serial) {
-                extra -= 1;
-                false
-            } else {
-                true
-            }
-        });
-    }
-
-    /// The index of `model`'s plan, made on first sight.
-    fn plan_of(&mut self, model: &CompiledModel, key: &str) -> Result<usize, String> {
-        if let Some(at) = self.plans.iter().position(|p| p.serial == model.serial()) {
-            return Ok(at);
-        }
-        let scratch = Scratch::new(model)?;
-        // SAFETY: model and data are live.
-        let nbytes = unsafe { mjf_patch_nbytes(model.raw(), scratch.0.as_ptr()) };
-        self.plans.push(Plan {
-            serial: model.serial(),
-            key: key.to_string(),
-            scratch,
-            fields: Vec::new(),
-            targets: Vec::new(),
-            nbytes: usize::try_from(nbytes).unwrap_or(0),
-        });
-        Ok(self.plans.len() - 1)
-    }
-
-    fn patch_model(
-        &mut self,
-        model: &mut CompiledModel,
-        key: &str,
-        entries: &[PatchEntry],
-    ) -> Result<(), String> {
-        let at = self.plan_of(model, key)?;
-        let plan = &mut self.plans[at];
-        let same =
-            plan.fields.len() == entries.len()
-                && plan.fields.iter().zip(entries).all(|(f, e)| {
-                    f.0 == e.object && f.1 == e.name && f.2 == e.id && f.3 == e.field
-                });
-        if !same {
-            plan.targets = resolve(model, entries)?;
-            plan.fields = entries
-                .iter()
-                .map(|e| (e.object, e.name.clone(), e.id, e.field))
-                .collect();
-        }
-        let ptr = model.as_mut_ptr();
-        for (t, e) in plan.targets.iter().zip(entries) {
-            write(ptr, t, &e.value)?;
-        }
-        let stat = self.stats.get(key).copied().unwrap_or_default();
-        // SAFETY: the model and its scratch data are live and of one structure.
-        unsafe { mjf_patch_finish(ptr, plan.scratch.0.as_ptr(), self.fixed, stat.as_ptr()) };
-        let plan = self.plans.remove(at);
-        self.plans.push(plan);
-        self.patches += 1;
-        Ok(())
+        self.store.insert(key, model, self.fixed)
     }
 }
 
@@ -579,129 +356,4 @@ fn kept_dofs(model: &mut CompiledModel, parked: &[String]) -> Result<Vec<c_int>,
     Ok((0..nv as c_int)
         .filter(|&d| !parked_dof[d as usize])
         .collect())
-}
-
-/// Writes one entry's value at its target.
-fn write(model: *mut MjModel, t: &Target, value: &PatchValue) -> Result<(), String> {
-    match value {
-        PatchValue::Id { object, name } => {
-            let kind = CString::new(*object).map_err(|e| e.to_string())?;
-            let name = CString::new(name.as_str()).map_err(|e| e.to_string())?;
-            // SAFETY: the model is live; both strings are NUL-terminated.
-            let id = unsafe { mjf_patch_name2id(model, kind.as_ptr(), name.as_ptr()) };
-            if id < 0 || !t.int || t.elem != 4 {
-                return Err(format!("no {} named '{}'", object, name.to_string_lossy()));
-            }
-            // SAFETY: `ptr` points at `n` >= 1 ints of the live model (see `resolve`).
-            unsafe { t.ptr.cast::<c_int>().write_unaligned(id) };
-        }
-        PatchValue::Numbers(v) => {
-            for k in 0..t.n {
-                let x = if v.len() == 1 { v[0] } else { v[k] };
-                // SAFETY: `ptr` points at `n` elements of `elem` bytes of the live model,
-                // checked against the array's length in `resolve`.
-                unsafe {
-                    match (t.elem, t.int) {
-                        (4, true) => t.ptr.cast::<c_int>().add(k).write_unaligned(x as c_int),
-                        (4, false) => t.ptr.cast::<f32>().add(k).write_unaligned(x as f32),
-                        _ => t.ptr.cast::<f64>().add(k).write_unaligned(x),
-                    }
-                }
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Where every entry lands in `model`.
-fn resolve(model: &mut CompiledModel, entries: &[PatchEntry]) -> Result<Vec<Target>, String> {
-    let ptr = model.as_mut_ptr();
-    let array = |name: &str| -> Result<(*mut u8, usize, usize), String> {
-        let c = CString::new(name).map_err(|e| e.to_string())?;
-        let (mut elem, mut count) = (0usize, 0usize);
-        // SAFETY: the model is live; `c` is NUL-terminated.
-        let p = unsafe { mjf_patch_array(ptr, c.as_ptr(), &mut elem, &mut count) };
-        if p.is_null() && count > 0 || elem == 0 {
-            return Err(format!("this MuJoCo's mjModel has no array {name}"));
-        }
-        Ok((p.cast(), elem, count))
-    };
-    let int_at = |name: &str, i: usize| -> Result<usize, String> {
-        let (p, elem, count) = array(name)?;
-        if elem != 4 || i >= count {
-            return Err(format!("{name}[{i}] out of range"));
-        }
-        // SAFETY: `i` < count ints at `p`.
-        let v = unsafe { p.cast::<c_int>().add(i).read_unaligned() };
-        usize::try_from(v).map_err(|_| format!("{name}[{i}] is negative"))
-    };
-    let mut out = Vec::with_capacity(entries.len());
-    for e in entries {
-        let id = match e.id {
-            Some(id) => id,
-            None => {
-                let kind = CString::new(e.object).map_err(|x| x.to_string())?;
-                let name = CString::new(e.name.as_str()).map_err(|x| x.to_string())?;
-                // SAFETY: the model is live; both strings are NUL-terminated.
-                let id = unsafe { mjf_patch_name2id(ptr, kind.as_ptr(), name.as_ptr()) };
-                usize::try_from(id).map_err(|_| {
-                    format!(
-                        "the patch names {} '{}', which the compiled model does not have",
-                        e.object, e.name
-                    )
-                })?
-            }
-        };
-        let width = match &e.value {
-            PatchValue::Numbers(v) => v.len(),
-            PatchValue::Id { .. } => 1,
-        };
-        let (name, offset, n) = match (e.object, e.field) {
-            ("joint", f @ ("damping" | "armature" | "frictionloss")) => {
-                let dofs = match int_at("jnt_type", id)? {
-                    0 => 6,
-                    1 => 3,
-                    _ => 1,
-                };
-                (format!("dof_{f}"), int_at("jnt_dofadr", id)?, dofs)
-            }
-            ("joint", f @ ("qpos0" | "qpos_spring")) => {
-                let n = match int_at("jnt_type", id)? {
-                    0 => 7,
-                    1 => 4,
-                    _ => 1,
-                };
-                (f.to_string(), int_at("jnt_qposadr", id)?, n)
-            }
-            (object, field) => {
-                let prefix = match object {
-                    "body" => "body_",
-                    "joint" => "jnt_",
-                    "geom" => "geom_",
-                    "site" => "site_",
-                    "camera" => "cam_",
-                    "light" => "light_",
-                    _ => "mat_",
-                };
-                (format!("{prefix}{field}"), id * width, width)
-            }
-        };
-        let (p, elem, count) = array(&name)?;
-        if offset + n > count {
-            return Err(format!(
-                "{} '{}': {name}[{offset}..{}] is outside the model's {count}",
-                e.object,
-                e.name,
-                offset + n
-            ));
-        }
-        out.push(Target {
-            // SAFETY: in bounds, checked above.
-            ptr: unsafe { p.add(offset * elem) },
-            elem,
-            n,
-            int: matches!(e.field, "matid" | "contype" | "conaffinity"),
-        });
-    }
-    Ok(out)
 }

@@ -1,14 +1,18 @@
-//! The compiled tier: a scene's variants as MuJoCo models, made at patch cost (builds with
-//! the cargo feature `mujoco`).
+//! The compiled tier: MuJoCo models made at patch cost (builds with the cargo feature
+//! `mujoco`).
 //!
 //! [`ModelCache`] compiles each structure of a [`Scene`](crate::scene::Scene) once and
 //! turns that model into any variant of the structure by writing the variant's patch into
-//! its arrays. This tier is where whatever hands compiled variants to simulators belongs:
-//! model caches, and the per-world arrays batched simulators take.
+//! its arrays; [`DocumentCache`] does the same for any [`Document`](crate::Document),
+//! finding its structure and patch by reading it
+//! ([`split_document`](crate::scene::split_document)). Both keep their models in one
+//! mechanism (`store.rs`: models by structure key, least recently used out, and how a
+//! model is patched). This tier is where whatever hands compiled models to simulators
+//! belongs: model caches, and the per-world arrays batched simulators take.
 //!
-//! May use: the scene tier (variants, their patches, the superset), the MuJoCo FFI
-//! (`crate::mujoco`: compiling, and the raw model through its `pub(crate)` items) and the
-//! tiers below them. Sits above both; only the faces (CLI, Python) use it.
+//! May use: the scene tier (variants, their patches, the superset, document splits), the
+//! MuJoCo FFI (`crate::mujoco`: compiling, and the raw model through its `pub(crate)`
+//! items) and the tiers below them. Sits above both; only the faces (CLI, Python) use it.
 //!
 //! ```no_run
 //! use mjcf_forge::compiled::ModelCache;
@@ -19,10 +23,27 @@
 //! println!("{} bodies", cache.model(0).unwrap().sizes().nbody);
 //! ```
 
-// The cache writes into MuJoCo's models through its own C (`patch.c`, which `build.rs`
+// The caches write into MuJoCo's models through their own C (`patch.c`, which `build.rs`
 // compiles against the linked MuJoCo's headers), as the FFI tier does.
 #![allow(unsafe_code)]
 
 mod cache;
+mod document;
+mod store;
 
 pub use cache::ModelCache;
+pub use document::DocumentCache;
+
+/// The statistics a `<statistic>` fixes as the bits `patch.c`'s `mjf_patch_finish` takes.
+fn fixed_bits(names: &[&str]) -> std::ffi::c_int {
+    names
+        .iter()
+        .map(|s| match *s {
+            "meaninertia" => 1,
+            "meanmass" => 2,
+            "meansize" => 4,
+            "extent" => 8,
+            _ => 16,
+        })
+        .fold(0, |a, b| a | b)
+}

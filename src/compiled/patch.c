@@ -31,17 +31,35 @@ void* mjf_patch_array(mjModel* m, const char* name, size_t* elem_size, size_t* c
 }
 
 // The id of the element of `kind` ("body", "joint", "geom", "site", "camera", "light",
-// "material") named `name`; -1 when there is none.
+// "material", "actuator") named `name`; -1 when there is none.
 int mjf_patch_name2id(const mjModel* m, const char* kind, const char* name) {
   static const struct { const char* name; int obj; } kinds[] = {
     {"body", mjOBJ_BODY},     {"joint", mjOBJ_JOINT}, {"geom", mjOBJ_GEOM},
     {"site", mjOBJ_SITE},     {"camera", mjOBJ_CAMERA}, {"light", mjOBJ_LIGHT},
-    {"material", mjOBJ_MATERIAL},
+    {"material", mjOBJ_MATERIAL}, {"actuator", mjOBJ_ACTUATOR},
   };
   for (size_t i = 0; i < sizeof(kinds) / sizeof(kinds[0]); i++) {
     if (strcmp(kinds[i].name, kind) == 0) return mj_name2id(m, kinds[i].obj, name);
   }
   return -1;
+}
+
+// A writable field of the model's mjOption (MJOPTION_FIELDS), the size of its elements in
+// bytes and how many it has; NULL and 0 when `name` is not one.
+void* mjf_patch_option(mjModel* m, const char* name, size_t* elem_size, size_t* count) {
+#define X(type, field, n)                               \
+  if (strcmp(name, #field) == 0) {                      \
+    *elem_size = sizeof(type);                          \
+    *count = (size_t)(n);                               \
+    return (void*)&m->opt.field;                        \
+  }
+#define XVEC X
+  MJOPTION_FIELDS
+#undef XVEC
+#undef X
+  *elem_size = 0;
+  *count = 0;
+  return NULL;
 }
 
 mjData* mjf_patch_make_data(const mjModel* m) { return mj_makeData(m); }

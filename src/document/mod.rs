@@ -16,7 +16,8 @@
 //!   copied between documents or into one of their own), [`text`] (text and tail),
 //!   [`import`] (nodes copied between arenas, and the [`NodeMap`](import::NodeMap) of where
 //!   they went);
-//! - writing: [`write`](mod@write) (compact and pretty XML; files through `output`);
+//! - writing: [`write`](mod@write) (compact and pretty XML; files through `output`), and
+//!   [`locate`] (MuJoCo's errors about what was written, back at the user's sources);
 //! - [`limits`]: the input limits every reader honours.
 //!
 //! May use: `crate::error` and `crate::output` (atomic files). Knows nothing of models,
@@ -28,6 +29,7 @@ pub(crate) mod import;
 pub(crate) mod inertia;
 pub(crate) mod limits;
 pub(crate) mod load;
+pub(crate) mod locate;
 pub(crate) mod names;
 pub(crate) mod paths;
 pub(crate) mod prefix;

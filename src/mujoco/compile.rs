@@ -12,6 +12,8 @@ use std::sync::OnceLock;
 
 use super::model::CompiledModel;
 use super::sys;
+use crate::document::Document;
+use crate::error::Error;
 
 /// Bytes for MuJoCo's error (or warning) text; longer text is cut at this length.
 const ERROR_BUF_LEN: usize = 4096;
@@ -57,7 +59,7 @@ impl CompileError {
     pub fn from_message(message: impl Into<String>) -> Self {
         let mut message = message.into();
         message.truncate(message.trim_end().len());
-        let element_line = parse_line(&message);
+        let element_line = crate::document::locate::error_line(&message);
         Self {
             message,
             element_line,
@@ -87,30 +89,6 @@ impl From<String> for CompileError {
     fn from(message: String) -> Self {
         Self::local(message)
     }
-}
-
-/// The line number in a MuJoCo error message: MuJoCo's `", line N"` (it ends the
-/// `Element ...` line of its messages), else tinyxml2's `"Line number=N"`.
-fn parse_line(message: &str) -> Option<u32> {
-    let element_line = message
-        .lines()
-        .rev()
-        .filter(|line| line.trim_start().starts_with("Element"))
-        .find_map(|line| number_after(line, ", line "));
-    element_line
-        .or_else(|| number_after(message, ", line "))
-        .or_else(|| number_after(message, "Line number="))
-}
-
-/// The decimal number right after the last `marker` in `text` that has one.
-fn number_after(text: &str, marker: &str) -> Option<u32> {
-    text.rmatch_indices(marker).find_map(|(at, _)| {
-        let rest = &text[at + marker.len()..];
-        let end = rest
-            .find(|c: char| !c.is_ascii_digit())
-            .unwrap_or(rest.len());
-        rest[..end].parse().ok()
-    })
 }
 
 /// Compiles the MJCF (or URDF) file at `path`; its relative file references (includes,
@@ -171,6 +149,26 @@ pub fn compile_str(xml: &str, dir: &Path) -> Result<CompiledModel, CompileError>
         )));
     }
     load_xml(&name, Some(&vfs))
+}
+
+/// Compiles `doc` as MuJoCo reads it (its indented XML, relative references resolved from
+/// the model's folder, though loading made them absolute already), with MuJoCo's error,
+/// if any, at the element it names in the user's sources ([`Document::mujoco_error`]):
+/// `robot.xml:12:7: Error: mesh 'nope' not found in geom 0`, the rest of MuJoCo's message
+/// (whose own `line N` counts lines of the XML it was given) and the include chain.
+///
+/// ```
+/// use mjcf_forge::Document;
+/// use mjcf_forge::mujoco::compile_document;
+///
+/// let doc = Document::from_str("<mujoco>\n<worldbody>\n<geom type='mesh' mesh='nope'/>\n</worldbody>\n</mujoco>", ".")?;
+/// let err = compile_document(&doc).unwrap_err();
+/// assert!(err.to_string().starts_with("<string>:3:1: "), "{err}");
+/// # Ok::<(), mjcf_forge::Errors>(())
+/// ```
+pub fn compile_document(doc: &Document) -> Result<CompiledModel, Error> {
+    let xml = doc.to_pretty_string();
+    compile_str(&xml, doc.model_dir()).map_err(|e| doc.mujoco_error(&xml, &e.message))
 }
 
 /// Runs `mj_loadXML` and wraps the result.

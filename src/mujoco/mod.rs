@@ -1,6 +1,6 @@
 //! The MuJoCo FFI tier: compile MJCF with MuJoCo's own C library (cargo feature `mujoco`).
 //!
-//! [`compile_file`] and [`compile_str`] run MuJoCo's XML loader (`mj_loadXML`: parse,
+//! [`compile_file`], [`compile_str`] and [`compile_document`] run MuJoCo's XML loader (`mj_loadXML`: parse,
 //! then compile) and return a [`CompiledModel`], a safe owning handle to the resulting
 //! `mjModel`, or a [`CompileError`] carrying MuJoCo's own message and, when MuJoCo names
 //! one, the line of the offending element. [`write_inertials`] and
@@ -57,7 +57,7 @@ mod inertia;
 mod model;
 mod sys;
 
-pub use compile::{CompileError, compile_file, compile_str};
+pub use compile::{CompileError, compile_document, compile_file, compile_str};
 pub(crate) use inertia::{compiled_inertia, free_joint_qpos0};
 pub use inertia::{write_all_inertials, write_inertials};
 pub use model::{CompiledModel, Contact, ObjType, Sizes};

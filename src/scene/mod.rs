@@ -26,7 +26,8 @@
 //!
 //! Files: `spec.rs` (the scene file), `load/` (checks, template, instances), `place.rs`,
 //! `randomize.rs`, `rng.rs`, `splice.rs` (variants as text), `params.rs` (the manifest),
-//! `patch.rs` (structure keys and patches), `superset.rs` (one model for every variant),
+//! `patch.rs` (structure keys and patches), `document_patch.rs` (the same for any
+//! document), `superset.rs` (one model for every variant),
 //! `check.rs` (MuJoCo validation), `demo.rs` (the built-in scene).
 //!
 //! May use: the model and document tiers, `crate::output` (asset store, ordered pipeline),
@@ -36,6 +37,7 @@
 #[cfg(mjcf_mujoco)]
 mod check;
 mod demo;
+mod document_patch;
 mod load;
 mod params;
 mod patch;
@@ -59,6 +61,7 @@ use crate::model::merge::MergePart;
 
 #[cfg(mjcf_mujoco)]
 pub use check::{PENETRATION_TOLERANCE, check_model, check_variant};
+pub use document_patch::{DocumentPatch, PATCHABLE_OPTIONS, split_document};
 pub use params::{Params, PlacedObject, RandomizedValue};
 pub use patch::{PATCHABLE, PatchEntry, PatchValue, VariantPatch};
 pub use randomize::MUJOCO_DEFAULTS;

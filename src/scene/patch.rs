@@ -100,14 +100,14 @@ pub const PATCHABLE: &[(&str, &str, &str, usize, bool)] = &[
 pub(crate) struct Rules {
     /// Masses and inertias land unchanged (no `settotalmass`, bounds, balancing, or
     /// inertia from geoms over `<inertial>`).
-    mass: bool,
+    pub(crate) mass: bool,
     /// Body frames land unchanged (no keyframes, whose rows would follow a placed free
     /// joint; no static bodies fused away; no free bodies aligned with their inertial
     /// frames).
-    poses: bool,
+    pub(crate) poses: bool,
     /// Compiled ids of the template's elements that can be patched unnamed, when nothing
     /// reorders them (see [`template_ids`]).
-    ids: Option<ahash::AHashMap<Node, usize>>,
+    pub(crate) ids: Option<ahash::AHashMap<Node, usize>>,
     /// Variants are compiled with `discardvisual`: visual geoms and every material are
     /// not in the compiled model.
     pub(crate) discard: bool,
@@ -136,10 +136,7 @@ impl Rules {
         // A dampratio actuator's damping is derived from the masses at compile time.
         let dampratio = std::iter::once(template)
             .chain(parts.iter().copied())
-            .any(|d| {
-                d.descendants(d.root())
-                    .any(|n| d.attr(n, "dampratio").is_some())
-            });
+            .any(|d| d.descendants(d.root()).any(|n| derives_damping(d, n)));
         // Objects merged in bring only bodies to the world (their elements come after the
         // template's), unless a part has world-level elements of its own.
         let world_level = parts.iter().any(|d| {
@@ -157,6 +154,21 @@ impl Rules {
             discard,
         }
     }
+}
+
+/// Whether an actuator's damping is a damping ratio, which the compiler turns into a
+/// damping from the masses at `qpos0` (`mj_setConst` of 3.17.0 does not redo it): a
+/// `dampratio`, or, as a position shortcut with one is written as `<general>`, an affine
+/// bias whose third parameter is positive.
+pub(crate) fn derives_damping(doc: &Document, node: Node) -> bool {
+    if doc.attr(node, "dampratio").is_some() {
+        return true;
+    }
+    doc.attr(node, "biastype").map(str::trim) == Some("affine")
+        && doc
+            .attr(node, "biasprm")
+            .and_then(|v| v.split_ascii_whitespace().nth(2))
+            .is_some_and(|t| t.parse::<f64>().map_or(true, |x| x > 0.0))
 }
 
 /// The element types an unnamed element of the template can be patched by id.
@@ -206,15 +218,23 @@ pub(crate) fn discarded(doc: &Document, geom: Node) -> Option<bool> {
 /// numbers bodies depth first in document order and each body's elements (through frames)
 /// in document order, body after body (with `discard`, the geoms `discardvisual` drops
 /// take no id). `None` when the template has what changes that order (`replicate`,
-/// `attach`, an `include` left unexpanded).
-fn template_ids(template: &Document, discard: bool) -> Option<ahash::AHashMap<Node, usize>> {
+/// `attach`, an `include` left unexpanded, `composite`, `flexcomp`).
+pub(crate) fn template_ids(
+    template: &Document,
+    discard: bool,
+) -> Option<ahash::AHashMap<Node, usize>> {
     let world = template.worldbody()?;
     let mut order = ahash::AHashMap::new();
     order.insert(world, 0usize);
     let mut elements: Vec<(usize, usize, Node)> = Vec::new();
     for n in template.descendants(world) {
         let tag = template.tag(n);
-        if matches!(tag, "replicate" | "attach" | "include") {
+        // Each of these makes elements the arena does not hold (composite and flexcomp
+        // make bodies, geoms and sites of their own).
+        if matches!(
+            tag,
+            "replicate" | "attach" | "include" | "composite" | "flexcomp"
+        ) {
             return None;
         }
         if tag == "body" {

@@ -23,12 +23,14 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use ahash::AHashSet;
+use mjcf_forge::scene::{PatchValue, split_document};
 use mjcf_forge::{CompiledInertia, Document, MergePart, Node, Section};
 use pyo3::exceptions::{PyFutureWarning, PyTypeError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyString, PyTuple};
+use pyo3::types::{PyBytes, PyDict, PyString, PyTuple};
 
 use crate::errors::{Failure, run};
+use crate::scene::patch_list;
 
 pub(crate) use attrib::PyAttrib;
 pub(crate) use cell::{DocCell, retarget};
@@ -324,6 +326,66 @@ impl PyDocument {
     /// :class:`MjcfError` listing every problem with its position.
     fn validate(&self, py: Python<'_>) -> PyResult<()> {
         run(py, || Ok(self.doc.read_detached().validate()?))
+    }
+
+    /// The document's structure key (32 hex digits): equal for two documents exactly
+    /// when MuJoCo compiles them to models that differ only in the values of
+    /// :attr:`patch` (and what ``mj_setConst`` derives from them). Found by reading the
+    /// document: every value that cannot be written into a compiled model exactly, and
+    /// where the others land. See :class:`DocumentCache`.
+    #[getter]
+    fn structure_key(&self, py: Python<'_>) -> PyResult<String> {
+        run(py, || {
+            Ok(split_document(&self.doc.read_detached()).structure_key)
+        })
+    }
+
+    /// The values that turn a compiled model of this document's structure into its own,
+    /// shaped as :attr:`Variant.patch`: a tuple of ``(object, name, field, value)``,
+    /// meaning ``model.<object>(name).<field> = value`` (``name`` is the compiled id, an
+    /// ``int``, for an unnamed element; ``object`` may also be ``"actuator"``, and
+    /// ``"option"`` with id 0 for ``model.opt.<field>``).
+    #[getter]
+    fn patch<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let split = run(py, || Ok(split_document(&self.doc.read_detached())))?;
+        PyTuple::new(py, patch_list(py, &split.entries)?)
+    }
+
+    /// The split as the model cache takes it: ``(structure_key, numbers, materials,
+    /// fixed_statistics)``: every number of :attr:`patch` end to end as float64 bytes,
+    /// the material names of its ``matid`` entries in order, and the statistics the
+    /// document's ``<statistic>`` sets.
+    #[allow(clippy::type_complexity)]
+    fn _split<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(String, Bound<'py, PyBytes>, Vec<String>, Vec<&'static str>)> {
+        let (key, numbers, materials, fixed) = run(py, || {
+            let split = split_document(&self.doc.read_detached());
+            let mut numbers: Vec<u8> = Vec::new();
+            let mut materials = Vec::new();
+            for e in &split.entries {
+                match &e.value {
+                    PatchValue::Numbers(v) => {
+                        numbers.extend(v.iter().flat_map(|x| x.to_le_bytes()));
+                    }
+                    PatchValue::Id { name, .. } => materials.push(name.clone()),
+                }
+            }
+            Ok((
+                split.structure_key,
+                numbers,
+                materials,
+                split.fixed_statistics,
+            ))
+        })?;
+        Ok((key, PyBytes::new(py, &numbers), materials, fixed))
+    }
+
+    /// MuJoCo's error ``message`` about ``xml`` (this document as :meth:`to_xml` wrote
+    /// it) as ``file:line:col: message`` at the element it names in the sources.
+    fn _mujoco_error(&self, py: Python<'_>, xml: &str, message: &str) -> String {
+        self.doc.read(py).mujoco_error(xml, message).to_string()
     }
 
     /// An independent copy (cheap: a few flat buffers).

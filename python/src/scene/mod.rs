@@ -11,6 +11,7 @@ mod stream;
 mod superset;
 mod variant;
 
+pub(crate) use patch::patch_list;
 pub(crate) use stream::PyVariantIter;
 pub(crate) use superset::PySuperset;
 pub(crate) use variant::PyVariant;

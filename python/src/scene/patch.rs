@@ -9,7 +9,7 @@ use pyo3::types::{PyList, PyTuple};
 pub(super) type PatchTuple<'py> = (String, Bound<'py, PyAny>, String, Bound<'py, PyAny>);
 
 /// A patch as Python tuples (see `Variant.patch`).
-pub(super) fn patch_list<'py>(
+pub(crate) fn patch_list<'py>(
     py: Python<'py>,
     entries: &[PatchEntry],
 ) -> PyResult<Bound<'py, PyList>> {

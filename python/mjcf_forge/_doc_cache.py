@@ -1,0 +1,285 @@
+"""Compiled models of any documents at patch cost: :class:`DocumentCache`.
+
+A document splits into its *structure* (``doc.structure_key``: everything that cannot be
+written into a compiled model exactly, and where the rest lands) and its *patch*
+(``doc.patch``: colours, frictions, poses, masses, gains, option values... as compiled
+values), found by reading the document (in Rust). The cache compiles a structure the first
+time it sees it and from then on writes the patch into that model, then ``mj_setConst``
+and the compiler's statistics, as :class:`ModelCache` does for a scene's variants: the
+model MuJoCo compiles from the document, every array and size, at patch cost.
+"""
+
+from __future__ import annotations
+
+import collections
+import copy
+import os
+import threading
+from typing import Any
+
+import numpy as np
+
+from ._cache import _Plan, _copy, _error, _evict
+from ._mjcf_forge import Document
+
+# The sizes that count rows of mesh, texture, height field, skin and bounding-volume data:
+# no patch writes them and they are most of a model's bytes (70 MB of lift5's 70.5), so
+# they are not restored before a patch (see DocumentCache).
+_BULK_SIZES = frozenset(
+    {
+        "nmeshvert", "nmeshnormal", "nmeshtexcoord", "nmeshface", "nmeshgraph", "nmeshpoly",
+        "nmeshpolyvert", "nmeshpolymap", "ntexdata", "nhfielddata", "nbvh", "nbvhstatic",
+        "nbvhdynamic", "noct", "nskinvert", "nskintexvert", "nskinface", "nskinbonevert",
+    }
+)
+# The same arrays by name, for a mujoco without introspection.
+_BULK_PREFIXES = (
+    "mesh_vert", "mesh_normal", "mesh_texcoord", "mesh_face", "mesh_graph", "mesh_poly",
+    "tex_data", "hfield_data", "bvh_", "oct_", "skin_vert", "skin_texcoord", "skin_face",
+    "skin_bonevert",
+)
+# The parts of mjVisual, each a struct of numbers.
+_VISUAL = ("global_", "quality", "headlight", "map", "scale", "rgba")
+
+
+def _restored_arrays(mujoco: Any, model: Any) -> list[str]:
+    """The arrays of ``model`` written back before each patch: all but the bulk data."""
+    try:
+        from mujoco.introspect import structs
+
+        fields = structs.STRUCTS["mjModel"].fields
+        names = [
+            f.name
+            for f in fields
+            if getattr(f, "array_extent", None) and str(f.array_extent[0]) not in _BULK_SIZES
+        ]
+    except (ImportError, KeyError, AttributeError):
+        names = [n for n in dir(model) if not n.startswith(("_",) + _BULK_PREFIXES)]
+    return [n for n in names if isinstance(getattr(model, n, None), np.ndarray)]
+
+
+def _struct_fields(obj: Any) -> list[str]:
+    """The number fields of a struct of the bindings (``model.opt``, ``model.vis.map``)."""
+    return [
+        n
+        for n in dir(obj)
+        if not n.startswith("_")
+        and isinstance(getattr(obj, n, None), (int, float, np.ndarray))
+        and not callable(getattr(obj, n))
+    ]
+
+
+class _Snapshot:
+    """A structure's values as MuJoCo compiled them, of everything a patch or a caller may
+    change (every array but the bulk data, ``model.opt``, ``model.vis``): taken once, after
+    the compile, and written back into a model of the structure before each patch, so that
+    what a caller changed in a model it was given does not outlive the next call."""
+
+    def __init__(self, mujoco: Any, model: Any) -> None:
+        self.arrays = {n: getattr(model, n).copy() for n in _restored_arrays(mujoco, model)}
+        self.structs: dict[tuple[str, ...], dict[str, Any]] = {}
+        for path in [("opt",)] + [("vis", v) for v in _VISUAL]:
+            obj = _walk(model, path)
+            if obj is not None:
+                self.structs[path] = {n: _copy(getattr(obj, n)) for n in _struct_fields(obj)}
+        self.nbytes = sum(a.nbytes for a in self.arrays.values())
+
+
+def _walk(model: Any, path: tuple[str, ...]) -> Any:
+    obj = model
+    for part in path:
+        obj = getattr(obj, part, None)
+    return obj
+
+
+class _Working:
+    """One model of a structure, the one a thread is given: its plan (scratch data, where
+    each entry lands) and its views of what the snapshot restores."""
+
+    def __init__(self, mujoco: Any, model: Any, structure: "_Structure") -> None:
+        self.model = model
+        self.plan = _Plan(mujoco, model, structure.key, structure.fixed, superset=False)
+        self.plan.resolve(list(structure.layout))
+        snap = structure.snapshot
+        self.arrays = [(getattr(model, n), saved) for n, saved in snap.arrays.items()]
+        self.structs = []
+        for path, values in snap.structs.items():
+            obj = _walk(model, path)
+            for name, saved in values.items():
+                if isinstance(saved, np.ndarray):
+                    self.arrays.append((getattr(obj, name), saved))
+                else:
+                    self.structs.append((obj, name, saved))
+
+    def patch(self, values: np.ndarray, materials: list) -> None:
+        for view, saved in self.arrays:
+            np.copyto(view, saved)
+        for obj, name, saved in self.structs:
+            setattr(obj, name, saved)
+        self.plan.write(values, materials)
+        self.plan.finish()
+
+
+class _Structure:
+    """A compiled structure: its snapshot, the layout of its patch, the statistics its
+    ``<statistic>`` fixes, and one model per thread that asked for it."""
+
+    def __init__(self, mujoco: Any, key: str, model: Any, doc: Any, fixed: list) -> None:
+        self.key = key
+        self.layout = doc.patch
+        self.fixed = [(s, _copy(getattr(model.stat, s))) for s in fixed]
+        self.snapshot = _Snapshot(mujoco, model)
+        self.models: dict[int, _Working] = {}
+
+    @property
+    def nbytes(self) -> int:
+        return self.snapshot.nbytes + sum(w.plan.nbytes for w in self.models.values())
+
+
+class DocumentCache:
+    """Compiled models of any MJCF documents, one per structure, patched per document;
+    bounded in count (``max_models`` structures) and bytes (``max_bytes``: models, their
+    scratch data and snapshots), least recently used first out.
+
+    ``cache.model(source)`` takes a :class:`Document`, MJCF text (with ``base_dir``, the
+    folder its relative file names resolve from) or a path, and gives a
+    ``mujoco.MjModel`` equal to MuJoCo compiling it (every array, every size): the cached
+    model of the document's structure (``doc.structure_key``) with the document's values
+    (``doc.patch``) written in, or on a miss the document compiled. No one tells the cache
+    what changed: documents built any way (robosuite's classes, your own code) are read.
+
+    The model is the cache's, one per structure and thread: the next call for the same
+    structure from the same thread patches it again (``copy.copy`` it to keep one). You
+    may change it in place (domain randomization does) without changing what the cache
+    gives next: before each patch every array but the bulk data (mesh, texture, height
+    field, skin and bounding-volume data), ``model.opt`` and ``model.vis`` are written
+    back as compiled. The bulk data is shared as compiled: change it (a texture's pixels)
+    in a copy.
+
+    Two threads asking for one structure compile it once; each gets a model of its own.
+    MuJoCo's error, when it refuses a document, comes as an :class:`MjcfError` at the
+    element it names in the document's sources (``file:line:col: message``), and leaves
+    the cache as it was.
+
+    >>> import mjcf_forge
+    >>> cache = mjcf_forge.DocumentCache(max_models=4)
+    >>> xml = "<mujoco><worldbody><geom name='g' size='.1' rgba='{}'/></worldbody></mujoco>"
+    >>> red = cache.model(xml.format("1 0 0 1"))     # compiled
+    >>> blue = cache.model(xml.format("0 0 1 1"))    # the same structure: patched
+    >>> blue.geom("g").rgba.tolist(), cache.compiles, cache.patches
+    ([0.0, 0.0, 1.0, 1.0], 1, 1)
+    """
+
+    def __init__(self, max_models: int = 8, max_bytes: int | None = None) -> None:
+        import mujoco
+
+        if max_models < 1:
+            raise ValueError("max_models must be at least 1")
+        self._mujoco = mujoco
+        self._max_models = max_models
+        self._max_bytes = max_bytes
+        self._lock = threading.Lock()
+        # Compiled structures by key, least recently used first.
+        self._entries: collections.OrderedDict[str, _Structure] = collections.OrderedDict()
+        # Structures being compiled, each with the event its waiters wait on.
+        self._compiling: dict[str, threading.Event] = {}
+        #: Models compiled (misses) and patches applied (hits) so far.
+        self.compiles = 0
+        self.patches = 0
+
+    def __len__(self) -> int:
+        return len(self._entries)
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes held: every model, its scratch ``MjData`` and its structure's snapshot."""
+        with self._lock:
+            return self._nbytes()
+
+    def _nbytes(self) -> int:
+        return sum(s.nbytes for s in self._entries.values())
+
+    def model(self, source: Any, base_dir: Any = None) -> Any:
+        """The ``mujoco.MjModel`` MuJoCo compiles from ``source`` (a :class:`Document`,
+        MJCF text read from ``base_dir``, or a path); see the class."""
+        doc = _document(source, base_dir)
+        key, numbers, materials, fixed = doc._split()
+        values = np.frombuffer(numbers, dtype="<f8")
+        me = threading.get_ident()
+        while True:
+            with self._lock:
+                structure = self._entries.get(key)
+                if structure is not None:
+                    self._entries.move_to_end(key)
+                    working = structure.models.get(me)
+                    other = next(iter(structure.models.values()), None)
+                    break
+                waiting = self._compiling.get(key)
+                if waiting is None:
+                    self._compiling[key] = threading.Event()
+            if waiting is None:
+                return self._compile(doc, key, fixed)
+            # Another thread compiles this structure: its model, copied, is ours.
+            waiting.wait()
+        if working is None:
+            working = self._adopt(structure, me, other)
+        try:
+            working.patch(values, materials)
+        except Exception:
+            # A value the model cannot take (a material that does not exist): MuJoCo's
+            # own verdict. The model is whole again after its next patch, which writes
+            # every entry of the structure.
+            return self._compile(doc, key, fixed, replace=True)
+        with self._lock:
+            self.patches += 1
+        return working.model
+
+    def _adopt(self, structure: _Structure, me: int, other: _Working | None) -> _Working:
+        """A model of ``structure`` for this thread: a copy of another thread's (what the
+        snapshot restores is written back before its first patch; the bulk data is never
+        written)."""
+        model = copy.copy(other.model) if other is not None else None
+        if model is None:
+            raise _error(f"structure {structure.key} has no model to copy")
+        working = _Working(self._mujoco, model, structure)
+        with self._lock:
+            structure.models[me] = working
+            self._trim()
+        return working
+
+    def _compile(self, doc: Any, key: str, fixed: list, replace: bool = False) -> Any:
+        """Compiles ``doc`` (this thread registered the compile of ``key``, unless
+        ``replace``), keeps it, and wakes the threads waiting for it."""
+        try:
+            xml = doc.to_xml(pretty=True)
+            try:
+                model = self._mujoco.MjModel.from_xml_string(xml)
+            except ValueError as e:
+                raise _error(doc._mujoco_error(xml, str(e))) from None
+            structure = _Structure(self._mujoco, key, model, doc, fixed)
+            structure.models[threading.get_ident()] = _Working(self._mujoco, model, structure)
+            with self._lock:
+                self.compiles += 1
+                self._entries[key] = structure
+                self._entries.move_to_end(key)
+                self._trim()
+            return model
+        finally:
+            if not replace:
+                with self._lock:
+                    self._compiling.pop(key).set()
+
+    def _trim(self) -> None:
+        _evict(self._entries, self._max_models, self._max_bytes, self._nbytes, lambda k, s: None)
+
+
+def _document(source: Any, base_dir: Any) -> Any:
+    if isinstance(source, Document):
+        return source
+    if isinstance(source, str):
+        return Document.from_string(source, base_dir)
+    if isinstance(source, os.PathLike):
+        return Document.load(source)
+    raise TypeError(
+        f"DocumentCache.model takes a Document, MJCF text or a path, not {type(source).__name__}"
+    )

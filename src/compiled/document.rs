@@ -1,0 +1,132 @@
+//! Compiled models of any documents at patch cost: a [`DocumentCache`] splits each document
+//! it is given into a structure key and a patch
+//! ([`split_document`](crate::scene::split_document)), compiles a structure the first time
+//! it sees it, and from then on writes the patch into that model (then `mj_setConst` and
+//! the compiler's statistics, as [`super::ModelCache`] does): the model MuJoCo compiles
+//! from the document, every array bit for bit (`tests/document_cache.rs`).
+
+use std::path::Path;
+
+use super::store::Store;
+use crate::document::Document;
+use crate::error::{Error, ErrorKind, Errors};
+use crate::mujoco::{CompiledModel, compile_document};
+use crate::scene::split_document;
+
+/// Compiled models of documents, one per structure, patched per document; bounded in
+/// count and bytes (models and their scratch data), least recently used out.
+///
+/// [`DocumentCache::model`] returns a model equal to MuJoCo compiling the document,
+/// compiling only when no model of its structure is cached. The model is borrowed from
+/// the cache: it cannot be changed through the reference, and the next call for the same
+/// structure patches it again; `clone()` it (`mj_copyModel`) to keep or edit one.
+///
+/// MuJoCo reads each mesh and texture file once per process whatever the cache does: its
+/// own asset cache (500 MB by default) keeps them decoded by file name and modification
+/// time, so a compile after the first only checks the files' times.
+///
+/// ```
+/// use mjcf_forge::Document;
+/// use mjcf_forge::compiled::DocumentCache;
+///
+/// let xml = |rgba: &str, mass: &str| {
+///     format!(
+///         "<mujoco><worldbody><body name='box' pos='0 0 1'><freejoint/>\
+///          <geom name='g' type='box' size='.1 .1 .1' rgba='{rgba}' mass='{mass}'/>\
+///          </body></worldbody></mujoco>"
+///     )
+/// };
+/// let mut cache = DocumentCache::new(8, None);
+/// let red = Document::from_str(&xml("1 0 0 1", "1"), ".")?;
+/// assert_eq!(cache.model(&red)?.sizes().ngeom, 1); // compiled
+/// let blue = Document::from_str(&xml("0 0 1 1", "1"), ".")?;
+/// cache.model(&blue)?; // the same structure: patched
+/// let heavy = Document::from_str(&xml("0 0 1 1", "2"), ".")?;
+/// cache.model(&heavy)?; // a geom's mass is structure: compiled
+/// assert_eq!((cache.compiles(), cache.patches()), (2, 1));
+/// # Ok::<(), mjcf_forge::Errors>(())
+/// ```
+pub struct DocumentCache {
+    store: Store,
+}
+
+impl DocumentCache {
+    /// A cache holding at most `max_models` compiled models (at least one) and, when
+    /// given, about `max_bytes` of models and scratch data.
+    pub fn new(max_models: usize, max_bytes: Option<usize>) -> DocumentCache {
+        DocumentCache {
+            store: Store::new(max_models, max_bytes),
+        }
+    }
+
+    /// `doc` as MuJoCo compiles it: the cached model of its structure patched, or on a
+    /// miss the document compiled (and kept). MuJoCo's error, when it refuses the
+    /// document, is at the element it names in the document's sources
+    /// ([`Document::mujoco_error`]); the cache is then as it was.
+    pub fn model(&mut self, doc: &Document) -> Result<&CompiledModel, Errors> {
+        let split = split_document(doc);
+        let key = split.structure_key.as_str();
+        // When a value does not fit the cached model (a material that does not exist),
+        // MuJoCo's own verdict follows. The cached model is whole again after its next
+        // patch, which writes every entry of the structure.
+        if self.store.touch(key) && self.store.patch_last(key, &split.entries).is_ok() {
+            self.store.trim();
+            return self.last();
+        }
+        let model = compile_document(doc).map_err(|e| Errors(vec![e]))?;
+        self.store.remove(key);
+        let fixed = super::fixed_bits(&split.fixed_statistics);
+        self.store.insert(key, model, fixed).map_err(internal)?;
+        self.last()
+    }
+
+    /// The MJCF text `xml` as MuJoCo compiles it, relative file names resolved against
+    /// `dir` (read as [`Document::from_str`] reads it; its errors are ours, with their
+    /// positions, when it cannot be read).
+    pub fn model_xml(
+        &mut self,
+        xml: &str,
+        dir: impl AsRef<Path>,
+    ) -> Result<&CompiledModel, Errors> {
+        let doc = Document::from_str(xml, dir)?;
+        self.model(&doc)
+    }
+
+    fn last(&self) -> Result<&CompiledModel, Errors> {
+        self.store
+            .last()
+            .ok_or_else(|| internal("the cache holds no model".to_string()))
+    }
+
+    /// Models compiled so far (misses).
+    pub fn compiles(&self) -> u64 {
+        self.store.state.compiles
+    }
+
+    /// Patches applied so far (hits).
+    pub fn patches(&self) -> u64 {
+        self.store.state.patches
+    }
+
+    /// How many compiled models the cache holds.
+    pub fn len(&self) -> usize {
+        self.store.entries.len()
+    }
+
+    /// Whether the cache holds none.
+    pub fn is_empty(&self) -> bool {
+        self.store.entries.is_empty()
+    }
+
+    /// Bytes held: the cached models and their scratch data.
+    pub fn nbytes(&self) -> usize {
+        self.store.nbytes()
+    }
+}
+
+fn internal(message: String) -> Errors {
+    Errors(vec![Error {
+        location: None,
+        kind: ErrorKind::Invalid(message),
+    }])
+}

@@ -1,0 +1,473 @@
+//! The mechanism both model caches share: compiled models kept by structure key, least
+//! recently used out past a count and a byte bound, and how one model is patched in place
+//! (its plan: scratch data for `mj_setConst`, and where each entry of the structure's patch
+//! lands, resolved once). [`super::ModelCache`] (a scene's variants) and
+//! [`super::DocumentCache`] (any document) sit on it.
+//!
+//! The C side (`patch.c`) is compiled against the linked MuJoCo's headers, as the FFI's
+//! shim is; arrays are found by name through MuJoCo's X-macro table, so no Rust copy of
+//! `mjModel`'s layout is needed. Models come from the FFI ([`crate::mujoco`]), which hands
+//! over the raw model, its serial number and the writable pointer through `pub(crate)` items.
+
+use std::collections::HashMap;
+use std::ffi::{CString, c_char, c_int, c_void};
+use std::ptr::NonNull;
+
+use crate::mujoco::{CompiledModel, MjModel, ObjType, Sizes};
+use crate::scene::{PatchEntry, PatchValue};
+
+/// mjData, opaque here: only the C side reads it.
+#[repr(C)]
+pub(super) struct RawData {
+    _private: [u8; 0],
+}
+
+unsafe extern "C" {
+    pub(super) fn mjf_patch_array(
+        m: *mut MjModel,
+        name: *const c_char,
+        elem: *mut usize,
+        count: *mut usize,
+    ) -> *mut c_void;
+    pub(super) fn mjf_patch_name2id(
+        m: *const MjModel,
+        kind: *const c_char,
+        name: *const c_char,
+    ) -> c_int;
+    pub(super) fn mjf_patch_make_data(m: *const MjModel) -> *mut RawData;
+    pub(super) fn mjf_patch_delete_data(d: *mut RawData);
+    pub(super) fn mjf_patch_nbytes(m: *const MjModel, d: *const RawData) -> i64;
+    pub(super) fn mjf_patch_get_stat(m: *const MjModel, out: *mut f64);
+    pub(super) fn mjf_patch_finish(
+        m: *mut MjModel,
+        d: *mut RawData,
+        fixed: c_int,
+        values: *const f64,
+    );
+    pub(super) fn mjf_patch_array_name(i: c_int) -> *const c_char;
+    fn mjf_patch_option(
+        m: *mut MjModel,
+        name: *const c_char,
+        elem: *mut usize,
+        count: *mut usize,
+    ) -> *mut c_void;
+    pub(super) fn mjf_patch_meaninertia(
+        m: *mut MjModel,
+        d: *const RawData,
+        keep: *const c_int,
+        n: c_int,
+    );
+}
+
+/// Scratch mjData for `mj_setConst` (which overwrites the qpos of the data it is given).
+pub(super) struct Scratch(pub(super) NonNull<RawData>);
+
+// SAFETY: exclusively owned heap data without thread affinity.
+unsafe impl Send for Scratch {}
+
+impl Scratch {
+    fn new(model: &CompiledModel) -> Result<Scratch, String> {
+        // SAFETY: the model is live.
+        let d = unsafe { mjf_patch_make_data(model.raw()) };
+        NonNull::new(d)
+            .map(Scratch)
+            .ok_or_else(|| "MuJoCo could not allocate mjData for the model".to_string())
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        // SAFETY: made by mj_makeData, owned here alone.
+        unsafe { mjf_patch_delete_data(self.0.as_ptr()) }
+    }
+}
+
+/// Where one patch entry lands: `n` elements at `ptr` (`elem` bytes each; a one-value
+/// entry fills all `n`, as a joint's damping fills each of its dofs).
+pub(super) struct Target {
+    ptr: *mut u8,
+    elem: usize,
+    n: usize,
+    /// The field holds integers: an id (`geom_matid`, the value a material's name) or
+    /// collision bits (`geom_contype`, `geom_conaffinity`).
+    int: bool,
+}
+
+/// How to patch one model: its structure key, scratch data and resolved targets.
+pub(super) struct Plan {
+    pub(super) serial: u64,
+    pub(super) key: String,
+    pub(super) scratch: Scratch,
+    fields: Vec<(&'static str, String, Option<usize>, &'static str)>,
+    targets: Vec<Target>,
+    nbytes: usize,
+}
+
+// SAFETY: the raw pointers point into the model the plan belongs to, which is only
+// written through `&mut` of that model.
+unsafe impl Send for Plan {}
+
+/// What a structure is: the sizes and names of its model, to refuse a model of another.
+#[derive(PartialEq)]
+pub(super) struct Signature {
+    sizes: Sizes,
+    names: Vec<Vec<String>>,
+}
+
+impl Signature {
+    pub(super) fn of(m: &CompiledModel) -> Signature {
+        Signature {
+            sizes: m.sizes(),
+            names: [ObjType::Body, ObjType::Joint, ObjType::Geom, ObjType::Site]
+                .into_iter()
+                .map(|o| m.names(o))
+                .collect(),
+        }
+    }
+}
+
+/// Compiled models by structure key, least recently used first, and the state that
+/// patches them.
+pub(super) struct Store {
+    pub(super) entries: Vec<(String, CompiledModel)>,
+    pub(super) state: State,
+}
+
+impl Store {
+    /// A store of at most `max_models` models (at least one) and, when given, about
+    /// `max_bytes` of models and scratch data.
+    pub(super) fn new(max_models: usize, max_bytes: Option<usize>) -> Store {
+        Store {
+            entries: Vec::new(),
+            state: State {
+                max_models: max_models.max(1),
+                max_bytes,
+                plans: Vec::new(),
+                signatures: HashMap::new(),
+                stats: HashMap::new(),
+                compiles: 0,
+                patches: 0,
+            },
+        }
+    }
+
+    /// Whether a model of structure `key` is cached; if so it becomes the most recent.
+    pub(super) fn touch(&mut self, key: &str) -> bool {
+        match self.entries.iter().position(|(k, _)| k == key) {
+            Some(at) => {
+                let entry = self.entries.remove(at);
+                self.entries.push(entry);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Keeps `model`, just compiled for structure `key`, as the most recent model: its
+    /// signature, its statistics (`fixed`: the bits of those its `<statistic>` sets, as
+    /// `mjf_patch_finish` takes them) and its plan, whose bytes count from now on.
+    pub(super) fn insert(
+        &mut self,
+        key: &str,
+        model: CompiledModel,
+        fixed: c_int,
+    ) -> Result<(), String> {
+        let state = &mut self.state;
+        state.compiles += 1;
+        let mut stat = [0.0; 7];
+        // SAFETY: the model is live; `stat` holds 7 values.
+        unsafe { mjf_patch_get_stat(model.raw(), stat.as_mut_ptr()) };
+        state.stats.insert(key.to_string(), (fixed, stat));
+        state
+            .signatures
+            .insert(key.to_string(), Signature::of(&model));
+        state.plan_of(&model, key)?;
+        self.entries.push((key.to_string(), model));
+        self.state.trim(&mut self.entries);
+        Ok(())
+    }
+
+    /// Drops the model of structure `key`, if cached, with its plan.
+    pub(super) fn remove(&mut self, key: &str) {
+        if let Some(at) = self.entries.iter().position(|(k, _)| k == key) {
+            let (_, gone) = self.entries.remove(at);
+            self.state.plans.retain(|p| p.serial != gone.serial());
+        }
+    }
+
+    /// The most recent model.
+    pub(super) fn last(&self) -> Option<&CompiledModel> {
+        self.entries.last().map(|(_, m)| m)
+    }
+
+    /// Patches the most recent model (of structure `key`) with `entries`.
+    pub(super) fn patch_last(&mut self, key: &str, entries: &[PatchEntry]) -> Result<(), String> {
+        let Some((_, model)) = self.entries.last_mut() else {
+            return Err("no model to patch".to_string());
+        };
+        self.state.patch_model(model, key, entries)
+    }
+
+    /// Drops the least recently used models beyond the bounds.
+    pub(super) fn trim(&mut self) {
+        self.state.trim(&mut self.entries);
+    }
+
+    /// Bytes held: the cached models and every plan's scratch data.
+    pub(super) fn nbytes(&self) -> usize {
+        self.state.nbytes()
+    }
+}
+
+/// Everything but the cached models (so that a cached model and the plans can be borrowed
+/// at once).
+pub(super) struct State {
+    max_models: usize,
+    max_bytes: Option<usize>,
+    /// Plans by model serial (cached models' and callers'), least recently used first.
+    pub(super) plans: Vec<Plan>,
+    pub(super) signatures: HashMap<String, Signature>,
+    /// Per structure, the statistics its `<statistic>` fixes (bits as `mjf_patch_finish`
+    /// takes them) and the values MuJoCo compiled.
+    stats: HashMap<String, (c_int, [f64; 7])>,
+    pub(super) compiles: u64,
+    pub(super) patches: u64,
+}
+
+impl State {
+    pub(super) fn nbytes(&self) -> usize {
+        self.plans.iter().map(|p| p.nbytes).sum()
+    }
+
+    /// Drops the least recently used models (and plans) beyond the bounds.
+    pub(super) fn trim(&mut self, entries: &mut Vec<(String, CompiledModel)>) {
+        while entries.len() > 1
+            && (entries.len() > self.max_models
+                || self.max_bytes.is_some_and(|b| self.nbytes() > b))
+        {
+            let (_, gone) = entries.remove(0);
+            self.plans.retain(|p| p.serial != gone.serial());
+        }
+        // Plans of callers' models: as many as cached models are allowed.
+        let cached: Vec<u64> = entries.iter().map(|(_, m)| m.serial()).collect();
+        let mut extra = self
+            .plans
+            .iter()
+            .filter(|p| !cached.contains(&p.serial))
+            .count();
+        self.plans.retain(|p| {
+            if extra > self.max_models && !cached.contains(&p.serial) {
+                extra -= 1;
+                false
+            } else {
+                true
+            }
+        });
+    }
+
+    /// The index of `model`'s plan, made on first sight.
+    fn plan_of(&mut self, model: &CompiledModel, key: &str) -> Result<usize, String> {
+        if let Some(at) = self.plans.iter().position(|p| p.serial == model.serial()) {
+            return Ok(at);
+        }
+        let scratch = Scratch::new(model)?;
+        // SAFETY: model and data are live.
+        let nbytes = unsafe { mjf_patch_nbytes(model.raw(), scratch.0.as_ptr()) };
+        self.plans.push(Plan {
+            serial: model.serial(),
+            key: key.to_string(),
+            scratch,
+            fields: Vec::new(),
+            targets: Vec::new(),
+            nbytes: usize::try_from(nbytes).unwrap_or(0),
+        });
+        Ok(self.plans.len() - 1)
+    }
+
+    pub(super) fn patch_model(
+        &mut self,
+        model: &mut CompiledModel,
+        key: &str,
+        entries: &[PatchEntry],
+    ) -> Result<(), String> {
+        let at = self.plan_of(model, key)?;
+        let plan = &mut self.plans[at];
+        let same =
+            plan.fields.len() == entries.len()
+                && plan.fields.iter().zip(entries).all(|(f, e)| {
+                    f.0 == e.object && f.1 == e.name && f.2 == e.id && f.3 == e.field
+                });
+        if !same {
+            plan.targets = resolve(model, entries)?;
+            plan.fields = entries
+                .iter()
+                .map(|e| (e.object, e.name.clone(), e.id, e.field))
+                .collect();
+        }
+        let ptr = model.as_mut_ptr();
+        for (t, e) in plan.targets.iter().zip(entries) {
+            write(ptr, t, &e.value)?;
+        }
+        let (fixed, stat) = self.stats.get(key).copied().unwrap_or_default();
+        // SAFETY: the model and its scratch data are live and of one structure.
+        unsafe { mjf_patch_finish(ptr, plan.scratch.0.as_ptr(), fixed, stat.as_ptr()) };
+        let plan = self.plans.remove(at);
+        self.plans.push(plan);
+        self.patches += 1;
+        Ok(())
+    }
+}
+
+/// Writes one entry's value at its target.
+fn write(model: *mut MjModel, t: &Target, value: &PatchValue) -> Result<(), String> {
+    match value {
+        PatchValue::Id { object, name } => {
+            let kind = CString::new(*object).map_err(|e| e.to_string())?;
+            let name = CString::new(name.as_str()).map_err(|e| e.to_string())?;
+            // SAFETY: the model is live; both strings are NUL-terminated.
+            let id = unsafe { mjf_patch_name2id(model, kind.as_ptr(), name.as_ptr()) };
+            if id < 0 || !t.int || t.elem != 4 {
+                return Err(format!("no {} named '{}'", object, name.to_string_lossy()));
+            }
+            // SAFETY: `ptr` points at `n` >= 1 ints of the live model (see `resolve`).
+            unsafe { t.ptr.cast::<c_int>().write_unaligned(id) };
+        }
+        PatchValue::Numbers(v) => {
+            for k in 0..t.n {
+                let x = if v.len() == 1 { v[0] } else { v[k] };
+                // SAFETY: `ptr` points at `n` elements of `elem` bytes of the live model,
+                // checked against the array's length in `resolve`.
+                unsafe {
+                    match (t.elem, t.int) {
+                        (4, true) => t.ptr.cast::<c_int>().add(k).write_unaligned(x as c_int),
+                        (4, false) => t.ptr.cast::<f32>().add(k).write_unaligned(x as f32),
+                        _ => t.ptr.cast::<f64>().add(k).write_unaligned(x),
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Where every entry lands in `model`.
+fn resolve(model: &mut CompiledModel, entries: &[PatchEntry]) -> Result<Vec<Target>, String> {
+    let ptr = model.as_mut_ptr();
+    let array = |name: &str| -> Result<(*mut u8, usize, usize), String> {
+        let c = CString::new(name).map_err(|e| e.to_string())?;
+        let (mut elem, mut count) = (0usize, 0usize);
+        // SAFETY: the model is live; `c` is NUL-terminated.
+        let p = unsafe { mjf_patch_array(ptr, c.as_ptr(), &mut elem, &mut count) };
+        if p.is_null() && count > 0 || elem == 0 {
+            return Err(format!("this MuJoCo's mjModel has no array {name}"));
+        }
+        Ok((p.cast(), elem, count))
+    };
+    let int_at = |name: &str, i: usize| -> Result<usize, String> {
+        let (p, elem, count) = array(name)?;
+        if elem != 4 || i >= count {
+            return Err(format!("{name}[{i}] out of range"));
+        }
+        // SAFETY: `i` < count ints at `p`.
+        let v = unsafe { p.cast::<c_int>().add(i).read_unaligned() };
+        usize::try_from(v).map_err(|_| format!("{name}[{i}] is negative"))
+    };
+    let mut out = Vec::with_capacity(entries.len());
+    for e in entries {
+        if e.object == "option" {
+            out.push(option_target(ptr, e)?);
+            continue;
+        }
+        let id = match e.id {
+            Some(id) => id,
+            None => {
+                let kind = CString::new(e.object).map_err(|x| x.to_string())?;
+                let name = CString::new(e.name.as_str()).map_err(|x| x.to_string())?;
+                // SAFETY: the model is live; both strings are NUL-terminated.
+                let id = unsafe { mjf_patch_name2id(ptr, kind.as_ptr(), name.as_ptr()) };
+                usize::try_from(id).map_err(|_| {
+                    format!(
+                        "the patch names {} '{}', which the compiled model does not have",
+                        e.object, e.name
+                    )
+                })?
+            }
+        };
+        let width = match &e.value {
+            PatchValue::Numbers(v) => v.len(),
+            PatchValue::Id { .. } => 1,
+        };
+        let (name, offset, n) = match (e.object, e.field) {
+            ("joint", f @ ("damping" | "armature" | "frictionloss")) => {
+                let dofs = match int_at("jnt_type", id)? {
+                    0 => 6,
+                    1 => 3,
+                    _ => 1,
+                };
+                (format!("dof_{f}"), int_at("jnt_dofadr", id)?, dofs)
+            }
+            ("joint", f @ ("qpos0" | "qpos_spring")) => {
+                let n = match int_at("jnt_type", id)? {
+                    0 => 7,
+                    1 => 4,
+                    _ => 1,
+                };
+                (f.to_string(), int_at("jnt_qposadr", id)?, n)
+            }
+            (object, field) => {
+                let prefix = match object {
+                    "body" => "body_",
+                    "joint" => "jnt_",
+                    "geom" => "geom_",
+                    "site" => "site_",
+                    "camera" => "cam_",
+                    "light" => "light_",
+                    "actuator" => "actuator_",
+                    _ => "mat_",
+                };
+                (format!("{prefix}{field}"), id * width, width)
+            }
+        };
+        let (p, elem, count) = array(&name)?;
+        if offset + n > count {
+            return Err(format!(
+                "{} '{}': {name}[{offset}..{}] is outside the model's {count}",
+                e.object,
+                e.name,
+                offset + n
+            ));
+        }
+        out.push(Target {
+            // SAFETY: in bounds, checked above.
+            ptr: unsafe { p.add(offset * elem) },
+            elem,
+            n,
+            int: matches!(e.field, "matid" | "contype" | "conaffinity"),
+        });
+    }
+    Ok(out)
+}
+
+/// Where an `<option>` value lands: its `mjOption` field.
+fn option_target(model: *mut MjModel, e: &PatchEntry) -> Result<Target, String> {
+    let c = CString::new(e.field).map_err(|x| x.to_string())?;
+    let (mut elem, mut count) = (0usize, 0usize);
+    // SAFETY: the model is live; `c` is NUL-terminated.
+    let p = unsafe { mjf_patch_option(model, c.as_ptr(), &mut elem, &mut count) };
+    let width = match &e.value {
+        PatchValue::Numbers(v) => v.len(),
+        PatchValue::Id { .. } => 0,
+    };
+    if p.is_null() || elem != std::mem::size_of::<f64>() || count != width {
+        return Err(format!(
+            "this MuJoCo's mjOption has no field {} of {width}",
+            e.field
+        ));
+    }
+    Ok(Target {
+        ptr: p.cast(),
+        elem,
+        n: count,
+        int: false,
+    })
+}
