@@ -15,6 +15,7 @@ mod attrib;
 mod cell;
 mod children;
 mod element;
+pub(crate) mod patch;
 mod path;
 mod sort;
 mod values;
@@ -30,7 +31,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyString, PyTuple};
 
 use crate::errors::{Failure, run};
-use crate::scene::patch_list;
+use patch::patch_list;
 
 pub(crate) use attrib::PyAttrib;
 pub(crate) use cell::{DocCell, retarget};

@@ -3,15 +3,13 @@
 //! A `Scene` is an `Arc` of the library's `Scene` (`Send + Sync`), so Python threads share
 //! one and every call releases the GIL. The files mirror the library's `scene` module:
 //! `variant.rs` (one variant and what a worker makes for it), `stream.rs` (many variants
-//! made on Rust threads, handed over in order), `patch.rs` (patches as Python tuples) and
-//! `superset.rs` (one model for every variant).
+//! made on Rust threads, handed over in order) and `superset.rs` (one model for every
+//! variant); patches as Python tuples are the document module's (`document/patch.rs`).
 
-mod patch;
 mod stream;
 mod superset;
 mod variant;
 
-pub(crate) use patch::patch_list;
 pub(crate) use stream::PyVariantIter;
 pub(crate) use superset::PySuperset;
 pub(crate) use variant::PyVariant;

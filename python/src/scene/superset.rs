@@ -6,7 +6,7 @@ use mjcf_forge::scene::{Scene, Superset};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
-use super::patch::patch_list;
+use crate::document::patch::patch_list;
 use crate::errors::run;
 
 /// A scene's superset: the template with every object any slot can hold, so that every

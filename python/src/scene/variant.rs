@@ -9,8 +9,8 @@ use pyo3::exceptions::PyImportError;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
-use super::patch::{PatchTuple, patch_entry, patch_list};
 use crate::document::PyDocument;
+use crate::document::patch::{PatchTuple, patch_entry, patch_list};
 use crate::errors::{Failure, catch, run};
 
 /// What a worker makes for one index: the variant's text forms, so that the Python side

@@ -1,4 +1,5 @@
-//! Patches as Python holds them: `(object, name or id, field, value)` tuples.
+//! Patches as Python holds them: `(object, name or id, field, value)` tuples, for a
+//! document's patch (`Document.patch`) and a variant's (`Variant.patch`, `Superset.patch`).
 
 use mjcf_forge::scene::{PatchEntry, PatchValue};
 use pyo3::exceptions::PyValueError;
@@ -6,7 +7,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyList, PyTuple};
 
 /// A patch entry as Python holds it: `(object, name or id, field, value)`.
-pub(super) type PatchTuple<'py> = (String, Bound<'py, PyAny>, String, Bound<'py, PyAny>);
+pub(crate) type PatchTuple<'py> = (String, Bound<'py, PyAny>, String, Bound<'py, PyAny>);
 
 /// A patch as Python tuples (see `Variant.patch`).
 pub(crate) fn patch_list<'py>(
@@ -32,7 +33,7 @@ pub(crate) fn patch_list<'py>(
 
 /// A patch entry back from its Python tuple (an unpickled variant's): the object and
 /// field names are the library's own, matched against its table.
-pub(super) fn patch_entry(
+pub(crate) fn patch_entry(
     object: String,
     name: &Bound<'_, PyAny>,
     field: String,
