@@ -6,8 +6,11 @@ and installs the package into .cache/venv and downloads the wheel corpora).
 from __future__ import annotations
 
 import os
+import importlib.machinery
+import importlib.util
 import subprocess
 import sys
+import types
 from pathlib import Path
 
 import pytest
@@ -43,3 +46,28 @@ def forge_cli() -> Path:
         ["cargo", "build", "--quiet", "--bin", "mjcf-forge"], cwd=ROOT, check=True
     )
     return binary
+
+
+ROBOSUITE_PKG = ROOT / ".cache" / "corpus" / "robosuite-1.5.2" / "robosuite"
+
+
+def stub_robosuite() -> None:
+    """Makes robosuite 1.5.2's unpacked wheel importable as the package `robosuite` without
+    running its __init__.py (which imports every environment), as
+    scripts/bench_robosuite.py does; stand-ins for PIL and termcolor when they are not
+    installed (the model classes never call them)."""
+    if not ROBOSUITE_PKG.is_dir():
+        pytest.fail(f"{ROBOSUITE_PKG} missing: run scripts/setup.sh")
+    for name in ("PIL", "termcolor"):
+        try:
+            __import__(name)
+        except ImportError:
+            stand_in = types.ModuleType(name)
+            stand_in.Image = None
+            stand_in.colored = lambda text, *args, **kwargs: text
+            sys.modules[name] = stand_in
+    spec = importlib.machinery.ModuleSpec("robosuite", None, is_package=True)
+    spec.submodule_search_locations = [str(ROBOSUITE_PKG)]
+    pkg = importlib.util.module_from_spec(spec)
+    pkg.__file__ = str(ROBOSUITE_PKG / "__init__.py")
+    sys.modules["robosuite"] = pkg

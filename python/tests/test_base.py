@@ -8,7 +8,6 @@ docs/model-hierarchy.md ("Where we differ from robosuite").
 """
 from __future__ import annotations
 
-import importlib.machinery
 import importlib.util
 import os
 import sys
@@ -21,7 +20,7 @@ import pytest
 
 import judge
 import merge_judge
-from conftest import ROOT, RS_ASSETS
+from conftest import ROOT, RS_ASSETS, stub_robosuite
 from mjcf_forge import Element, MjcfError
 from mjcf_forge import base
 from mjcf_forge.base import MujocoModel, MujocoXML, MujocoXMLModel, XMLError
@@ -94,23 +93,8 @@ def rs():
     """robosuite.models.base of the unpacked 1.5.2 wheel, without robosuite/__init__.py
     (which imports every environment). Stand-ins for PIL and termcolor when they are not
     installed: the code compared never calls them. Unloaded afterwards."""
-    pkg_dir = ROOT / ".cache" / "corpus" / "robosuite-1.5.2" / "robosuite"
-    if not pkg_dir.is_dir():
-        pytest.fail(f"{pkg_dir} missing: run scripts/setup.sh")
     before = set(sys.modules)
-    for name in ("PIL", "termcolor"):
-        try:
-            __import__(name)
-        except ImportError:
-            stand_in = types.ModuleType(name)
-            stand_in.Image = None
-            stand_in.colored = lambda text, *args, **kwargs: text
-            sys.modules[name] = stand_in
-    spec = importlib.machinery.ModuleSpec("robosuite", None, is_package=True)
-    spec.submodule_search_locations = [str(pkg_dir)]
-    pkg = importlib.util.module_from_spec(spec)
-    pkg.__file__ = str(pkg_dir / "__init__.py")
-    sys.modules["robosuite"] = pkg
+    stub_robosuite()
     import robosuite.models.base as theirs
 
     yield theirs

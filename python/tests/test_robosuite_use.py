@@ -9,9 +9,7 @@ is a failure, not a skip), in two processes
 """
 from __future__ import annotations
 
-import importlib.machinery
 import inspect
-import importlib.util
 import json
 import os
 import subprocess
@@ -26,10 +24,9 @@ import pytest
 import judge
 import mjcf_forge
 import mjcf_forge.robosuite as forge_robosuite
-from conftest import ROOT
+from conftest import ROOT, stub_robosuite
 from mjcf_forge import base, etree
 
-RS_PKG = ROOT / ".cache" / "corpus" / "robosuite-1.5.2" / "robosuite"
 RS_ENV = ROOT / ".cache" / "venv-robosuite-env" / "bin" / "python"
 
 
@@ -42,24 +39,6 @@ def clean_imports(monkeypatch):
     for name in set(sys.modules) - before:
         if name.split(".")[0] in ("robosuite", "PIL", "termcolor"):
             del sys.modules[name]
-
-
-def stub_robosuite():
-    """The unpacked wheel as the package `robosuite`, without its __init__.py (as
-    scripts/bench_robosuite.py does); PIL and termcolor stand-ins when missing."""
-    for name in ("PIL", "termcolor"):
-        try:
-            __import__(name)
-        except ImportError:
-            stand_in = types.ModuleType(name)
-            stand_in.Image = None
-            stand_in.colored = lambda text, *args, **kwargs: text
-            sys.modules[name] = stand_in
-    spec = importlib.machinery.ModuleSpec("robosuite", None, is_package=True)
-    spec.submodule_search_locations = [str(RS_PKG)]
-    pkg = importlib.util.module_from_spec(spec)
-    pkg.__file__ = str(RS_PKG / "__init__.py")
-    sys.modules["robosuite"] = pkg
 
 
 def test_use_rebinds_robosuites_base_classes_and_et(clean_imports):
