@@ -57,6 +57,7 @@ pub mod scene;
 pub use document::import::NodeMap;
 pub use document::inertia::{CompiledInertia, InertiaCompiler};
 pub use document::limits::Limits;
+pub use document::load_cache::LoadCache;
 pub use document::tree::Node;
 pub use document::vocab;
 pub use document::{Document, Section};

@@ -13,6 +13,7 @@
   per structure (``variant.structure_key``), then ``variant.patch`` written into it.
 - :class:`DocumentCache`: the same for any document or MJCF text: its structure
   (``doc.structure_key``) and patch (``doc.patch``) found by reading it.
+- :class:`LoadCache`: loaded files served again, copied, while unchanged.
 - :class:`MjcfError`: the one exception type (a ``ValueError``), with ``.errors``.
 - :mod:`mjcf_forge.base`: robosuite's ``MujocoXML``, ``MujocoModel`` and
   ``MujocoXMLModel`` (``robosuite.models.base``) over documents, for code written for
@@ -24,6 +25,7 @@ from ._mjcf_forge import (
     Attrib,
     Document,
     Element,
+    LoadCache,
     MergeReport,
     MjcfError,
     Model,
@@ -43,6 +45,7 @@ __all__ = [
     "Document",
     "DocumentCache",
     "Element",
+    "LoadCache",
     "MergeReport",
     "MjcfError",
     "Model",

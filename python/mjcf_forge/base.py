@@ -33,13 +33,14 @@ from typing import Any, Callable, Optional
 
 import numpy as np
 
-from ._mjcf_forge import Document, Element, MjcfError
+from ._mjcf_forge import Document, Element, LoadCache, MjcfError
 from . import etree as ET
 
 __all__ = [
     "MujocoModel",
     "MujocoXML",
     "MujocoXMLModel",
+    "FILE_CACHE",
     "USING_INSTANCE_RANDOMIZATION",
     "XMLError",
     "sort_elements",
@@ -49,6 +50,12 @@ __all__ = [
 #: material a default one, as robosuite does for its domain randomization. When
 #: ``robosuite.macros`` is imported, its value is the one read.
 USING_INSTANCE_RANDOMIZATION = False
+
+#: Where :class:`MujocoXML` reads its files: a :class:`~mjcf_forge.LoadCache`, which serves
+#: a file that has not changed since it was last read as a copy of that load (robosuite
+#: reads the same robot, gripper, arena and object files at every environment reset).
+#: ``None``: every file is read anew. Either way the document is the file as it is now.
+FILE_CACHE: Optional[LoadCache] = LoadCache(256)
 
 
 # --------------------------------------------------------------------------------------
@@ -293,7 +300,8 @@ class MujocoXML(object):
     ``MujocoXML``).
 
     ``MujocoXML(fname)`` reads the file as MuJoCo does (:meth:`mjcf_forge.Document.load`:
-    includes expanded, default classes inlined, asset paths absolute). Attributes, as in
+    includes expanded, default classes inlined, asset paths absolute), through
+    :data:`FILE_CACHE` (an unchanged file read before is a copy of that load). Attributes, as in
     robosuite: ``file``, ``folder``, ``tree`` (an ``ElementTree`` over ``root``),
     ``root`` (``<mujoco>``), and the sections ``worldbody``, ``actuator``, ``sensor``,
     ``asset``, ``tendon``, ``equality``, ``contact`` (created when missing). Ours besides:
@@ -312,7 +320,8 @@ class MujocoXML(object):
         self.file = fname
         self.folder = os.path.dirname(fname)
         try:
-            self.document = Document.load(fname)
+            files = FILE_CACHE
+            self.document = Document.load(fname) if files is None else files.load(fname)
         except MjcfError as e:
             raise _reraised(e) from None
         self.root = self.document.root

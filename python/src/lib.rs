@@ -55,6 +55,7 @@ fn _mjcf_forge(m: &Bound<'_, PyModule>) -> PyResult<()> {
         .getattr("MutableMapping")?
         .call_method1("register", (m.py().get_type::<document::PyAttrib>(),))?;
     m.add_class::<document::PyMergeReport>()?;
+    m.add_class::<document::PyLoadCache>()?;
     m.add_class::<model::PyModel>()?;
     m.add_class::<scene::PyScene>()?;
     m.add_class::<scene::PyVariant>()?;

@@ -21,6 +21,7 @@ import pytest
 import judge
 import merge_judge
 from conftest import ROOT, RS_ASSETS, stub_robosuite
+import mjcf_forge
 from mjcf_forge import Element, MjcfError
 from mjcf_forge import base
 from mjcf_forge.base import MujocoModel, MujocoXML, MujocoXMLModel, XMLError
@@ -353,6 +354,40 @@ def test_load_errors_are_xml_errors(tmp_path):
     # A prefix MuJoCo would read as two names.
     with pytest.raises(XMLError, match="prefix 'a b_' holds white space"):
         MyModel(idn="a b")
+
+
+def test_files_are_read_through_the_file_cache_and_always_as_they_are_now(tmp_path, monkeypatch):
+    monkeypatch.setattr(base, "FILE_CACHE", mjcf_forge.LoadCache(4))
+    path = tmp_path / "m.xml"
+    path.write_text('<mujoco><worldbody><body name="b"><geom size="1"/></body></worldbody></mujoco>')
+    first = MujocoXML(str(path))
+    first.worldbody.find("body").set("pos", "1 2 3")  # an edit of one instance
+    second = MujocoXML(str(path))
+    assert base.FILE_CACHE.hits == 1 and second.worldbody.find("body").get("pos") is None
+    # A changed file is read again, and what it now says is what comes back.
+    path.write_text('<mujoco><worldbody><body name="c"><geom size="2"/></body></worldbody></mujoco>')
+    assert MujocoXML(str(path)).worldbody.find("body").get("name") == "c"
+    assert base.FILE_CACHE.hits == 1
+    # Without the cache: read every time, the same document.
+    monkeypatch.setattr(base, "FILE_CACHE", None)
+    assert MujocoXML(str(path)).get_xml() == second.get_xml().replace('name="b"', 'name="c"').replace(
+        'size="1"', 'size="2"')
+
+
+def test_load_cache_serves_copies_and_keeps_no_errors(tmp_path):
+    files = mjcf_forge.LoadCache(2)
+    path = tmp_path / "m.xml"
+    path.write_text('<mujoco><worldbody><geom name="g" size="1"/></worldbody></mujoco>')
+    a = files.load(path)
+    a.prefix("p_")
+    b = files.load(str(path))
+    assert (files.hits, len(files)) == (1, 1)
+    assert b.to_xml() == mjcf_forge.Document.load(path).to_xml() != a.to_xml()
+    with pytest.raises(MjcfError, match="missing.xml"):
+        files.load(tmp_path / "missing.xml")
+    assert len(files) == 1
+    files.clear()
+    assert len(files) == 0
 
 
 # ------------------------------------------------------------------------------------

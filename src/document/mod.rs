@@ -5,7 +5,8 @@
 //! files. Around it, one file per operation on a single model:
 //!
 //! - reading: [`read`] (the markup into the arena, `<include>` expanded), [`load`] (read,
-//!   then [`defaults`] inlined and [`paths`] made absolute), [`skin`] (binary skin files);
+//!   then [`defaults`] inlined and [`paths`] made absolute), [`load_cache`] (loaded files
+//!   served again while unchanged), [`skin`] (binary skin files);
 //! - the MJCF vocabulary: [`vocab`] (generated from MuJoCo's schema) and its index
 //!   [`schema`] (which attributes declare names and which refer to them);
 //! - editing and checking: [`prefix`] (renaming every name and reference), [`validate`]
@@ -29,6 +30,7 @@ pub(crate) mod import;
 pub(crate) mod inertia;
 pub(crate) mod limits;
 pub(crate) mod load;
+pub(crate) mod load_cache;
 pub(crate) mod locate;
 pub(crate) mod names;
 pub(crate) mod paths;

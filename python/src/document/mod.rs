@@ -5,6 +5,7 @@
 //! - `cell.rs`: the shared, lockable document and the registry of one proxy per node;
 //! - `element.rs`: `Element`, the proxy; `children.rs`, `path.rs`, `attrib.rs` its child
 //!   edits, ElementPath and live attribute mapping;
+//! - `load_cache.rs`: `LoadCache`, loaded files served again while unchanged;
 //! - `values.rs`: attribute values from Python, and the checks of what XML can carry.
 //!
 //! A `Document` is one cell: Python threads may share it, readers run at once, and an
@@ -15,6 +16,7 @@ mod attrib;
 mod cell;
 mod children;
 mod element;
+mod load_cache;
 pub(crate) mod patch;
 mod path;
 mod sort;
@@ -36,6 +38,7 @@ use patch::patch_list;
 pub(crate) use attrib::PyAttrib;
 pub(crate) use cell::{DocCell, retarget};
 pub(crate) use element::PyElement;
+pub(crate) use load_cache::PyLoadCache;
 pub(crate) use values::check_xml_text;
 
 /// A shared, lockable document.

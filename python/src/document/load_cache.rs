@@ -1,0 +1,63 @@
+//! `LoadCache`: loaded files served again, copied, while unchanged (the library's
+//! [`mjcf_forge::LoadCache`]).
+
+use std::path::PathBuf;
+
+use mjcf_forge::LoadCache;
+use pyo3::prelude::*;
+
+use super::PyDocument;
+use crate::errors::run;
+
+/// Documents loaded from files, kept and served again while their file holds the same
+/// bytes: a load of an unchanged file reads and compares the bytes, then copies the kept
+/// document instead of parsing, inlining and resolving paths again. Files with ``<include>`` are read every time.
+/// At most ``capacity`` documents are kept, the oldest going first. Safe to share between
+/// threads.
+///
+/// Example::
+///
+///     files = LoadCache(256)
+///     doc = files.load("panda.xml")    # read, inlined, made absolute, kept
+///     again = files.load("panda.xml")  # a copy of the kept document
+///     assert files.hits == 1
+#[pyclass(name = "LoadCache", module = "mjcf_forge", frozen)]
+pub(crate) struct PyLoadCache {
+    cache: LoadCache,
+}
+
+#[pymethods]
+impl PyLoadCache {
+    #[new]
+    #[pyo3(signature = (capacity = 256))]
+    fn new(capacity: usize) -> PyLoadCache {
+        PyLoadCache {
+            cache: LoadCache::new(capacity),
+        }
+    }
+
+    /// :meth:`Document.load` of ``path``, or a copy of the document kept from an earlier
+    /// load of the same path while the file holds the same bytes. A new document every call: edits
+    /// to it never reach the kept one.
+    ///
+    /// Raises :class:`MjcfError` as :meth:`Document.load` does (errors are not kept).
+    fn load(&self, py: Python<'_>, path: PathBuf) -> PyResult<PyDocument> {
+        run(py, || Ok(self.cache.load(&path)?)).map(PyDocument::new)
+    }
+
+    /// How many loads were served from kept documents.
+    #[getter]
+    fn hits(&self) -> u64 {
+        self.cache.hits()
+    }
+
+    /// Forgets every kept document.
+    fn clear(&self) {
+        self.cache.clear()
+    }
+
+    /// How many documents are kept.
+    fn __len__(&self) -> usize {
+        self.cache.len()
+    }
+}
