@@ -9,6 +9,7 @@ import collections.abc
 import copy
 import gc
 import io
+import pickle
 import xml.etree.ElementTree as ET
 
 import pytest
@@ -377,6 +378,28 @@ def test_copies_are_detached_element_trees():
         assert doc.find(".//body[@name='twin']") is twin
         twin.attrib["name"] = "gone"
         doc.worldbody.remove(twin)
+
+
+def test_elements_pickle_as_xml_etrees_do():
+    doc = Document.from_string(
+        '<mujoco><custom><text name="t" data="a &amp; b"/>x<numeric name="n"/>tail</custom>'
+        '<worldbody><body name="b" pos="0 0 1"><geom size="1"/></body></worldbody></mujoco>'
+    )
+    doc.find(".//numeric").text = "1 < 2"
+    theirs = ET.fromstring(doc.to_xml())
+    for path in [".//body", "custom", ".//text", ".//numeric"]:
+        ours = doc.find(path)
+        back = pickle.loads(pickle.dumps(ours))
+        their_back = pickle.loads(pickle.dumps(theirs.find(path)))
+        assert isinstance(back, Element) and back.parent is None and back is not ours
+        their_back.tail = None  # a detached element of ours has no tail (as its copies)
+        assert ET.tostring(back) == ET.tostring(their_back), path
+        assert back.text == their_back.text and back.tail is None, path
+    # Into another process's document: appended like any new element.
+    body = pickle.loads(pickle.dumps(doc.find(".//body")))
+    other = Document.from_string("<mujoco><worldbody/></mujoco>")
+    other.worldbody.append(body)
+    assert body.parent is other.worldbody and other.find(".//geom").get("size") == "1"
 
 
 def test_text_and_tail_read_and_write_as_xml_etree():

@@ -43,6 +43,14 @@ def test_lists_are_the_named_objects_mujoco_compiles():
     assert info["joints"] == robot.joints
 
 
+def test_lists_are_made_with_the_model_as_robosuites_are():
+    robot = Model(PANDA, "robot0")
+    joints = robot.joints
+    robot.document.find_named("body", "robot0_link7").append("joint", {"name": "robot0_extra"})
+    assert robot.document.find_named("joint", "robot0_extra") is not None
+    assert robot.joints == joints  # as listed when the model was made
+
+
 @pytest.mark.parametrize("path", [PANDA, GRIPPER, MOUNT, *OBJECTS], ids=lambda p: p.stem)
 def test_offsets_are_mujocos_geometry(path, tmp_path):
     model = Model(path, 0)

@@ -11,7 +11,7 @@ use std::sync::{Arc, Mutex};
 use mjcf_forge::{Document, Node};
 use pyo3::exceptions::{PyDeprecationWarning, PyKeyError, PyTypeError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList, PyString};
+use pyo3::types::{PyDict, PyList, PyString, PyTuple};
 
 use super::attrib::PyAttrib;
 use super::cell::{DocCell, next_serial, proxies, proxy};
@@ -524,6 +524,16 @@ impl PyElement {
         _memo: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyElement>> {
         self.__copy__(py)
+    }
+
+    /// Pickling (multiprocessing, Ray) goes through the element's XML, read back by
+    /// ``mjcf_forge.etree`` as a new, detached element: the same tag, attributes, text and
+    /// children, and, as a copy, no tail (the text after an element lives in its parent).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let xml = self.read(py, |d, n| d.element_document(n).0.to_xml_string());
+        let rebuild = py.import("mjcf_forge.etree")?.getattr("fromstring")?;
+        let args = PyTuple::new(py, [xml])?;
+        PyTuple::new(py, [rebuild, args.into_any()])
     }
 
     fn __repr__(slf: &Bound<'_, Self>) -> String {
