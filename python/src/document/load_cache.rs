@@ -10,8 +10,10 @@ use super::PyDocument;
 use crate::errors::run;
 
 /// Documents loaded from files, kept and served again while their file holds the same
-/// bytes: a load of an unchanged file reads and compares the bytes, then copies the kept
-/// document instead of parsing, inlining and resolving paths again. Files with ``<include>`` are read every time.
+/// bytes: a load of an unchanged file copies the kept document instead of parsing,
+/// inlining and resolving paths again. One ``stat`` tells a file is unchanged once its
+/// bytes were seen 3 s or more after its last change (any later write moves its change
+/// time); until then the file is read and compared at each load. Files with ``<include>`` are read every time.
 /// At most ``capacity`` documents are kept, the oldest going first. Safe to share between
 /// threads.
 ///
