@@ -38,5 +38,7 @@ echo "== python package (pytest: API, errors, threads, MuJoCo judge, Gymnasium, 
 .cache/venv/bin/python -m pytest python/tests -q -p no:cacheprovider
 echo "== ModelCache and DocumentCache under MuJoCo 4.0.0 (patched models judged against 4.0.0's compile)"
 .cache/venv-mj4/bin/python -m pytest python/tests/test_model_cache.py python/tests/test_document_cache.py -q -p no:cacheprovider
+# robosuite's task XMLs (written by the robosuite venv) through a DocumentCache, judged by 4.0.0.
+.cache/venv-mj4/bin/python -m pytest python/tests/test_robosuite_resets.py -k task_xmls -q -p no:cacheprovider
 echo "== fuzz smoke run (5 s per target; long campaigns: bash scripts/fuzz.sh SECONDS)"
 bash scripts/fuzz.sh 5

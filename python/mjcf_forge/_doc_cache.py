@@ -14,6 +14,7 @@ from __future__ import annotations
 import collections
 import copy
 import os
+import sys
 import threading
 from typing import Any
 
@@ -93,7 +94,7 @@ def _walk(model: Any, path: tuple[str, ...]) -> Any:
 
 
 class _Working:
-    """One model of a structure, the one a thread is given: its plan (scratch data, where
+    """One model of a structure that a thread is given: its plan (scratch data, where
     each entry lands) and its views of what the snapshot restores."""
 
     def __init__(self, mujoco: Any, model: Any, structure: "_Structure") -> None:
@@ -110,6 +111,18 @@ class _Working:
                     self.arrays.append((getattr(obj, name), saved))
                 else:
                     self.structs.append((obj, name, saved))
+        # The references the cache itself holds (this object's views and plan), counted
+        # by calibrate() once the model's maker has let go of it.
+        self.own = sys.maxsize
+
+    def calibrate(self) -> None:
+        self.own = sys.getrefcount(self.model)
+
+    def held(self) -> bool:
+        """Whether anyone but the cache still holds the model (a simulation made on it, one
+        of its arrays): such a model is never patched again (CPython's reference count, the
+        same expression as in calibrate())."""
+        return sys.getrefcount(self.model) > self.own
 
     def patch(self, values: np.ndarray, materials: list) -> None:
         for view, saved in self.arrays:
@@ -120,20 +133,46 @@ class _Working:
         self.plan.finish()
 
 
+# Models of one structure a thread keeps: one to patch while a simulation made on the
+# previous one is still alive (robosuite makes its next simulation before it drops the
+# last), and room for a few environments in one process.
+_POOL = 4
+
+
 class _Structure:
     """A compiled structure: its snapshot, the layout of its patch, the statistics its
-    ``<statistic>`` fixes, and one model per thread that asked for it."""
+    ``<statistic>`` fixes, and per thread that asked for it the models it was given."""
 
     def __init__(self, mujoco: Any, key: str, model: Any, doc: Any, fixed: list) -> None:
         self.key = key
         self.layout = doc.patch
         self.fixed = [(s, _copy(getattr(model.stat, s))) for s in fixed]
         self.snapshot = _Snapshot(mujoco, model)
-        self.models: dict[int, _Working] = {}
+        self.models: dict[int, list[_Working]] = {}
 
     @property
     def nbytes(self) -> int:
-        return self.snapshot.nbytes + sum(w.plan.nbytes for w in self.models.values())
+        return self.snapshot.nbytes + sum(w.plan.nbytes for w in self.workings())
+
+    def workings(self) -> list[_Working]:
+        return [w for pool in self.models.values() for w in pool]
+
+    def free(self, me: int) -> _Working | None:
+        """A model of this thread that no one but the cache holds."""
+        for working in self.models.get(me, ()):
+            if not working.held():
+                return working
+        return None
+
+    def keep(self, me: int, working: _Working) -> None:
+        """Adds ``working`` to this thread's models; beyond ``_POOL`` of them the cache
+        forgets the oldest held ones (their holders keep them)."""
+        pool = self.models.setdefault(me, [])
+        pool.append(working)
+        for old in [w for w in pool if w is not working and w.held()]:
+            if len(pool) <= _POOL:
+                break
+            pool.remove(old)
 
 
 class DocumentCache:
@@ -148,13 +187,15 @@ class DocumentCache:
     (``doc.patch``) written in, or on a miss the document compiled. No one tells the cache
     what changed: documents built any way (robosuite's classes, your own code) are read.
 
-    The model is the cache's, one per structure and thread: the next call for the same
-    structure from the same thread patches it again (``copy.copy`` it to keep one). You
-    may change it in place (domain randomization does) without changing what the cache
-    gives next: before each patch every array but the bulk data (mesh, texture, height
-    field, skin and bounding-volume data), ``model.opt`` and ``model.vis`` are written
-    back as compiled. The bulk data is shared as compiled: change it (a texture's pixels)
-    in a copy.
+    The model is the cache's, kept per structure and thread, and it is yours for as long
+    as you hold it: a model that anyone still holds (a simulation made on it, one of its
+    arrays) is never patched again; the next call for its structure patches another model
+    of the structure (a copy of one, made once, when all are held). Once you let go of it,
+    a later call may patch it. You may change it in place (domain randomization does)
+    without changing what the cache gives next: before each patch every array but the
+    bulk data (mesh, texture, height field, skin and bounding-volume data), ``model.opt``
+    and ``model.vis`` are written back as compiled. The bulk data is shared between a
+    structure's models as compiled: change it (a texture's pixels) in a ``copy.copy``.
 
     Two threads asking for one structure compile it once; each gets a model of its own.
     MuJoCo's error, when it refuses a document, comes as an :class:`MjcfError` at the
@@ -211,8 +252,9 @@ class DocumentCache:
                 structure = self._entries.get(key)
                 if structure is not None:
                     self._entries.move_to_end(key)
-                    working = structure.models.get(me)
-                    other = next(iter(structure.models.values()), None)
+                    working = structure.free(me)
+                    if working is None:
+                        other = next(iter(structure.workings()), None)
                     break
                 waiting = self._compiling.get(key)
                 if waiting is None:
@@ -235,15 +277,16 @@ class DocumentCache:
         return working.model
 
     def _adopt(self, structure: _Structure, me: int, other: _Working | None) -> _Working:
-        """A model of ``structure`` for this thread: a copy of another thread's (what the
-        snapshot restores is written back before its first patch; the bulk data is never
-        written)."""
-        model = copy.copy(other.model) if other is not None else None
-        if model is None:
+        """A model of ``structure`` for this thread: a copy of another of its models (what
+        the snapshot restores is written back before its first patch; the bulk data is
+        never written)."""
+        if other is None:
             raise _error(f"structure {structure.key} has no model to copy")
-        working = _Working(self._mujoco, model, structure)
+        # No local name holds the copy, so that calibrate() counts the cache's own.
+        working = _Working(self._mujoco, copy.copy(other.model), structure)
+        working.calibrate()
         with self._lock:
-            structure.models[me] = working
+            structure.keep(me, working)
             self._trim()
         return working
 
@@ -257,13 +300,16 @@ class DocumentCache:
             except ValueError as e:
                 raise _error(doc._mujoco_error(xml, str(e))) from None
             structure = _Structure(self._mujoco, key, model, doc, fixed)
-            structure.models[threading.get_ident()] = _Working(self._mujoco, model, structure)
+            working = _Working(self._mujoco, model, structure)
+            del model  # calibrate() counts the cache's own references
+            working.calibrate()
+            structure.keep(threading.get_ident(), working)
             with self._lock:
                 self.compiles += 1
                 self._entries[key] = structure
                 self._entries.move_to_end(key)
                 self._trim()
-            return model
+            return working.model
         finally:
             if not replace:
                 with self._lock:

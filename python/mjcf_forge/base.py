@@ -43,6 +43,8 @@ __all__ = [
     "FILE_CACHE",
     "USING_INSTANCE_RANDOMIZATION",
     "XMLError",
+    "model_cache",
+    "set_model_cache",
     "sort_elements",
 ]
 
@@ -235,10 +237,12 @@ def _find_elements(root: Any, tags: Any, attribs: Optional[dict] = None) -> Opti
 def _compile_inertia(xml: str, model_dir: Any) -> tuple:
     """The bodies' names, masses and inertias as the installed ``mujoco`` compiles ``xml``
     alone: what a merge writes out when a part's compiler mass settings differ from the
-    base's (``Document.merge(compile_inertia=...)``)."""
+    base's (``Document.merge(compile_inertia=...)``). Through the process's model cache
+    when it is on: robosuite merges the same arena at every hard reset."""
     import mujoco
 
-    model = mujoco.MjModel.from_xml_string(xml)
+    cache = model_cache()
+    model = cache.model(xml) if cache is not None else mujoco.MjModel.from_xml_string(xml)
     names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, i) or "" for i in range(model.nbody)]
     return (
         names,
@@ -284,6 +288,66 @@ def _asset_name(asset: Any) -> Optional[str]:
         stem = os.path.splitext(os.path.basename(asset.get("file").replace("\\", "/")))[0]
         return stem or None
     return None
+
+
+# --------------------------------------------------------------------------------------
+# The process's model cache
+# --------------------------------------------------------------------------------------
+
+#: The environment variable that turns the process's model cache off before it is made:
+#: ``MJCF_FORGE_MODEL_CACHE=0`` (or ``off``, ``false``, ``no``).
+MODEL_CACHE_ENV = "MJCF_FORGE_MODEL_CACHE"
+
+_UNSET: Any = object()
+_model_cache: Any = _UNSET
+
+
+def model_cache() -> Optional[Any]:
+    """The process's :class:`~mjcf_forge.DocumentCache`, through which
+    :meth:`MujocoXML.get_model` (and, with :func:`mjcf_forge.robosuite.use`, robosuite's
+    simulations) compiles, or ``None`` when it is off.
+
+    On by default: made on first use (at most 8 structures, least recently used out), unless
+    the environment variable ``MJCF_FORGE_MODEL_CACHE`` is ``0``, ``off``, ``false`` or
+    ``no``. :func:`set_model_cache` replaces it or turns it off.
+    """
+    global _model_cache
+    if _model_cache is _UNSET:
+        if os.environ.get(MODEL_CACHE_ENV, "").strip().lower() in ("0", "off", "false", "no"):
+            _model_cache = None
+        else:
+            from ._doc_cache import DocumentCache
+
+            _model_cache = DocumentCache(max_models=8)
+    return _model_cache
+
+
+def set_model_cache(cache: Any) -> Optional[Any]:
+    """Sets the process's model cache (see :func:`model_cache`) and returns the one it
+    replaces (``None`` if it was off), so a caller can put it back.
+
+    Args:
+        cache: a :class:`~mjcf_forge.DocumentCache` (yours, with your bounds), ``True`` (a
+            new default one), or ``None`` / ``False`` (off: every ``get_model`` compiles)
+
+    >>> from mjcf_forge import base
+    >>> previous = base.set_model_cache(None)      # off: MuJoCo compiles every model
+    >>> base.model_cache() is None
+    True
+    >>> _ = base.set_model_cache(previous)         # as it was
+    """
+    global _model_cache
+    from ._doc_cache import DocumentCache
+
+    if cache is True:
+        cache = DocumentCache(max_models=8)
+    elif cache is False:
+        cache = None
+    elif cache is not None and not isinstance(cache, DocumentCache):
+        raise TypeError(f"set_model_cache takes a DocumentCache, True, False or None, not {type(cache).__name__}")
+    previous = model_cache()
+    _model_cache = cache
+    return previous
 
 
 # --------------------------------------------------------------------------------------
@@ -421,7 +485,15 @@ class MujocoXML(object):
         return repr(self.root.get("model")) if self.root.get("model") else str(self.file)
 
     def get_model(self, mode="mujoco"):
-        """The model compiled by the installed ``mujoco`` (a ``mujoco.MjModel``).
+        """The model compiled by the installed ``mujoco`` (a ``mujoco.MjModel``), equal to
+        ``mujoco.MjModel.from_xml_string(self.get_xml())``.
+
+        Through the process's model cache (:func:`model_cache`, on by default): a model
+        whose structure the cache has seen is that structure's model with this one's values
+        written in, at patch cost; a new structure compiles. The model is yours while you
+        hold it: the cache patches only models no one else holds (see
+        :class:`~mjcf_forge.DocumentCache`). ``set_model_cache(None)`` makes every call
+        compile.
 
         Args:
             mode (str): "mujoco", the only mode
@@ -431,6 +503,9 @@ class MujocoXML(object):
         """
         available_modes = ["mujoco"]
         if mode == "mujoco":
+            cache = model_cache()
+            if cache is not None:
+                return cache.model(self.document)
             import mujoco
 
             return mujoco.MjModel.from_xml_string(self.document.to_xml())

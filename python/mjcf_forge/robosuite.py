@@ -19,7 +19,16 @@ modules has run:
 - every module-level name bound to ``xml.etree.ElementTree`` (robosuite's ``ET``) is
   :mod:`mjcf_forge.etree`, so the elements robosuite makes (``new_element``,
   ``ET.Element``, ``ET.fromstring``) are ours and go into our documents as robosuite
-  appends them.
+  appends them;
+- ``robosuite.utils.binding_utils.MjSim.from_xml_string`` (what an environment's hard
+  reset compiles its task with) gets its model from the process's model cache
+  (:func:`mjcf_forge.base.model_cache`, on by default): a reset compiles only a structure
+  the cache has not seen, and otherwise patches that structure's model, a model no
+  earlier simulation still holds, with every array written back as compiled first (so
+  ``DomainRandomizationWrapper``'s changes do not outlive the reset);
+- ``RobotModel.mujoco_model``, the robot compiled alone at every load
+  (``set_mujoco_model()``), which robosuite never reads, is compiled on first read, from
+  the robot as it was when ``set_mujoco_model()`` was called.
 
 robosuite's own code keeps running as written, its ``mjcf_utils`` included: objects that
 robosuite builds element by element (``MujocoGeneratedObject``, ``MujocoXMLObject``'s
@@ -55,6 +64,74 @@ def _adapt(module: Any) -> None:
         module.MujocoXML = _base.MujocoXML
         module.MujocoModel = _base.MujocoModel
         module.MujocoXMLModel = _base.MujocoXMLModel
+    elif module.__name__ == "robosuite.utils.binding_utils":
+        _cache_simulations(module.MjSim)
+    elif module.__name__ == "robosuite.models.robots.robot_model":
+        _lazy_robot_model(module.RobotModel)
+
+
+def _cache_simulations(sim_class: Any) -> None:
+    """``MjSim.from_xml_string`` through the process's model cache (when it is on)."""
+    compile_sim = sim_class.__dict__["from_xml_string"].__func__
+
+    def from_xml_string(cls: Any, xml: str) -> Any:
+        cache = _base.model_cache()
+        if cache is None:
+            return compile_sim(cls, xml)
+        return cls(cache.model(xml))
+
+    from_xml_string.__doc__ = compile_sim.__doc__
+    from_xml_string.__wrapped__ = compile_sim  # type: ignore[attr-defined]
+    sim_class.from_xml_string = classmethod(from_xml_string)
+
+
+class _Pending:
+    """A robot's model not compiled yet: the robot's document as it was when
+    ``set_mujoco_model()`` was called (a copy: the robot is merged into its task later)."""
+
+    __slots__ = ("document",)
+
+    def __init__(self, document: Any) -> None:
+        self.document = document
+
+
+class _LazyModel:
+    """``RobotModel.mujoco_model``: what ``set_mujoco_model()`` was given, or the robot
+    compiled on first read (through :meth:`mjcf_forge.base.MujocoXML.get_model`'s cache)."""
+
+    def __get__(self, robot: Any, owner: Any = None) -> Any:
+        if robot is None:
+            return self
+        value = robot.__dict__.get("_mjcf_forge_model")
+        if isinstance(value, _Pending):
+            cache = _base.model_cache()
+            if cache is not None:
+                value = cache.model(value.document)
+            else:
+                import mujoco
+
+                value = mujoco.MjModel.from_xml_string(value.document.to_xml())
+            robot.__dict__["_mjcf_forge_model"] = value
+        return value
+
+    def __set__(self, robot: Any, value: Any) -> None:
+        robot.__dict__["_mjcf_forge_model"] = value
+
+
+def _lazy_robot_model(robot_class: Any) -> None:
+    robot_class.mujoco_model = _LazyModel()
+
+    def set_mujoco_model(self: Any, mujoco_model: Any = None) -> None:
+        if mujoco_model is not None:
+            self.mujoco_model = mujoco_model
+        else:
+            self.mujoco_model = _Pending(self.document.copy())
+
+    set_mujoco_model.__doc__ = (
+        "Sets ``mujoco_model``: the model given, or else this robot compiled alone, "
+        "on first read (mjcf_forge.robosuite)."
+    )
+    robot_class.set_mujoco_model = set_mujoco_model
 
 
 class _Loader(importlib.abc.Loader):

@@ -313,6 +313,8 @@ def compare_models(a: mujoco.MjModel, b: mujoco.MjModel, prefix: str = "") -> li
             i = next((k for k, (x, y) in enumerate(zip(va, vb)) if x != y), min(len(va), len(vb)))
             out.append(f"{n}[{i}]: {va[i:i + 20]!r} != {vb[i:i + 20]!r} (lengths {len(va)}, {len(vb)})")
     for n, label in PATHS_STRINGS.items():
+        if not hasattr(a, n):  # MuJoCo before 3.2.7 (robosuite's 3.9.0 venv) has none
+            continue
         sa, sb = _strings(a.paths, getattr(a, n)), _strings(b.paths, getattr(b, n))
         if len(sa) == len(sb):  # else the size difference is already reported
             for i, (x, y) in enumerate(zip(sa, sb)):

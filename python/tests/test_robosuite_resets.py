@@ -1,0 +1,122 @@
+"""robosuite's hard resets through the process's model cache, judged by MuJoCo.
+
+robosuite_resets.py runs in the robosuite venv (.cache/venv-robosuite-env: robosuite
+1.5.2 with MuJoCo 3.9.0; a missing venv is a failure, not a skip) with
+mjcf_forge.robosuite.use() on: every robosuite environment with Panda (two for the TwoArm
+ones), made and hard-reset, plain and inside robosuite's DomainRandomizationWrapper; every
+model a simulation is given is compared with MuJoCo compiling the same XML. The task
+XMLs it writes are judged again here through a DocumentCache, under this venv's MuJoCo
+(3.17.0, and 4.0.0 when scripts/test.sh runs test_document_cache.py's neighbours under
+.cache/venv-mj4).
+"""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+from pathlib import Path
+
+import mujoco
+import pytest
+
+import judge
+import mjcf_forge
+from conftest import ROOT
+from test_model_cache import not_bit_identical
+
+RS_ENV = ROOT / ".cache" / "venv-robosuite-env" / "bin" / "python"
+SCRIPT = Path(__file__).with_name("robosuite_resets.py")
+RESETS = 2
+
+
+def run_in_robosuite(tmp: Path, *args: str) -> None:
+    assert RS_ENV.exists(), f"{RS_ENV} missing: run scripts/setup_robosuite_env.sh"
+    # This run's mjcf_forge alone on the path (its install folder holds another MuJoCo),
+    # and the judge.
+    only = tmp / "path"
+    only.mkdir(exist_ok=True)
+    if not (only / "mjcf_forge").exists():
+        (only / "mjcf_forge").symlink_to(Path(mjcf_forge.__file__).resolve().parent)
+    env = dict(os.environ, PYTHONPATH=f"{only}{os.pathsep}{ROOT / 'tests' / 'judge'}")
+    env.pop("MJCF_FORGE_MODEL_CACHE", None)
+    run = subprocess.run(
+        [str(RS_ENV), str(SCRIPT), *args], cwd=tmp, env=env, capture_output=True, text=True,
+        timeout=1200,
+    )
+    assert run.returncode == 0, run.stderr[-3000:]
+
+
+@pytest.fixture(scope="module")
+def judged(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("robosuite_resets")
+    run_in_robosuite(tmp, "judge", str(tmp / "out.json"), "--resets", str(RESETS))
+    return json.loads((tmp / "out.json").read_text())
+
+
+ENVS = [
+    "Door", "Lift", "NutAssembly", "NutAssemblyRound", "NutAssemblySingle",
+    "NutAssemblySquare", "PickPlace", "PickPlaceBread", "PickPlaceCan", "PickPlaceCereal",
+    "PickPlaceMilk", "PickPlaceSingle", "Stack", "ToolHang", "TwoArmHandover", "TwoArmLift",
+    "TwoArmPegInHole", "TwoArmTransport", "Wipe",
+]
+
+
+def test_every_environment_was_judged(judged):
+    assert set(judged) == {f"{e}{m}" for e in ENVS for m in ("", "+dr")}
+    errors = {k: v["error"] for k, v in judged.items() if "error" in v}
+    assert {k.split("+")[0] for k in errors} <= REFUSED, errors
+
+
+# robosuite attaches the peg to a robot's hand without its material (the task gets the
+# peg's assets later): mjcf_forge.base's merge, compiling the part alone for its
+# inertias, is refused by MuJoCo. Not the cache's; when the merge takes it, this passes.
+REFUSED = {"TwoArmPegInHole"}
+
+
+@pytest.mark.parametrize("name", [
+    pytest.param(e, marks=pytest.mark.xfail(strict=True, reason="merge of the peg without its material"))
+    if e in REFUSED else e
+    for e in ENVS
+])
+def test_every_model_a_hard_reset_gets_is_mujocos_compile(judged, name):
+    for mode in ("", "+dr"):
+        got = judged[name + mode]
+        # The construction's simulation and each reset's.
+        assert got["judged"] == 1 + RESETS, got
+        assert got["diffs"] == [], got["diffs"]
+        assert got["compiles"] + got["patches"] >= got["judged"]
+        # robosuite never reads a robot's model compiled alone: never compiled.
+        assert got["robot_models_compiled"] == 0
+    # The wrapper changed every reset's model in place, and the next reset's model was
+    # still MuJoCo's compile: its changes did not leak.
+    assert judged[name + "+dr"]["randomized_resets"] == RESETS
+
+
+def test_resets_of_a_fixed_structure_are_patches(judged):
+    # PickPlace and NutAssembly place their objects after the compile: one structure.
+    for name in ("PickPlace", "NutAssembly", "Door", "TwoArmLift"):
+        assert judged[name]["patches"] >= RESETS, (name, judged[name])
+
+
+@pytest.fixture(scope="module")
+def task_xmls(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("robosuite_xml")
+    names = "Lift,PickPlace,NutAssembly,Door,Stack,ToolHang,TwoArmTransport,Wipe"
+    run_in_robosuite(tmp, "xml", str(tmp / "xml"), "--resets", "2", "--envs", names)
+    return sorted((tmp / "xml").glob("*.xml"))
+
+
+def test_robosuite_task_xmls_through_a_document_cache(task_xmls):
+    """Under this venv's MuJoCo: the cache on robosuite's task XMLs (as text, as robosuite's
+    MjSim gives them), each equal to MuJoCo's compile."""
+    assert len(task_xmls) == 8 * 3
+    cache = mjcf_forge.DocumentCache(max_models=16)
+    for path in task_xmls:
+        xml = path.read_text()
+        model = cache.model(xml)
+        ref = mujoco.MjModel.from_xml_string(xml)
+        assert judge.compare_models(ref, model) == [], path.name
+        assert not_bit_identical(ref, model) == [], path.name
+        model.geom_rgba[:] = 0.3  # robosuite's modders, in place
+        del model
+    assert cache.patches >= 8
