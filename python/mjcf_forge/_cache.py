@@ -157,6 +157,15 @@ class _Plan:
         self.matids: list[tuple[Any, int, int]] = []
         # (field of model.opt, first of its numbers, how many) per option entry.
         self.options: list[tuple[str, int, int]] = []
+        # The bodies of the patch's "geoms" entries, in order, and the little models of
+        # their geoms compiled so far (MJCF text -> model), the newest last.
+        self.bodies: list[int] = []
+        self.body_models: dict[str, Any] = {}
+        # Per "geoms" entry: its little model as the structure compiled it (what the
+        # snapshot's arrays hold), and the one last written into this model (None: not
+        # known; the bounding volumes are not restored before a patch).
+        self.body_xml0: list[str] = []
+        self.body_written: list[Any] = []
         # The <statistic> values the scene sets: MuJoCo keeps them over what it computes.
         self.fixed = fixed
         # Views (fetching one from the bindings costs microseconds) and constants.
@@ -169,7 +178,8 @@ class _Plan:
         self.nbody, self.nv = model.nbody, model.nv
         self.dof_length = model.dof_length
         # Geom radii for the bounding box: a plane or height field (rbound 0) counts a
-        # tenth of its largest size. Sizes are never patched: constant per structure.
+        # tenth of its largest size. Sizes are patched only through "geoms" entries, which
+        # update these (compiled_body()).
         size, kind = model.geom_size, model.geom_type
         rbound = model.geom_rbound.copy()
         plane = (rbound <= 0) & (kind == mujoco.mjtGeom.mjGEOM_PLANE)
@@ -181,12 +191,14 @@ class _Plan:
             rbound[g] = max(h[0], max(h[1], max(h[2], h[3]))) * 0.1
         rbound[rbound < 0] = 0.0
         self.box_radius = rbound[:, None]
+        self.box_radius0 = self.box_radius.copy()
         self.joint_body = model.jnt_bodyid.copy()
         self.joint_parent = model.body_parentid[self.joint_body]
         geoms = np.flatnonzero((model.geom_rbound > 0) & (model.geom_bodyid > 0))
         self.sized_geoms = geoms
         self.sized_geom_body = model.geom_bodyid[geoms]
         self.sized_geom_rbound = model.geom_rbound[geoms].copy()
+        self.sized_geom_rbound0 = self.sized_geom_rbound.copy()
         jnt = model.dof_jntid
         jtype = model.jnt_type[jnt]
         offset = np.arange(model.nv) - model.jnt_dofadr[jnt]
@@ -202,6 +214,8 @@ class _Plan:
         groups: dict[str, tuple[Any, list[int], list[int]]] = {}
         matids: list[tuple[Any, int, int]] = []
         options: list[tuple[str, int, int]] = []
+        bodies: list[int] = []
+        body_xml: list[str] = []
         numbers = 0
         for obj, name, field, value in patch:
             if obj == "option":
@@ -218,6 +232,10 @@ class _Plan:
                 raise _error(
                     f"the patch names {obj} '{name}', which the compiled model does not have"
                 )
+            if field == "geoms":
+                bodies.append(int(i))
+                body_xml.append(value)
+                continue
             if obj == "joint" and field in _DOF_FIELDS:
                 array = f"dof_{field}"
                 first = int(model.jnt_dofadr[i])
@@ -246,6 +264,9 @@ class _Plan:
         self.groups = [(flat, np.array(t), np.array(s)) for flat, t, s in groups.values()]
         self.matids = matids
         self.options = options
+        self.bodies = bodies
+        self.body_xml0 = body_xml
+        self.body_written = [None] * len(bodies)
         self.fields = [tuple(e[:3]) for e in patch]
 
     def apply(self, patch: list) -> None:
@@ -261,12 +282,13 @@ class _Plan:
             itertools.chain.from_iterable(e[3] for e in patch if not isinstance(e[3], str)),
             dtype=np.float64,
         )
-        self.write(values, [e[3] for e in patch if isinstance(e[3], str)])
+        materials = [e[3] for e in patch if isinstance(e[3], str) and e[2] != "geoms"]
+        self.write(values, materials, [e[3] for e in patch if e[2] == "geoms"])
         self.finish()
 
-    def write(self, values: np.ndarray, materials: list) -> None:
-        """Writes a patch of the resolved layout: its numbers end to end (``values``) and
-        the names of its materials in order."""
+    def write(self, values: np.ndarray, materials: list, bodies: list = ()) -> None:
+        """Writes a patch of the resolved layout: its numbers end to end (``values``), the
+        names of its materials in order, and the little models of its bodies' geoms."""
         for flat, targets, sources in self.groups:
             # A float32 array takes the numbers rounded as MuJoCo rounds them (they are).
             flat[targets] = values[sources]
@@ -281,6 +303,58 @@ class _Plan:
                 setattr(opt, field, float(values[first]))
             else:
                 getattr(opt, field)[:] = values[first : first + n]
+        if self.bodies:
+            # The statistics' radii as compiled, then each body's as written below.
+            self.box_radius[:] = self.box_radius0
+            self.sized_geom_rbound[:] = self.sized_geom_rbound0
+            for k, (body, xml) in enumerate(zip(self.bodies, bodies)):
+                # As compiled and as last written: the arrays already hold it.
+                if xml == self.body_xml0[k] and self.body_written[k] == xml:
+                    continue
+                self.body_written[k] = None
+                self.compiled_body(body, xml)
+                self.body_written[k] = xml
+
+    def compiled_body(self, body: int, xml: str) -> None:
+        """Writes what MuJoCo derives from ``body``'s geoms, read off its compile of their
+        little model ``xml`` (the same computation on the same numbers: each geom's size,
+        bounding radius and box, the body's mass, inertia and inertial frame, its bounding
+        volumes). Raises when the little model's layout is not the body's (the document is
+        then compiled)."""
+        mini = self.body_models.get(xml)
+        if mini is None:
+            mini = self.mujoco.MjModel.from_xml_string(xml)
+            if len(self.body_models) >= 64:
+                del self.body_models[next(iter(self.body_models))]
+            self.body_models[xml] = mini
+        model = self.model
+        first, n = int(model.body_geomadr[body]), int(model.body_geomnum[body])
+        mfirst = int(mini.body_geomadr[1]) if mini.nbody == 2 else -1
+        bvh, nbvh = int(model.body_bvhadr[body]), int(model.body_bvhnum[body])
+        mbvh = int(mini.body_bvhadr[1]) if mini.nbody == 2 else -1
+        if (
+            mini.nbody != 2
+            or int(mini.body_geomnum[1]) != n
+            or int(mini.body_sameframe[1]) != int(model.body_sameframe[body])
+            or int(mini.body_bvhnum[1]) != nbvh
+            or not np.array_equal(mini.geom_type[mfirst : mfirst + n], model.geom_type[first : first + n])
+            or not np.array_equal(mini.bvh_child[mbvh : mbvh + nbvh], model.bvh_child[bvh : bvh + nbvh])
+            or not np.array_equal(mini.bvh_depth[mbvh : mbvh + nbvh], model.bvh_depth[bvh : bvh + nbvh])
+            or not np.array_equal(mini.bvh_nodeid[mbvh : mbvh + nbvh] + (first - mfirst) * (mini.bvh_nodeid[mbvh : mbvh + nbvh] >= 0), model.bvh_nodeid[bvh : bvh + nbvh])
+        ):
+            raise _error(f"body {body}: its geoms' compile is not a patch of this structure")
+        geoms, mgeoms = slice(first, first + n), slice(mfirst, mfirst + n)
+        for field in ("geom_size", "geom_rbound", "geom_aabb"):
+            getattr(model, field)[geoms] = getattr(mini, field)[mgeoms]
+        for field in ("body_mass", "body_inertia", "body_ipos", "body_iquat"):
+            getattr(model, field)[body] = getattr(mini, field)[1]
+        model.bvh_aabb[bvh : bvh + nbvh] = mini.bvh_aabb[mbvh : mbvh + nbvh]
+        # The bounding radii the statistics take (primitives: rbound > 0).
+        rbound = mini.geom_rbound[mgeoms]
+        self.box_radius[geoms, 0] = rbound
+        at = np.searchsorted(self.sized_geoms, np.arange(first, first + n))
+        hit = (at < len(self.sized_geoms)) & (self.sized_geoms[np.minimum(at, len(self.sized_geoms) - 1)] == np.arange(first, first + n))
+        self.sized_geom_rbound[at[hit]] = rbound[hit]
 
     def finish(self) -> None:
         """What follows the values: ``mj_setConst``, the compiler's statistics, and the

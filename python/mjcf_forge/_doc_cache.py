@@ -99,8 +99,6 @@ class _Working:
 
     def __init__(self, mujoco: Any, model: Any, structure: "_Structure") -> None:
         self.model = model
-        self.plan = _Plan(mujoco, model, structure.key, structure.fixed, superset=False)
-        self.plan.resolve(list(structure.layout))
         snap = structure.snapshot
         self.arrays = [(getattr(model, n), saved) for n, saved in snap.arrays.items()]
         self.structs = []
@@ -111,6 +109,10 @@ class _Working:
                     self.arrays.append((getattr(obj, name), saved))
                 else:
                     self.structs.append((obj, name, saved))
+        # The plan reads the model as compiled (a copy of another model may hold its patch).
+        self.restore()
+        self.plan = _Plan(mujoco, model, structure.key, structure.fixed, superset=False)
+        self.plan.resolve(list(structure.layout))
         # The references the cache itself holds (this object's views and plan), counted
         # by calibrate() once the model's maker has let go of it.
         self.own = sys.maxsize
@@ -124,12 +126,16 @@ class _Working:
         same expression as in calibrate())."""
         return sys.getrefcount(self.model) > self.own
 
-    def patch(self, values: np.ndarray, materials: list) -> None:
+    def restore(self) -> None:
+        """Writes back what the snapshot holds."""
         for view, saved in self.arrays:
             np.copyto(view, saved)
         for obj, name, saved in self.structs:
             setattr(obj, name, saved)
-        self.plan.write(values, materials)
+
+    def patch(self, values: np.ndarray, materials: list, bodies: list) -> None:
+        self.restore()
+        self.plan.write(values, materials, bodies)
         self.plan.finish()
 
 
@@ -244,7 +250,7 @@ class DocumentCache:
         """The ``mujoco.MjModel`` MuJoCo compiles from ``source`` (a :class:`Document`,
         MJCF text read from ``base_dir``, or a path); see the class."""
         doc = _document(source, base_dir)
-        key, numbers, materials, fixed = doc._split()
+        key, numbers, materials, fixed, bodies = doc._split()
         values = np.frombuffer(numbers, dtype="<f8")
         me = threading.get_ident()
         while True:
@@ -266,7 +272,7 @@ class DocumentCache:
         if working is None:
             working = self._adopt(structure, me, other)
         try:
-            working.patch(values, materials)
+            working.patch(values, materials, bodies)
         except Exception:
             # A value the model cannot take (a material that does not exist): MuJoCo's
             # own verdict. The model is whole again after its next patch, which writes

@@ -118,10 +118,17 @@ def new_value(tag: str, attr: str, old: str, rng: random.Random) -> str | None:
     return fmt(make()) if make else None
 
 
+PRIMITIVES = {"sphere", "capsule", "ellipsoid", "cylinder", "box"}
+
+
 def edit_values(doc, rng: random.Random) -> int:
     """Changes a random half of the document's patchable values; how many it changed."""
     changed = 0
     for el in doc.root.iter():
+        if (el.tag == "geom" and el.get("type", "sphere") in PRIMITIVES and "fromto" not in el.attrib
+                and "size" in el.attrib and rng.random() < 0.5):
+            el.attrib["size"] = fmt([float(x) * rng.uniform(0.8, 1.25) for x in el.attrib["size"].split()])
+            changed += 1
         if el.tag == "inertial":
             if rng.random() < 0.5 and "mass" in el.attrib and "diaginertia" in el.attrib:
                 f = rng.uniform(0.5, 2)
@@ -156,7 +163,7 @@ def test_scene_variants_as_documents_are_exact(path):
 def test_random_value_edits_of_wheel_models_are_exact():
     rng = random.Random(21)
     cache = mjcf_forge.DocumentCache(max_models=4)
-    edits = hits = 0
+    edits = hits = sized = 0
     for path, doc in sample_docs():
         check_exact(doc, cache.model(doc), path)
         key = doc.structure_key
@@ -168,10 +175,55 @@ def test_random_value_edits_of_wheel_models_are_exact():
             if edited.structure_key == key:
                 assert cache.patches == patches + 1, path
                 hits += 1
+                sized += any(f == "geoms" for _, _, f, _ in edited.patch)
     assert edits > 500, edits
     # Most edited documents are patched; the others compile (a muscle model patches only
-    # visual values; poses of unnamed bodies and of models with keyframes are compiled).
-    assert hits >= 40, hits
+    # visual values; poses of unnamed bodies and of models with keyframes are compiled;
+    # sizes of world geoms, of geoms sized by fromto or in bodies with meshes, and sizes
+    # under inertiafromgeom="true" are structure).
+    assert hits >= 25, hits
+    assert sized >= 10, sized  # with bodies whose geoms' sizes were patched
+
+
+def test_sizes_of_primitive_geoms_are_patched_through_their_bodys_compile():
+    xml = """<mujoco><compiler angle="degree"/><asset><material name="m" rgba="1 0 0 1"/></asset>
+      <worldbody><geom name="floor" type="plane" size="1 1 0.1"/>
+      <body name="cube" pos="0 0 0.1"><freejoint/>
+        <geom name="c" type="box" size="{a}" material="m" euler="0 0 30"/>
+        <geom name="c_vis" type="box" size="{a}" contype="0" conaffinity="0" group="1" mass="0"/>
+        <site name="s" size="0.01"/></body>
+      <body name="arm" pos="0.3 0 0.2"><joint name="j" axis="0 1 0"/>
+        <inertial pos="0 0 0" mass="1" diaginertia="0.01 0.01 0.01"/>
+        <geom type="capsule" size="{r} 0.1"/><geom type="cylinder" size="{r} 0.05" pos="0 0 0.1"/>
+        <body name="tip" pos="0 0 0.2"><joint axis="1 0 0"/><geom type="ellipsoid" size="{a}"/>
+          <geom type="sphere" size="{r}" pos="0.05 0 0"/></body></body>
+      <body name="pair" pos="0 0.3 0.1"><freejoint/><geom type="box" size="{b}"/>
+        <geom type="box" size="{b}"/></body>
+      </worldbody></mujoco>"""
+    cache = mjcf_forge.DocumentCache()
+    rng = random.Random(3)
+    docs = []
+    for k in range(8):
+        a = fmt([rng.uniform(0.02, 0.04) for _ in range(3)])
+        r = fmt([rng.uniform(0.01, 0.03)])
+        b = fmt(sorted(rng.uniform(0.01, 0.03) for _ in range(3)))
+        docs.append(mjcf_forge.Document.from_string(xml.format(a=a, r=r, b=b)))
+    assert len({d.structure_key for d in docs}) == 1
+    for k, doc in enumerate(docs):
+        check_exact(doc, cache.model(doc), f"sizes {k}")
+    assert (cache.compiles, cache.patches) == (1, 7)
+    # Two boxes with their sizes in the other order turn the pair's principal axes: MuJoCo
+    # then keeps its inertial frame apart from the body's (body_sameframe, body_simple),
+    # which no patch changes: compiled, exact.
+    uneven = mjcf_forge.Document.from_string(xml.format(a="0.03 0.03 0.03", r="0.02", b="0.03 0.02 0.01"))
+    assert uneven.structure_key == docs[0].structure_key
+    check_exact(uneven, cache.model(uneven), "uneven pair")
+    assert cache.compiles == 2
+    # The same structure again, patched, exact after the fallback.
+    check_exact(docs[3], cache.model(docs[3]), "after the fallback")
+    # World geoms, meshes and fromto stay structure.
+    sizes = [(o, f) for o, _, f, _ in docs[0].patch if f == "geoms"]
+    assert sizes == [("body", "geoms")] * 4
 
 
 def test_structural_edits_are_compiled_and_exact():

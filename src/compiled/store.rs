@@ -332,6 +332,9 @@ fn write(model: *mut MjModel, t: &Target, value: &PatchValue) -> Result<(), Stri
             // SAFETY: `ptr` points at `n` >= 1 ints of the live model (see `resolve`).
             unsafe { t.ptr.cast::<c_int>().write_unaligned(id) };
         }
+        PatchValue::Compiled(_) => {
+            return Err("a compiled body's geoms are not patched here".to_string());
+        }
         PatchValue::Numbers(v) => {
             for k in 0..t.n {
                 let x = if v.len() == 1 { v[0] } else { v[k] };
@@ -396,6 +399,13 @@ fn resolve(model: &mut CompiledModel, entries: &[PatchEntry]) -> Result<Vec<Targ
         let width = match &e.value {
             PatchValue::Numbers(v) => v.len(),
             PatchValue::Id { .. } => 1,
+            // Never in the splits this cache makes (`split_document`'s default options).
+            PatchValue::Compiled(_) => {
+                return Err(format!(
+                    "{} '{}': a compiled body's geoms are not patched here",
+                    e.object, e.name
+                ));
+            }
         };
         let (name, offset, n) = match (e.object, e.field) {
             ("joint", f @ ("damping" | "armature" | "frictionloss")) => {
@@ -456,7 +466,7 @@ fn option_target(model: *mut MjModel, e: &PatchEntry) -> Result<Target, String> 
     let p = unsafe { mjf_patch_option(model, c.as_ptr(), &mut elem, &mut count) };
     let width = match &e.value {
         PatchValue::Numbers(v) => v.len(),
-        PatchValue::Id { .. } => 0,
+        PatchValue::Id { .. } | PatchValue::Compiled(_) => 0,
     };
     if p.is_null() || elem != std::mem::size_of::<f64>() || count != width {
         return Err(format!(

@@ -18,11 +18,23 @@
 
 use std::path::Path;
 
+use super::body_model::{body_model, qualifies, sized_primitive};
 use super::patch::{
     self, PatchEntry, PatchValue, Rules, derives_damping, entry, numbers, owner, setting,
 };
 use crate::document::tree::Node;
 use crate::document::{Document, Section};
+
+/// What a split may patch beyond the values a compiled model takes as they are written.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SplitOptions {
+    /// Sizes of primitive geoms (sphere, capsule, ellipsoid, cylinder, box, sized by
+    /// `size`): their body's entry is a [`PatchValue::Compiled`] model of its geoms, whose
+    /// compile gives what MuJoCo derives from them (sizes, bounds, mass and inertia,
+    /// bounding volumes). Only for a model cache that compiles those (Python's
+    /// `DocumentCache`).
+    pub compiled_bodies: bool,
+}
 
 /// A document as a structure key and a patch (see [`split_document`]).
 #[derive(Clone, Debug, PartialEq)]
@@ -74,10 +86,16 @@ struct DocRules {
     /// The compiled id of each actuator (MuJoCo numbers them in order), when the ids of
     /// unnamed elements are known at all.
     actuator_ids: Option<ahash::AHashMap<Node, usize>>,
+    /// Sizes of primitive geoms are patched through their bodies' little models
+    /// ([`body_model`]): asked for, masses land unchanged and feed nothing the compiler
+    /// keeps (no length-range simulation), every geom of the compiled model is one of the
+    /// document (no `discardvisual`), and no spatial tendon, flex, composite or skin hangs
+    /// on a geom's size or a body's inertia.
+    sizes: bool,
 }
 
 impl DocRules {
-    fn new(doc: &Document) -> DocRules {
+    fn new(doc: &Document, options: SplitOptions) -> DocRules {
         let discard = setting(doc, "compiler", "discardvisual").map(str::trim) == Some("true");
         let mut base = Rules::new(doc, &[], discard);
         let all = || doc.descendants(doc.root());
@@ -97,10 +115,11 @@ impl DocRules {
         }
         // A spatial tendon's spring length is its length at qpos0, which mj_setConst of
         // 3.17.0 and 4.0.0 leaves as compiled; flexes and composites hang on body frames.
-        if all().any(|n| {
+        let hanging = all().any(|n| {
             matches!(doc.tag(n), "spatial" | "flex" | "flexcomp" | "composite")
                 || (doc.tag(n) == "skin" && doc.elements(n).next().is_some())
-        }) {
+        });
+        if hanging {
             base.poses = false;
         }
         let muscle = |n: Node| {
@@ -117,8 +136,10 @@ impl DocRules {
             .ids
             .as_ref()
             .map(|_| actuators.iter().enumerate().map(|(i, &n)| (n, i)).collect());
+        let dynamics = !actuators.iter().any(|&n| muscle(n)) && !lengthrange_all;
         DocRules {
-            dynamics: !actuators.iter().any(|&n| muscle(n)) && !lengthrange_all,
+            sizes: options.compiled_bodies && base.mass && dynamics && !discard && !hanging,
+            dynamics,
             armature: !dampratio && !inherited("armature"),
             damping: !inherited("damping"),
             options: doc
@@ -156,17 +177,40 @@ impl DocRules {
 /// # Ok::<(), mjcf_forge::Errors>(())
 /// ```
 pub fn split_document(doc: &Document) -> DocumentPatch {
+    split_document_with(doc, SplitOptions::default())
+}
+
+/// [`split_document`] with [`SplitOptions`]: with `compiled_bodies`, documents that differ
+/// in the sizes of primitive geoms share a structure.
+///
+/// ```
+/// use mjcf_forge::Document;
+/// use mjcf_forge::scene::{PatchValue, SplitOptions, split_document_with};
+///
+/// let xml = |size: &str| {
+///     format!("<mujoco><worldbody><body name='b'><freejoint/><geom size='{size}'/></body></worldbody></mujoco>")
+/// };
+/// let sizes = SplitOptions { compiled_bodies: true };
+/// let a = split_document_with(&Document::from_str(&xml("0.1"), ".")?, sizes);
+/// let b = split_document_with(&Document::from_str(&xml("0.2"), ".")?, sizes);
+/// assert_eq!(a.structure_key, b.structure_key);
+/// assert_eq!((b.entries[0].object, b.entries[0].field), ("body", "geoms"));
+/// let PatchValue::Compiled(body) = &b.entries[0].value else { unreachable!() };
+/// assert_eq!(body, r#"<mujoco><worldbody><body><geom size="0.2"/></body></worldbody></mujoco>"#);
+/// # Ok::<(), mjcf_forge::Errors>(())
+/// ```
+pub fn split_document_with(doc: &Document, options: SplitOptions) -> DocumentPatch {
     if doc
         .elements(doc.root())
         .any(|n| doc.tag(n) == "default" && doc.elements(n).next().is_some())
     {
         let mut resolved = doc.clone();
         return match crate::document::defaults::inline_defaults(&mut resolved) {
-            Ok(()) => split_resolved(&resolved),
+            Ok(()) => split_resolved(&resolved, options),
             Err(_) => all_structure(doc),
         };
     }
-    split_resolved(doc)
+    split_resolved(doc, options)
 }
 
 /// The key of a document taken whole, with no patch.
@@ -226,8 +270,8 @@ impl Key {
     }
 }
 
-fn split_resolved(doc: &Document) -> DocumentPatch {
-    let rules = DocRules::new(doc);
+fn split_resolved(doc: &Document, options: SplitOptions) -> DocumentPatch {
+    let rules = DocRules::new(doc, options);
     let mut key = Key::new(doc);
     let mut entries: Vec<PatchEntry> = Vec::new();
     // The open elements, to mark where each one closes (the key holds the tree's shape).
@@ -292,10 +336,15 @@ struct Patched<'d> {
 
 impl<'d> Patched<'d> {
     fn add(&mut self, attr: &'d str, e: PatchEntry) {
+        self.mark(attr);
+        self.entries.push(e);
+    }
+
+    /// An attribute whose value an entry of another element carries.
+    fn mark(&mut self, attr: &'d str) {
         if !self.attrs.contains(&attr) {
             self.attrs.push(attr);
         }
-        self.entries.push(e);
     }
 }
 
@@ -304,6 +353,9 @@ fn element_entries<'d>(doc: &'d Document, node: Node, rules: &DocRules) -> Patch
     let mut out = Patched::default();
     let tag = doc.tag(node);
     let parent_tag = doc.parent(node).map(|p| doc.tag(p));
+    if rules.sizes {
+        compiled_body_entries(doc, node, &mut out);
+    }
     match (tag, parent_tag) {
         ("body", _) => body_entries(doc, node, rules, &mut out),
         ("option", Some("mujoco")) if rules.options && rules.dynamics => {
@@ -398,6 +450,32 @@ fn body_entries<'d>(doc: &'d Document, body: Node, rules: &DocRules, out: &mut P
             };
             out.add(attr, e);
         }
+    }
+}
+
+/// A body's entry of its little model ([`body_model`]), and a sized geom's `size`, which
+/// that entry carries.
+fn compiled_body_entries<'d>(doc: &'d Document, node: Node, out: &mut Patched<'d>) {
+    match doc.tag(node) {
+        "body" => {
+            if let Some(model) = body_model(doc, node) {
+                let name = doc.attr(node, "name").unwrap_or_default().to_string();
+                out.entries.push(PatchEntry {
+                    object: "body",
+                    name,
+                    id: None,
+                    field: "geoms",
+                    value: PatchValue::Compiled(model),
+                });
+            }
+        }
+        "geom"
+            if sized_primitive(doc, node)
+                && doc.parent(node).is_some_and(|body| qualifies(doc, body)) =>
+        {
+            out.mark("size");
+        }
+        _ => {}
     }
 }
 

@@ -34,6 +34,7 @@
 //! `crate::error`, and the MuJoCo FFI (`check.rs`, in builds with MuJoCo). Knows nothing of
 //! the compiled-model cache or the faces above.
 
+mod body_model;
 #[cfg(mjcf_mujoco)]
 mod check;
 mod demo;
@@ -61,7 +62,9 @@ use crate::model::merge::MergePart;
 
 #[cfg(mjcf_mujoco)]
 pub use check::{PENETRATION_TOLERANCE, check_model, check_variant};
-pub use document_patch::{DocumentPatch, PATCHABLE_OPTIONS, split_document};
+pub use document_patch::{
+    DocumentPatch, PATCHABLE_OPTIONS, SplitOptions, split_document, split_document_with,
+};
 pub use params::{Params, PlacedObject, RandomizedValue};
 pub use patch::{PATCHABLE, PatchEntry, PatchValue, VariantPatch};
 pub use randomize::MUJOCO_DEFAULTS;

@@ -49,6 +49,10 @@ pub enum PatchValue {
         /// Its name.
         name: String,
     },
+    /// What MuJoCo derives from an element at compile time, to be read off the compile of
+    /// this MJCF model of it (a body's geoms: see
+    /// [`SplitOptions::compiled_bodies`](super::SplitOptions)).
+    Compiled(String),
 }
 
 /// Variant `index` as a structure key and a patch (see [`super::Scene::patch`]).

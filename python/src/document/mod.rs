@@ -26,7 +26,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use ahash::AHashSet;
-use mjcf_forge::scene::{PatchValue, split_document};
+use mjcf_forge::scene::{PatchValue, SplitOptions, split_document_with};
 use mjcf_forge::{CompiledInertia, Document, MergePart, Node, Section};
 use pyo3::exceptions::{PyFutureWarning, PyTypeError};
 use pyo3::prelude::*;
@@ -40,6 +40,17 @@ pub(crate) use cell::{DocCell, retarget};
 pub(crate) use element::PyElement;
 pub(crate) use load_cache::PyLoadCache;
 pub(crate) use values::check_xml_text;
+
+/// The document's split as Python's `DocumentCache` takes it: sizes of primitive geoms
+/// patched through their bodies' little models, which it compiles.
+fn split(doc: &Document) -> mjcf_forge::scene::DocumentPatch {
+    split_document_with(
+        doc,
+        SplitOptions {
+            compiled_bodies: true,
+        },
+    )
+}
 
 /// A shared, lockable document.
 pub(crate) type SharedDoc = Arc<DocCell>;
@@ -339,41 +350,50 @@ impl PyDocument {
     /// where the others land. See :class:`DocumentCache`.
     #[getter]
     fn structure_key(&self, py: Python<'_>) -> PyResult<String> {
-        run(py, || {
-            Ok(split_document(&self.doc.read_detached()).structure_key)
-        })
+        run(py, || Ok(split(&self.doc.read_detached()).structure_key))
     }
 
     /// The values that turn a compiled model of this document's structure into its own,
     /// shaped as :attr:`Variant.patch`: a tuple of ``(object, name, field, value)``,
     /// meaning ``model.<object>(name).<field> = value`` (``name`` is the compiled id, an
     /// ``int``, for an unnamed element; ``object`` may also be ``"actuator"``, and
-    /// ``"option"`` with id 0 for ``model.opt.<field>``).
+    /// ``"option"`` with id 0 for ``model.opt.<field>``). A body whose primitive geoms are
+    /// sized by the document has ``("body", name, "geoms", mjcf)``: what MuJoCo derives from
+    /// the sizes (each geom's size, bounding radius and box, the body's mass, inertia and
+    /// bounding volumes) is what it compiles from the model ``mjcf`` of the body's geoms.
     #[getter]
     fn patch<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
-        let split = run(py, || Ok(split_document(&self.doc.read_detached())))?;
+        let split = run(py, || Ok(split(&self.doc.read_detached())))?;
         PyTuple::new(py, patch_list(py, &split.entries)?)
     }
 
     /// The split as the model cache takes it: ``(structure_key, numbers, materials,
-    /// fixed_statistics)``: every number of :attr:`patch` end to end as float64 bytes,
-    /// the material names of its ``matid`` entries in order, and the statistics the
-    /// document's ``<statistic>`` sets.
+    /// fixed_statistics, bodies)``: every number of :attr:`patch` end to end as float64
+    /// bytes, the material names of its ``matid`` entries in order, the statistics the
+    /// document's ``<statistic>`` sets, and the little models of its ``geoms`` entries.
     #[allow(clippy::type_complexity)]
     fn _split<'py>(
         &self,
         py: Python<'py>,
-    ) -> PyResult<(String, Bound<'py, PyBytes>, Vec<String>, Vec<&'static str>)> {
-        let (key, numbers, materials, fixed) = run(py, || {
-            let split = split_document(&self.doc.read_detached());
+    ) -> PyResult<(
+        String,
+        Bound<'py, PyBytes>,
+        Vec<String>,
+        Vec<&'static str>,
+        Vec<String>,
+    )> {
+        let (key, numbers, materials, fixed, bodies) = run(py, || {
+            let split = split(&self.doc.read_detached());
             let mut numbers: Vec<u8> = Vec::new();
             let mut materials = Vec::new();
-            for e in &split.entries {
-                match &e.value {
+            let mut bodies = Vec::new();
+            for e in split.entries {
+                match e.value {
                     PatchValue::Numbers(v) => {
                         numbers.extend(v.iter().flat_map(|x| x.to_le_bytes()));
                     }
-                    PatchValue::Id { name, .. } => materials.push(name.clone()),
+                    PatchValue::Id { name, .. } => materials.push(name),
+                    PatchValue::Compiled(model) => bodies.push(model),
                 }
             }
             Ok((
@@ -381,9 +401,10 @@ impl PyDocument {
                 numbers,
                 materials,
                 split.fixed_statistics,
+                bodies,
             ))
         })?;
-        Ok((key, PyBytes::new(py, &numbers), materials, fixed))
+        Ok((key, PyBytes::new(py, &numbers), materials, fixed, bodies))
     }
 
     /// MuJoCo's error ``message`` about ``xml`` (this document as :meth:`to_xml` wrote

@@ -19,7 +19,9 @@ pub(crate) fn patch_list<'py>(
         .map(|e| {
             let value = match &e.value {
                 PatchValue::Numbers(v) => PyTuple::new(py, v)?.into_any(),
-                PatchValue::Id { name, .. } => name.as_str().into_pyobject(py)?.into_any(),
+                PatchValue::Id { name, .. } | PatchValue::Compiled(name) => {
+                    name.as_str().into_pyobject(py)?.into_any()
+                }
             };
             let name = match e.id {
                 Some(id) => id.into_pyobject(py)?.into_any(),
