@@ -125,6 +125,20 @@ def profile(env_name: str) -> None:
     stats.sort_stats("tottime").print_stats(25)
 
 
+def package() -> Path:
+    """The mjcf_forge that scripts/setup.sh installed into .cache/venv (built from this
+    checkout), else this checkout's sources if an extension was built into them."""
+    venv = ROOT / ".cache" / "venv" / "bin" / "python"
+    if venv.exists():
+        found = subprocess.run(
+            [str(venv), "-c", "import mjcf_forge, os; print(os.path.dirname(mjcf_forge.__file__))"],
+            capture_output=True, text=True,
+        )
+        if found.returncode == 0:
+            return Path(found.stdout.strip())
+    return ROOT / "python" / "mjcf_forge"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--envs", default="Lift,PickPlace,NutAssembly")
@@ -142,7 +156,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         # This checkout's mjcf_forge alone on the path (the folder it is installed in may
         # hold another MuJoCo; the robosuite venv may hold an older mjcf_forge).
-        (Path(tmp) / "mjcf_forge").symlink_to(ROOT / "python" / "mjcf_forge")
+        (Path(tmp) / "mjcf_forge").symlink_to(package())
         if args.profile:
             subprocess.run(
                 [sys.executable, __file__, "--worker", "profile", "--profile", args.profile],
