@@ -234,6 +234,23 @@ def _find_elements(root: Any, tags: Any, attribs: Optional[dict] = None) -> Opti
     return None
 
 
+def _without_materials(xml: str) -> str:
+    """``xml`` without its materials and textures, and without every reference to a
+    material: what no mass or inertia depends on. A part may refer to materials that the
+    model it goes into gets only later (robosuite's TwoArmPegInHole puts a peg with its
+    material into each robot and merges the material into the task afterwards), so the
+    part alone is compiled without them (and without decoding textures)."""
+    import xml.etree.ElementTree as XET
+
+    root = XET.fromstring(xml)
+    for asset in root.iter("asset"):
+        for child in [c for c in asset if c.tag in ("material", "texture")]:
+            asset.remove(child)
+    for element in root.iter():
+        element.attrib.pop("material", None)
+    return XET.tostring(root, encoding="unicode")
+
+
 def _compile_inertia(xml: str, model_dir: Any) -> tuple:
     """The bodies' names, masses and inertias as the installed ``mujoco`` compiles ``xml``
     alone: what a merge writes out when a part's compiler mass settings differ from the
@@ -241,6 +258,7 @@ def _compile_inertia(xml: str, model_dir: Any) -> tuple:
     when it is on: robosuite merges the same arena at every hard reset."""
     import mujoco
 
+    xml = _without_materials(xml)
     cache = model_cache()
     model = cache.model(xml) if cache is not None else mujoco.MjModel.from_xml_string(xml)
     names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, i) or "" for i in range(model.nbody)]

@@ -730,3 +730,22 @@ def test_difference_errors_are_xml_errors_that_say_what_is_wrong(rs):
     # An unnamed root body: robosuite's root_body and bodies fail on None.
     assert outcome(lambda: plain_model(rs, CAN).root_body) is TypeError
     assert plain_model(base, CAN).root_body is None
+
+
+def test_merge_converts_a_part_that_refers_to_materials_it_gets_later(tmp_path):
+    """robosuite's TwoArmPegInHole puts a peg with its material into each robot and merges
+    the material into the task afterwards: the robot, compiled alone for its inertias (its
+    compiler mass settings differ from the world's), refers to a material it lacks.
+    Materials weigh nothing, so the part is compiled without them."""
+    world = tmp_path / "world.xml"
+    world.write_text('<mujoco><compiler inertiagrouprange="0 0"/><worldbody/></mujoco>')
+    part = tmp_path / "part.xml"
+    part.write_text('<mujoco><worldbody><body name="arm"><joint/><geom size="0.1" group="1"/>'
+                    '<geom size="0.05" material="peg_mat"/></body></worldbody></mujoco>')
+    scene = MujocoXML(str(world))
+    scene.merge(MujocoXML(str(part)))
+    scene.asset.append(Element("material", {"name": "peg_mat", "rgba": "0 1 0 1"}))
+    alone = mujoco.MjModel.from_xml_string(part.read_text().replace(' material="peg_mat"', ""))
+    merged = scene.get_model()
+    assert merged.body("arm").mass == alone.body("arm").mass  # both geoms count, as alone
+    assert np.array_equal(merged.body("arm").inertia, alone.body("arm").inertia)

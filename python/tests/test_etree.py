@@ -335,8 +335,32 @@ def test_same_document_append_moves_and_other_documents_are_copied():
     assert table.parent is world and leg.parent is table  # the handles follow the copy
     table.set("pos", "9 9 9")
     assert 'name="table" pos="9 9 9"' in doc.to_xml() and "9 9 9" not in other.to_xml()
-    # The other document keeps its element; a new handle from it is the other's own.
-    assert other.find(".//body[@name='table']") is not table
+    # ElementTree would have one element in both trees: the other document's handles to
+    # the copied subtree are the copies' from now on (its text stays as it was).
+    assert other.find(".//body[@name='table']") is table
+    assert other.find(".//body[@name='table']/geom") is leg
+
+
+def test_an_element_appended_from_another_document_is_found_there_as_its_copy():
+    """robosuite's RobotModel.add_leg_base appends the base's bodies into the robot, finds
+    the base's support body again in the base's tree, and moves the arm into it."""
+    robot = Document.from_string(
+        '<mujoco><worldbody><body name="root"><body name="arm"/></body></worldbody></mujoco>')
+    base = Document.from_string(
+        '<mujoco><worldbody><body name="legs"><freejoint/><body name="support"/></body></worldbody></mujoco>')
+    root = robot.find(".//body[@name='root']")
+    arm = root.find("body")
+    for body in base.worldbody:
+        root.append(body)  # copied into the robot
+    support = base.find(".//body[@name='support']")  # looked up in the base's tree
+    assert support.parent.parent is root
+    free = base.worldbody.find(".//freejoint")
+    free.parent.remove(free)
+    support.append(copy.deepcopy(arm))
+    root.remove(arm)
+    assert robot.to_xml() == ('<mujoco><worldbody><body name="root"><body name="legs">'
+                              '<body name="support"><body name="arm"/></body></body></body></worldbody></mujoco>')
+    assert "freejoint" in base.to_xml()  # the base's own text is untouched
 
 
 def test_removed_elements_are_detached_not_dead():

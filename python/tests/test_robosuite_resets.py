@@ -64,20 +64,10 @@ ENVS = [
 def test_every_environment_was_judged(judged):
     assert set(judged) == {f"{e}{m}" for e in ENVS for m in ("", "+dr")}
     errors = {k: v["error"] for k, v in judged.items() if "error" in v}
-    assert {k.split("+")[0] for k in errors} <= REFUSED, errors
+    assert errors == {}, errors
 
 
-# robosuite attaches the peg to a robot's hand without its material (the task gets the
-# peg's assets later): mjcf_forge.base's merge, compiling the part alone for its
-# inertias, is refused by MuJoCo. Not the cache's; when the merge takes it, this passes.
-REFUSED = {"TwoArmPegInHole"}
-
-
-@pytest.mark.parametrize("name", [
-    pytest.param(e, marks=pytest.mark.xfail(strict=True, reason="merge of the peg without its material"))
-    if e in REFUSED else e
-    for e in ENVS
-])
+@pytest.mark.parametrize("name", ENVS)
 def test_every_model_a_hard_reset_gets_is_mujocos_compile(judged, name):
     for mode in ("", "+dr"):
         got = judged[name + mode]

@@ -50,6 +50,10 @@ struct Registry {
     /// Dead entries (their proxy freed while the registry was busy) are swept when the
     /// map passes this size.
     sweep_at: usize,
+    /// Subtrees appended into other documents ([`alias`]), the latest last: where each
+    /// copied node went. Nodes are never freed (removing detaches), so a node id keeps
+    /// meaning the node it was recorded for.
+    aliases: Vec<(Arc<DocCell>, NodeMap)>,
 }
 
 struct Entry {
@@ -246,12 +250,44 @@ impl DocCell {
     }
 }
 
-/// The one proxy of `node` in `cell`: the live one, or a new one, registered.
+/// Where `node` of `cell` answers from: the copy it was last appended as into another
+/// document (followed on, if that copy was appended on too), or itself.
+fn resolve(py: Python<'_>, cell: &Arc<DocCell>, node: Node) -> Option<(Arc<DocCell>, Node)> {
+    let mut at: Option<(Arc<DocCell>, Node)> = None;
+    loop {
+        let (c, n) = at.as_ref().map_or((cell, node), |(c, n)| (c, *n));
+        let next = c
+            .registry(py)
+            .aliases
+            .iter()
+            .rev()
+            .find_map(|(to, map)| Some((to.clone(), map.get(n)?)));
+        match next {
+            Some(next) => at = Some(next),
+            None => return at,
+        }
+    }
+}
+
+/// Makes the nodes of `from` that `map` copied into `to` answer with their copies from now
+/// on (see the module's documentation).
+pub(crate) fn alias(py: Python<'_>, from: &Arc<DocCell>, to: &Arc<DocCell>, map: &NodeMap) {
+    if Arc::ptr_eq(from, to) || map.is_empty() {
+        return;
+    }
+    from.registry(py).aliases.push((to.clone(), map.clone()));
+}
+
+/// The one proxy of `node` in `cell`: the live one, or a new one, registered; for a node
+/// appended into another document, its copy's.
 pub(crate) fn proxy<'py>(
     py: Python<'py>,
     cell: &Arc<DocCell>,
     node: Node,
 ) -> PyResult<Bound<'py, PyElement>> {
+    if let Some((to, copy)) = resolve(py, cell, node) {
+        return proxy(py, &to, copy);
+    }
     if let Some(p) = cell.live(py, node) {
         return Ok(p);
     }
@@ -267,6 +303,9 @@ pub(crate) fn proxies<'py>(
     nodes: impl IntoIterator<Item = Node>,
 ) -> PyResult<Vec<Bound<'py, PyElement>>> {
     let nodes: Vec<Node> = nodes.into_iter().collect();
+    if !cell.registry(py).aliases.is_empty() {
+        return nodes.into_iter().map(|n| proxy(py, cell, n)).collect();
+    }
     let found: Vec<Option<Bound<'py, PyAny>>> = {
         let reg = cell.registry(py);
         // Upgrading makes a strong reference, which frees nothing: safe under the lock.

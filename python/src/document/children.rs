@@ -4,7 +4,8 @@
 //! What comes in is sorted first ([`prepare`]): an element of the same document is moved
 //! (ElementTree has no parent pointers and would let it sit in two places; robosuite's code
 //! means "move it here"), an element of another document is copied in and its handles
-//! follow the copy, and an element of another ElementTree implementation (`xml.etree`,
+//! follow the copy (and the other document's view of it is the copy from then on: see
+//! `cell::alias`), and an element of another ElementTree implementation (`xml.etree`,
 //! lxml) is copied in. Positions count child elements once the moved element has left its
 //! old place.
 
@@ -15,7 +16,7 @@ use pyo3::exceptions::{PyIndexError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyList, PySlice, PyString};
 
-use super::cell::{DocCell, proxies, proxy, retarget};
+use super::cell::{DocCell, alias, proxies, proxy, retarget};
 use super::element::PyElement;
 use super::values::{attr_pairs, check_xml_name, check_xml_text};
 use crate::errors::{Failure, catch};
@@ -175,6 +176,7 @@ fn commit(
                 catch(|| Ok(dst.copy_element_from(&src, n, parent, index)))?
             };
             retarget(py, &from, cell, &map);
+            alias(py, &from, cell, &map);
         }
         Incoming::Foreign(flat) => {
             let mut doc = cell.write(py);
