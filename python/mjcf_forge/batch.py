@@ -58,6 +58,10 @@ _DERIVED = (
 # geoms' own margins): where a simulator holds one for all worlds, the largest of the
 # worlds' values is exact.
 _BOUNDS = ("body_margin",)
+# Fields MuJoCo Warp holds for all worlds but reads only when sleeping is enabled (a
+# rotational dof's length is its body's size, which for a massless root body depends on
+# where the body stands: parked or placed).
+_WARP_SLEEP_ONLY = ("dof_length",)
 # The compiler's statistics, per world (``stat.<name>`` in :attr:`WorldBatch.arrays`).
 _STATS = ("meaninertia", "meanmass", "meansize", "extent", "center")
 # A patch entry's object -> the prefix of its MjModel arrays (as ModelCache resolves them).
@@ -241,6 +245,9 @@ class WorldBatch:
             shape = getattr(spec, "shape", ())
             batched = bool(shape) and shape[0] == "*"
             if not batched:
+                sleep = self.model.opt.enableflags & self.cache._mujoco.mjtEnableBit.mjENBL_SLEEP
+                if name in _WARP_SLEEP_ONLY and not sleep:
+                    continue
                 rows = self.arrays.get(name)
                 if rows is not None and not (rows == rows[0]).all():
                     raise _error(
