@@ -13,6 +13,9 @@ bash scripts/setup.sh
 # robosuite 1.5.2 with MuJoCo 3.9.0, where python/tests/test_robosuite_use.py builds
 # robosuite's own classes both ways (idempotent; about 300 MB of wheels the first time).
 bash scripts/setup_robosuite_env.sh
+# MuJoCo Warp, MJX and JAX on CPU in .cache/venv-sim, with mjcf_forge built into it, for
+# python/tests/test_batch_sim.py (idempotent; Warp's kernels cached in .cache/warp-kernels).
+bash scripts/setup_sim_env.sh
 
 echo "== cargo fmt --check"
 cargo fmt --all -- --check
@@ -40,5 +43,7 @@ echo "== ModelCache and DocumentCache under MuJoCo 4.0.0 (patched models judged 
 .cache/venv-mj4/bin/python -m pytest python/tests/test_model_cache.py python/tests/test_document_cache.py -q -p no:cacheprovider
 # robosuite's task XMLs (written by the robosuite venv) through a DocumentCache, judged by 4.0.0.
 .cache/venv-mj4/bin/python -m pytest python/tests/test_robosuite_resets.py -k task_xmls -q -p no:cacheprovider
+echo "== batched simulators (MuJoCo Warp, MJX on JAX's CPU backend, CPU MuJoCo) judge WorldBatch"
+.cache/venv-sim/bin/python -m pytest python/tests/test_batch_sim.py -q -p no:cacheprovider
 echo "== fuzz smoke run (5 s per target; long campaigns: bash scripts/fuzz.sh SECONDS)"
 bash scripts/fuzz.sh 5

@@ -425,9 +425,11 @@ class ModelCache:
 
     With ``superset=True`` every variant is a patch of one model, the scene's
     :class:`Superset` (every object any slot can hold; those a variant does not place are
-    parked: no contacts, invisible, held still, below the world): ``cache.model(variant)``
+    parked: out of reach, each in its own cell high above the world, invisible, held
+    still; collision flags stay as authored): ``cache.model(variant)``
     is that model patched, and ``cache.batch(variants)`` gives the per-world arrays that
-    batched simulators (MJX, MuJoCo Warp, MuJoCo's batch API) take.
+    batched simulators (MJX, MuJoCo Warp, MuJoCo's batch API) take
+    (:class:`mjcf_forge.batch.WorldBatch` gives them in each simulator's own form).
 
     >>> import mjcf_forge
     >>> scene = mjcf_forge.Scene.demo()

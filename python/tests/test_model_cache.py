@@ -269,7 +269,10 @@ def test_superset_every_variant_is_a_patch_of_one_model():
     # Per-world arrays for batched simulators: one row per variant, where they differ.
     variants = [scene.variant(i) for i in range(5)]
     arrays = cache.batch(variants)
-    assert {"qpos0", "geom_contype", "geom_rgba", "body_gravcomp", "body_mass"} <= set(arrays)
+    assert {"qpos0", "geom_rgba", "body_gravcomp", "body_mass"} <= set(arrays)
+    # Parking is geometric: collision flags are the same in every world (batched
+    # simulators fix colliding pairs once for all worlds).
+    assert not {"geom_contype", "geom_conaffinity"} & set(arrays)
     model = cache.model(variants[3])
     for field, rows in arrays.items():
         assert rows.shape[0] == 5

@@ -7,10 +7,18 @@
 //! cannot switch on a geom compiled as non-colliding in a body whose other geoms collide),
 //! with gravity compensation on its bodies (so that `ngravcomp` counts them and switching
 //! it per body works). A variant's superset patch then sets, per candidate:
-//! - placed in the variant: its authored `contype`, `conaffinity`, `rgba` and `gravcomp`,
+//! - placed in the variant: its authored `rgba` and `gravcomp`,
 //!   and the variant's own values (pose, colours, ...);
-//! - not placed (parked): no contacts (`contype` = `conaffinity` = 0), invisible (alpha
-//!   0), held still (`gravcomp` 1, at rest), below the world, one place per candidate.
+//! - not placed (parked): out of reach (each candidate in its own cell of a grid high
+//!   above the world, see [`parking_cell`]), invisible (alpha 0), held still (`gravcomp`
+//!   1, at rest).
+//!
+//! Parking is geometric, never through collision flags: every candidate keeps its
+//! authored `contype` and `conaffinity` in every variant. Batched simulators fix the pairs
+//! of geoms that may collide once for all worlds (MuJoCo Warp in `put_model`, MJX in its
+//! collision groups), so a candidate switched off by its flags in one variant would have no
+//! contacts in the worlds that place it; and below the world a parked object would sink in
+//! a floor plane (a half-space) and be thrown away.
 
 use crate::document::Document;
 use crate::document::tree::Node;
@@ -21,10 +29,24 @@ use super::patch::{self, PatchEntry, PatchValue, VariantPatch};
 use super::randomize::AttrTarget as _;
 use super::{Scene, place};
 
-/// Where parked objects wait: straight below the world's origin, this deep, one candidate
-/// every `PARK_STEP` further down.
-const PARK_DEPTH: f64 = -50.0;
+/// Where parked objects wait: a horizontal grid of square cells `PARK_STEP` wide, centred
+/// `PARK_HEIGHT` straight above the world's origin: above any floor (a plane through the
+/// origin, as arenas have), out of reach of a robot or a table, and no further than needed
+/// (float32 simulators lose precision far from the origin). A candidate larger than a
+/// cell, or a template that reaches that high, is caught by the caller's contact check
+/// (python's `mjcf_forge.batch` refuses a superset whose parked geoms touch anything).
+const PARK_HEIGHT: f64 = 10.0;
 const PARK_STEP: f64 = 5.0;
+
+/// The parking cell of candidate `k` of `n`: row-major in a square grid centred above the
+/// origin.
+fn parking_cell(k: usize, n: usize) -> [f64; 3] {
+    let columns = (n as f64).sqrt().ceil().max(1.0) as usize;
+    let rows = n.div_ceil(columns);
+    let x = (k % columns) as f64 - (columns - 1) as f64 / 2.0;
+    let y = (k / columns) as f64 - (rows.max(1) - 1) as f64 / 2.0;
+    [x * PARK_STEP, y * PARK_STEP, PARK_HEIGHT]
+}
 
 /// The superset of a scene (see the module).
 #[derive(Debug)]
@@ -75,6 +97,11 @@ impl Scene {
         let mut doc = self.template.clone();
         let mut parts: Vec<(Document, String)> = Vec::new();
         let mut members = Vec::new();
+        let candidates: usize = self
+            .groups
+            .iter()
+            .map(|g| g.count.1 as usize * g.pool.len())
+            .sum();
         for (gi, group) in self.groups.iter().enumerate() {
             for slot in 0..group.count.1 {
                 for m in 0..group.pool.len() {
@@ -89,8 +116,7 @@ impl Scene {
                     if !tag.is_empty() {
                         part.apply_prefix(&tag).map_err(|e| Errors(vec![e]))?;
                     }
-                    let k = members.len() as f64;
-                    let parked = [0.0, 0.0, PARK_DEPTH - PARK_STEP * k];
+                    let parked = parking_cell(members.len(), candidates);
                     members.push(member(
                         &mut part,
                         inst.root,
@@ -164,8 +190,8 @@ impl Scene {
         // Per candidate, in one layout whatever the variant (so that a model cache resolves
         // the superset's targets once): every value a randomizer may give it (placed: the
         // variant's; parked: as authored, so that its model never depends on earlier
-        // variants), then its switches (gravity compensation, collision bits, colour with
-        // alpha 0 when parked), then its pose.
+        // variants), then its switches (gravity compensation, colour with alpha 0 when
+        // parked; collision bits stay as authored, see the module), then its pose.
         for (k, m) in superset.members.iter().enumerate() {
             let at = placed.iter().position(|p| *p == Some(k));
             let overlay = at.map(|j| &drawn.placed[j].1);
@@ -208,19 +234,13 @@ impl Scene {
                 let g = if active { *gravcomp } else { 1.0 };
                 push(&mut entries, "body", body, "gravcomp", numbers(&[g]));
             }
-            for (geom, contype, conaffinity, authored) in &m.geoms {
+            for (geom, _, _, authored) in &m.geoms {
                 let colour = rgba
                     .iter()
                     .rev()
                     .find(|(n, _)| n == geom)
                     .map_or(authored.to_vec(), |(_, v)| v.clone());
-                let (c, a, alpha) = if active {
-                    (*contype, *conaffinity, colour[3])
-                } else {
-                    (0.0, 0.0, 0.0)
-                };
-                push(&mut entries, "geom", geom, "contype", numbers(&[c]));
-                push(&mut entries, "geom", geom, "conaffinity", numbers(&[a]));
+                let alpha = if active { colour[3] } else { 0.0 };
                 push(
                     &mut entries,
                     "geom",

@@ -36,7 +36,8 @@ impl PySuperset {
 
     /// Variant ``index`` as a patch of the superset model (the same form as
     /// :attr:`Variant.patch`): the placed objects switched on with their values, the others
-    /// parked (no contacts, invisible, held still, below the world). An
+    /// parked (out of reach in their own cells high above the world, invisible, held
+    /// still; collision flags stay as authored). An
     /// :class:`MjcfError` when the variant randomizes a value no patch can carry.
     fn patch<'py>(&self, py: Python<'py>, index: u64) -> PyResult<Bound<'py, PyTuple>> {
         let p = run(py, || {

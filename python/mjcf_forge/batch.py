@@ -1,0 +1,393 @@
+"""Worlds of a scene for batched simulators: :class:`WorldBatch`.
+
+A scene's superset (:class:`Superset`, ``ModelCache(scene, superset=True)``) is one model
+holding every object any slot can hold; a variant is that model patched, the objects it
+does not place parked out of reach. A batched simulator runs many worlds of one model
+whose per-world fields differ: world ``w`` holds variant ``variants[w]``, and this module
+gives its fields in the shapes each simulator takes:
+
+- :meth:`WorldBatch.to_mjwarp`: a ready ``mujoco_warp`` ``Model`` and ``Data`` (fields
+  whose spec starts with ``*`` get one row per world, read at ``worldid % rows``);
+- :meth:`WorldBatch.to_mjx`: an MJX model whose per-world leaves have a leading world
+  axis, the ``in_axes`` to ``jax.vmap`` it, and a batched ``Data``;
+- :attr:`WorldBatch.arrays` and :meth:`WorldBatch.mujoco_models`: plain per-world arrays,
+  and per-world ``MjModel`` s for MuJoCo's own batch API (``mujoco.batch.Batch``);
+- :meth:`WorldBatch.assign`: other variants in some worlds, at reset, without rebuilding
+  the simulator's model.
+
+``mujoco_warp`` and ``jax`` are optional: imported only by the method that needs them.
+
+The superset keeps every candidate's collision flags as authored, so the pairs of geoms
+a batched simulator fixes once (``put_model``) hold in every world; parking is geometric
+(each parked candidate in its own cell high above the world, gravity compensated), and
+checked here: a parked geom in contact with anything at a world's initial pose is an error
+naming it. What parked bodies still change in a world is in docs/compiled.md.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+from collections.abc import Sequence
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from ._cache import _STATIC_PREFIXES, ModelCache, _error
+
+# Fields mj_setConst derives from values a patch writes (so they follow the variant even
+# when no patch entry names them).
+_DERIVED = (
+    "body_subtreemass",
+    "body_invweight0",
+    "dof_invweight0",
+    "dof_M0",
+    "tendon_length0",
+    "tendon_invweight0",
+    "actuator_acc0",
+    "actuator_length0",
+    "cam_pos0",
+    "cam_poscom0",
+    "cam_mat0",
+    "light_pos0",
+    "light_poscom0",
+    "light_dir0",
+    "dof_length",
+)
+# Bounds a simulator reads only to cull collision candidates (the narrow phase reads the
+# geoms' own margins): where a simulator holds one for all worlds, the largest of the
+# worlds' values is exact.
+_BOUNDS = ("body_margin",)
+# Fields MuJoCo Warp holds for all worlds but reads only when sleeping is enabled (a
+# rotational dof's length is its body's size, which for a massless root body depends on
+# where the body stands: parked or placed).
+_WARP_SLEEP_ONLY = ("dof_length",)
+# The compiler's statistics, per world (``stat.<name>`` in :attr:`WorldBatch.arrays`).
+_STATS = ("meaninertia", "meanmass", "meansize", "extent", "center")
+# A patch entry's object -> the prefix of its MjModel arrays (as ModelCache resolves them).
+_ARRAY_PREFIX = {
+    "body": "body_", "joint": "jnt_", "geom": "geom_", "site": "site_", "camera": "cam_",
+    "light": "light_", "material": "mat_", "actuator": "actuator_",
+}
+_JOINT_ARRAYS = {
+    "damping": "dof_damping", "armature": "dof_armature", "frictionloss": "dof_frictionloss",
+    "qpos0": "qpos0", "qpos_spring": "qpos_spring",
+}
+
+
+class _Index(NamedTuple):
+    """What a superset ModelCache reads of a variant: its index."""
+
+    index: int
+
+
+def _patched_arrays(patch: Sequence) -> set[str]:
+    """The MjModel arrays a superset patch writes (``matid`` included)."""
+    out = set()
+    for obj, _name, field, _value in patch:
+        if obj == "option":
+            continue
+        if obj == "joint" and field in _JOINT_ARRAYS:
+            out.add(_JOINT_ARRAYS[field])
+        elif obj in _ARRAY_PREFIX:
+            out.add(_ARRAY_PREFIX[obj] + field)
+    return out
+
+
+class WorldBatch:
+    """``nworld`` worlds of one scene, world ``w`` holding variant ``variants[w]``, as
+    per-world fields of the scene's superset model (see the module).
+
+    ``source`` is a :class:`Scene` or a ``ModelCache(scene, superset=True)``; ``variants``
+    are variant indices (or variants). Raises :class:`MjcfError` for zero worlds, a variant
+    the superset cannot express (it randomizes a structural value), or a parked object
+    within reach of another geom; all before any simulator array is built.
+
+    Attributes: ``model`` (the superset ``MjModel``, patched for world 0: every shared
+    field), ``arrays`` (per-world field -> ``(nworld, ...)`` array in MuJoCo's dtypes;
+    ``stat.<name>`` for the statistics), ``per_world`` (their names), ``world_variant``
+    (``(nworld,)`` variant index per world), ``qpos0`` and ``qpos`` (``(nworld, nq)``: the
+    worlds' reference and initial joint positions), ``parked_geoms`` (``(nworld, ngeom)``
+    bool: the geoms of objects the world parks).
+    """
+
+    def __init__(self, source: Any, variants: Sequence[Any]) -> None:
+        if isinstance(source, ModelCache):
+            cache = source
+        else:
+            cache = ModelCache(source, superset=True)
+        if cache.superset is None:
+            raise ValueError("WorldBatch needs ModelCache(scene, superset=True) or a Scene")
+        indices = [int(getattr(v, "index", v)) for v in variants]
+        if not indices:
+            raise _error("a batch needs at least one world: no variant was given (0 worlds)")
+        self.cache = cache
+        self.superset = cache.superset
+        # A variant the superset cannot express fails here, with its index.
+        patches = [self.superset.patch(i) for i in indices]
+        self.model = copy.copy(cache.model(_Index(indices[0])))
+        self._scratch = copy.copy(self.model)
+        self._patched = _patched_arrays(patches[0])
+        model = self.model
+        self._fields = [
+            n
+            for n in dir(model)
+            if not n.startswith("_")
+            and isinstance(getattr(model, n, None), np.ndarray)
+            and not n.startswith(_STATIC_PREFIXES)
+        ]
+        self._root_of_geom = model.body_rootid[model.geom_bodyid]
+        rows = [self._rows(i) for i in indices]
+        candidates = (self._patched | set(_DERIVED)) & set(self._fields)
+        varying = {
+            n for n in self._fields if any(not np.array_equal(r[n], rows[0][n]) for r in rows)
+        }
+        self.per_world = sorted(candidates | varying) + [f"stat.{s}" for s in _STATS]
+        self.arrays = {n: np.stack([r[n] for r in rows]) for n in self.per_world}
+        self.parked_geoms = np.stack([r["parked_geoms"] for r in rows])
+        self.world_variant = np.array(indices, dtype=np.int64)
+        self._warp: Any = None
+        self._mjx: Any = None
+        self._mjx_impl: str | None = None
+
+    @property
+    def nworld(self) -> int:
+        return len(self.world_variant)
+
+    @property
+    def qpos0(self) -> np.ndarray:
+        return self.arrays["qpos0"]
+
+    @property
+    def qpos(self) -> np.ndarray:
+        """The worlds' initial joint positions: each world's ``qpos0`` (an object's pose is
+        its free joint's ``qpos0``, as in the variant's own model)."""
+        return self.arrays["qpos0"].copy()
+
+    def _rows(self, index: int) -> dict[str, np.ndarray]:
+        """Every field of the superset patched for variant ``index``, its statistics, its
+        parked geoms; a parked geom that touches anything at the initial pose is an error."""
+        model = self.cache.apply(_Index(index), self._scratch)
+        out = {n: getattr(model, n).copy() for n in self._fields}
+        for s in _STATS:
+            out[f"stat.{s}"] = np.array(getattr(model.stat, s), dtype=np.float64)
+        mujoco = self.cache._mujoco
+        parked_roots = [model.body(r).id for r in self.superset.parked(index)]
+        parked = np.isin(self._root_of_geom, parked_roots)
+        out["parked_geoms"] = parked
+        data = mujoco.MjData(model)
+        mujoco.mj_forward(model, data)
+        for c in data.contact[: data.ncon]:
+            g1, g2 = int(c.geom[0]), int(c.geom[1])
+            if parked[g1] or parked[g2]:
+                a, b = (g1, g2) if parked[g1] else (g2, g1)
+                raise _error(
+                    f"variant {index}: parked geom '{model.geom(a).name or a}' (object "
+                    f"'{model.body(int(self._root_of_geom[a])).name}') touches geom "
+                    f"'{model.geom(b).name or b}': its parking cell is within reach"
+                )
+        return out
+
+    def assign(self, worlds: Sequence[int], variants: Sequence[Any]) -> np.ndarray:
+        """World ``worlds[k]`` holds variant ``variants[k]`` from now on: its rows of
+        :attr:`arrays` are the new variant's and, when built, the MuJoCo Warp model's rows
+        are written and those worlds' data reset (``mujoco_warp.reset_data``); MJX is
+        functional: :meth:`to_mjx` then gives the model with the new rows (no new
+        ``put_model``) and :meth:`mjx_reset` the data. Returns the ``(nworld,)`` mask of the
+        reassigned worlds. Raises :class:`MjcfError` when a new variant differs from the
+        batch in a field that is shared by all worlds (none for a superset patch)."""
+        worlds = [int(w) for w in worlds]
+        indices = [int(getattr(v, "index", v)) for v in variants]
+        if len(worlds) != len(indices):
+            raise ValueError("assign() needs one variant per world")
+        for w in worlds:
+            if not 0 <= w < self.nworld:
+                raise _error(f"world {w} is not in the batch (0 to {self.nworld - 1})")
+        rows = [self._rows(i) for i in indices]
+        for i, r in zip(indices, rows):
+            for n in self._fields:
+                if n not in self.arrays and not np.array_equal(r[n], getattr(self.model, n)):
+                    raise _error(
+                        f"variant {i}: field {n} differs from the batch's, where all worlds "
+                        "share one value (build a new WorldBatch)"
+                    )
+        for w, i, r in zip(worlds, indices, rows):
+            for n in self.per_world:
+                self.arrays[n][w] = r[n]
+            self.parked_geoms[w] = r["parked_geoms"]
+            self.world_variant[w] = i
+        mask = np.zeros(self.nworld, dtype=bool)
+        mask[worlds] = True
+        if self._warp is not None:
+            import mujoco_warp as mjw
+            import warp as wp
+
+            m, d, specs = self._warp
+            for name, rows_ in self._warp_rows(specs).items():
+                getattr(m, name).assign(wp.array(rows_, dtype=specs[name].dtype))
+            mjw.reset_data(m, d, reset=wp.array(mask, dtype=bool))
+        return mask
+
+    # ---------------------------------------------------------------- MuJoCo Warp
+    def _warp_specs(self) -> dict[str, Any]:
+        """Per-world fields MuJoCo Warp reads, by name, with their array specs; an error
+        naming a per-world field Warp has but cannot vary per world. Fields Warp does not
+        have (``dof_M0``, the statistics: Warp scales its solver by each world's mass
+        matrix instead) are left out."""
+        import mujoco_warp as mjw
+
+        types = {f.name: f.type for f in dataclasses.fields(mjw.Model)}
+        specs = {}
+        for name in self.per_world + ["geom_dataid"]:
+            spec = types.get(name)
+            if spec is None:
+                continue
+            shape = getattr(spec, "shape", ())
+            batched = bool(shape) and shape[0] == "*"
+            if not batched:
+                sleep = self.model.opt.enableflags & self.cache._mujoco.mjtEnableBit.mjENBL_SLEEP
+                if name in _WARP_SLEEP_ONLY and not sleep:
+                    continue
+                rows = self.arrays.get(name)
+                if rows is not None and not (rows == rows[0]).all():
+                    raise _error(
+                        f"MuJoCo Warp cannot vary {name} per world (its Model field is shared "
+                        "by all worlds), and the batch's worlds differ in it"
+                    )
+                continue
+            specs[name] = spec
+        return specs
+
+    def _warp_rows(self, specs: dict[str, Any]) -> dict[str, np.ndarray]:
+        out = {}
+        for name, spec in specs.items():
+            if name == "geom_dataid":
+                # A parked mesh geom is absent from its world (mjlab's switch for padded
+                # slots): no collision work for it, whatever its pose.
+                rows = np.tile(self.model.geom_dataid, (self.nworld, 1))
+                mesh = self.model.geom_type == self.cache._mujoco.mjtGeom.mjGEOM_MESH
+                rows[self.parked_geoms & mesh[None, :]] = -1
+            else:
+                rows = self.arrays[name]
+            dtype_shape = getattr(spec.dtype, "_shape_", ())
+            rows = rows.reshape((self.nworld,) + rows.shape[1:-1] + (-1,)) if dtype_shape else rows
+            out[name] = rows
+        return out
+
+    def to_mjwarp(self, **make_data: Any) -> tuple[Any, Any]:
+        """A ``mujoco_warp`` ``Model`` with every per-world field one row per world (its
+        dtypes: float32 vectors and quaternions, int32 ids) and a ``Data`` of ``nworld``
+        worlds at their initial pose (``reset_data``: each world's ``qpos0``).
+        ``make_data`` goes to ``mujoco_warp.make_data`` (``nconmax``, ``njmax``...)."""
+        import mujoco_warp as mjw
+        import warp as wp
+
+        specs = self._warp_specs()
+        rows = self._warp_rows(specs)
+        m = mjw.put_model(self.model)
+        for name, r in rows.items():
+            # Warp converts MuJoCo's float64 and int32 rows to the field's own dtype.
+            arr = wp.array(r, dtype=specs[name].dtype)
+            arr._is_batched = True
+            setattr(m, name, arr)
+        d = mjw.make_data(self.model, nworld=self.nworld, **make_data)
+        mjw.reset_data(m, d)
+        self._warp = (m, d, specs)
+        return m, d
+
+    # ---------------------------------------------------------------- MJX
+    def to_mjx(self, impl: str | None = None) -> tuple[Any, Any]:
+        """An MJX model whose per-world leaves have a leading world axis (MJX's dtypes:
+        float32 unless JAX runs in x64) and the matching ``in_axes`` (0 for those leaves,
+        None elsewhere): ``jax.vmap(mjx.step, in_axes=(in_axes, 0))(model, data)``. The
+        first call runs ``mjx.put_model``; later ones (after :meth:`assign`) only replace
+        the per-world leaves. Fields MJX does not have are left out; one it holds as a
+        static (NumPy) array cannot vary per world: an error names it. ``impl`` goes to
+        ``mjx.put_model`` ("jax", "warp"...)."""
+        import jax
+        import jax.numpy as jnp
+        from mujoco import mjx
+
+        if self._mjx is None:
+            shared = copy.copy(self.model)
+            for name in _BOUNDS:
+                if name in self.arrays:
+                    getattr(shared, name)[...] = self.arrays[name].max(axis=0)
+            self._mjx = mjx.put_model(shared, impl=impl)
+            self._mjx_impl = impl
+        base = self._mjx
+        replace: dict[str, Any] = {}
+        for name in self.per_world:
+            path = name if not name.startswith("stat.") else name
+            leaf = _mjx_leaf(base, path)
+            if leaf is None:
+                continue
+            rows = self.arrays[name]
+            if not isinstance(leaf, jax.Array):
+                if (rows == rows[0]).all() or name in _BOUNDS:
+                    continue
+                raise _error(
+                    f"MJX cannot vary {name} per world (put_model keeps it as a static NumPy "
+                    "array), and the batch's worlds differ in it"
+                )
+            replace[_mjx_path(base, path)] = jnp.asarray(rows.reshape((self.nworld,) + leaf.shape), dtype=leaf.dtype)
+        model = base.tree_replace(replace)
+        in_axes = jax.tree_util.tree_map(lambda _: None, base)
+        in_axes = in_axes.tree_replace({k: 0 for k in replace})
+        return model, in_axes
+
+    def mjx_data(self, **make_data: Any) -> Any:
+        """An MJX ``Data`` of ``nworld`` worlds (leading axis) at their initial pose, of the
+        model's ``impl``; ``make_data`` goes to ``mjx.make_data`` (``nconmax``...)."""
+        import jax
+        import jax.numpy as jnp
+        from mujoco import mjx
+
+        if self._mjx is None:
+            self.to_mjx()
+        one = mjx.make_data(self.model, impl=self._mjx_impl, **make_data)
+        data = jax.tree_util.tree_map(lambda x: jnp.broadcast_to(x, (self.nworld,) + x.shape), one)
+        return data.replace(qpos=jnp.asarray(self.qpos, dtype=one.qpos.dtype))
+
+    def mjx_reset(self, data: Any, mask: np.ndarray) -> Any:
+        """``data`` with the worlds of ``mask`` back at their initial pose (after
+        :meth:`assign`); the others as they were."""
+        import jax
+        import jax.numpy as jnp
+
+        fresh = self.mjx_data()
+        keep = jnp.asarray(mask)
+
+        def pick(new, old):
+            m = keep.reshape((-1,) + (1,) * (old.ndim - 1))
+            return jnp.where(m, new, old)
+
+        return jax.tree_util.tree_map(pick, fresh, data)
+
+    # ---------------------------------------------------------------- MuJoCo (CPU)
+    def mujoco_models(self) -> list[Any]:
+        """One ``MjModel`` per world: the superset patched for the world's variant (what
+        ``ModelCache(scene, superset=True).model`` gives), for
+        ``mujoco.batch.Batch.set_models`` or a loop of ``mj_step``."""
+        out = []
+        for i in self.world_variant:
+            out.append(copy.copy(self.cache.apply(_Index(int(i)), self._scratch)))
+        return out
+
+
+def _mjx_path(model: Any, name: str) -> str:
+    if name.startswith("stat."):
+        return name
+    if name in {f.name for f in dataclasses.fields(model)}:
+        return name
+    return f"_impl.{name}"
+
+
+def _mjx_leaf(model: Any, name: str) -> Any:
+    obj = model
+    for part in _mjx_path(model, name).split("."):
+        fields = {f.name for f in dataclasses.fields(obj)} if dataclasses.is_dataclass(obj) else set()
+        if part not in fields:
+            return None
+        obj = object.__getattribute__(obj, part)
+    return obj
