@@ -59,12 +59,45 @@ TWO_ARM = {"TwoArmHandover", "TwoArmLift", "TwoArmPegInHole", "TwoArmTransport"}
 out: dict[str, dict] = {}
 
 
+# What a part's elements compile to alone (row 5 of the differences): by the MuJoCo of
+# this venv, the one whose compile a merge wrote out (another MuJoCo computes a mesh's
+# inertia a few ulps apart).
+OWN = {
+    "body_mass": "mjOBJ_BODY", "body_inertia": "mjOBJ_BODY", "body_ipos": "mjOBJ_BODY",
+    "body_iquat": "mjOBJ_BODY", "jnt_range": "mjOBJ_JOINT", "geom_pos": "mjOBJ_GEOM",
+    "geom_quat": "mjOBJ_GEOM",
+}
+
+
+def own_values(part_xml):
+    """``{array: {name: values}}`` of the part compiled alone (without its materials, as a
+    merge compiles it), or the compiler's error."""
+    from mjcf_forge.base import _without_materials
+
+    try:
+        model = mujoco.MjModel.from_xml_string(_without_materials(part_xml))
+    except ValueError as e:
+        return {"error": str(e)}
+    values = {}
+    for array, kind in OWN.items():
+        obj = getattr(mujoco.mjtObj, kind)
+        rows = getattr(model, array)
+        values[array] = {
+            mujoco.mj_id2name(model, obj, i): np.asarray(rows[i], dtype=float).ravel().tolist()
+            for i in range(len(rows))
+            if mujoco.mj_id2name(model, obj, i)
+        }
+    return values
+
+
 def case(name, build):
     if only and name not in only:
         return
     np.random.seed(0)  # what robosuite draws from numpy's global generator
     try:
         out[name] = build()
+        if "parts" in out[name]:
+            out[name]["parts_own"] = [own_values(x) for x in out[name]["parts"]]
     except Exception as e:  # noqa: BLE001 - written out and compared
         traceback.print_exc()
         out[name] = {"error": f"{type(e).__name__}: {e}"}
