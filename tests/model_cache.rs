@@ -236,3 +236,29 @@ fn aligned_free_bodies_make_their_poses_structure() {
     }
     assert!(aligned >= 4, "{aligned} variants with an aligned object");
 }
+
+#[test]
+fn placements_under_keyframes_are_patched_bit_for_bit() {
+    // Each key's rows for a placed object's free joint are its pose: patched with it.
+    let scene = Scene::load(root().join("corpora/scenes/keyframe/keyframe.toml")).unwrap();
+    let groups = by_structure(&scene, 16);
+    // One or two objects, each a box or a cylinder: six structures at most, whatever the
+    // placements.
+    assert!(groups.len() <= 6, "{} structures", groups.len());
+    let mut cache = ModelCache::new(&scene, 8, None);
+    for indices in groups.values() {
+        for &i in indices.iter().take(4) {
+            let want = compiled(&scene, i);
+            let got = cache.model(i).unwrap();
+            assert_eq!(got.differences(&want), Vec::<String>::new(), "variant {i}");
+        }
+    }
+    assert_eq!(cache.compiles(), groups.len() as u64);
+    assert!(cache.patches() > 0);
+    // Every variant is a patch of the superset (structures of one, two objects).
+    let superset = scene.superset().unwrap();
+    for i in 0..6 {
+        let patch = scene.superset_patch(&superset, i).unwrap();
+        assert!(patch.entries.iter().any(|e| e.field == "key_qpos"));
+    }
+}

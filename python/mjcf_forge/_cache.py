@@ -244,6 +244,17 @@ class _Plan:
                 array = field
                 first = int(model.jnt_qposadr[i])
                 rows = range(first, first + _JOINT_QPOS[int(model.jnt_type[i])])
+            elif obj == "joint" and field == "key_qpos":
+                # The joint's rows of every keyframe (one row of nq per key).
+                array = field
+                first = int(model.jnt_qposadr[i])
+                width = _JOINT_QPOS[int(model.jnt_type[i])]
+                _, targets, sources = groups.setdefault(array, (model.key_qpos.reshape(-1), [], []))
+                for k in range(model.nkey):
+                    targets.extend(range(k * model.nq + first, k * model.nq + first + width))
+                    sources.extend(range(numbers, numbers + len(value)))
+                numbers += len(value)
+                continue
             else:
                 array = _PREFIX[obj] + field
                 width = 1 if isinstance(value, str) else len(value)

@@ -91,6 +91,10 @@ pub(super) struct Target {
     /// The field holds integers: an id (`geom_matid`, the value a material's name) or
     /// collision bits (`geom_contype`, `geom_conaffinity`).
     int: bool,
+    /// The `n` elements again every `stride` elements, `runs` times in all: a joint's rows
+    /// of every keyframe (`key_qpos`, one row of `nq` per key). One run elsewhere.
+    runs: usize,
+    stride: usize,
 }
 
 /// How to patch one model: its structure key, scratch data and resolved targets.
@@ -336,15 +340,19 @@ fn write(model: *mut MjModel, t: &Target, value: &PatchValue) -> Result<(), Stri
             return Err("a compiled body's geoms are not patched here".to_string());
         }
         PatchValue::Numbers(v) => {
-            for k in 0..t.n {
-                let x = if v.len() == 1 { v[0] } else { v[k] };
-                // SAFETY: `ptr` points at `n` elements of `elem` bytes of the live model,
-                // checked against the array's length in `resolve`.
-                unsafe {
-                    match (t.elem, t.int) {
-                        (4, true) => t.ptr.cast::<c_int>().add(k).write_unaligned(x as c_int),
-                        (4, false) => t.ptr.cast::<f32>().add(k).write_unaligned(x as f32),
-                        _ => t.ptr.cast::<f64>().add(k).write_unaligned(x),
+            for run in 0..t.runs {
+                for k in 0..t.n {
+                    let x = if v.len() == 1 { v[0] } else { v[k] };
+                    let at = run * t.stride + k;
+                    // SAFETY: `ptr` points at `runs` runs of `n` elements of `elem` bytes
+                    // of the live model, `stride` apart, checked against the array's
+                    // length in `resolve`.
+                    unsafe {
+                        match (t.elem, t.int) {
+                            (4, true) => t.ptr.cast::<c_int>().add(at).write_unaligned(x as c_int),
+                            (4, false) => t.ptr.cast::<f32>().add(at).write_unaligned(x as f32),
+                            _ => t.ptr.cast::<f64>().add(at).write_unaligned(x),
+                        }
                     }
                 }
             }
@@ -407,6 +415,7 @@ fn resolve(model: &mut CompiledModel, entries: &[PatchEntry]) -> Result<Vec<Targ
                 ));
             }
         };
+        let (mut runs, mut stride) = (1, 0);
         let (name, offset, n) = match (e.object, e.field) {
             ("joint", f @ ("damping" | "armature" | "frictionloss")) => {
                 let dofs = match int_at("jnt_type", id)? {
@@ -416,12 +425,19 @@ fn resolve(model: &mut CompiledModel, entries: &[PatchEntry]) -> Result<Vec<Targ
                 };
                 (format!("dof_{f}"), int_at("jnt_dofadr", id)?, dofs)
             }
-            ("joint", f @ ("qpos0" | "qpos_spring")) => {
+            ("joint", f @ ("qpos0" | "qpos_spring" | "key_qpos")) => {
                 let n = match int_at("jnt_type", id)? {
                     0 => 7,
                     1 => 4,
                     _ => 1,
                 };
+                if f == "key_qpos" {
+                    // The joint's rows of every keyframe: one row of nq per key.
+                    let (_, _, nq) = array("qpos0")?;
+                    let (_, _, all) = array("key_qpos")?;
+                    runs = all.checked_div(nq).unwrap_or(0);
+                    stride = nq;
+                }
                 (f.to_string(), int_at("jnt_qposadr", id)?, n)
             }
             (object, field) => {
@@ -439,20 +455,21 @@ fn resolve(model: &mut CompiledModel, entries: &[PatchEntry]) -> Result<Vec<Targ
             }
         };
         let (p, elem, count) = array(&name)?;
-        if offset + n > count {
+        let end = offset + n + runs.saturating_sub(1) * stride;
+        if runs > 0 && end > count {
             return Err(format!(
-                "{} '{}': {name}[{offset}..{}] is outside the model's {count}",
-                e.object,
-                e.name,
-                offset + n
+                "{} '{}': {name}[{offset}..{end}] is outside the model's {count}",
+                e.object, e.name,
             ));
         }
         out.push(Target {
-            // SAFETY: in bounds, checked above.
-            ptr: unsafe { p.add(offset * elem) },
+            // SAFETY: in bounds, checked above (no key: nothing is written).
+            ptr: unsafe { p.add(offset.min(count) * elem) },
             elem,
             n,
             int: matches!(e.field, "matid" | "contype" | "conaffinity"),
+            runs,
+            stride,
         });
     }
     Ok(out)
@@ -479,5 +496,7 @@ fn option_target(model: *mut MjModel, e: &PatchEntry) -> Result<Target, String> 
         elem,
         n: count,
         int: false,
+        runs: 1,
+        stride: 0,
     })
 }

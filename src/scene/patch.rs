@@ -105,10 +105,15 @@ pub(crate) struct Rules {
     /// Masses and inertias land unchanged (no `settotalmass`, bounds, balancing, or
     /// inertia from geoms over `<inertial>`).
     pub(crate) mass: bool,
-    /// Body frames land unchanged (no keyframes, whose rows would follow a placed free
-    /// joint; no static bodies fused away; no free bodies aligned with their inertial
-    /// frames).
+    /// Body frames land unchanged (no static bodies fused away; no free bodies aligned
+    /// with their inertial frames; with keyframes, no free joint or mocap body of the
+    /// template, whose rows a key may give or take from the body, and no keyframe in a
+    /// part).
     pub(crate) poses: bool,
+    /// The model has keyframes: a placed object's free joint's rows in each of them are
+    /// its pose (the merge writes them so; MuJoCo normalizes the quaternion), patched with
+    /// it (`key_qpos` entries).
+    pub(crate) keys: bool,
     /// Compiled ids of the template's elements that can be patched unnamed, when nothing
     /// reorders them (see [`template_ids`]).
     pub(crate) ids: Option<ahash::AHashMap<Node, usize>>,
@@ -132,9 +137,26 @@ impl Rules {
         // A free body MuJoCo aligns with its inertial frame lands in the inertial frame's
         // pose, which only the compiler knows.
         let aligned = |d: &Document| d.descendants(d.root()).any(|n| d.aligns_free_body(n));
+        // With keyframes, a key's rows for the template's free joints and mocap bodies may
+        // be its own or the body's; the parts' rows are written from their poses by the
+        // merge (and a part's own keyframes are its author's).
+        let keys = has_keys(template) || parts.iter().any(|d| has_keys(d));
+        let follows_keys = |d: &Document| {
+            d.descendants(d.root()).any(|n| {
+                d.tag(n) == "freejoint"
+                    || (d.tag(n) == "joint" && d.attr(n, "type").map(str::trim) == Some("free"))
+                    || (d.tag(n) == "body" && d.attr(n, "mocap").map(str::trim) == Some("true"))
+            })
+        };
         let poses = setting("fusestatic").is_none_or(|v| v.trim() == "false")
-            && !has_keys(template)
+            && !(has_keys(template) && follows_keys(template))
             && !parts.iter().any(|d| has_keys(d))
+            && !(keys
+                && parts.iter().any(|d| {
+                    d.descendants(d.root()).any(|n| {
+                        d.tag(n) == "body" && d.attr(n, "mocap").map(str::trim) == Some("true")
+                    })
+                }))
             && !aligned(template)
             && !parts.iter().any(|d| aligned(d));
         // A dampratio actuator's damping is derived from the masses at compile time.
@@ -152,6 +174,7 @@ impl Rules {
         Rules {
             mass: mass && !dampratio,
             poses,
+            keys,
             ids: (!world_level)
                 .then(|| template_ids(template, discard))
                 .flatten(),
@@ -373,7 +396,12 @@ pub(crate) fn split_parts(
                 continue;
             };
             let qpos: Vec<f64> = pos.into_iter().chain(quat).collect();
-            for field in ["qpos0", "qpos_spring"] {
+            let fields: &[&'static str] = if rules.keys {
+                &["qpos0", "qpos_spring", "key_qpos"]
+            } else {
+                &["qpos0", "qpos_spring"]
+            };
+            for &field in fields {
                 entries.push(PatchEntry {
                     object: "joint",
                     name: joint.to_string(),

@@ -277,6 +277,9 @@ impl Scene {
                 let qpos: Vec<f64> = pos.iter().chain(&quat).copied().collect();
                 push(&mut entries, "joint", j, "qpos0", numbers(&qpos));
                 push(&mut entries, "joint", j, "qpos_spring", numbers(&qpos));
+                if rules.keys {
+                    push(&mut entries, "joint", j, "key_qpos", numbers(&qpos));
+                }
             }
         }
         // The template's own values.

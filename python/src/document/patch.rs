@@ -60,6 +60,7 @@ pub(crate) fn patch_entry(
             .chain([
                 "qpos0",
                 "qpos_spring",
+                "key_qpos",
                 "ipos",
                 "iquat",
                 "gravcomp",
