@@ -148,15 +148,16 @@ impl Rules {
                     || (d.tag(n) == "body" && d.attr(n, "mocap").map(str::trim) == Some("true"))
             })
         };
+        let mocap = |d: &Document| {
+            d.descendants(d.root())
+                .any(|n| d.tag(n) == "body" && d.attr(n, "mocap").map(str::trim) == Some("true"))
+        };
+        let keys_follow_poses = !keys
+            || (!follows_keys(template)
+                && !parts.iter().any(|d| has_keys(d))
+                && !parts.iter().any(|d| mocap(d)));
         let poses = setting("fusestatic").is_none_or(|v| v.trim() == "false")
-            && !(has_keys(template) && follows_keys(template))
-            && !parts.iter().any(|d| has_keys(d))
-            && !(keys
-                && parts.iter().any(|d| {
-                    d.descendants(d.root()).any(|n| {
-                        d.tag(n) == "body" && d.attr(n, "mocap").map(str::trim) == Some("true")
-                    })
-                }))
+            && keys_follow_poses
             && !aligned(template)
             && !parts.iter().any(|d| aligned(d));
         // A dampratio actuator's damping is derived from the masses at compile time.
