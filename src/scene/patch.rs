@@ -307,19 +307,23 @@ pub(crate) fn split(
     split_parts(fingerprint, rules, index, drawn).0
 }
 
+/// A randomized value that went into the key: its part (0: the template, k: placed
+/// object k - 1), element and attribute.
+pub(crate) type Refused = (usize, Node, String);
+
 /// [`split`], with per entry the part it came from (0: the template, k: placed object
-/// k - 1) and how many values went into the key (values, not object choices).
+/// k - 1) and the values that went into the key (values, not object choices).
 pub(crate) fn split_parts(
     fingerprint: &[u8; 32],
     rules: &Rules,
     index: u64,
     drawn: &Drawn<'_>,
-) -> (VariantPatch, Vec<usize>, usize) {
+) -> (VariantPatch, Vec<usize>, Vec<Refused>) {
     let mut key = blake3::Hasher::new();
     key.update(fingerprint);
     let mut entries = Vec::new();
     let mut parts = Vec::new();
-    let mut in_key = 0;
+    let mut in_key = Vec::new();
     for o in &drawn.params.objects {
         for s in [o.group.as_str(), &o.slot.to_string(), &o.model] {
             key.update(&(s.len() as u64).to_le_bytes());
@@ -350,7 +354,7 @@ pub(crate) fn split_parts(
                     parts.push(part);
                 }
                 None => {
-                    in_key += 1;
+                    in_key.push((part, *node, attr.clone()));
                     key.update(&(part as u64).to_le_bytes());
                     key.update(&(crate::document::tree::Tree::index(*node) as u64).to_le_bytes());
                     for s in [attr.as_str(), value.as_str()] {

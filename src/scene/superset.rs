@@ -74,6 +74,40 @@ struct Member {
     /// Superset names of its geoms (those the compiled model keeps), their authored
     /// `contype`, `conaffinity` and `rgba` (as `f32`).
     geoms: Vec<(String, f64, f64, [f64; 4])>,
+    /// The instance with its unnamed bodies and geoms named (see [`name_internally`]),
+    /// before the tag: what its patch entries are read from.
+    named: Document,
+}
+
+/// Names the unnamed bodies and geoms below `root` (itself included) of an instance whose
+/// names carry `prefix`: `{prefix}unnamed_body{k}` and `{prefix}unnamed_geom{k}`, `k`
+/// counting that instance's unnamed elements of the kind in document order (a name the
+/// instance already has is skipped). So a candidate's every body and geom can be switched
+/// and patched by name in the superset; in a variant's own model they stay unnamed, and
+/// the `k`-th unnamed geom of an object there is `{prefix}unnamed_geom{k}` here.
+fn name_internally(doc: &mut Document, root: Node, prefix: &str) {
+    let nodes: Vec<Node> = std::iter::once(root).chain(doc.descendants(root)).collect();
+    let taken: ahash::AHashSet<String> = nodes
+        .iter()
+        .filter_map(|&n| doc.attr(n, "name"))
+        .map(str::to_string)
+        .collect();
+    for kind in ["body", "geom"] {
+        let mut k = 0usize;
+        for &n in &nodes {
+            if doc.tag(n) != kind || doc.attr(n, "name").is_some() {
+                continue;
+            }
+            let name = loop {
+                let name = format!("{prefix}unnamed_{kind}{k}");
+                k += 1;
+                if !taken.contains(&name) {
+                    break name;
+                }
+            };
+            doc.set_attr(n, "name", &name);
+        }
+    }
 }
 
 fn number(doc: &Document, node: Node, attr: &str, default: f64) -> f64 {
@@ -106,7 +140,9 @@ impl Scene {
             for slot in 0..group.count.1 {
                 for m in 0..group.pool.len() {
                     let inst = self.instance(group, slot, m)?;
-                    let mut part = inst.doc.clone();
+                    let mut named = inst.doc.clone();
+                    name_internally(&mut named, inst.root, &inst.prefix);
+                    let mut part = named.clone();
                     place::clear_orientation(&mut part, inst.root);
                     let tag = if group.pool.len() > 1 {
                         format!("m{m}_")
@@ -124,6 +160,7 @@ impl Scene {
                         tag,
                         parked,
                         self.discard_visual,
+                        named,
                     )?);
                     parts.push((part, inst.prefix.clone()));
                 }
@@ -164,18 +201,37 @@ impl Scene {
     pub fn superset_patch(&self, superset: &Superset, index: u64) -> Result<VariantPatch, Errors> {
         let drawn = self.draw(index)?;
         let (rules, fingerprint) = self.structure();
-        let (own, parts, in_key) = patch::split_parts(fingerprint, rules, index, &drawn);
+        let (own, parts, refused) = patch::split_parts(fingerprint, rules, index, &drawn);
+        let placed: Vec<Option<usize>> = drawn
+            .choices
+            .iter()
+            .map(|c| superset.members.iter().position(|m| m.choice == *c))
+            .collect();
+        // A placed object's value refused only for want of a name is patched by its
+        // internal name (see `name_internally`).
+        let in_key = refused
+            .iter()
+            .filter(|(part, node, attr)| {
+                let Some(j) = part.checked_sub(1) else {
+                    return true;
+                };
+                let (Some((inst, overlay)), Some(Some(k))) = (drawn.placed.get(j), placed.get(j))
+                else {
+                    return true;
+                };
+                let named = &superset.members[*k].named;
+                overlay.get(*node, attr).is_none_or(|value| {
+                    patch::entry(named, *node, attr, value, rules, None, *node == inst.root)
+                        .is_none()
+                })
+            })
+            .count();
         if in_key > 0 {
             return Err(Errors(vec![Error::bare(ErrorKind::Invalid(format!(
                 "variant {index}: {in_key} randomized value(s) cannot be patched (see \
                  PATCHABLE), so the variant is not a patch of the superset"
             )))]));
         }
-        let placed: Vec<Option<usize>> = drawn
-            .choices
-            .iter()
-            .map(|c| superset.members.iter().position(|m| m.choice == *c))
-            .collect();
         let mut entries = Vec::new();
         let numbers = |v: &[f64]| PatchValue::Numbers(v.to_vec());
         let push = |entries: &mut Vec<PatchEntry>, object, name: &str, field, value| {
@@ -198,24 +254,24 @@ impl Scene {
             let (g, slot, model) = m.choice;
             let inst = self.instance(&self.groups[g], slot, model)?;
             let mut rgba: Vec<(String, Vec<f64>)> = Vec::new();
+            // The instance with its unnamed elements named (the same nodes as inst.doc).
+            let doc = &m.named;
             for (r, targets) in &inst.targets {
                 for t in targets {
-                    for attr in self.randomizers[*r].attributes_set(&inst.doc, t.node) {
-                        let tag = inst.doc.tag(t.node);
+                    for attr in self.randomizers[*r].attributes_set(doc, t.node) {
+                        let tag = doc.tag(t.node);
                         let value = match overlay {
                             Some(o) => o.get(t.node, attr),
-                            None => inst
-                                .doc
+                            None => doc
                                 .attr(t.node, attr)
                                 .or_else(|| super::randomize::mujoco_default(tag, attr)),
                         };
                         let Some(value) = value else { continue };
-                        if rules.discard && patch::dropped(&inst.doc, t.node, attr) != Some(false) {
+                        if rules.discard && patch::dropped(doc, t.node, attr) != Some(false) {
                             continue;
                         }
                         let root = t.node == inst.root;
-                        let Some(mut e) =
-                            patch::entry(&inst.doc, t.node, attr, value, rules, None, root)
+                        let Some(mut e) = patch::entry(doc, t.node, attr, value, rules, None, root)
                         else {
                             continue;
                         };
@@ -341,6 +397,7 @@ fn member(
     tag: String,
     parked: [f64; 3],
     discard: bool,
+    named: Document,
 ) -> Result<Member, Errors> {
     let unnamed = |part: &Document, what: &str| {
         Errors(vec![part.error_at(
@@ -416,5 +473,6 @@ fn member(
         parked,
         bodies,
         geoms,
+        named,
     })
 }
