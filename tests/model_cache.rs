@@ -262,3 +262,21 @@ fn placements_under_keyframes_are_patched_bit_for_bit() {
         assert!(patch.entries.iter().any(|e| e.field == "key_qpos"));
     }
 }
+
+#[test]
+fn armature_beside_a_damping_ratio_is_compiled() {
+    // The compiler derives a damping ratio's damping from the joint-space inertia at qpos0
+    // (armature included): armature is structure there, colours stay patches.
+    let scene = Scene::load(root().join("corpora/scenes/patch/dampratio.toml")).unwrap();
+    let groups = by_structure(&scene, 4);
+    assert_eq!(groups.len(), 4, "each armature draw is a structure");
+    let patch = scene.patch(0).unwrap();
+    assert!(patch.entries.iter().all(|e| e.field != "armature"));
+    assert!(patch.entries.iter().any(|e| e.field == "rgba"));
+    let mut cache = ModelCache::new(&scene, 4, None);
+    for i in 0..4 {
+        let want = compiled(&scene, i);
+        let got = cache.model(i).unwrap();
+        assert_eq!(got.differences(&want), Vec::<String>::new(), "variant {i}");
+    }
+}

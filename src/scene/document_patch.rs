@@ -76,11 +76,6 @@ struct DocRules {
     /// length-range simulation depends on every dynamic value, so with one only visual
     /// values are patched.
     dynamics: bool,
-    /// A joint's armature lands unchanged and nothing derived from it stays stale (no
-    /// damping ratio, no actuator armature).
-    armature: bool,
-    /// A joint's damping lands unchanged (no actuator gives its joint damping).
-    damping: bool,
     /// One `<option>`.
     options: bool,
     /// The compiled id of each actuator (MuJoCo numbers them in order), when the ids of
@@ -97,31 +92,18 @@ struct DocRules {
 impl DocRules {
     fn new(doc: &Document, options: SplitOptions) -> DocRules {
         let discard = setting(doc, "compiler", "discardvisual").map(str::trim) == Some("true");
-        let mut base = Rules::new(doc, &[], discard);
+        // The scene tier's rules: damping ratios, fused static bodies, spatial tendons,
+        // flexes, composites and skins, and actuators' own armature and damping included.
+        let base = Rules::new(doc, &[], discard);
         let all = || doc.descendants(doc.root());
         let actuators: Vec<Node> = doc
             .find_section(Section::Actuator)
             .map(|s| doc.elements(s).collect())
             .unwrap_or_default();
-        let dampratio = actuators.iter().any(|&a| derives_damping(doc, a));
-        // The joint-space inertia at qpos0 feeds a damping ratio's conversion.
-        if dampratio {
-            base.poses = false;
-        }
-        if setting(doc, "compiler", "fusestatic").map(str::trim) == Some("true") {
-            // Static bodies, with their masses and elements, are fused into their parents.
-            base.mass = false;
-            base.ids = None;
-        }
-        // A spatial tendon's spring length is its length at qpos0, which mj_setConst of
-        // 3.17.0 and 4.0.0 leaves as compiled; flexes and composites hang on body frames.
         let hanging = all().any(|n| {
             matches!(doc.tag(n), "spatial" | "flex" | "flexcomp" | "composite")
                 || (doc.tag(n) == "skin" && doc.elements(n).next().is_some())
         });
-        if hanging {
-            base.poses = false;
-        }
         let muscle = |n: Node| {
             doc.tag(n) == "muscle"
                 || ["dyntype", "gaintype", "biastype"]
@@ -131,7 +113,6 @@ impl DocRules {
         let lengthrange_all = all().any(|n| {
             doc.tag(n) == "lengthrange" && doc.attr(n, "mode").map(str::trim) == Some("all")
         });
-        let inherited = |a: &str| actuators.iter().any(|&n| doc.attr(n, a).is_some());
         let actuator_ids = base
             .ids
             .as_ref()
@@ -140,8 +121,6 @@ impl DocRules {
         DocRules {
             sizes: options.compiled_bodies && base.mass && dynamics && !discard && !hanging,
             dynamics,
-            armature: !dampratio && !inherited("armature"),
-            damping: !inherited("damping"),
             options: doc
                 .elements(doc.root())
                 .filter(|&n| doc.tag(n) == "option")
@@ -375,12 +354,7 @@ fn element_entries<'d>(doc: &'d Document, node: Node, rules: &DocRules) -> Patch
                 let Some(e) = entry(doc, node, attr, value, &rules.base, ids, false) else {
                     continue;
                 };
-                let allowed = match (e.object, e.field) {
-                    ("joint", "armature") => rules.armature,
-                    ("joint", "damping") => rules.damping,
-                    _ => true,
-                };
-                if allowed && (rules.dynamics || visual(&e)) && accepted(&e) {
+                if (rules.dynamics || visual(&e)) && accepted(&e) {
                     out.add(attr, e);
                 }
             }

@@ -114,6 +114,11 @@ pub(crate) struct Rules {
     /// its pose (the merge writes them so; MuJoCo normalizes the quaternion), patched with
     /// it (`key_qpos` entries).
     pub(crate) keys: bool,
+    /// A joint's armature lands unchanged and nothing derived from it stays stale (no
+    /// damping ratio, no actuator that adds armature to its joint).
+    pub(crate) armature: bool,
+    /// A joint's damping lands unchanged (no actuator adds damping to its joint).
+    pub(crate) damping: bool,
     /// Compiled ids of the template's elements that can be patched unnamed, when nothing
     /// reorders them (see [`template_ids`]).
     pub(crate) ids: Option<ahash::AHashMap<Node, usize>>,
@@ -160,10 +165,28 @@ impl Rules {
             && keys_follow_poses
             && !aligned(template)
             && !parts.iter().any(|d| aligned(d));
-        // A dampratio actuator's damping is derived from the masses at compile time.
-        let dampratio = std::iter::once(template)
-            .chain(parts.iter().copied())
-            .any(|d| d.descendants(d.root()).any(|n| derives_damping(d, n)));
+        let all = || {
+            std::iter::once(template)
+                .chain(parts.iter().copied())
+                .flat_map(|d| d.descendants(d.root()).map(move |n| (d, n)))
+        };
+        // A dampratio actuator's damping is derived from the masses and the joint-space
+        // inertia at qpos0 (armature included) at compile time.
+        let dampratio = all().any(|(d, n)| derives_damping(d, n));
+        // A spatial tendon's spring length is its length at qpos0, which mj_setConst of
+        // 3.17.0 and 4.0.0 leaves as compiled; flexes and composites hang on body frames.
+        let hanging = all().any(|(d, n)| {
+            matches!(d.tag(n), "spatial" | "flex" | "flexcomp" | "composite")
+                || (d.tag(n) == "skin" && d.elements(n).next().is_some())
+        });
+        // Static bodies, with their masses and elements, are fused into their parents.
+        let fused = setting("fusestatic").is_some_and(|v| v.trim() == "true");
+        // An actuator's own armature or damping is added to its joint's.
+        let actuated = |a: &str| {
+            all().any(|(d, n)| {
+                d.parent(n).is_some_and(|p| d.tag(p) == "actuator") && d.attr(n, a).is_some()
+            })
+        };
         // Objects merged in bring only bodies to the world (their elements come after the
         // template's), unless a part has world-level elements of its own.
         let world_level = parts.iter().any(|d| {
@@ -173,10 +196,12 @@ impl Rules {
             })
         });
         Rules {
-            mass: mass && !dampratio,
-            poses,
+            mass: mass && !dampratio && !fused,
+            poses: poses && !dampratio && !hanging,
             keys,
-            ids: (!world_level)
+            armature: !dampratio && !actuated("armature"),
+            damping: !actuated("damping"),
+            ids: (!world_level && !fused)
                 .then(|| template_ids(template, discard))
                 .flatten(),
             discard,
@@ -493,6 +518,11 @@ pub(crate) fn entry(
     let &(_, _, field, n, float) = PATCHABLE
         .iter()
         .find(|(k, a, ..)| *k == tag && *a == attr)?;
+    if (tag, attr) == ("joint", "armature") && !rules.armature
+        || (tag, attr) == ("joint", "damping") && !rules.damping
+    {
+        return None;
+    }
     let (object, (name, id)) = match tag {
         "inertial" => {
             if !rules.mass || doc.attr(node, "fullinertia").is_some() {
