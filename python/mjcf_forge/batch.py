@@ -62,6 +62,9 @@ _BOUNDS = ("body_margin",)
 # rotational dof's length is its body's size, which for a massless root body depends on
 # where the body stands: parked or placed).
 _WARP_SLEEP_ONLY = ("dof_length",)
+# Contacts a placed free object may have at once in MuJoCo Warp's default sizes (a box on
+# a table: 4; lift5's worlds: at most 24 for 5 objects and the gripper, measured).
+_CONTACTS_PER_OBJECT = 16
 # The compiler's statistics, per world (``stat.<name>`` in :attr:`WorldBatch.arrays`).
 _STATS = ("meaninertia", "meanmass", "meansize", "extent", "center")
 # A patch entry's object -> the prefix of its MjModel arrays (as ModelCache resolves them).
@@ -274,14 +277,54 @@ class WorldBatch:
             out[name] = rows
         return out
 
+    def warp_sizes(self) -> dict[str, int]:
+        """``nconmax`` and ``njmax`` for :meth:`to_mjwarp` when not given, from the model.
+
+        MuJoCo Warp's own defaults count none of the superset's objects (48 contacts and
+        64 constraint rows for a model without height fields, whatever it holds): lift5's
+        worlds need up to 24 contacts and 140 rows (measured, scripts/sim_gap.py). Here:
+        Warp's default contacts plus ``_CONTACTS_PER_OBJECT`` for each free body a world
+        places (its largest count over the worlds); rows: that many contacts times the
+        rows a contact of the model's largest ``condim`` takes (``2 (condim - 1)``
+        pyramidal, ``condim`` elliptic), plus a row for every equality's
+        (6: a weld), limited joint or tendon and dof or tendon with friction loss. An
+        estimate, not a bound: a world past it sets its bit of Warp's ``d.overflow``
+        (contacts beyond are dropped); give ``nconmax``/``njmax`` then."""
+        mujoco = self.cache._mujoco
+        m = self.model
+        free = m.jnt_bodyid[m.jnt_type == mujoco.mjtJoint.mjJNT_FREE]
+        placed = 0
+        for w in range(self.nworld):
+            parked_roots = set(m.body_rootid[m.geom_bodyid[self.parked_geoms[w]]].tolist())
+            placed = max(placed, sum(int(m.body_rootid[b]) not in parked_roots for b in free))
+        colliding = (m.geom_contype != 0) | (m.geom_conaffinity != 0)
+        condim = int(max(m.geom_condim[colliding].max(initial=1), m.pair_dim.max(initial=1)))
+        elliptic = m.opt.cone == mujoco.mjtCone.mjCONE_ELLIPTIC
+        rows = condim if elliptic or condim == 1 else 2 * (condim - 1)
+        fixed = (
+            6 * m.neq
+            + int(m.jnt_limited.sum())
+            + int(m.tendon_limited.sum())
+            + int((m.dof_frictionloss > 0).sum())
+            + int((m.tendon_frictionloss > 0).sum())
+        )
+        from mujoco_warp._src.io import _default_nconmax
+
+        nconmax = _default_nconmax(m) + _CONTACTS_PER_OBJECT * placed
+        return {"nconmax": int(nconmax), "njmax": int(nconmax * rows + fixed)}
+
     def to_mjwarp(self, **make_data: Any) -> tuple[Any, Any]:
         """A ``mujoco_warp`` ``Model`` with every per-world field one row per world (its
         dtypes: float32 vectors and quaternions, int32 ids) and a ``Data`` of ``nworld``
         worlds at their initial pose (``reset_data``: each world's ``qpos0``).
-        ``make_data`` goes to ``mujoco_warp.make_data`` (``nconmax``, ``njmax``...)."""
+        ``make_data`` goes to ``mujoco_warp.make_data``; ``nconmax`` and ``njmax`` default
+        to :meth:`warp_sizes` (Warp's own fit one robot alone)."""
         import mujoco_warp as mjw
         import warp as wp
 
+        if "naconmax" not in make_data:
+            for key, value in self.warp_sizes().items():
+                make_data.setdefault(key, value)
         specs = self._warp_specs()
         rows = self._warp_rows(specs)
         m = mjw.put_model(self.model)
