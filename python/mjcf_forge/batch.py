@@ -126,11 +126,10 @@ class WorldBatch:
             raise _error("a batch needs at least one world: no variant was given (0 worlds)")
         self.cache = cache
         self.superset = cache.superset
-        # A variant the superset cannot express fails here, with its index.
-        patches = [self.superset.patch(i) for i in indices]
+        # A variant the superset cannot express fails (in its patch), with its index.
         self.model = copy.copy(cache.model(_Index(indices[0])))
         self._scratch = copy.copy(self.model)
-        self._patched = _patched_arrays(patches[0])
+        self._patched = _patched_arrays(self.superset.patch(indices[0]))
         model = self.model
         self._fields = [
             n
@@ -139,14 +138,20 @@ class WorldBatch:
             and isinstance(getattr(model, n, None), np.ndarray)
             and not n.startswith(_STATIC_PREFIXES)
         ]
+        self._candidates = sorted((self._patched | set(_DERIVED)) & set(self._fields))
+        # Every other field as the batch's first world holds it: a world's row of one is
+        # kept only when it differs (no superset patch makes one differ; checked anyway).
+        self._others = {
+            n: getattr(model, n).tobytes() for n in self._fields if n not in self._candidates
+        }
+        self._data: Any = None
         self._root_of_geom = model.body_rootid[model.geom_bodyid]
         rows = [self._rows(i) for i in indices]
-        candidates = (self._patched | set(_DERIVED)) & set(self._fields)
-        varying = {
-            n for n in self._fields if any(not np.array_equal(r[n], rows[0][n]) for r in rows)
+        varying = sorted({n for r in rows for n in r if n in self._others})
+        self.per_world = self._candidates + varying + [f"stat.{s}" for s in _STATS]
+        self.arrays = {
+            n: np.stack([r[n] if n in r else getattr(model, n) for r in rows]) for n in self.per_world
         }
-        self.per_world = sorted(candidates | varying) + [f"stat.{s}" for s in _STATS]
-        self.arrays = {n: np.stack([r[n] for r in rows]) for n in self.per_world}
         self.parked_geoms = np.stack([r["parked_geoms"] for r in rows])
         self.world_variant = np.array(indices, dtype=np.int64)
         self._warp: Any = None
@@ -171,15 +176,24 @@ class WorldBatch:
         """Every field of the superset patched for variant ``index``, its statistics, its
         parked geoms; a parked geom that touches anything at the initial pose is an error."""
         model = self.cache.apply(_Index(index), self._scratch)
-        out = {n: getattr(model, n).copy() for n in self._fields}
+        out = {n: getattr(model, n).copy() for n in self._candidates}
+        for n, first in self._others.items():
+            value = getattr(model, n)
+            if value.tobytes() != first:
+                out[n] = value.copy()
         for s in _STATS:
             out[f"stat.{s}"] = np.array(getattr(model.stat, s), dtype=np.float64)
         mujoco = self.cache._mujoco
         parked_roots = [model.body(r).id for r in self.superset.parked(index)]
         parked = np.isin(self._root_of_geom, parked_roots)
         out["parked_geoms"] = parked
-        data = mujoco.MjData(model)
-        mujoco.mj_forward(model, data)
+        if self._data is None:
+            self._data = mujoco.MjData(model)
+        data = self._data
+        mujoco.mj_resetData(model, data)
+        # The initial pose's contacts: positions and collision only.
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_collision(model, data)
         for c in data.contact[: data.ncon]:
             g1, g2 = int(c.geom[0]), int(c.geom[1])
             if parked[g1] or parked[g2]:
@@ -208,15 +222,15 @@ class WorldBatch:
                 raise _error(f"world {w} is not in the batch (0 to {self.nworld - 1})")
         rows = [self._rows(i) for i in indices]
         for i, r in zip(indices, rows):
-            for n in self._fields:
-                if n not in self.arrays and not np.array_equal(r[n], getattr(self.model, n)):
+            for n in r:
+                if n not in self.arrays and n != "parked_geoms":
                     raise _error(
                         f"variant {i}: field {n} differs from the batch's, where all worlds "
                         "share one value (build a new WorldBatch)"
                     )
         for w, i, r in zip(worlds, indices, rows):
             for n in self.per_world:
-                self.arrays[n][w] = r[n]
+                self.arrays[n][w] = r[n] if n in r else getattr(self.model, n)
             self.parked_geoms[w] = r["parked_geoms"]
             self.world_variant[w] = i
         mask = np.zeros(self.nworld, dtype=bool)
