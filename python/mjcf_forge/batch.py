@@ -62,6 +62,9 @@ _BOUNDS = ("body_margin",)
 # rotational dof's length is its body's size, which for a massless root body depends on
 # where the body stands: parked or placed).
 _WARP_SLEEP_ONLY = ("dof_length",)
+# Contacts a placed free object may have at once in MuJoCo Warp's default sizes (a box on
+# a table: 4; lift5's worlds: at most 24 for 5 objects and the gripper, measured).
+_CONTACTS_PER_OBJECT = 16
 # The compiler's statistics, per world (``stat.<name>`` in :attr:`WorldBatch.arrays`).
 _STATS = ("meaninertia", "meanmass", "meansize", "extent", "center")
 # A patch entry's object -> the prefix of its MjModel arrays (as ModelCache resolves them).
@@ -123,11 +126,10 @@ class WorldBatch:
             raise _error("a batch needs at least one world: no variant was given (0 worlds)")
         self.cache = cache
         self.superset = cache.superset
-        # A variant the superset cannot express fails here, with its index.
-        patches = [self.superset.patch(i) for i in indices]
+        # A variant the superset cannot express fails (in its patch), with its index.
         self.model = copy.copy(cache.model(_Index(indices[0])))
         self._scratch = copy.copy(self.model)
-        self._patched = _patched_arrays(patches[0])
+        self._patched = _patched_arrays(self.superset.patch(indices[0]))
         model = self.model
         self._fields = [
             n
@@ -136,14 +138,20 @@ class WorldBatch:
             and isinstance(getattr(model, n, None), np.ndarray)
             and not n.startswith(_STATIC_PREFIXES)
         ]
+        self._candidates = sorted((self._patched | set(_DERIVED)) & set(self._fields))
+        # Every other field as the batch's first world holds it: a world's row of one is
+        # kept only when it differs (no superset patch makes one differ; checked anyway).
+        self._others = {
+            n: getattr(model, n).tobytes() for n in self._fields if n not in self._candidates
+        }
+        self._data: Any = None
         self._root_of_geom = model.body_rootid[model.geom_bodyid]
         rows = [self._rows(i) for i in indices]
-        candidates = (self._patched | set(_DERIVED)) & set(self._fields)
-        varying = {
-            n for n in self._fields if any(not np.array_equal(r[n], rows[0][n]) for r in rows)
+        varying = sorted({n for r in rows for n in r if n in self._others})
+        self.per_world = self._candidates + varying + [f"stat.{s}" for s in _STATS]
+        self.arrays = {
+            n: np.stack([r[n] if n in r else getattr(model, n) for r in rows]) for n in self.per_world
         }
-        self.per_world = sorted(candidates | varying) + [f"stat.{s}" for s in _STATS]
-        self.arrays = {n: np.stack([r[n] for r in rows]) for n in self.per_world}
         self.parked_geoms = np.stack([r["parked_geoms"] for r in rows])
         self.world_variant = np.array(indices, dtype=np.int64)
         self._warp: Any = None
@@ -168,15 +176,24 @@ class WorldBatch:
         """Every field of the superset patched for variant ``index``, its statistics, its
         parked geoms; a parked geom that touches anything at the initial pose is an error."""
         model = self.cache.apply(_Index(index), self._scratch)
-        out = {n: getattr(model, n).copy() for n in self._fields}
+        out = {n: getattr(model, n).copy() for n in self._candidates}
+        for n, first in self._others.items():
+            value = getattr(model, n)
+            if value.tobytes() != first:
+                out[n] = value.copy()
         for s in _STATS:
             out[f"stat.{s}"] = np.array(getattr(model.stat, s), dtype=np.float64)
         mujoco = self.cache._mujoco
         parked_roots = [model.body(r).id for r in self.superset.parked(index)]
         parked = np.isin(self._root_of_geom, parked_roots)
         out["parked_geoms"] = parked
-        data = mujoco.MjData(model)
-        mujoco.mj_forward(model, data)
+        if self._data is None:
+            self._data = mujoco.MjData(model)
+        data = self._data
+        mujoco.mj_resetData(model, data)
+        # The initial pose's contacts: positions and collision only.
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_collision(model, data)
         for c in data.contact[: data.ncon]:
             g1, g2 = int(c.geom[0]), int(c.geom[1])
             if parked[g1] or parked[g2]:
@@ -205,15 +222,15 @@ class WorldBatch:
                 raise _error(f"world {w} is not in the batch (0 to {self.nworld - 1})")
         rows = [self._rows(i) for i in indices]
         for i, r in zip(indices, rows):
-            for n in self._fields:
-                if n not in self.arrays and not np.array_equal(r[n], getattr(self.model, n)):
+            for n in r:
+                if n not in self.arrays and n != "parked_geoms":
                     raise _error(
                         f"variant {i}: field {n} differs from the batch's, where all worlds "
                         "share one value (build a new WorldBatch)"
                     )
         for w, i, r in zip(worlds, indices, rows):
             for n in self.per_world:
-                self.arrays[n][w] = r[n]
+                self.arrays[n][w] = r[n] if n in r else getattr(self.model, n)
             self.parked_geoms[w] = r["parked_geoms"]
             self.world_variant[w] = i
         mask = np.zeros(self.nworld, dtype=bool)
@@ -274,14 +291,54 @@ class WorldBatch:
             out[name] = rows
         return out
 
+    def warp_sizes(self) -> dict[str, int]:
+        """``nconmax`` and ``njmax`` for :meth:`to_mjwarp` when not given, from the model.
+
+        MuJoCo Warp's own defaults count none of the superset's objects (48 contacts and
+        64 constraint rows for a model without height fields, whatever it holds): lift5's
+        worlds need up to 24 contacts and 140 rows (measured, scripts/sim_gap.py). Here:
+        Warp's default contacts plus ``_CONTACTS_PER_OBJECT`` for each free body a world
+        places (its largest count over the worlds); rows: that many contacts times the
+        rows a contact of the model's largest ``condim`` takes (``2 (condim - 1)``
+        pyramidal, ``condim`` elliptic), plus a row for every equality's
+        (6: a weld), limited joint or tendon and dof or tendon with friction loss. An
+        estimate, not a bound: a world past it sets its bit of Warp's ``d.overflow``
+        (contacts beyond are dropped); give ``nconmax``/``njmax`` then."""
+        mujoco = self.cache._mujoco
+        m = self.model
+        free = m.jnt_bodyid[m.jnt_type == mujoco.mjtJoint.mjJNT_FREE]
+        placed = 0
+        for w in range(self.nworld):
+            parked_roots = set(m.body_rootid[m.geom_bodyid[self.parked_geoms[w]]].tolist())
+            placed = max(placed, sum(int(m.body_rootid[b]) not in parked_roots for b in free))
+        colliding = (m.geom_contype != 0) | (m.geom_conaffinity != 0)
+        condim = int(max(m.geom_condim[colliding].max(initial=1), m.pair_dim.max(initial=1)))
+        elliptic = m.opt.cone == mujoco.mjtCone.mjCONE_ELLIPTIC
+        rows = condim if elliptic or condim == 1 else 2 * (condim - 1)
+        fixed = (
+            6 * m.neq
+            + int(m.jnt_limited.sum())
+            + int(m.tendon_limited.sum())
+            + int((m.dof_frictionloss > 0).sum())
+            + int((m.tendon_frictionloss > 0).sum())
+        )
+        from mujoco_warp._src.io import _default_nconmax
+
+        nconmax = _default_nconmax(m) + _CONTACTS_PER_OBJECT * placed
+        return {"nconmax": int(nconmax), "njmax": int(nconmax * rows + fixed)}
+
     def to_mjwarp(self, **make_data: Any) -> tuple[Any, Any]:
         """A ``mujoco_warp`` ``Model`` with every per-world field one row per world (its
         dtypes: float32 vectors and quaternions, int32 ids) and a ``Data`` of ``nworld``
         worlds at their initial pose (``reset_data``: each world's ``qpos0``).
-        ``make_data`` goes to ``mujoco_warp.make_data`` (``nconmax``, ``njmax``...)."""
+        ``make_data`` goes to ``mujoco_warp.make_data``; ``nconmax`` and ``njmax`` default
+        to :meth:`warp_sizes` (Warp's own fit one robot alone)."""
         import mujoco_warp as mjw
         import warp as wp
 
+        if "naconmax" not in make_data:
+            for key, value in self.warp_sizes().items():
+                make_data.setdefault(key, value)
         specs = self._warp_specs()
         rows = self._warp_rows(specs)
         m = mjw.put_model(self.model)

@@ -30,10 +30,6 @@ BOXES = ROOT / "corpora" / "scenes" / "patch" / "boxes.toml"
 WORLDS = 8
 STEPS = 500
 TOLERANCE = 1e-4
-# lift5 in MuJoCo Warp (expected to fail, see SCENES): the variant's own model alone in Warp
-# already ends 4.8e-4 m from CPU MuJoCo after 500 steps; the superset's worlds end up to
-# 2.9e-3 m from it (world 4).
-TOLERANCE_BY_SCENE = {"lift5": 1e-3}
 # Two worlds that take other variants at the reset halfway.
 REASSIGN = ([1, 6], [WORLDS + 3, WORLDS + 5])
 
@@ -54,15 +50,21 @@ def reference(scene, index: int, steps: int) -> dict[str, np.ndarray]:
     return _references[key]
 
 
-def deviation(batch: WorldBatch, scene, world: int, xpos: np.ndarray) -> float:
-    """The largest distance (per axis) of a world's placed bodies from its variant's own."""
-    index = int(batch.world_variant[world])
-    tags = batch.superset.names(index)
+def _deviation(batch: WorldBatch, world: int, xpos: np.ndarray, ref: dict) -> float:
+    """The largest distance (per axis) of a world's placed bodies from ``ref`` (body
+    positions by the variant's names)."""
+    tags = batch.superset.names(int(batch.world_variant[world]))
     worst = 0.0
-    for body, ref in reference(scene, index, STEPS).items():
+    for body, pos in ref.items():
         name = next((t + body for p, t in tags if body.startswith(p)), body)
-        worst = max(worst, float(np.abs(xpos[world, batch.model.body(name).id] - ref).max()))
+        worst = max(worst, float(np.abs(xpos[world, batch.model.body(name).id] - pos).max()))
     return worst
+
+
+def deviation(batch: WorldBatch, scene, world: int, xpos: np.ndarray) -> float:
+    """The largest distance (per axis) of a world's placed bodies from its variant's own on
+    CPU MuJoCo after STEPS steps."""
+    return _deviation(batch, world, xpos, reference(scene, int(batch.world_variant[world]), STEPS))
 
 
 def parked_bodies(batch: WorldBatch, world: int) -> list[int]:
@@ -98,34 +100,9 @@ def judge(scene, batch: WorldBatch, run, contacts, tolerance: float = TOLERANCE)
     return report
 
 
-SCENES = [
-    pytest.param(PATCH, id="patch"),
-    pytest.param(
-        LIFT5,
-        id="lift5",
-        marks=[
-            pytest.mark.skipif(not RS_ASSETS.is_dir(), reason="setup not run"),
-            # Measured: world 4 ends 2.9e-3 m from CPU MuJoCo after 500 steps, and the
-            # variant's own model alone in Warp already differs from CPU (4.8e-4 m for
-            # variant 0): Warp's float32 contact solve, not the superset. To do: judge each
-            # world against its variant's own model stepped in Warp.
-            pytest.mark.xfail(reason="Warp vs CPU MuJoCo differ beyond 1e-4 m on lift5", strict=False),
-        ],
-    ),
-]
-
-
-@pytest.mark.parametrize("path", SCENES)
-def test_mujoco_warp_worlds_agree_with_each_variant(path):
+def warp_step(m, d):
     import mujoco_warp as mjw
     import warp as wp
-
-    wp.config.quiet = True
-    scene = mjcf_forge.Scene.load(path)
-    batch = WorldBatch(scene, range(WORLDS))
-    # Room for lift5's contacts and constraint rows (Warp's defaults fit one robot alone).
-    m, d = batch.to_mjwarp(nconmax=256, njmax=1024)
-    state = {"m": m, "d": d}
 
     def run(steps):
         for _ in range(steps):
@@ -141,9 +118,100 @@ def test_mujoco_warp_worlds_agree_with_each_variant(path):
         world = d.contact.worldid.numpy()[:n]
         return [(int(w), int(g[0]), int(g[1])) for w, g in zip(world, geom)]
 
-    report = judge(scene, batch, run, contacts, TOLERANCE_BY_SCENE.get(path.stem, TOLERANCE))
-    print("mujoco_warp", path.stem, report)
-    assert state["m"] is m  # assign() wrote into the same Warp model
+    return run, contacts
+
+
+def test_mujoco_warp_worlds_agree_with_each_variant():
+    """The patch scene in MuJoCo Warp, with to_mjwarp's default sizes: every world within
+    1e-4 m of its variant compiled alone on CPU MuJoCo after 500 steps."""
+    import warp as wp
+
+    wp.config.quiet = True
+    scene = mjcf_forge.Scene.load(PATCH)
+    batch = WorldBatch(scene, range(WORLDS))
+    m, d = batch.to_mjwarp()
+    run, contacts = warp_step(m, d)
+    report = judge(scene, batch, run, contacts)
+    assert not d.overflow.numpy().any(), "to_mjwarp's default nconmax/njmax overflowed"
+    print("mujoco_warp patch", report)
+
+
+_warp_alone: dict = {}
+
+
+def warp_alone(scene, index: int, steps: int) -> dict[str, np.ndarray]:
+    """Variant ``index`` compiled alone and stepped in MuJoCo Warp (one world): its objects'
+    body positions after ``steps`` steps, by variant name."""
+    import mujoco_warp as mjw
+
+    key = (str(scene.file), index, steps)
+    if key not in _warp_alone:
+        v = scene.variant(index)
+        model = mujoco.MjModel.from_xml_string(v.xml)
+        m = mjw.put_model(model)
+        d = mjw.make_data(model, nworld=1, nconmax=128, njmax=1024)
+        mjw.reset_data(m, d)
+        xpos = warp_step(m, d)[0](steps)[0]
+        _warp_alone[key] = {o["body"]: xpos[model.body(o["body"]).id] for o in v.params["objects"]}
+    return _warp_alone[key]
+
+
+def deviations(batch, scene, worlds, xpos, steps) -> tuple[float, float]:
+    """The largest deviation of the worlds' placed bodies from their variants alone in
+    MuJoCo Warp, and from them on CPU MuJoCo."""
+    alone = cpu = 0.0
+    for w in worlds:
+        index = int(batch.world_variant[w])
+        alone = max(alone, _deviation(batch, w, xpos, warp_alone(scene, index, steps)))
+        cpu = max(cpu, _deviation(batch, w, xpos, reference(scene, index, steps)))
+    return alone, cpu
+
+
+# lift5 in MuJoCo Warp (docs/compiled.md, measured with scripts/sim_gap.py): its objects
+# roll and rock on the table, and Warp amplifies any float32 rounding by about 10x per 50
+# steps there: a superset world and its variant's own model, both in Warp, agree within 1.0e-5 m
+# at 100 steps and part by up to 1.1e-3 m at 500; Warp and CPU MuJoCo, each on the variant's
+# own model, part by up to 5.4e-3 m at 500 (6e-5 m at 100). So the bounds hold at 100 steps
+# (superset world against the variant alone in Warp: 3e-5 m; against CPU MuJoCo: 1e-4 m),
+# and 500 steps are judged for parked bodies, overflow, and the figures printed.
+LIFT5_EARLY = 100
+LIFT5_VS_WARP = 3e-5
+
+
+@pytest.mark.skipif(not RS_ASSETS.is_dir(), reason="setup not run")
+def test_mujoco_warp_lift5_worlds_agree_with_each_variant():
+    import warp as wp
+
+    wp.config.quiet = True
+    scene = mjcf_forge.Scene.load(LIFT5)
+    batch = WorldBatch(scene, range(WORLDS))
+    m, d = batch.to_mjwarp()  # the default sizes (Warp's own overflow on lift5)
+    run, contacts = warp_step(m, d)
+    start = run(0)
+    parked = {w: parked_bodies(batch, w) for w in range(WORLDS)}
+    xpos = run(LIFT5_EARLY)
+    alone, cpu = deviations(batch, scene, range(WORLDS), xpos, LIFT5_EARLY)
+    report = {"vs_warp_alone_100": alone, "vs_cpu_100": cpu}
+    assert alone <= LIFT5_VS_WARP and cpu <= TOLERANCE, report
+    xpos = run(STEPS - LIFT5_EARLY)
+    report["vs_cpu_500"] = max(deviation(batch, scene, w, xpos) for w in range(WORLDS))
+    for w in range(WORLDS):
+        assert np.array_equal(xpos[w, parked[w]], start[w, parked[w]]), f"world {w}: a parked body moved"
+    for w, g1, g2 in contacts():
+        assert not (batch.parked_geoms[w, g1] or batch.parked_geoms[w, g2]), (w, g1, g2)
+    assert not d.overflow.numpy().any(), "to_mjwarp's default nconmax/njmax overflowed"
+    # Other variants in two worlds at reset.
+    worlds, variants = REASSIGN
+    batch.assign(worlds, variants)
+    start = run(0)
+    xpos = run(LIFT5_EARLY)
+    alone, cpu = deviations(batch, scene, worlds, xpos, LIFT5_EARLY)
+    report.update(reassigned_vs_warp_alone_100=alone, reassigned_vs_cpu_100=cpu)
+    assert alone <= LIFT5_VS_WARP and cpu <= TOLERANCE, report
+    for w in worlds:
+        p = parked_bodies(batch, w)
+        assert np.array_equal(xpos[w, p], start[w, p]), f"world {w}: a parked body moved"
+    print("mujoco_warp lift5", report)
 
 
 def test_mujoco_cpu_worlds_agree_with_each_variant():
