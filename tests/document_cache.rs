@@ -457,3 +457,56 @@ fn derived_values_mujoco_set_const_leaves_stay_structure() {
     assert_eq!(key(inertia("1 1 1")), key(inertia("1 2 2")));
     assert_ne!(key(inertia("1 1 1")), key(inertia("1 1 3")));
 }
+
+#[test]
+fn sizes_of_primitive_geoms_are_patched_through_their_bodies_little_models() {
+    let xml = |a: &str, r: &str, b: &str| {
+        format!(
+            r#"<mujoco><compiler angle="degree"/><asset><material name="m" rgba="1 0 0 1"/></asset>
+            <worldbody><geom name="floor" type="plane" size="1 1 0.1"/>
+            <body name="cube" pos="0 0 0.1"><freejoint/>
+              <geom name="c" type="box" size="{a}" material="m" euler="0 0 30"/>
+              <geom name="c_vis" type="box" size="{a}" contype="0" conaffinity="0" group="1" mass="0"/></body>
+            <body name="arm" pos="0.3 0 0.2"><joint name="j" axis="0 1 0"/>
+              <inertial pos="0 0 0" mass="1" diaginertia="0.01 0.01 0.01"/>
+              <geom type="capsule" size="{r} 0.1"/><geom type="cylinder" size="{r} 0.05" pos="0 0 0.1"/></body>
+            <body name="pair" pos="0 0.3 0.1"><freejoint/><geom type="box" size="{b}"/>
+              <geom type="box" size="{b}"/></body>
+            </worldbody></mujoco>"#
+        )
+    };
+    let mut cache = DocumentCache::new(4, None);
+    let mut rng = Rng(7);
+    let mut keys = std::collections::HashSet::new();
+    for k in 0..6 {
+        let a = list(&[
+            rng.uniform(0.02, 0.04),
+            rng.uniform(0.02, 0.04),
+            rng.uniform(0.02, 0.04),
+        ]);
+        let r = list(&[rng.uniform(0.01, 0.03)]);
+        let mut b = [
+            rng.uniform(0.01, 0.03),
+            rng.uniform(0.01, 0.03),
+            rng.uniform(0.01, 0.03),
+        ];
+        b.sort_by(f64::total_cmp);
+        let doc = Document::from_str(&xml(&a, &r, &list(&b)), ".").unwrap();
+        keys.insert(
+            mjcf_forge::scene::split_document_with(
+                &doc,
+                mjcf_forge::scene::SplitOptions {
+                    compiled_bodies: true,
+                },
+            )
+            .structure_key,
+        );
+        exact(&mut cache, &doc, &format!("sizes {k}"));
+    }
+    assert_eq!(keys.len(), 1);
+    assert_eq!((cache.compiles(), cache.patches()), (1, 5));
+    // Boxes in the other order turn the pair's principal axes (body_sameframe): compiled.
+    let turned = Document::from_str(&xml("0.03 0.03 0.03", "0.02", "0.03 0.02 0.01"), ".").unwrap();
+    exact(&mut cache, &turned, "turned");
+    assert_eq!(cache.compiles(), 2);
+}

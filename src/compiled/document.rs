@@ -11,7 +11,7 @@ use super::store::Store;
 use crate::document::Document;
 use crate::error::{Error, ErrorKind, Errors};
 use crate::mujoco::{CompiledModel, compile_document};
-use crate::scene::split_document;
+use crate::scene::{SplitOptions, split_document_with};
 
 /// Compiled models of documents, one per structure, patched per document; bounded in
 /// count and bytes (models and their scratch data), least recently used out.
@@ -64,7 +64,12 @@ impl DocumentCache {
     /// document, is at the element it names in the document's sources
     /// ([`Document::mujoco_error`]); the cache is then as it was.
     pub fn model(&mut self, doc: &Document) -> Result<&CompiledModel, Errors> {
-        let split = split_document(doc);
+        let split = split_document_with(
+            doc,
+            SplitOptions {
+                compiled_bodies: true,
+            },
+        );
         let key = split.structure_key.as_str();
         // When a value does not fit the cached model (a material that does not exist),
         // MuJoCo's own verdict follows. The cached model is whole again after its next

@@ -29,6 +29,7 @@
 
 mod cache;
 mod document;
+mod little;
 mod store;
 
 pub use cache::ModelCache;

@@ -13,6 +13,7 @@ use std::collections::HashMap;
 use std::ffi::{CString, c_char, c_int, c_void};
 use std::ptr::NonNull;
 
+use super::little::Little;
 use crate::mujoco::{CompiledModel, MjModel, ObjType, Sizes};
 use crate::scene::{PatchEntry, PatchValue};
 
@@ -95,6 +96,8 @@ pub(super) struct Target {
     /// of every keyframe (`key_qpos`, one row of `nq` per key). One run elsewhere.
     runs: usize,
     stride: usize,
+    /// A body whose little model the entry is (`PatchValue::Compiled`): nothing at `ptr`.
+    body: Option<usize>,
 }
 
 /// How to patch one model: its structure key, scratch data and resolved targets.
@@ -104,6 +107,8 @@ pub(super) struct Plan {
     pub(super) scratch: Scratch,
     fields: Vec<(&'static str, String, Option<usize>, &'static str)>,
     targets: Vec<Target>,
+    /// The little models of its bodies compiled so far.
+    little: Little,
     nbytes: usize,
 }
 
@@ -283,6 +288,7 @@ impl State {
             scratch,
             fields: Vec::new(),
             targets: Vec::new(),
+            little: Little::default(),
             nbytes: usize::try_from(nbytes).unwrap_or(0),
         });
         Ok(self.plans.len() - 1)
@@ -310,7 +316,10 @@ impl State {
         }
         let ptr = model.as_mut_ptr();
         for (t, e) in plan.targets.iter().zip(entries) {
-            write(ptr, t, &e.value)?;
+            match (t.body, &e.value) {
+                (Some(body), PatchValue::Compiled(xml)) => plan.little.write(ptr, body, xml)?,
+                _ => write(ptr, t, &e.value)?,
+            }
         }
         let (fixed, stat) = self.stats.get(key).copied().unwrap_or_default();
         // SAFETY: the model and its scratch data are live and of one structure.
@@ -337,7 +346,7 @@ fn write(model: *mut MjModel, t: &Target, value: &PatchValue) -> Result<(), Stri
             unsafe { t.ptr.cast::<c_int>().write_unaligned(id) };
         }
         PatchValue::Compiled(_) => {
-            return Err("a compiled body's geoms are not patched here".to_string());
+            return Err("a body's little model is written by its plan".to_string());
         }
         PatchValue::Numbers(v) => {
             for run in 0..t.runs {
@@ -407,12 +416,17 @@ fn resolve(model: &mut CompiledModel, entries: &[PatchEntry]) -> Result<Vec<Targ
         let width = match &e.value {
             PatchValue::Numbers(v) => v.len(),
             PatchValue::Id { .. } => 1,
-            // Never in the splits this cache makes (`split_document`'s default options).
             PatchValue::Compiled(_) => {
-                return Err(format!(
-                    "{} '{}': a compiled body's geoms are not patched here",
-                    e.object, e.name
-                ));
+                out.push(Target {
+                    ptr: std::ptr::null_mut(),
+                    elem: 0,
+                    n: 0,
+                    int: false,
+                    runs: 0,
+                    stride: 0,
+                    body: Some(id),
+                });
+                continue;
             }
         };
         let (mut runs, mut stride) = (1, 0);
@@ -470,6 +484,7 @@ fn resolve(model: &mut CompiledModel, entries: &[PatchEntry]) -> Result<Vec<Targ
             int: matches!(e.field, "matid" | "contype" | "conaffinity"),
             runs,
             stride,
+            body: None,
         });
     }
     Ok(out)
@@ -498,5 +513,6 @@ fn option_target(model: *mut MjModel, e: &PatchEntry) -> Result<Target, String> 
         int: false,
         runs: 1,
         stride: 0,
+        body: None,
     })
 }

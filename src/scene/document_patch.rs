@@ -31,8 +31,8 @@ pub struct SplitOptions {
     /// Sizes of primitive geoms (sphere, capsule, ellipsoid, cylinder, box, sized by
     /// `size`): their body's entry is a [`PatchValue::Compiled`] model of its geoms, whose
     /// compile gives what MuJoCo derives from them (sizes, bounds, mass and inertia,
-    /// bounding volumes). Only for a model cache that compiles those (Python's
-    /// `DocumentCache`).
+    /// bounding volumes). For a model cache that compiles those (`DocumentCache`, in Rust
+    /// and Python).
     pub compiled_bodies: bool,
 }
 
