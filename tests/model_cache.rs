@@ -280,3 +280,25 @@ fn armature_beside_a_damping_ratio_is_compiled() {
         assert_eq!(got.differences(&want), Vec::<String>::new(), "variant {i}");
     }
 }
+
+#[test]
+fn geom_sizes_frames_and_densities_are_carried_by_little_models() {
+    // What MuJoCo derives from them comes from compiling the body's geoms alone: one
+    // structure, every variant exact (a variant whose geoms turn the body's inertial frame
+    // is compiled instead).
+    let scene = Scene::load(root().join("corpora/scenes/patch/geoms.toml")).unwrap();
+    assert_eq!(by_structure(&scene, 8).len(), 1);
+    let mut cache = ModelCache::new(&scene, 2, None);
+    for i in 0..8 {
+        let want = compiled(&scene, i);
+        let got = cache.model(i).unwrap();
+        assert_eq!(got.differences(&want), Vec::<String>::new(), "variant {i}");
+    }
+    assert_eq!(cache.compiles() + cache.patches(), 8);
+    assert!(cache.patches() >= 4);
+    // The demo turns a block's slab: its superset carries it.
+    let demo = Scene::demo().unwrap();
+    let superset = demo.superset().unwrap();
+    let patch = demo.superset_patch(&superset, 0).unwrap();
+    assert!(patch.entries.iter().any(|e| e.field == "geoms"));
+}

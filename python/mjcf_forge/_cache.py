@@ -349,13 +349,18 @@ class _Plan:
             or int(mini.body_sameframe[1]) != int(model.body_sameframe[body])
             or int(mini.body_bvhnum[1]) != nbvh
             or not np.array_equal(mini.geom_type[mfirst : mfirst + n], model.geom_type[first : first + n])
+            or not np.array_equal(mini.geom_sameframe[mfirst : mfirst + n], model.geom_sameframe[first : first + n])
             or not np.array_equal(mini.bvh_child[mbvh : mbvh + nbvh], model.bvh_child[bvh : bvh + nbvh])
             or not np.array_equal(mini.bvh_depth[mbvh : mbvh + nbvh], model.bvh_depth[bvh : bvh + nbvh])
             or not np.array_equal(mini.bvh_nodeid[mbvh : mbvh + nbvh] + (first - mfirst) * (mini.bvh_nodeid[mbvh : mbvh + nbvh] >= 0), model.bvh_nodeid[bvh : bvh + nbvh])
         ):
-            raise _error(f"body {body}: its geoms' compile is not a patch of this structure")
+            raise _error(
+                f"body '{model.body(body).name}': its geoms compile to another layout than "
+                "this structure's (sizes, frames or densities that move or turn its inertial "
+                "frame off its own, or another bounding-volume tree): not a patch of it"
+            )
         geoms, mgeoms = slice(first, first + n), slice(mfirst, mfirst + n)
-        for field in ("geom_size", "geom_rbound", "geom_aabb"):
+        for field in ("geom_size", "geom_rbound", "geom_aabb", "geom_pos", "geom_quat"):
             getattr(model, field)[geoms] = getattr(mini, field)[mgeoms]
         for field in ("body_mass", "body_inertia", "body_ipos", "body_iquat"):
             getattr(model, field)[body] = getattr(mini, field)[1]
@@ -564,7 +569,14 @@ class ModelCache:
             return self._compile(variant)
         self._entries.move_to_end(key)
         plan = self._plans.get(id(model)) or self._plan(model, key)
-        plan.apply(patch)
+        try:
+            plan.apply(patch)
+        except MjcfError:
+            if self.superset is not None:
+                raise
+            # A body's geoms that compile to another layout (sizes that turn its principal
+            # axes): not a patch of this structure, so the variant is compiled (and kept).
+            return self._compile(variant)
         if self.superset is not None:
             self._variant_inertia(model, plan, variant)
         self.patches += 1

@@ -86,7 +86,6 @@ def test_structural_values_are_compiled_never_patched():
     variants = [scene.variant(i) for i in range(8)]
     randomized = {(r["kind"], r["attribute"]) for r in variants[0].params["randomized"]}
     assert randomized == {
-        ("geom", "size"), ("geom", "density"), ("geom", "euler"), ("geom", "pos"),
         ("light", "dir"), ("light", "cutoff"), ("camera", "pos"),
         ("joint", "range"), ("joint", "ref"), ("position", "gear"), ("mesh", "file"),
     }
@@ -101,6 +100,30 @@ def test_structural_values_are_compiled_never_patched():
         check_exact(v, cache.model(v))
     assert cache.compiles == 3 and cache.patches == 0
     assert len(cache) == 2
+
+
+def test_geom_sizes_frames_and_densities_are_carried_by_little_models():
+    # What MuJoCo derives from a geom's size, frame and density (bounding radius and box,
+    # the body's mass, inertia, inertial frame and bounding volumes) comes from compiling
+    # the body's geoms alone: one structure, every variant exact.
+    scene = mjcf_forge.Scene.load(PATCH / "geoms.toml")
+    variants = [scene.variant(i) for i in range(8)]
+    randomized = {(r["kind"], r["attribute"]) for r in variants[0].params["randomized"]}
+    assert randomized == {("geom", "size"), ("geom", "density"), ("geom", "euler"), ("geom", "pos")}
+    assert len({v.structure_key for v in variants}) == 1
+    assert sum(f == "geoms" for _, _, f, _ in variants[0].patch) == 2  # the box, the block
+    cache = mjcf_forge.ModelCache(scene)
+    for v in variants:
+        check_exact(v, cache.model(v))
+    # A visual geom moved off the box's centre may turn its inertial frame away from the
+    # body's (body_sameframe): such a variant is compiled, never patched.
+    assert cache.compiles + cache.patches == 8 and cache.patches >= 4
+    # The superset has one structure: a variant that moves the box's centre of mass off its
+    # frame (its visual geom moved) is refused, saying why, never approximated.
+    sup = mjcf_forge.ModelCache(scene, superset=True)
+    with pytest.raises(mjcf_forge.MjcfError, match="clutter0_box': its geoms compile to another layout"):
+        for v in variants:
+            sup.model(v)
 
 
 def test_demo_scene_is_exact():
@@ -348,8 +371,15 @@ def test_superset_names_unnamed_geoms_itself():
     assert sum("unnamed_geom" in model.geom(g).name for g in range(model.ngeom)) >= len(unnamed)
 
 
+def test_superset_carries_the_demo_scene():
+    # The demo turns a block's slab (a geom's orientation): carried by the block's little
+    # model, placed or parked.
+    cache = _superset_check(mjcf_forge.Scene.demo(), range(4), trajectory_tolerance=1e-4)
+    assert cache.compiles == 1
+
+
 def test_superset_refuses_a_variant_it_cannot_carry():
-    scene = mjcf_forge.Scene.demo()      # randomizes a geom's orientation: structure
+    scene = mjcf_forge.Scene.load(PATCH / "structural.toml")   # a joint's range: structure
     sup = scene.superset()
     with pytest.raises(mjcf_forge.MjcfError, match="not a patch of the superset"):
         sup.patch(0)

@@ -193,22 +193,32 @@ impl<'s> ModelCache<'s> {
             // The superset as compiled parks every object: place the variant's.
             self.superset.is_some()
         };
-        let store = &mut self.store;
-        let Some((_, model)) = store.entries.last_mut() else {
-            return Err("the cache holds no model".to_string());
-        };
         if patch_it {
+            let store = &mut self.store;
+            let Some((_, model)) = store.entries.last_mut() else {
+                return Err("the cache holds no model".to_string());
+            };
             let target = (index, key.as_str(), patch.entries.as_slice());
-            patch_variant(
+            let patched = patch_variant(
                 self.scene,
                 &mut self.superset,
                 &mut store.state,
                 target,
                 model,
-            )?;
-            store.trim();
+            );
+            match patched {
+                Ok(()) => store.trim(),
+                // A body's geoms that compile to another layout (sizes that turn its
+                // principal axes): not a patch of this structure, so the variant is
+                // compiled (and kept). The superset has no other structure to offer.
+                Err(_) if self.superset.is_none() => {
+                    self.store.remove(&key);
+                    self.compile(index, &key)?;
+                }
+                Err(e) => return Err(e),
+            }
         }
-        store
+        self.store
             .last()
             .ok_or_else(|| "the cache holds no model".to_string())
     }

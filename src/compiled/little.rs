@@ -1,9 +1,9 @@
 //! A body's little model (`PatchValue::Compiled`, see `scene::SplitOptions`): the body's
 //! geoms compiled alone, whose compile gives what MuJoCo derives from them (each geom's
-//! size, bounding radius and box, the body's mass, inertia and inertial frame, its
+//! size, frame, bounding radius and box, the body's mass, inertia and inertial frame, its
 //! bounding volumes), copied into the body of a model of the whole structure. A little
-//! model whose layout is not the body's (another `body_sameframe`, bounding-volume tree
-//! or geom types) is refused: the document is then compiled.
+//! model whose layout is not the body's (another `body_sameframe` or `geom_sameframe`,
+//! bounding-volume tree or geom types) is refused: the document is then compiled.
 
 use std::ffi::{CString, c_int};
 use std::path::Path;
@@ -167,15 +167,24 @@ impl Little {
             || lnv != nv
             || int(little, "body_sameframe", 1)? != int(model, "body_sameframe", body)?
             || !same("geom_type", 1, (g, n), (lg, ln))?
+            || !same("geom_sameframe", 1, (g, n), (lg, ln))?
             || !same("bvh_child", 2, (v, nv), (lv, lnv))?
             || !same("bvh_depth", 1, (v, nv), (lv, lnv))?
             || shifted != nodes(model, v, nv)?
         {
             return Err(format!(
-                "body {body}: its geoms' compile is not a patch of this structure"
+                "body {body}: its geoms compile to another layout than this structure's \
+                 (sizes, frames or densities that move or turn its inertial frame off its own, \
+                 or another bounding-volume tree): not a patch of it"
             ));
         }
-        for (name, width) in [("geom_size", 3), ("geom_rbound", 1), ("geom_aabb", 6)] {
+        for (name, width) in [
+            ("geom_size", 3),
+            ("geom_rbound", 1),
+            ("geom_aabb", 6),
+            ("geom_pos", 3),
+            ("geom_quat", 4),
+        ] {
             copy(name, width, n, (little, lg), (model, g))?;
         }
         for (name, width) in [

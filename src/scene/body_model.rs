@@ -49,6 +49,35 @@ pub(crate) fn sized_primitive(doc: &Document, geom: Node) -> bool {
         && PRIMITIVES.contains(&doc.attr(geom, "type").map_or("sphere", str::trim))
 }
 
+/// Geom attributes a body's little model carries into the compiled model: sizes, frames,
+/// densities and masses (what MuJoCo derives from them is what the little model compiles
+/// to).
+const CARRIED: [&str; 9] = [
+    "size",
+    "pos",
+    "quat",
+    "euler",
+    "axisangle",
+    "xyaxes",
+    "zaxis",
+    "density",
+    "mass",
+];
+
+/// The body whose little model carries `attr` of `node`: a geom's size (a sized
+/// primitive), frame, density or mass, in a body that has a little model.
+pub(crate) fn carried_by(doc: &Document, node: Node, attr: &str) -> Option<Node> {
+    if doc.tag(node) != "geom"
+        || !CARRIED.contains(&attr)
+        || needs_asset(doc, node)
+        || doc.attr(node, "fromto").is_some()
+        || (attr == "size" && !sized_primitive(doc, node))
+    {
+        return None;
+    }
+    doc.parent(node).filter(|&body| qualifies(doc, body))
+}
+
 /// Whether a geom needs an asset (a mesh, height field or signed distance field).
 fn needs_asset(doc: &Document, geom: Node) -> bool {
     doc.attr(geom, "mesh").is_some()

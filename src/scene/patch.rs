@@ -12,6 +12,7 @@
 //! rules; `tests/scene_patch.rs` and `python/tests/test_model_cache.py` hold each against
 //! MuJoCo compiling the variant's XML.
 
+use super::body_model::{body_model, carried_by};
 use crate::document::tree::Node;
 use crate::document::{Document, Section};
 
@@ -119,6 +120,11 @@ pub(crate) struct Rules {
     pub(crate) armature: bool,
     /// A joint's damping lands unchanged (no actuator adds damping to its joint).
     pub(crate) damping: bool,
+    /// A geom's size, frame, density or mass is carried by its body's little model
+    /// (`body_model`): masses land unchanged, every geom of the compiled model is one of
+    /// the document (no `discardvisual`), and no spatial tendon, flex, composite or skin
+    /// hangs on a geom's size or a body's inertia.
+    pub(crate) little: bool,
     /// Compiled ids of the template's elements that can be patched unnamed, when nothing
     /// reorders them (see [`template_ids`]).
     pub(crate) ids: Option<ahash::AHashMap<Node, usize>>,
@@ -201,6 +207,7 @@ impl Rules {
             keys,
             armature: !dampratio && !actuated("armature"),
             damping: !actuated("damping"),
+            little: mass && !dampratio && !fused && !discard && !hanging,
             ids: (!world_level && !fused)
                 .then(|| template_ids(template, discard))
                 .flatten(),
@@ -362,9 +369,22 @@ pub(crate) fn split_parts(
         // Unnamed elements are known by id in the template only.
         let ids = if part == 0 { rules.ids.as_ref() } else { None };
         let mut bodies: Vec<Node> = Vec::new();
+        // Bodies whose little models carry randomized values of their geoms, and those
+        // values.
+        let mut little: Vec<Node> = Vec::new();
+        let mut carried: Vec<(Node, Node, &str, &str)> = Vec::new();
         for (node, attr, value) in &overlay.values {
             if rules.discard && dropped(doc, *node, attr) == Some(true) {
                 // Not in the compiled model: its value changes nothing.
+                continue;
+            }
+            if rules.little
+                && let Some(body) = carried_by(doc, *node, attr)
+            {
+                if !little.contains(&body) {
+                    little.push(body);
+                }
+                carried.push((body, *node, attr, value));
                 continue;
             }
             let structural = rules.discard && dropped(doc, *node, attr).is_none();
@@ -383,6 +403,35 @@ pub(crate) fn split_parts(
                     key.update(&(part as u64).to_le_bytes());
                     key.update(&(crate::document::tree::Tree::index(*node) as u64).to_le_bytes());
                     for s in [attr.as_str(), value.as_str()] {
+                        key.update(&(s.len() as u64).to_le_bytes());
+                        key.update(s.as_bytes());
+                    }
+                }
+            }
+        }
+        if !little.is_empty() {
+            let mut applied = doc.clone();
+            overlay.apply_to(&mut applied);
+            for body in little {
+                if let (Some(model), Some(name)) =
+                    (body_model(&applied, body), applied.attr(body, "name"))
+                {
+                    entries.push(PatchEntry {
+                        object: "body",
+                        name: name.to_string(),
+                        id: None,
+                        field: "geoms",
+                        value: PatchValue::Compiled(model),
+                    });
+                    parts.push(part);
+                    continue;
+                }
+                // No little model after all: its values are structure.
+                for &(_, node, attr, value) in carried.iter().filter(|c| c.0 == body) {
+                    in_key.push((part, node, attr.to_string()));
+                    key.update(&(part as u64).to_le_bytes());
+                    key.update(&(crate::document::tree::Tree::index(node) as u64).to_le_bytes());
+                    for s in [attr, value] {
                         key.update(&(s.len() as u64).to_le_bytes());
                         key.update(s.as_bytes());
                     }

@@ -27,7 +27,7 @@ use crate::model::merge::MergePart;
 
 use super::patch::{self, PatchEntry, PatchValue, VariantPatch};
 use super::randomize::AttrTarget as _;
-use super::{Scene, place};
+use super::{Scene, body_model, place};
 
 /// Where parked objects wait: a horizontal grid of square cells `PARK_STEP` wide, centred
 /// `PARK_HEIGHT` straight above the world's origin: above any floor (a plane through the
@@ -256,9 +256,20 @@ impl Scene {
             let mut rgba: Vec<(String, Vec<f64>)> = Vec::new();
             // The instance with its unnamed elements named (the same nodes as inst.doc).
             let doc = &m.named;
+            // Bodies whose little models carry randomized values of their geoms (sizes,
+            // frames, densities): one entry each, placed or parked.
+            let mut little: Vec<Node> = Vec::new();
             for (r, targets) in &inst.targets {
                 for t in targets {
                     for attr in self.randomizers[*r].attributes_set(doc, t.node) {
+                        if rules.little
+                            && let Some(body) = body_model::carried_by(doc, t.node, attr)
+                        {
+                            if !little.contains(&body) {
+                                little.push(body);
+                            }
+                            continue;
+                        }
                         let tag = doc.tag(t.node);
                         let value = match overlay {
                             Some(o) => o.get(t.node, attr),
@@ -283,6 +294,38 @@ impl Scene {
                             _ => entries.push(e),
                         }
                     }
+                }
+            }
+            if !little.is_empty() {
+                // Placed: the variant's values; parked: as authored.
+                let applied;
+                let source = match overlay {
+                    Some(o) => {
+                        let mut copy = doc.clone();
+                        o.apply_to(&mut copy);
+                        applied = copy;
+                        &applied
+                    }
+                    None => doc,
+                };
+                for body in little {
+                    let (Some(model), Some(name)) = (
+                        body_model::body_model(source, body),
+                        source.attr(body, "name"),
+                    ) else {
+                        return Err(Errors(vec![Error::bare(ErrorKind::Invalid(format!(
+                            "variant {index}: a geom of '{}' changes what its body derives, \
+                             and the body cannot be compiled alone",
+                            m.root
+                        )))]));
+                    };
+                    entries.push(PatchEntry {
+                        object: "body",
+                        name: format!("{}{name}", m.tag),
+                        id: None,
+                        field: "geoms",
+                        value: PatchValue::Compiled(model),
+                    });
                 }
             }
             let active = overlay.is_some();
