@@ -38,7 +38,8 @@ echo "== judge self-tests (MuJoCo 3.17.0 and 4.0.0)"
 .cache/venv/bin/python -m pytest tests/judge -q -p no:cacheprovider
 .cache/venv-mj4/bin/python -m pytest tests/judge -q -p no:cacheprovider
 echo "== python package (pytest: API, errors, threads, MuJoCo judge, Gymnasium, Ray)"
-.cache/venv/bin/python -m pytest python/tests -q -p no:cacheprovider
+# (test_batch_sim.py needs MuJoCo Warp and JAX: it runs in .cache/venv-sim below.)
+.cache/venv/bin/python -m pytest python/tests -q -p no:cacheprovider --ignore=python/tests/test_batch_sim.py
 echo "== ModelCache and DocumentCache under MuJoCo 4.0.0 (patched models judged against 4.0.0's compile)"
 .cache/venv-mj4/bin/python -m pytest python/tests/test_model_cache.py python/tests/test_document_cache.py -q -p no:cacheprovider
 # robosuite's task XMLs (written by the robosuite venv) through a DocumentCache, judged by 4.0.0.
