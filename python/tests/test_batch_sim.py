@@ -256,9 +256,9 @@ def test_bad_input_is_refused_before_any_array():
     scene = mjcf_forge.Scene.load(PATCH)
     with pytest.raises(mjcf_forge.MjcfError, match="0 worlds"):
         WorldBatch(scene, [])
-    # The demo randomizes a geom's orientation: no superset patch carries it.
+    # structural.toml randomizes a joint's range (among others): no superset patch carries it.
     with pytest.raises(mjcf_forge.MjcfError, match="not a patch of the superset"):
-        WorldBatch(mjcf_forge.Scene.demo(), range(2))
+        WorldBatch(mjcf_forge.Scene.load(PATCH.parent / "structural.toml"), range(2))
     batch = WorldBatch(scene, range(2))
     with pytest.raises(mjcf_forge.MjcfError, match="world 5 is not in the batch"):
         batch.assign([5], [3])
