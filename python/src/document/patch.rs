@@ -53,6 +53,8 @@ pub(crate) fn patch_entry(
     let object = *OBJECTS.iter().find(|o| **o == object).ok_or_else(unknown)?;
     let field = if field == "matid" {
         "matid"
+    } else if field == "geoms" {
+        "geoms"
     } else {
         mjcf_forge::scene::PATCHABLE
             .iter()
@@ -71,6 +73,8 @@ pub(crate) fn patch_entry(
             .ok_or_else(unknown)?
     };
     let value = match value.extract::<String>() {
+        // A body's little model: its geoms as MJCF text.
+        Ok(model) if field == "geoms" => PatchValue::Compiled(model),
         Ok(target) => PatchValue::Id {
             object: "material",
             name: target,
