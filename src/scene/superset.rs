@@ -71,9 +71,9 @@ struct Member {
     parked: [f64; 3],
     /// Superset names of its bodies and their authored `gravcomp`.
     bodies: Vec<(String, f64)>,
-    /// Superset names of its geoms (those the compiled model keeps), their authored
-    /// `contype`, `conaffinity` and `rgba` (as `f32`).
-    geoms: Vec<(String, f64, f64, [f64; 4])>,
+    /// Superset names of its geoms (those the compiled model keeps) and their authored
+    /// `rgba` (as `f32`).
+    geoms: Vec<(String, [f64; 4])>,
     /// The instance with its unnamed bodies and geoms named (see [`name_internally`]),
     /// before the tag: what its patch entries are read from.
     named: Document,
@@ -333,7 +333,7 @@ impl Scene {
                 let g = if active { *gravcomp } else { 1.0 };
                 push(&mut entries, "body", body, "gravcomp", numbers(&[g]));
             }
-            for (geom, _, _, authored) in &m.geoms {
+            for (geom, authored) in &m.geoms {
                 let colour = rgba
                     .iter()
                     .rev()
@@ -497,12 +497,7 @@ fn member(
                     [r, g, b, a] => [r, g, b, a],
                     _ => return Err(unnamed(part, "geom with a readable rgba,")),
                 };
-                geoms.push((
-                    name,
-                    number(part, n, "contype", 1.0),
-                    number(part, n, "conaffinity", 1.0),
-                    rgba,
-                ));
+                geoms.push((name, rgba));
             }
             _ => {}
         }
