@@ -302,3 +302,102 @@ fn geom_sizes_frames_and_densities_are_carried_by_little_models() {
     let patch = demo.superset_patch(&superset, 0).unwrap();
     assert!(patch.entries.iter().any(|e| e.field == "geoms"));
 }
+
+#[test]
+fn mass_of_bodies_without_inertial_scales_their_geoms() {
+    use mjcf_forge::mujoco::ObjType;
+    // What the scaled densities compile to, against the same variant without the mass
+    // randomizer: each object's mass and inertia multiplied by one factor in the drawn
+    // range, its centre of mass and principal axes unchanged.
+    let dir = root().join("corpora/scenes/patch");
+    let text = std::fs::read_to_string(dir.join("mass.toml")).unwrap();
+    let scene = Scene::from_toml_str(&text, &dir).unwrap();
+    let cut = text.find("[[randomize]]").unwrap();
+    let plain = Scene::from_toml_str(&text[..cut], &dir).unwrap();
+    let mut kinds = std::collections::HashSet::new();
+    for i in 0..8 {
+        let (got, want) = (compiled(&scene, i), compiled(&plain, i));
+        assert_eq!(got.names(ObjType::Body), want.names(ObjType::Body));
+        for (b, name) in want.names(ObjType::Body).iter().enumerate() {
+            if !name.starts_with("clutter") {
+                assert_eq!(got.body_mass()[b], want.body_mass()[b], "{name}");
+                continue;
+            }
+            kinds.insert(name.split('_').nth(1).unwrap().to_string());
+            let factor = got.body_mass()[b] / want.body_mass()[b];
+            assert!(
+                (0.5..=2.0).contains(&factor),
+                "variant {i}: {name}: {factor}"
+            );
+            for k in 0..3 {
+                let r = got.body_inertia()[3 * b + k] / want.body_inertia()[3 * b + k];
+                assert!((r / factor - 1.0).abs() < 1e-9, "variant {i}: {name}");
+                let (p, q) = (got.body_ipos()[3 * b + k], want.body_ipos()[3 * b + k]);
+                assert!((p - q).abs() < 1e-12, "variant {i}: {name}");
+            }
+        }
+        // The variant's record: every geom of the object, one factor per body.
+        let (_, params) = scene.variant_xml(i).unwrap();
+        assert!(params.to_json(i, None).contains("\"density\""));
+    }
+    assert_eq!(kinds.len(), 3, "box, framed and meshbox drawn: {kinds:?}");
+    // Patches, bit for bit; the superset holds them.
+    let mut cache = ModelCache::new(&scene, 4, None);
+    for indices in by_structure(&scene, 24).values() {
+        for &i in indices.iter().take(3) {
+            let want = compiled(&scene, i);
+            assert_eq!(
+                cache.model(i).unwrap().differences(&want),
+                Vec::<String>::new()
+            );
+        }
+    }
+    let groups: Vec<usize> = by_structure(&scene, 24).values().map(Vec::len).collect();
+    assert!(
+        cache.patches() >= 4,
+        "{} patches, {} compiles, groups {groups:?}",
+        cache.patches(),
+        cache.compiles()
+    );
+    let superset = scene.superset().unwrap();
+    let mut cache = ModelCache::new(&scene, 2, None).with_superset().unwrap();
+    for i in 0..6 {
+        let patch = scene.superset_patch(&superset, i).unwrap();
+        assert!(
+            patch.entries.iter().any(|e| e.field == "geoms"),
+            "variant {i}"
+        );
+        let want = compiled(&scene, i);
+        let tags = scene.superset_names(&superset, i).unwrap();
+        let got = cache.model(i).unwrap();
+        let got_bodies = got.names(ObjType::Body);
+        for (b, n) in want.names(ObjType::Body).iter().enumerate().skip(1) {
+            let tagged = tags
+                .iter()
+                .find(|(p, _)| n.starts_with(p.as_str()))
+                .map_or(n.to_string(), |(_, t)| format!("{t}{n}"));
+            let k = got_bodies.iter().position(|x| *x == tagged).unwrap();
+            assert_eq!(got.body_mass()[k], want.body_mass()[b], "variant {i}: {n}");
+            assert_eq!(
+                got.body_inertia()[3 * k..3 * k + 3],
+                want.body_inertia()[3 * b..3 * b + 3]
+            );
+            assert_eq!(
+                got.body_ipos()[3 * k..3 * k + 3],
+                want.body_ipos()[3 * b..3 * b + 3]
+            );
+        }
+    }
+    assert_eq!(cache.compiles(), 1);
+}
+
+#[test]
+fn absolute_mass_of_a_body_without_inertial_is_refused_with_the_fix() {
+    let dir = root().join("corpora/scenes/patch");
+    let text = std::fs::read_to_string(dir.join("mass.toml"))
+        .unwrap()
+        .replace("scale = true\n", "");
+    let err = Scene::from_toml_str(&text, &dir).unwrap_err().to_string();
+    assert!(err.contains("its mass comes from its geoms"), "{err}");
+    assert!(err.contains("scale = true"), "{err}");
+}

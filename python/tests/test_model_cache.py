@@ -126,6 +126,25 @@ def test_geom_sizes_frames_and_densities_are_carried_by_little_models():
             sup.model(v)
 
 
+def test_mass_of_bodies_without_inertial_is_a_patch():
+    # A body without <inertial> (a box of two geoms, one with a frame and a written mass,
+    # a mesh): its mass scale scales every geom's density or mass by one factor, carried by
+    # the body's little model (frames and meshes included), so its variants are patches
+    # and the superset holds them.
+    scene = mjcf_forge.Scene.load(PATCH / "mass.toml")
+    variants = [scene.variant(i) for i in range(24)]
+    randomized = {(r["kind"], r["attribute"]) for v in variants for r in v.params["randomized"]}
+    assert randomized == {("geom", "density"), ("geom", "mass")}
+    cache = mjcf_forge.ModelCache(scene)
+    seen = set()
+    for v in variants:
+        if v.structure_key in seen or len(seen) < 3:
+            check_exact(v, cache.model(v))
+        seen.add(v.structure_key)
+    assert cache.patches >= 2
+    _superset_check(scene, range(4), trajectory_tolerance=0.0)
+
+
 def test_demo_scene_is_exact():
     scene = mjcf_forge.Scene.demo()
     cache = mjcf_forge.ModelCache(scene, max_models=64)

@@ -65,17 +65,33 @@ const CARRIED: [&str; 9] = [
 ];
 
 /// The body whose little model carries `attr` of `node`: a geom's size (a sized
-/// primitive), frame, density or mass, in a body that has a little model.
+/// primitive) or frame, in a body that [`qualifies`]; its density or mass, in a body whose
+/// little model is [`complete`] (frames and meshes included).
 pub(crate) fn carried_by(doc: &Document, node: Node, attr: &str) -> Option<Node> {
-    if doc.tag(node) != "geom"
-        || !CARRIED.contains(&attr)
-        || needs_asset(doc, node)
+    if doc.tag(node) != "geom" || !CARRIED.contains(&attr) {
+        return None;
+    }
+    let body = owner(doc, node)?;
+    if matches!(attr, "density" | "mass") {
+        return complete(doc, body).then_some(body);
+    }
+    if needs_asset(doc, node)
         || doc.attr(node, "fromto").is_some()
         || (attr == "size" && !sized_primitive(doc, node))
+        || doc.parent(node) != Some(body)
     {
         return None;
     }
-    doc.parent(node).filter(|&body| qualifies(doc, body))
+    qualifies(doc, body).then_some(body)
+}
+
+/// The body a geom belongs to: its parent, through any `<frame>`s.
+fn owner(doc: &Document, geom: Node) -> Option<Node> {
+    let mut at = doc.parent(geom)?;
+    while doc.tag(at) == "frame" {
+        at = doc.parent(at)?;
+    }
+    (doc.tag(at) == "body").then_some(at)
 }
 
 /// Whether a geom needs an asset (a mesh, height field or signed distance field).
@@ -88,10 +104,34 @@ fn needs_asset(doc: &Document, geom: Node) -> bool {
         )
 }
 
-/// The little model of `body` (see the module), if the body qualifies and has a geom of
-/// [`sized_primitive`].
+/// A mesh geom whose little model can hold its mesh: the `<mesh>` asset it names, with no
+/// plugin (a height field or signed distance field is not carried).
+fn mesh_asset(doc: &Document, geom: Node) -> Option<Node> {
+    if doc.attr(geom, "hfield").is_some()
+        || !matches!(doc.attr(geom, "type").map(str::trim), Some("mesh") | None)
+    {
+        return None;
+    }
+    let name = doc.attr(geom, "mesh")?.trim();
+    let stem = |file: &str| {
+        let base = file.rsplit(['/', '\\']).next().unwrap_or(file);
+        base.rsplit_once('.').map_or(base, |(s, _)| s).to_string()
+    };
+    doc.elements(doc.root())
+        .filter(|&n| doc.tag(n) == "asset")
+        .flat_map(|a| doc.elements(a))
+        .filter(|&m| doc.tag(m) == "mesh")
+        .find(|&m| match doc.attr(m, "name") {
+            Some(n) => n.trim() == name,
+            None => doc.attr(m, "file").is_some_and(|f| stem(f) == name),
+        })
+        .filter(|&m| doc.elements(m).next().is_none())
+}
+
+/// The little model of `body` (see the module), if the body's little model is
+/// [`complete`].
 pub(crate) fn body_model(doc: &Document, body: Node) -> Option<String> {
-    if !qualifies(doc, body) {
+    if !complete(doc, body) {
         return None;
     }
     let mut xml = String::from("<mujoco>");
@@ -101,49 +141,95 @@ pub(crate) fn body_model(doc: &Document, body: Node) -> Option<String> {
     {
         xml.push_str("<compiler");
         for (attr, value) in doc.attrs(compiler) {
-            // No asset is read: the folders do not matter.
+            // Mesh files are absolute (documents are loaded so): the folders do not matter.
             if !matches!(attr, "meshdir" | "texturedir" | "assetdir") {
                 push_attr(&mut xml, attr, value);
             }
         }
         xml.push_str("/>");
     }
-    xml.push_str("<worldbody><body>");
-    for child in doc.elements(body) {
-        let tag = doc.tag(child);
-        if tag != "geom" && tag != "inertial" {
-            continue;
-        }
-        xml.push('<');
-        xml.push_str(tag);
-        for (attr, value) in doc.attrs(child) {
-            if !LEFT_OUT.contains(&attr) {
+    let mut meshes: Vec<Node> = Vec::new();
+    let mut inner = String::new();
+    push_children(doc, body, &mut inner, &mut meshes);
+    if !meshes.is_empty() {
+        xml.push_str("<asset>");
+        for mesh in meshes {
+            xml.push_str("<mesh");
+            for (attr, value) in doc.attrs(mesh) {
                 push_attr(&mut xml, attr, value);
             }
+            xml.push_str("/>");
         }
-        xml.push_str("/>");
+        xml.push_str("</asset>");
     }
+    xml.push_str("<worldbody><body>");
+    xml.push_str(&inner);
     xml.push_str("</body></worldbody></mujoco>");
     Some(xml)
 }
 
-/// Whether `body` has a little model (see [`body_model`]).
+/// Writes the `<inertial>`, geoms and `<frame>`s (with their geoms) of `node` as the little
+/// model has them, collecting the meshes its geoms use.
+fn push_children(doc: &Document, node: Node, xml: &mut String, meshes: &mut Vec<Node>) {
+    for child in doc.elements(node) {
+        let tag = doc.tag(child);
+        if !matches!(tag, "geom" | "inertial" | "frame") {
+            continue;
+        }
+        if tag == "geom"
+            && let Some(mesh) = mesh_asset(doc, child)
+            && !meshes.contains(&mesh)
+        {
+            meshes.push(mesh);
+        }
+        xml.push('<');
+        xml.push_str(tag);
+        for (attr, value) in doc.attrs(child) {
+            if !LEFT_OUT.contains(&attr) && attr != "childclass" {
+                push_attr(xml, attr, value);
+            }
+        }
+        if tag == "frame" {
+            xml.push('>');
+            push_children(doc, child, xml, meshes);
+            xml.push_str("</frame>");
+        } else {
+            xml.push_str("/>");
+        }
+    }
+}
+
+/// Whether `body`'s geoms can be compiled alone for its sizes and frames: its little model
+/// is complete without meshes or frames, and it has a geom of [`sized_primitive`] (the
+/// document cache makes an entry for every such body).
 pub(crate) fn qualifies(doc: &Document, body: Node) -> bool {
+    complete(doc, body)
+        && doc.elements(body).all(|c| {
+            let tag = doc.tag(c);
+            tag != "frame" && !(tag == "geom" && needs_asset(doc, c))
+        })
+        && doc.elements(body).any(|c| sized_primitive(doc, c))
+}
+
+/// Whether `body` has a complete little model: a named body whose children are all of
+/// [`KNOWN_CHILDREN`] or `<frame>`s of geoms, whose geoms need no asset but a `<mesh>` (see
+/// [`mesh_asset`]), and no free joint of which aligns the body with its inertial frame.
+pub(crate) fn complete(doc: &Document, body: Node) -> bool {
     if doc.tag(body) != "body" || doc.attr(body, "name").is_none() {
         return false;
     }
-    let mut sized = false;
-    for child in doc.elements(body) {
-        let tag = doc.tag(child);
-        if !KNOWN_CHILDREN.contains(&tag)
-            || (tag == "geom" && needs_asset(doc, child))
-            || doc.aligns_free_body(child)
-        {
-            return false;
-        }
-        sized |= sized_primitive(doc, child);
+    fn frame_of_geoms(doc: &Document, frame: Node) -> bool {
+        doc.elements(frame).all(|c| match doc.tag(c) {
+            "geom" => !needs_asset(doc, c) || mesh_asset(doc, c).is_some(),
+            "frame" => frame_of_geoms(doc, c),
+            _ => false,
+        })
     }
-    sized
+    doc.elements(body).all(|child| match doc.tag(child) {
+        "geom" => !needs_asset(doc, child) || mesh_asset(doc, child).is_some(),
+        "frame" => frame_of_geoms(doc, child),
+        tag => KNOWN_CHILDREN.contains(&tag) && !doc.aligns_free_body(child),
+    })
 }
 
 fn push_attr(xml: &mut String, attr: &str, value: &str) {
@@ -181,20 +267,59 @@ mod tests {
 
     #[test]
     fn bodies_that_need_more_than_their_geoms_do_not_qualify() {
-        let with = |inner: &str| {
-            body(&format!(
-                r#"<mujoco><asset><mesh name="m" vertex="0 0 0 1 0 0 0 1 0 0 0 1"/></asset>
-                <worldbody><body name="b">{inner}</body></worldbody></mujoco>"#
-            ))
+        let doc = |inner: &str| {
+            Document::from_str(
+                &format!(
+                    r#"<mujoco><asset><mesh name="m" vertex="0 0 0 1 0 0 0 1 0 0 0 1"/><hfield name="h" nrow="2" ncol="2" size="1 1 1 1"/></asset>
+                    <worldbody><body name="b">{inner}</body></worldbody></mujoco>"#
+                ),
+                ".",
+            )
+            .unwrap()
         };
-        assert!(with(r#"<geom size="0.1"/>"#).is_some());
-        assert!(with(r#"<geom size="0.1"/><geom type="mesh" mesh="m"/>"#).is_none());
-        assert!(with(r#"<frame><geom size="0.1"/></frame><geom size="0.1"/>"#).is_none());
-        assert!(with(r#"<geom fromto="0 0 0 1 0 0" size="0.1" type="capsule"/>"#).is_none());
-        assert!(with(r#"<freejoint align="true"/><geom size="0.1"/>"#).is_none());
+        // (complete: a little model exists; qualifies: its sizes are patched through it)
+        let facts = |inner: &str| {
+            let d = doc(inner);
+            let b = d
+                .descendants(d.root())
+                .find(|&n| d.tag(n) == "body")
+                .unwrap();
+            (complete(&d, b), qualifies(&d, b))
+        };
+        assert_eq!(facts(r#"<geom size="0.1"/>"#), (true, true));
+        // Meshes and frames of geoms: their densities and masses are carried, not sizes.
+        assert_eq!(
+            facts(r#"<geom size="0.1"/><geom type="mesh" mesh="m"/>"#),
+            (true, false)
+        );
+        assert_eq!(
+            facts(r#"<frame><geom size="0.1"/></frame><geom size="0.1"/>"#),
+            (true, false)
+        );
+        assert_eq!(facts(r#"<geom type="hfield" hfield="h"/>"#), (false, false));
+        assert_eq!(facts(r#"<frame><site/></frame>"#), (false, false));
+        assert_eq!(
+            facts(r#"<geom fromto="0 0 0 1 0 0" size="0.1" type="capsule"/>"#),
+            (true, false)
+        );
+        assert_eq!(
+            facts(r#"<freejoint align="true"/><geom size="0.1"/>"#),
+            (false, false)
+        );
         assert!(
             body(r#"<mujoco><worldbody><body><geom size="0.1"/></body></worldbody></mujoco>"#)
                 .is_none()
+        );
+    }
+
+    #[test]
+    fn a_little_model_holds_its_frames_and_meshes() {
+        let xml = r#"<mujoco><asset><mesh name="m" vertex="0 0 0 1 0 0 0 1 0 0 0 1"/><mesh name="n" vertex="0 0 0 1 0 0 0 1 0 0 0 2"/></asset>
+            <worldbody><body name="b"><geom name="g" type="mesh" mesh="m" density="5"/>
+            <frame name="f" pos="1 0 0"><geom size="0.1" mass="2"/></frame></body></worldbody></mujoco>"#;
+        assert_eq!(
+            body(xml).unwrap(),
+            r#"<mujoco><asset><mesh name="m" vertex="0 0 0 1 0 0 0 1 0 0 0 1"/></asset><worldbody><body><geom type="mesh" mesh="m" density="5"/><frame pos="1 0 0"><geom size="0.1" mass="2"/></frame></body></worldbody></mujoco>"#
         );
     }
 }

@@ -432,7 +432,9 @@ fn body_entries<'d>(doc: &'d Document, body: Node, rules: &DocRules, out: &mut P
 fn compiled_body_entries<'d>(doc: &'d Document, node: Node, out: &mut Patched<'d>) {
     match doc.tag(node) {
         "body" => {
-            if let Some(model) = body_model(doc, node) {
+            if qualifies(doc, node)
+                && let Some(model) = body_model(doc, node)
+            {
                 let name = doc.attr(node, "name").unwrap_or_default().to_string();
                 out.entries.push(PatchEntry {
                     object: "body",

@@ -123,6 +123,10 @@ pub(crate) struct Target {
     part: Arc<str>,
     /// The prefix of that part's names (given to chosen names of objects).
     prefix: Arc<str>,
+    /// For a geom that carries its body's mass (a body whose inertia MuJoCo infers from its
+    /// geoms): that body. Its geoms' `density` (or `mass`, where written) are scaled by
+    /// one factor drawn per body.
+    mass_of: Option<Node>,
 }
 
 /// A group of objects: its pool, count, prefix pattern and placement.

@@ -4,8 +4,9 @@
 //!
 //! Two rules keep a randomized model consistent:
 //! - a body's mass lives on its `<inertial>`; changing it scales the inertia by the same
-//!   factor, so the body keeps its shape of inertia (a mass inferred from geoms is set on
-//!   the geoms: `mass` or `density`, and MuJoCo derives the inertia);
+//!   factor, so the body keeps its shape of inertia; a mass MuJoCo infers from the body's
+//!   geoms is scaled on the geoms (each one's `density`, or `mass` where written, times one
+//!   factor per body: MuJoCo's mass properties are linear in them);
 //! - angles given with a `unit` are converted into the units of the model the element
 //!   belongs to (`<compiler angle>`), before that model is merged into the scene.
 
@@ -268,6 +269,44 @@ impl Randomizer {
                     continue;
                 }
             }
+            if self.kind == "body" && self.attribute == "mass" && mass_from_geoms(doc, node) {
+                // MuJoCo's mass properties are linear in each geom's density (or mass), so
+                // scaling all of them scales the body's mass and inertia by that factor and
+                // keeps its centre of mass and principal axes.
+                if !self.scale || self.components.is_some() {
+                    errors.push(doc.error_at(
+                        node,
+                        ErrorKind::Invalid(format!(
+                            "randomizer at {}: body {} has no <inertial>: its mass comes from its geoms, so it can only be scaled (add `scale = true`, without `components`), or give the body an <inertial>",
+                            self.location,
+                            quoted(name)
+                        )),
+                    ));
+                    continue;
+                }
+                let geoms = body_geoms(doc, node);
+                if geoms.is_empty() {
+                    errors.push(doc.error_at(
+                        node,
+                        ErrorKind::Invalid(format!(
+                            "randomizer at {}: body {} has neither an <inertial> nor geoms: it has no mass to scale",
+                            self.location,
+                            quoted(name)
+                        )),
+                    ));
+                    continue;
+                }
+                for g in geoms {
+                    out.push(Target {
+                        node: g,
+                        name: doc.attr(g, "name").map(str::to_string),
+                        part: part.clone(),
+                        prefix: Arc::from(prefix),
+                        mass_of: Some(node),
+                    });
+                }
+                continue;
+            }
             let target = if self.kind == "body" && self.attribute == "mass" {
                 match doc.elements(node).find(|&k| doc.tag(k) == "inertial") {
                     Some(inertial) => inertial,
@@ -275,7 +314,7 @@ impl Randomizer {
                         errors.push(doc.error_at(
                             node,
                             ErrorKind::Invalid(format!(
-                                "randomizer at {}: body {} has no <inertial>: its mass comes from its geoms; randomize the geoms' mass or density",
+                                "randomizer at {}: body {} has no <inertial> and its compiler infers no mass from geoms (inertiafromgeom=\"false\"): it has no mass to randomize",
                                 self.location,
                                 quoted(name)
                             )),
@@ -295,6 +334,7 @@ impl Randomizer {
                 name: name.map(str::to_string),
                 part: part.clone(),
                 prefix: Arc::from(prefix),
+                mass_of: None,
             });
         }
         if errors.is_empty() {
@@ -348,7 +388,35 @@ impl Randomizer {
         draws: &mut Draws,
         params: &mut Params,
     ) -> Result<(), Errors> {
+        // The factor drawn for the body whose geoms carry its mass (one draw per body).
+        let mut body_factor: Option<(Node, f64)> = None;
         for t in targets {
+            if let Some(body) = t.mass_of {
+                let factor = match body_factor {
+                    Some((b, f)) if b == body => f,
+                    _ => match self.draw(draws) {
+                        Drawn::Numbers(x) => x[0],
+                        Drawn::Choice(_) => unreachable!("a body's mass from geoms is scaled"),
+                    },
+                };
+                body_factor = Some((body, factor));
+                let attr = geom_mass_attribute(out.doc(), t.node);
+                let current = out
+                    .get(t.node, attr)
+                    .or_else(|| mujoco_default("geom", attr))
+                    .and_then(|v| v.trim().parse::<f64>().ok())
+                    .unwrap_or(0.0);
+                let value = join(&[current * factor]);
+                params.randomized.push(RandomizedValue {
+                    kind: "geom".to_string(),
+                    name: t.name.clone(),
+                    part: t.part.to_string(),
+                    attribute: attr.to_string(),
+                    value: value.clone(),
+                });
+                out.set(t.node, attr, value);
+                continue;
+            }
             let drawn = self.draw(draws);
             let value = match drawn {
                 Drawn::Choice(i) => {
@@ -384,6 +452,9 @@ impl Randomizer {
     /// The attributes this randomizer sets on `node`, in the order it sets them.
     pub(crate) fn attributes_set(&self, doc: &Document, node: Node) -> Vec<&str> {
         let mut out = Vec::new();
+        if self.kind == "body" && self.attribute == "mass" && doc.tag(node) == "geom" {
+            return vec![geom_mass_attribute(doc, node)];
+        }
         if self.kind == "body" && self.attribute == "mass" {
             for a in ["diaginertia", "fullinertia"] {
                 if doc.attr(node, a).is_some() {
@@ -494,6 +565,59 @@ impl Randomizer {
             current[c] = if self.scale { current[c] * x } else { x };
         }
         Ok(join(&current))
+    }
+}
+
+/// Whether MuJoCo infers `body`'s mass and inertia from its geoms: it has no `<inertial>`
+/// (under `inertiafromgeom` "auto", MuJoCo's default, or "true"), or the compiler's
+/// `inertiafromgeom="true"` overrides its `<inertial>` with a massive geom in
+/// `inertiagrouprange`.
+fn mass_from_geoms(doc: &Document, body: Node) -> bool {
+    let compiler = |attr: &str| {
+        doc.elements(doc.root())
+            .filter(|&n| doc.tag(n) == "compiler")
+            .filter_map(|n| doc.attr(n, attr))
+            .last()
+            .map(str::trim)
+    };
+    let has_inertial = doc.elements(body).any(|k| doc.tag(k) == "inertial");
+    match compiler("inertiafromgeom") {
+        Some("false") => false,
+        Some("true") => {
+            !has_inertial
+                || doc
+                    .has_massive_geom_in_range(body, compiler("inertiagrouprange").unwrap_or("0 5"))
+        }
+        _ => !has_inertial,
+    }
+}
+
+/// The geoms of `body` (directly or inside `<frame>`s, not in child bodies), in order.
+fn body_geoms(doc: &Document, body: Node) -> Vec<Node> {
+    let mut out = Vec::new();
+    let mut stack: Vec<Node> = doc.elements(body).collect();
+    stack.reverse();
+    while let Some(n) = stack.pop() {
+        match doc.tag(n) {
+            "geom" => out.push(n),
+            "frame" => {
+                let mut inner: Vec<Node> = doc.elements(n).collect();
+                inner.reverse();
+                stack.extend(inner);
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+/// The attribute that holds a geom's share of its body's mass: `mass` where written (MuJoCo
+/// then ignores `density`), else `density`.
+fn geom_mass_attribute(doc: &Document, geom: Node) -> &'static str {
+    if doc.attr(geom, "mass").is_some() {
+        "mass"
+    } else {
+        "density"
     }
 }
 
