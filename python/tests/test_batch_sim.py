@@ -27,6 +27,8 @@ from mjcf_forge.batch import WorldBatch  # noqa: E402
 PATCH = ROOT / "corpora" / "scenes" / "patch" / "patch.toml"
 LIFT5 = ROOT / "benches" / "scenes" / "lift5.toml"
 BOXES = ROOT / "corpora" / "scenes" / "patch" / "boxes.toml"
+# Fixed-base objects varying per world beside free ones (boxes only, for MJX too).
+FIXED = ROOT / "corpora" / "scenes" / "patch" / "fixed.toml"
 WORLDS = 8
 STEPS = 500
 TOLERANCE = 1e-4
@@ -121,19 +123,21 @@ def warp_step(m, d):
     return run, contacts
 
 
-def test_mujoco_warp_worlds_agree_with_each_variant():
-    """The patch scene in MuJoCo Warp, with to_mjwarp's default sizes: every world within
-    1e-4 m of its variant compiled alone on CPU MuJoCo after 500 steps."""
+@pytest.mark.parametrize("path", [PATCH, FIXED], ids=["patch", "fixed"])
+def test_mujoco_warp_worlds_agree_with_each_variant(path):
+    """The patch scene (and fixed-base objects varying per world) in MuJoCo Warp, with
+    to_mjwarp's default sizes: every world within 1e-4 m of its variant compiled alone on
+    CPU MuJoCo after 500 steps."""
     import warp as wp
 
     wp.config.quiet = True
-    scene = mjcf_forge.Scene.load(PATCH)
+    scene = mjcf_forge.Scene.load(path)
     batch = WorldBatch(scene, range(WORLDS))
     m, d = batch.to_mjwarp()
     run, contacts = warp_step(m, d)
     report = judge(scene, batch, run, contacts)
     assert not d.overflow.numpy().any(), "to_mjwarp's default nconmax/njmax overflowed"
-    print("mujoco_warp patch", report)
+    print("mujoco_warp", path.stem, report)
 
 
 _warp_alone: dict = {}
@@ -264,14 +268,15 @@ def test_bad_input_is_refused_before_any_array():
         batch.assign([5], [3])
 
 
-def test_mjx_worlds_agree_with_each_variant():
+@pytest.mark.parametrize("path", [BOXES, FIXED], ids=["boxes", "fixed"])
+def test_mjx_worlds_agree_with_each_variant(path):
     """MJX on JAX's CPU backend, vmapped over the worlds with the batch's in_axes. Its JAX
     collision has no cylinder-box pair (the patch scene's arm and clutter need it; lift5's
     meshes make its compile take minutes on CPU), so it runs the patch arena with boxes."""
     import jax
     from mujoco import mjx
 
-    scene = mjcf_forge.Scene.load(BOXES)
+    scene = mjcf_forge.Scene.load(path)
     batch = WorldBatch(scene, range(WORLDS))
     step = jax.vmap(mjx.step, in_axes=None)  # replaced per model below
     state: dict = {}
@@ -315,4 +320,4 @@ def test_mjx_worlds_agree_with_each_variant():
 
     batch.assign = assign
     report = judge(scene, batch, run, contacts)
-    print("mjx", report)
+    print("mjx", path.stem, report)

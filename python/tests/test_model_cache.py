@@ -145,6 +145,15 @@ def test_mass_of_bodies_without_inertial_is_a_patch():
     _superset_check(scene, range(4), trajectory_tolerance=0.0)
 
 
+def test_superset_varies_fixed_base_objects_per_world():
+    # A group placed without free joints (fixed bases: the placement is the body's pos and
+    # quat), present in some variants and not others, beside free boxes.
+    scene = mjcf_forge.Scene.load(PATCH / "fixed.toml")
+    groups = [{o["group"] for o in scene.variant(i).params["objects"]} for i in range(8)]
+    assert {"fixtures"} <= set().union(*groups) and any("fixtures" not in g for g in groups)
+    _superset_check(scene, range(8), trajectory_tolerance=0.0)
+
+
 def test_demo_scene_is_exact():
     scene = mjcf_forge.Scene.demo()
     cache = mjcf_forge.ModelCache(scene, max_models=64)
