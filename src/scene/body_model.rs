@@ -37,8 +37,23 @@ const KNOWN_CHILDREN: [&str; 8] = [
 ];
 
 /// Geom attributes the little model leaves out: they name or reference what it does not
-/// have, and the compiler derives nothing of the geom's shape or mass from them.
-const LEFT_OUT: [&str; 4] = ["name", "material", "user", "class"];
+/// have, or set contact and looks, and the compiler derives nothing of the geom's shape,
+/// bounds or mass from them (so a variant that randomizes them finds its little model
+/// compiled already).
+const LEFT_OUT: [&str; 12] = [
+    "name",
+    "material",
+    "user",
+    "class",
+    "rgba",
+    "friction",
+    "solref",
+    "solimp",
+    "solmix",
+    "priority",
+    "condim",
+    "fluidcoef",
+];
 
 /// Whether `geom`'s `size` can be patched through its body's little model: a primitive
 /// type, sized by `size` (not `fromto`).

@@ -284,18 +284,9 @@ impl Randomizer {
                     ));
                     continue;
                 }
+                // A body with neither <inertial> nor geoms weighs nothing: nothing to scale
+                // (robosuite's and LIBERO's objects hold their geoms in an inner body).
                 let geoms = body_geoms(doc, node);
-                if geoms.is_empty() {
-                    errors.push(doc.error_at(
-                        node,
-                        ErrorKind::Invalid(format!(
-                            "randomizer at {}: body {} has neither an <inertial> nor geoms: it has no mass to scale",
-                            self.location,
-                            quoted(name)
-                        )),
-                    ));
-                    continue;
-                }
                 for g in geoms {
                     out.push(Target {
                         node: g,
