@@ -93,6 +93,7 @@ mod mujoco {
         println!("cargo::rerun-if-env-changed={PYTHON_VAR}");
         println!("cargo::rerun-if-changed=src/mujoco/shim.c");
         println!("cargo::rerun-if-changed=src/compiled/patch.c");
+        println!("cargo::rerun-if-changed=src/preview/render.c");
 
         let mujoco = find().unwrap_or_else(|tried| stop(&not_found(&tried)));
         if mujoco.version < OLDEST {
@@ -122,6 +123,14 @@ mod mujoco {
             &include,
             "mjcf_forge_compiled_patch",
         );
+        // The preview tier's renderer: opens EGL or OSMesa at run time (dlopen), so nothing
+        // of OpenGL is linked; only libdl (part of libc since glibc 2.34).
+        compile_c(
+            "src/preview/render.c",
+            &include,
+            "mjcf_forge_preview_render",
+        );
+        println!("cargo::rustc-link-lib=dylib=dl");
         // After the C libraries, which need its symbols. By file name: the wheel ships the
         // versioned file only, no `libmujoco.so` for `-lmujoco` to find.
         println!("cargo::rustc-link-search=native={}", mujoco.dir.display());
