@@ -1,9 +1,9 @@
 //! Build script: does something only with the cargo feature `mujoco`, which links MuJoCo's C
 //! library (3.17.0 or later) through our own C shim.
 //!
-//! No Rust copy of MuJoCo's headers exists: `src/mujoco/shim.c` (the FFI) and
-//! `src/compiled/patch.c` (the model cache) are compiled against the headers of the very
-//! MuJoCo the build links, so struct layouts and constants always match the library. The
+//! No Rust copy of MuJoCo's headers exists: `src/mujoco/shim.c` (the FFI),
+//! `src/compiled/patch.c` (the model cache) and `src/preview/render.c` (the renderer) are
+//! compiled against the headers of the very MuJoCo the build links, so struct layouts and constants always match the library. The
 //! MuJoCo is a folder laid out like the PyPI wheel's `mujoco/` package
 //! (`include/mujoco/mujoco.h` beside `libmujoco.so.X.Y.Z`), looked for in this order:
 //!
