@@ -1,9 +1,9 @@
 //! Build script: does something only with the cargo feature `mujoco`, which links MuJoCo's C
 //! library (3.17.0 or later) through our own C shim.
 //!
-//! No Rust copy of MuJoCo's headers exists: `src/mujoco/shim.c` (the FFI) and
-//! `src/compiled/patch.c` (the model cache) are compiled against the headers of the very
-//! MuJoCo the build links, so struct layouts and constants always match the library. The
+//! No Rust copy of MuJoCo's headers exists: `src/mujoco/shim.c` (the FFI),
+//! `src/compiled/patch.c` (the model cache) and `src/preview/render.c` (the renderer) are
+//! compiled against the headers of the very MuJoCo the build links, so struct layouts and constants always match the library. The
 //! MuJoCo is a folder laid out like the PyPI wheel's `mujoco/` package
 //! (`include/mujoco/mujoco.h` beside `libmujoco.so.X.Y.Z`), looked for in this order:
 //!
@@ -93,6 +93,7 @@ mod mujoco {
         println!("cargo::rerun-if-env-changed={PYTHON_VAR}");
         println!("cargo::rerun-if-changed=src/mujoco/shim.c");
         println!("cargo::rerun-if-changed=src/compiled/patch.c");
+        println!("cargo::rerun-if-changed=src/preview/render.c");
 
         let mujoco = find().unwrap_or_else(|tried| stop(&not_found(&tried)));
         if mujoco.version < OLDEST {
@@ -122,6 +123,14 @@ mod mujoco {
             &include,
             "mjcf_forge_compiled_patch",
         );
+        // The preview tier's renderer: opens EGL or OSMesa at run time (dlopen), so nothing
+        // of OpenGL is linked; only libdl (part of libc since glibc 2.34).
+        compile_c(
+            "src/preview/render.c",
+            &include,
+            "mjcf_forge_preview_render",
+        );
+        println!("cargo::rustc-link-lib=dylib=dl");
         // After the C libraries, which need its symbols. By file name: the wheel ships the
         // versioned file only, no `libmujoco.so` for `-lmujoco` to find.
         println!("cargo::rustc-link-search=native={}", mujoco.dir.display());

@@ -152,3 +152,14 @@ else
   "$CACHE/venv-mj4/bin/python" "$ROOT/scripts/list_models.py" --suffix -mj4
   echo "$models_key" > "$models_stamp"
 fi
+
+# 4. a headless OpenGL for the contact sheets (`mjcf-forge preview`, Scene.preview and their
+#    tests): EGL or OSMesa, opened at run time. Checked, never installed here: the system's
+#    packages are the machine owner's business.
+gl_libs="$( (ldconfig -p || /sbin/ldconfig -p) 2>/dev/null || true)"
+if ! grep -qE 'libEGL\.so\.1|libOSMesa\.so' <<<"$gl_libs"; then
+  echo "setup: warning: neither libEGL.so.1 nor libOSMesa.so is installed, so the contact" >&2
+  echo "setup:   sheets (mjcf-forge preview, Scene.preview) and their tests cannot render." >&2
+  echo "setup:   On Debian/Ubuntu: apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri" >&2
+  echo "setup:   (or libosmesa6); see docs/install.md, \"Rendering\"." >&2
+fi

@@ -11,6 +11,7 @@
 //! | `model/` | instances with a prefix, merging, geometry and placement offsets |
 //! | `scene/` | the batch tier: a scene file in, seeded variants out |
 //! | `compiled/` | compiled variants at patch cost (builds with the `mujoco` feature) |
+//! | `preview/` | contact sheets of variants, drawn by MuJoCo's renderer (`mujoco` feature) |
 //!
 //! The faces sit on top: the command line (`src/main.rs`, `src/cli/`) and the Python
 //! package (`python/`), both through the public API only.
@@ -34,8 +35,8 @@
 //! # Ok::<(), mjcf_forge::Errors>(())
 //! ```
 #![cfg_attr(not(mjcf_mujoco), forbid(unsafe_code))]
-// The two tiers that call into MuJoCo's C, `mujoco` (the FFI) and `compiled` (the model
-// cache), opt back in; everything else stays safe.
+// The tiers that call into MuJoCo's C, `mujoco` (the FFI), `compiled` (the model cache)
+// and `preview` (the renderer), opt back in; everything else stays safe.
 #![cfg_attr(mjcf_mujoco, deny(unsafe_code))]
 #![warn(missing_docs)]
 
@@ -52,6 +53,8 @@ mod model;
 #[cfg(mjcf_mujoco)]
 pub mod mujoco;
 pub mod output;
+#[cfg(mjcf_mujoco)]
+pub mod preview;
 pub mod scene;
 
 pub use document::import::NodeMap;

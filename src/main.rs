@@ -54,6 +54,10 @@ enum Command {
     /// Make seeded variants of a scene (a TOML scene file, or the built-in demo): a folder
     /// with one XML per variant, `manifest.jsonl` and `assets/`, a `.tar` file, or `-`.
     Generate(cli::generate::Args),
+    /// A contact sheet of variants of a scene: each drawn by MuJoCo's renderer, headless
+    /// (EGL, else OSMesa), into one cell of a PNG grid, labelled with its index (needs the
+    /// `mujoco` feature).
+    Preview(cli::preview::Args),
 }
 
 fn main() -> ExitCode {
@@ -65,5 +69,6 @@ fn main() -> ExitCode {
         Command::Compile(args) => cli::compile::run(args),
         Command::Export(args) => cli::export::run(args),
         Command::Generate(args) => cli::generate::run(args),
+        Command::Preview(args) => cli::preview::run(args),
     }
 }

@@ -4,8 +4,8 @@
 use std::path::{Path, PathBuf};
 
 /// The tiers from the bottom up: a file of a tier may name itself and anything earlier.
-const TIERS: [&str; 7] = [
-    "error", "output", "document", "mujoco", "model", "scene", "compiled",
+const TIERS: [&str; 8] = [
+    "error", "output", "document", "mujoco", "model", "scene", "compiled", "preview",
 ];
 
 /// The Python bindings' modules (`python/src/`), which mirror the tiers, from the bottom up.

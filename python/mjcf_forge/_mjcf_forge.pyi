@@ -345,6 +345,18 @@ class Scene:
     @property
     def template(self) -> Document: ...
     def variant(self, index: int) -> Variant: ...
+    def preview(
+        self,
+        indices: Union[int, Iterable[int]],
+        path: Optional[_Path] = None,
+        *,
+        cell: Sequence[int] = (320, 240),
+        columns: Optional[int] = None,
+        camera: Optional[str] = None,
+        geoms: str = "default",
+        labels: bool = True,
+        segmentation: bool = False,
+    ) -> np.ndarray: ...
     def variants(
         self,
         indices: Iterable[int],

@@ -10,6 +10,7 @@ pub mod info;
 pub mod inline;
 pub mod merge;
 pub mod prefix;
+pub mod preview;
 
 use std::io::Write as _;
 use std::path::Path;

@@ -180,6 +180,43 @@ impl PyScene {
         run(py, || Ok(self.scene.template().clone())).map(PyDocument::new)
     }
 
+    /// A contact sheet of variants ``indices`` (an iterable of ints, or ``n`` for
+    /// ``range(n)``; an index may come twice): each variant compiled with your ``mujoco``
+    /// and drawn by ``mujoco.Renderer`` at its initial pose into one ``cell`` (width,
+    /// height) of a grid of ``columns`` (default: the smallest whose square holds every
+    /// cell), 2 pixels apart, labelled with its index unless ``labels=False``. Returns the
+    /// sheet as a ``uint8`` array (height, width, 3) and writes it as PNG to ``path`` when
+    /// given (atomically; no Pillow needed).
+    ///
+    /// ``camera``: a camera of the scene by its full name; without it every cell shares
+    /// the free camera of the first variant that ``mjcf-forge preview`` uses (docs/cli.md).
+    /// ``geoms``: ``"default"`` (groups 0-2, as MuJoCo draws), ``"visual"``,
+    /// ``"collision"`` or ``"all"``. With ``segmentation=True`` the result is instead an
+    /// ``int32`` array (height, width) of the geom id drawn at each pixel (ids of that
+    /// cell's variant's model; -1 for none and between cells), and nothing is written.
+    ///
+    /// Rendering is ``mujoco``'s: ``MUJOCO_GL`` picks the OpenGL platform; unset (and
+    /// ``mujoco`` not imported yet) it is set to ``egl``, or ``osmesa`` without EGL.
+    ///
+    /// Example::
+    ///
+    ///     sheet = scene.preview(16, "sheet.png")     # variants 0..15, 4 x 4 cells
+    ///     sheet.shape                                # (966, 1286, 3)
+    #[pyo3(signature = (indices, path = None, **options))]
+    fn preview<'py>(
+        slf: &Bound<'py, Self>,
+        indices: &Bound<'py, PyAny>,
+        path: Option<&Bound<'py, PyAny>>,
+        options: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        // Drawn with the user's mujoco, in Python (mjcf_forge/_preview.py): this module
+        // links no MuJoCo.
+        slf.py()
+            .import("mjcf_forge._preview")?
+            .getattr("preview")?
+            .call((slf, indices, path), options)
+    }
+
     /// Variant ``index`` (made with the GIL released). Raises :class:`MjcfError` when it
     /// cannot be made, e.g. a group whose objects find no place (the message names the
     /// group, the region and the index).

@@ -1,0 +1,322 @@
+//! [`Renderer`]: a headless OpenGL context and MuJoCo's renderer drawing one compiled model
+//! into an [`Image`], from a [`Camera`], with the geoms [`Geoms`] picks.
+
+use std::ffi::c_int;
+use std::fmt;
+use std::marker::PhantomData;
+use std::ptr::NonNull;
+use std::str::FromStr;
+
+use super::image::Image;
+use super::sys::{self, RawGl};
+use crate::error::{Error, ErrorKind};
+use crate::mujoco::{CompiledModel, ObjType};
+
+/// Which geoms are drawn.
+///
+/// ```
+/// use mjcf_forge::preview::Geoms;
+///
+/// assert_eq!("collision".parse::<Geoms>(), Ok(Geoms::Collision));
+/// assert_eq!(Geoms::default().to_string(), "default");
+/// assert!("nope".parse::<Geoms>().is_err());
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Geoms {
+    /// As MuJoCo draws a model by default: the geoms of groups 0, 1 and 2.
+    #[default]
+    Default,
+    /// The geoms that do not collide (`contype` and `conaffinity` 0), in any group, and
+    /// every geom of a body that has no such geom (so no body disappears).
+    Visual,
+    /// The geoms that collide (`contype` or `conaffinity` not 0), in any group.
+    Collision,
+    /// Every geom of every group.
+    All,
+}
+
+impl Geoms {
+    /// Every value, in declaration order.
+    pub const ALL: [Geoms; 4] = [Geoms::Default, Geoms::Visual, Geoms::Collision, Geoms::All];
+
+    /// Its name on the command line and in Python: `default`, `visual`, `collision`, `all`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Geoms::Default => "default",
+            Geoms::Visual => "visual",
+            Geoms::Collision => "collision",
+            Geoms::All => "all",
+        }
+    }
+
+    fn code(self) -> c_int {
+        match self {
+            Geoms::Default => 0,
+            Geoms::Visual => 1,
+            Geoms::Collision => 2,
+            Geoms::All => 3,
+        }
+    }
+}
+
+impl fmt::Display for Geoms {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl FromStr for Geoms {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Geoms, String> {
+        Geoms::ALL
+            .into_iter()
+            .find(|g| g.as_str() == s)
+            .ok_or_else(|| format!("unknown geom set '{s}' (default, visual, collision, all)"))
+    }
+}
+
+/// Where a render looks from.
+///
+/// ```
+/// use std::path::Path;
+/// use mjcf_forge::mujoco::compile_str;
+/// use mjcf_forge::preview::Camera;
+///
+/// let model = compile_str(r#"<mujoco><worldbody><camera name="top" pos="0 0 2"/>
+///   <geom size="0.1"/></worldbody></mujoco>"#, Path::new(".")).unwrap();
+/// assert_eq!(Camera::named(&model, "top").unwrap(), Camera::Fixed(0));
+/// assert!(Camera::named(&model, "side").is_err());
+/// let Camera::Free { distance, .. } = Camera::free(&model) else { unreachable!() };
+/// assert!(distance > 0.0);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Camera {
+    /// A free camera, as MuJoCo's `mjvCamera` of type `mjCAMERA_FREE`.
+    Free {
+        /// The point looked at.
+        lookat: [f64; 3],
+        /// Its distance from the camera.
+        distance: f64,
+        /// Azimuth in degrees.
+        azimuth: f64,
+        /// Elevation in degrees.
+        elevation: f64,
+    },
+    /// The model's camera of this id.
+    Fixed(usize),
+}
+
+impl Camera {
+    /// The free camera that frames `model`'s bodies at its initial pose (`qpos0`): from
+    /// the azimuth and elevation MuJoCo's viewer starts with (`mjv_defaultFreeCamera`,
+    /// i.e. `<visual><global azimuth elevation>`), looking at the centre of the bounding
+    /// box of every geom of a body other than the world (floors, walls and any geom of the
+    /// world body left out, and planes), from the distance at which the sphere around that
+    /// box fits the vertical field of view (`<visual><global fovy>`). A model whose geoms
+    /// all belong to the world gets `mjv_defaultFreeCamera` unchanged (the statistic
+    /// `center`, 1.5 `extent`s away).
+    pub fn free(model: &CompiledModel) -> Camera {
+        let [x, y, z, distance, azimuth, elevation] = sys::free_camera(model.raw());
+        Camera::Free {
+            lookat: [x, y, z],
+            distance,
+            azimuth,
+            elevation,
+        }
+    }
+
+    /// The model's camera named `name` (its full name, prefix included).
+    pub fn named(model: &CompiledModel, name: &str) -> Result<Camera, String> {
+        let names = model.names(ObjType::Camera);
+        names
+            .iter()
+            .position(|n| n == name)
+            .map(Camera::Fixed)
+            .ok_or_else(|| {
+                let known = if names.iter().all(String::is_empty) {
+                    "it has no named camera".to_owned()
+                } else {
+                    let named: Vec<&str> = names
+                        .iter()
+                        .filter(|n| !n.is_empty())
+                        .map(String::as_str)
+                        .collect();
+                    format!("its cameras: {}", named.join(", "))
+                };
+                format!("the model has no camera named '{name}' ({known})")
+            })
+    }
+}
+
+/// A headless OpenGL context, current on the thread that made it, with which MuJoCo's own
+/// renderer (`mjv_updateScene`, `mjr_render`) draws compiled models into memory.
+///
+/// The context is EGL's (`libEGL.so.1`: a device display, else Mesa's surfaceless
+/// platform, else the default display), else OSMesa's (`libOSMesa.so`), both opened at
+/// run time; the environment variable `MUJOCO_GL` set to `egl` or `osmesa` allows only
+/// that one. A renderer stays on its thread (it is neither `Send` nor `Sync`); two
+/// renderers on one thread would take each other's context.
+///
+/// ```no_run
+/// use std::path::Path;
+/// use mjcf_forge::mujoco::compile_str;
+/// use mjcf_forge::preview::{Camera, Geoms, Renderer};
+///
+/// let mut model = compile_str("<mujoco><worldbody><geom size='0.1'/></worldbody></mujoco>",
+///                             Path::new(".")).unwrap();
+/// let mut renderer = Renderer::new(320, 240).unwrap();
+/// let camera = Camera::free(&model);
+/// let image = renderer.render(&mut model, camera, Geoms::Default, Some("0")).unwrap();
+/// assert_eq!((image.width, image.height), (320, 240));
+/// ```
+pub struct Renderer {
+    gl: NonNull<RawGl>,
+    width: u32,
+    height: u32,
+    /// Bound to its thread: the context is current there only.
+    _not_send: PhantomData<*mut ()>,
+}
+
+impl fmt::Debug for Renderer {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Renderer")
+            .field("backend", &self.backend())
+            .field("width", &self.width)
+            .field("height", &self.height)
+            .finish()
+    }
+}
+
+impl Drop for Renderer {
+    fn drop(&mut self) {
+        // SAFETY: made by `gl_new`, freed once, here.
+        unsafe { sys::gl_free(self.gl) }
+    }
+}
+
+/// The largest image side drawn (MuJoCo's offscreen buffers; GL drivers allow more, but a
+/// contact sheet cell needs no more).
+pub const MAX_SIDE: u32 = 4096;
+
+impl Renderer {
+    /// A context for images of `width` x `height` pixels (1 to [`MAX_SIDE`] each), made
+    /// current on this thread; the error names every backend tried and why it failed.
+    pub fn new(width: u32, height: u32) -> Result<Renderer, Error> {
+        check_size(width, height)?;
+        let backend = match std::env::var("MUJOCO_GL").ok().as_deref().map(str::trim) {
+            Some(v) if v.eq_ignore_ascii_case("egl") => 1,
+            Some(v) if v.eq_ignore_ascii_case("osmesa") => 2,
+            _ => 0,
+        };
+        let gl = sys::gl_new(backend, width as c_int, height as c_int).map_err(|why| {
+            invalid(format!(
+                "cannot create a headless OpenGL context: {why} (docs/install.md, \"Rendering\")"
+            ))
+        })?;
+        Ok(Renderer {
+            gl,
+            width,
+            height,
+            _not_send: PhantomData,
+        })
+    }
+
+    /// The OpenGL platform in use: `"egl"` or `"osmesa"`.
+    pub fn backend(&self) -> &'static str {
+        sys::gl_kind(self.gl)
+    }
+
+    /// `model` at its initial pose (`qpos0`) drawn from `camera`, with `label` in the top
+    /// left corner (MuJoCo's `mjr_overlay`); sites are not drawn. The model's visual
+    /// settings and geom groups are changed for the render and restored before this
+    /// returns, hence `&mut`.
+    pub fn render(
+        &mut self,
+        model: &mut CompiledModel,
+        camera: Camera,
+        geoms: Geoms,
+        label: Option<&str>,
+    ) -> Result<Image, Error> {
+        let (rgb, _) = self.run(model, camera, geoms, label, false)?;
+        Ok(Image::from_bottom_up(self.width, self.height, rgb))
+    }
+
+    /// Segmentation: for each pixel (top row first, `width * height` of them) the id of
+    /// the geom drawn there, `-1` where none is; drawn as [`Renderer::render`] draws
+    /// (without multisampling, whose blended edges would be other ids).
+    pub fn segment(
+        &mut self,
+        model: &mut CompiledModel,
+        camera: Camera,
+        geoms: Geoms,
+    ) -> Result<Vec<i32>, Error> {
+        let (_, seg) = self.run(model, camera, geoms, None, true)?;
+        let row = self.width as usize;
+        Ok(seg.chunks(row.max(1)).rev().flatten().copied().collect())
+    }
+
+    fn run(
+        &mut self,
+        model: &mut CompiledModel,
+        camera: Camera,
+        geoms: Geoms,
+        label: Option<&str>,
+        segment: bool,
+    ) -> Result<(Vec<u8>, Vec<i32>), Error> {
+        let (free_cam, camid) = match camera {
+            Camera::Free {
+                lookat,
+                distance,
+                azimuth,
+                elevation,
+            } => (
+                [
+                    lookat[0], lookat[1], lookat[2], distance, azimuth, elevation,
+                ],
+                -1,
+            ),
+            Camera::Fixed(id) => {
+                let ncam = model.sizes().ncam;
+                if id >= ncam {
+                    return Err(invalid(format!(
+                        "camera id {id} is out of range (the model has {ncam} cameras)"
+                    )));
+                }
+                ([0.0; 6], id as c_int)
+            }
+        };
+        let job = sys::Job {
+            width: self.width as c_int,
+            height: self.height as c_int,
+            free_cam,
+            camid,
+            geoms: geoms.code(),
+            label,
+            segment,
+        };
+        // Another renderer on this thread may have taken the context since.
+        if !sys::gl_make_current(self.gl) {
+            return Err(invalid("cannot make the OpenGL context current".to_owned()));
+        }
+        // SAFETY: `&mut model` is exclusive for the call, and this renderer's context is
+        // current on this thread (the type is neither Send nor Sync).
+        unsafe { sys::render(model.as_mut_ptr(), &job) }.map_err(invalid)
+    }
+}
+
+fn check_size(width: u32, height: u32) -> Result<(), Error> {
+    if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
+        return Err(invalid(format!(
+            "image size {width}x{height}: each side must be 1 to {MAX_SIDE} pixels"
+        )));
+    }
+    Ok(())
+}
+
+pub(super) fn invalid(message: String) -> Error {
+    Error {
+        location: None,
+        kind: ErrorKind::Invalid(message),
+    }
+}
