@@ -751,7 +751,8 @@ fn not_empty(path: &Path, entry: &str) -> Error {
 }
 
 /// The first entry of `path` in the folder's own order (any one will do), `None` for an
-/// empty folder or none at all.
+/// empty folder or none at all (or a path that cannot be a folder: creating it reports
+/// that).
 fn first_entry(path: &Path) -> Result<Option<String>, Error> {
     let fail = |e: std::io::Error| {
         Error::bare(ErrorKind::Invalid(format!(
@@ -761,9 +762,14 @@ fn first_entry(path: &Path) -> Result<Option<String>, Error> {
     };
     let entries = match std::fs::read_dir(path) {
         Ok(entries) => entries,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) if e.kind() == std::io::ErrorKind::NotADirectory => {
-            return Err(fail(std::io::Error::new(e.kind(), "not a folder")));
+        // Nothing there to mix with; making the folder says what is wrong with the path.
+        Err(e)
+            if matches!(
+                e.kind(),
+                std::io::ErrorKind::NotFound | std::io::ErrorKind::NotADirectory
+            ) =>
+        {
+            return Ok(None);
         }
         Err(e) => return Err(fail(e)),
     };
