@@ -131,13 +131,7 @@ fn generate_shows_progress_on_long_runs_and_nothing_with_quiet() {
     // `--quiet`: nothing at all.
     assert_eq!(run("quiet", &["--quiet"], Some("0.005")), "");
     // A run shorter than a second shows no progress, only its summary.
-    let short = forge(&[
-        "generate",
-        "-n",
-        "2",
-        "-o",
-        path_arg(&dir.join("short")),
-    ]);
+    let short = forge(&["generate", "-n", "2", "-o", path_arg(&dir.join("short"))]);
     assert_eq!(stderr(&short).lines().count(), 1, "{}", stderr(&short));
     if cfg!(mjcf_mujoco) {
         let err = run("validated", &["--validate"], Some("0.005"));
@@ -165,9 +159,9 @@ fn an_output_folder_is_never_mixed_with_a_previous_runs() {
         err.starts_with(&format!(
             "{}: the output folder is not empty (it holds '",
             out.display()
-        )) && err.trim_end().ends_with(
-            "'); add --replace to replace it whole, or choose another folder"
-        ),
+        )) && err
+            .trim_end()
+            .ends_with("'); add --replace to replace it whole, or choose another folder"),
         "{err}"
     );
     assert_eq!(listing(&out).len(), 30 + 1);
@@ -233,7 +227,12 @@ fn export_refuses_a_folder_that_is_not_empty_and_replaces_it_whole() {
     let dir = scratch("cli_edges_export");
     let out = dir.join("moveable");
     let export = |extra: &[&str]| {
-        let mut args = vec!["export", "corpora/scenes/demo/arm.xml", "-o", path_arg(&out)];
+        let mut args = vec![
+            "export",
+            "corpora/scenes/demo/arm.xml",
+            "-o",
+            path_arg(&out),
+        ];
         args.extend_from_slice(extra);
         forge(&args)
     };
@@ -335,9 +334,8 @@ fn validate_counts_what_it_compiled_and_what_it_patched() {
     ]);
     let err = stderr(&o);
     assert!(
-        err.contains(&format!(
-            "compiled, {patched} patched from a compiled one)"
-        )) && !err.contains("the other variants"),
+        err.contains(&format!("compiled, {patched} patched from a compiled one)"))
+            && !err.contains("the other variants"),
         "{err}"
     );
 }

@@ -224,8 +224,10 @@ fn export_errors_are_exact_and_leave_nothing() {
     let err = stderr(&out);
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(
-        err.starts_with(&format!("{}: the output folder is not empty (it holds '", out_dir.display()))
-            && err.ends_with("'); add --replace to replace it whole, or choose another folder\n"),
+        err.starts_with(&format!(
+            "{}: the output folder is not empty (it holds '",
+            out_dir.display()
+        )) && err.ends_with("'); add --replace to replace it whole, or choose another folder\n"),
         "{err}"
     );
     assert_eq!(listing(&out_dir), ["assets", "robot.xml"]);

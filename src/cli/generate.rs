@@ -231,7 +231,11 @@ impl Summary {
                  compiled, {} patched from a compiled one)",
                 c.as_secs_f64() * 1e3 / self.variants.max(1) as f64,
                 self.compiled,
-                if self.compiled == 1 { "model" } else { "models" },
+                if self.compiled == 1 {
+                    "model"
+                } else {
+                    "models"
+                },
                 self.patched
             ));
         }
@@ -287,7 +291,11 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
         _ => None,
     };
     let progress = Progress::default();
-    let show = if args.quiet { Show::Nothing } else { Show::Auto };
+    let show = if args.quiet {
+        Show::Nothing
+    } else {
+        Show::Auto
+    };
     let mut summary = Summary {
         variants: 0,
         bytes: 0,

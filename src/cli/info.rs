@@ -47,8 +47,8 @@ pub fn run(args: Args) -> ExitCode {
 /// The summary for a person, read off the JSON object so that the two forms always say
 /// the same: one line per list (its count, then its names) and per offset.
 fn summary(input: &str, json: &str) -> Result<String, String> {
-    let info: serde_json::Value =
-        serde_json::from_str(json).map_err(|e| format!("{input}: cannot read the model's info: {e}"))?;
+    let info: serde_json::Value = serde_json::from_str(json)
+        .map_err(|e| format!("{input}: cannot read the model's info: {e}"))?;
     let text = |key: &str| info[key].as_str().unwrap_or_default().to_owned();
     let mut out = String::new();
     let prefix = text("naming_prefix");
@@ -109,5 +109,9 @@ fn short(value: &serde_json::Value) -> String {
     };
     let text = format!("{x:.6}");
     let text = text.trim_end_matches('0').trim_end_matches('.');
-    if text == "-0" { "0".to_owned() } else { text.to_owned() }
+    if text == "-0" {
+        "0".to_owned()
+    } else {
+        text.to_owned()
+    }
 }

@@ -100,9 +100,7 @@ pub fn stdout_closed() -> bool {
         tv_nsec: 0,
     };
     poll(&mut fds, Some(&zero)).is_ok()
-        && fds[0]
-            .revents()
-            .intersects(PollFlags::ERR | PollFlags::HUP)
+        && fds[0].revents().intersects(PollFlags::ERR | PollFlags::HUP)
 }
 
 /// Prints the problems of all runs; success only when there were none. A run that ended
@@ -140,7 +138,10 @@ pub fn refuse_non_empty(dir: &Path, replace: bool) -> Result<(), String> {
             "{}: the output folder is not empty (it holds '{}'); add --replace to replace it \
              whole, or choose another folder",
             dir.display(),
-            entry.map_or_else(|e| e.to_string(), |e| e.file_name().to_string_lossy().into_owned())
+            entry.map_or_else(
+                |e| e.to_string(),
+                |e| e.file_name().to_string_lossy().into_owned()
+            )
         )),
         None => Ok(()),
     }

@@ -629,8 +629,8 @@ impl Document {
 
 /// ` (did you mean 'x'?)` for a name that is not among `names` but close to one: one that
 /// ends with it (the name given without its instance's prefix: `hand` for `robot0_hand`),
-/// else the nearest by edit distance, within a third of the name's length; empty when
-/// none is close.
+/// else the nearest by edit distance, within a third of the name's length (at least 2: a
+/// swap of two letters); empty when none is close.
 fn did_you_mean(name: &str, names: &[&str]) -> String {
     let suffixed: Vec<&str> = names
         .iter()
@@ -638,7 +638,7 @@ fn did_you_mean(name: &str, names: &[&str]) -> String {
         .filter(|n| n.len() > name.len() && n.ends_with(name))
         .collect();
     let close: Vec<&str> = if suffixed.is_empty() {
-        let bound = (name.chars().count() / 3).max(1);
+        let bound = (name.chars().count() / 3).max(2);
         let scored: Vec<(usize, &str)> = names
             .iter()
             .map(|n| (edit_distance(name, n), *n))
