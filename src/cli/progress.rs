@@ -74,7 +74,7 @@ impl Progress {
             return;
         }
         if std::io::stderr().is_terminal() {
-            self.draw_bar(total, validating, stopped);
+            self.draw_bar(total, validating, started, stopped);
         } else {
             loop {
                 eprintln!("{}", self.line(total, validating, started.elapsed()));
@@ -85,17 +85,30 @@ impl Progress {
         }
     }
 
-    fn draw_bar(&self, total: u64, validating: bool, stopped: &mpsc::Receiver<()>) {
+    /// The bar; its rate and time left are ours (those of the plain lines), not
+    /// indicatif's, whose estimate starts from the first draw, a second into the run.
+    fn draw_bar(
+        &self,
+        total: u64,
+        validating: bool,
+        started: Instant,
+        stopped: &mpsc::Receiver<()>,
+    ) {
         let bar = indicatif::ProgressBar::new(total);
         bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{bar:30} {pos}/{len} written  {msg}  {per_sec}  {eta} left",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} written {msg}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
         );
         loop {
-            bar.set_position(self.written.load(Ordering::Relaxed));
-            bar.set_message(self.counts(validating));
+            // Counts read after `written`, and the message set first: never fewer made
+            // than written on screen.
+            let written = self.written.load(Ordering::Relaxed);
+            let (rate, left) = rate_and_left(written, total, started.elapsed());
+            bar.set_message(format!(
+                "({}), {rate:.0}/s, {left}",
+                self.counts(validating)
+            ));
+            bar.set_position(written);
             if stopped.recv_timeout(BAR_EVERY) != Err(mpsc::RecvTimeoutError::Timeout) {
                 break;
             }
@@ -123,18 +136,24 @@ impl Progress {
     /// about 4.6 s left`.
     fn line(&self, total: u64, validating: bool, elapsed: Duration) -> String {
         let written = self.written.load(Ordering::Relaxed);
-        let rate = written as f64 / elapsed.as_secs_f64().max(1e-9);
-        let left = if written == 0 {
-            "time left unknown".to_owned()
-        } else {
-            format!(
-                "about {:.1} s left",
-                total.saturating_sub(written) as f64 / rate
-            )
-        };
+        let (rate, left) = rate_and_left(written, total, elapsed);
         format!(
             "generate: {written}/{total} written ({}), {rate:.0}/s, {left}",
             self.counts(validating)
         )
     }
+}
+
+/// Items written per second so far, and the time left at that rate, in words.
+fn rate_and_left(written: u64, total: u64, elapsed: Duration) -> (f64, String) {
+    let rate = written as f64 / elapsed.as_secs_f64().max(1e-9);
+    let left = if written == 0 {
+        "time left unknown".to_owned()
+    } else {
+        format!(
+            "about {:.1} s left",
+            total.saturating_sub(written) as f64 / rate
+        )
+    };
+    (rate, left)
 }
