@@ -3,7 +3,8 @@
 //! Every subcommand reports problems on standard error as `file:line:col: message`, one
 //! problem per line, and exits non-zero; it never writes a partial output file (outputs go
 //! through [`mjcf_forge::write_atomic`], and only after everything that can fail has run).
-//! Exit codes: 0 success, 1 a model failed (loading, compiling, writing), 2 bad usage.
+//! Exit codes: 0 success, 1 a model failed (loading, compiling, writing), 2 bad usage; a
+//! run whose standard output was closed by its reader (`| head`) ends quietly with 0.
 //!
 //! Each subcommand lives in its own file under `src/cli/` with its `Args` and `run`;
 //! adding one is that file plus one variant of [`Command`] and one arm of its dispatch.

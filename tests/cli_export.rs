@@ -212,8 +212,10 @@ fn export_errors_are_exact_and_leave_nothing() {
     );
     assert_eq!(listing(&dir), ["file", "model.xml"]);
 
-    // An existing folder whose assets/ is a file: the assets cannot be written, so the
-    // model is not written either, and what was there stays as it was.
+    // A folder that holds something (here an assets/ that is a file) is refused before
+    // anything is loaded, and what was there stays as it was; with --replace it is
+    // replaced whole (the new folder is written beside it, so its old files are in no
+    // one's way).
     std::fs::create_dir(&out_dir).unwrap();
     std::fs::write(out_dir.join("assets"), "not a folder").unwrap();
     std::fs::write(out_dir.join("robot.xml"), "old").unwrap();
@@ -222,8 +224,10 @@ fn export_errors_are_exact_and_leave_nothing() {
     let err = stderr(&out);
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(
-        err.starts_with(&format!("cannot write '{}/assets/", out_dir.display()))
-            && err.ends_with("': Not a directory (os error 20)\n"),
+        err.starts_with(&format!(
+            "{}: the output folder is not empty (it holds '",
+            out_dir.display()
+        )) && err.ends_with("'); add --replace to replace it whole, or choose another folder\n"),
         "{err}"
     );
     assert_eq!(listing(&out_dir), ["assets", "robot.xml"]);
@@ -233,8 +237,8 @@ fn export_errors_are_exact_and_leave_nothing() {
     );
 }
 
-/// A model exported twice into one folder: the second run finds every asset under its
-/// content name and writes the same bytes.
+/// A model exported twice into one folder (the second time replacing it): the same
+/// files, byte for byte.
 #[test]
 fn exporting_again_into_the_same_folder_gives_the_same_files() {
     let dir = scratch("cli_export_again");
@@ -262,7 +266,7 @@ fn exporting_again_into_the_same_folder_gives_the_same_files() {
     );
     let first = snapshot(&out_dir);
     assert!(
-        forge(&["export", model, "-o", path_arg(&out_dir)])
+        forge(&["export", model, "-o", path_arg(&out_dir), "--replace"])
             .status
             .success()
     );

@@ -114,13 +114,12 @@ fn a_free_body_only_goes_into_the_world() {
 }
 
 #[test]
-fn name_clashes_are_all_reported() {
+fn name_clashes_of_a_part_are_one_message_with_the_fix() {
     // The material is identical in both, so it is shared rather than a clash.
     assert_eq!(
         merge_error("corpora/errors/merge/base.xml", "", None),
         [
-            "corpora/errors/merge/base.xml:6:5: duplicate body name 'hand' (first at corpora/errors/merge/base.xml:6:5)",
-            "corpora/errors/merge/base.xml:7:7: duplicate joint name 'wrist' (first at corpora/errors/merge/base.xml:7:7)",
+            "corpora/errors/merge/base.xml:6:5: duplicate names: all 2 names this part declares are already in the model (body 'hand' first at corpora/errors/merge/base.xml:6:5, joint 'wrist'); is it merged twice, or without a prefix of its own? give each instance its own name prefix",
         ]
         .join("\n")
     );

@@ -211,7 +211,9 @@ def test_validate_and_merge_errors_list_every_problem():
     before = base.to_xml()
     with pytest.raises(MjcfError) as err:
         base.merge(part)
-    assert len(err.value.errors) == 2 and all("'x'" in e or "'y'" in e for e in err.value.errors)
+    # Every name of the part clashes: one line says so, naming them, with the fix.
+    assert len(err.value.errors) == 1 and "'x'" in err.value.errors[0] and "'y'" in err.value.errors[0]
+    assert "give each instance its own name prefix" in err.value.errors[0]
     assert base.to_xml() == before  # a refused merge changes nothing
     with pytest.raises(MjcfError) as err:
         base.merge(part, body="nowhere")

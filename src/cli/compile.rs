@@ -5,9 +5,6 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[cfg(mjcf_mujoco)]
-use std::io::Write as _;
-
-#[cfg(mjcf_mujoco)]
 use mjcf_forge::Document;
 
 #[derive(clap::Args)]
@@ -61,14 +58,7 @@ fn compile(input: &Path, json: bool, limits: &mjcf_forge::Limits) -> ExitCode {
             .map(|(key, value)| format!("{key:<width$} {value}\n"))
             .collect()
     };
-    let mut out = std::io::stdout().lock();
-    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("mjcf-forge: cannot write to standard output: {e}");
-            ExitCode::FAILURE
-        }
-    }
+    super::finish(&[super::write_stdout(text.as_bytes())])
 }
 
 /// `compile` in a build without MuJoCo: says how to get one.

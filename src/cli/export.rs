@@ -24,6 +24,10 @@ pub struct Args {
     /// folder.
     #[arg(long)]
     tar: bool,
+    /// Replace an output folder that is not empty, whole (atomically where the filesystem
+    /// allows); without it such a folder is refused.
+    #[arg(long)]
+    replace: bool,
     #[command(flatten)]
     write: WriteOptions,
 }
@@ -37,11 +41,24 @@ pub fn run(args: Args) -> ExitCode {
         return ExitCode::from(USAGE);
     };
     let options = args.write;
+    if !args.tar
+        && let Err(e) = super::refuse_non_empty(&args.output, args.replace)
+    {
+        // Before loading anything: nothing runs in vain.
+        eprintln!("{e}");
+        return ExitCode::FAILURE;
+    }
     let result = prepare(&args.input, options, &args.limits.limits()).and_then(|(store, text)| {
         if args.tar {
-            export_tar(&store, name, &text, &args.output)
+            export_tar(&store, name, &text, &args.output).map_err(|e| {
+                if args.output == Path::new("-") {
+                    super::quiet_if_stdout_closed(e)
+                } else {
+                    e
+                }
+            })
         } else {
-            export_dir(&store, name, &text, &args.output)
+            export_dir(&store, name, &text, &args.output, args.replace)
         }
     });
     finish(&[result])
@@ -70,19 +87,22 @@ fn prepare(
     Ok((store, text))
 }
 
-/// Assets first, the model last, each file atomically: the model never names a file
-/// that is not there yet. A folder this run created is removed again on failure.
-fn export_dir(store: &AssetStore, name: &str, text: &str, dir: &Path) -> Result<(), String> {
-    let existed = std::fs::symlink_metadata(dir).is_ok();
-    let out = OutputDir::create(dir).map_err(|e| e.to_string())?;
-    let written = store
+/// Assets first, the model last, into a folder staged beside `dir` and put in place whole
+/// at the end (replacing a folder there with `replace`): on failure nothing is left and
+/// `dir` stays as it was.
+fn export_dir(
+    store: &AssetStore,
+    name: &str,
+    text: &str,
+    dir: &Path,
+    replace: bool,
+) -> Result<(), String> {
+    let out: OutputDir = super::open_output_dir(dir, replace)?;
+    store
         .write_to_dir(&out)
         .and_then(|()| out.write(name, text.as_bytes()))
-        .and_then(|()| out.finish());
-    if written.is_err() && !existed {
-        let _ = std::fs::remove_dir_all(dir);
-    }
-    written.map_err(|e| e.to_string())
+        .and_then(|()| out.finish())
+        .map_err(|e| e.to_string())
 }
 
 /// The tar stream goes straight to its output as it is made (assets first, the model

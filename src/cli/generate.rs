@@ -8,8 +8,13 @@
 //! the same bytes for any thread count. With `--shard K/N` this process makes only its
 //! share of the indices; N processes given the same folder together write what one
 //! process writes (each its own manifest).
+//!
+//! An output folder is one run's output, never mixed with another's: without `--shard` it
+//! is written beside its destination and put in place whole at the end (refused when the
+//! destination holds something, replaced whole with `--replace`); the shards of one run
+//! share it, and refuse it when it holds a file that is not that run's.
 
-use std::io::{BufWriter, IsTerminal as _, Write};
+use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
@@ -18,7 +23,8 @@ use mjcf_forge::output::AtomicFile;
 use mjcf_forge::scene::{Params, Scene};
 use mjcf_forge::{AssetStore, OutputDir, TarWriter, frame_text_member};
 
-use super::{USAGE, refuse_validate_without_mujoco};
+use super::progress::{Progress, Show};
+use super::{QUIET_END, USAGE, quiet_if_stdout_closed, refuse_validate_without_mujoco};
 
 /// Variants made but not yet written, at most: enough that no worker waits while another
 /// one writes, few enough that their texts (~90 KB each for a robot scene as tar
@@ -60,6 +66,15 @@ pub struct Args {
     /// Indented XML instead of compact XML.
     #[arg(long)]
     pretty: bool,
+    /// Replace an output folder that is not empty, whole (atomically where the filesystem
+    /// allows); without it such a folder is refused. Not with `--shard` (the shards of a
+    /// run share their folder: empty it before starting them).
+    #[arg(long)]
+    replace: bool,
+    /// No progress and no summary on standard error (problems are still reported;
+    /// `--json` still prints its summary).
+    #[arg(short, long)]
+    quiet: bool,
 }
 
 /// A ring slot's reused buffers: the variant's XML, or for a tar stream its two members
@@ -106,6 +121,13 @@ pub fn run(args: Args) -> ExitCode {
             return ExitCode::from(USAGE);
         }
     };
+    if args.replace && args.shard.is_some() && !is_tar_output(&args.output) {
+        eprintln!(
+            "mjcf-forge: --replace cannot be used with --shard: the shards of a run share \
+             their folder (remove or empty it before starting them)"
+        );
+        return ExitCode::from(USAGE);
+    }
     let pool = match rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0))
         .build()
@@ -118,16 +140,16 @@ pub fn run(args: Args) -> ExitCode {
     };
     match pool.install(|| generate(&args, shard)) {
         Ok(summary) => {
-            let text = summary.text();
             if args.json {
                 let json = summary.json();
                 if args.output == Path::new("-") {
                     eprintln!("{json}");
-                } else {
-                    println!("{json}");
+                } else if super::write_stdout(format!("{json}\n").as_bytes()).is_err() {
+                    // Only a closed standard output ends here: the run itself succeeded.
+                    return ExitCode::SUCCESS;
                 }
-            } else {
-                eprintln!("{text}");
+            } else if !args.quiet {
+                eprintln!("{}", summary.text());
             }
             for f in &summary.failures {
                 eprintln!("{f}");
@@ -138,11 +160,17 @@ pub fn run(args: Args) -> ExitCode {
                 ExitCode::FAILURE
             }
         }
+        Err(e) if e == QUIET_END => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("{e}");
             ExitCode::FAILURE
         }
     }
+}
+
+/// Whether `-o` names a tar stream (a `.tar` file, or `-`) rather than a folder.
+fn is_tar_output(output: &Path) -> bool {
+    output == Path::new("-") || output.extension().is_some_and(|e| e == "tar")
 }
 
 /// `K/N` with `K < N`.
@@ -172,8 +200,10 @@ struct Summary {
     /// Time spent validating with MuJoCo (compiling or patching, and the contact check),
     /// summed over threads (with `--validate`).
     compile: Option<Duration>,
-    /// Models MuJoCo compiled for `--validate` (the other variants were patched).
+    /// Models MuJoCo compiled for `--validate`.
     compiled: u64,
+    /// Variants whose model for `--validate` was patched from one already compiled.
+    patched: u64,
     failures: Vec<String>,
     output: String,
     range: (u64, u64),
@@ -197,10 +227,16 @@ impl Summary {
         );
         if let Some(c) = self.compile {
             s.push_str(&format!(
-                "; validated by MuJoCo in {:.2} ms per variant (summed over threads; {} models \
-                 compiled, the other variants patched)",
+                "; validated by MuJoCo in {:.2} ms per variant (summed over threads; {} {} \
+                 compiled, {} patched from a compiled one)",
                 c.as_secs_f64() * 1e3 / self.variants.max(1) as f64,
-                self.compiled
+                self.compiled,
+                if self.compiled == 1 {
+                    "model"
+                } else {
+                    "models"
+                },
+                self.patched
             ));
         }
         s.push_str(&format!("; {} failed", self.failures.len()));
@@ -217,6 +253,7 @@ impl Summary {
             "xml_bytes": self.bytes,
             "compile_ms_per_variant": self.compile.map(|c| c.as_secs_f64() * 1e3 / self.variants.max(1) as f64),
             "models_compiled": self.compile.map(|_| self.compiled),
+            "models_patched": self.compile.map(|_| self.patched),
             "failures": self.failures,
             "output": self.output,
         })
@@ -243,13 +280,7 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
     if lo < hi {
         scene.variant(lo).map_err(|e| e.to_string())?;
     }
-    let outputs = open_sink(
-        &args.output,
-        &store,
-        args.validate,
-        (k, n),
-        args.shard.is_some(),
-    )?;
+    let outputs = open_sink(args, &store, (k, n))?;
     let check_dir: Option<PathBuf> = match (&outputs.files, &outputs.check_dir) {
         (Some(out), _) => Some(out.path().to_path_buf()),
         (None, dir) => dir.as_ref().map(|d| d.path().to_path_buf()),
@@ -259,22 +290,19 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
         (Some(dir), true) => Some(Validators::new(&scene, dir)),
         _ => None,
     };
-    let progress = std::io::stderr().is_terminal().then(|| {
-        let bar = indicatif::ProgressBar::new(hi - lo);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{bar:40} {pos}/{len} variants {per_sec} eta {eta}",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        bar
-    });
+    let progress = Progress::default();
+    let show = if args.quiet {
+        Show::Nothing
+    } else {
+        Show::Auto
+    };
     let mut summary = Summary {
         variants: 0,
         bytes: 0,
         seconds: 0.0,
         compile: args.validate.then_some(Duration::ZERO),
         compiled: 0,
+        patched: 0,
         failures: Vec::new(),
         output: args.output.display().to_string(),
         range: (lo, hi),
@@ -284,33 +312,54 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
     // made, so the ordered part is one write per variant, after the assets.
     let is_tar = matches!(outputs.writer, Writer::Tar { .. });
     let mut writer = outputs.writer;
-    mjcf_forge::output::for_each_ordered(
-        lo..hi,
-        RING,
-        |i, slot: &mut Slot| make_one(args, &scene, i, slot, is_tar, files, validators.as_ref()),
-        |_, slot, made| {
-            match made {
-                Ok((took, bytes)) => {
-                    writer.write(&store, &slot.json, &slot.framed)?;
-                    summary.variants += 1;
-                    summary.bytes += bytes;
-                    if let Some(c) = &mut summary.compile {
-                        *c += took;
+    let to_stdout = args.output == Path::new("-");
+    let stream_error = |e: String| {
+        if to_stdout {
+            quiet_if_stdout_closed(e)
+        } else {
+            e
+        }
+    };
+    progress.run(hi - lo, args.validate, show, || {
+        mjcf_forge::output::for_each_ordered(
+            lo..hi,
+            RING,
+            |i, slot: &mut Slot| {
+                make_one(
+                    args,
+                    &scene,
+                    i,
+                    slot,
+                    is_tar,
+                    files,
+                    validators.as_ref(),
+                    &progress,
+                )
+            },
+            |_, slot, made| {
+                match made {
+                    Ok((took, bytes)) => {
+                        writer
+                            .write(&store, &slot.json, &slot.framed)
+                            .map_err(stream_error)?;
+                        Progress::bump(&progress.written);
+                        summary.variants += 1;
+                        summary.bytes += bytes;
+                        if let Some(c) = &mut summary.compile {
+                            *c += took;
+                        }
+                    }
+                    Err(e) => {
+                        Progress::bump(&progress.failed);
+                        summary.failures.push(e);
                     }
                 }
-                Err(e) => summary.failures.push(e),
-            }
-            if let Some(bar) = &progress {
-                bar.inc(1);
-            }
-            Ok::<(), String>(())
-        },
-    )?;
-    summary.compiled = validators.as_ref().map_or(0, Validators::compiled);
-    if let Some(bar) = progress {
-        bar.finish_and_clear();
-    }
-    close_sink(writer, &store, outputs.files)?;
+                Ok::<(), String>(())
+            },
+        )
+    })?;
+    (summary.compiled, summary.patched) = validators.as_ref().map_or((0, 0), Validators::counts);
+    close_sink(writer, &store, outputs.files).map_err(stream_error)?;
     summary.seconds = started.elapsed().as_secs_f64();
     Ok(summary)
 }
@@ -318,6 +367,7 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
 /// Makes variant `i` into `slot` (for a tar stream, its members framed; its manifest
 /// line), writes its XML file into `files` when the output is a folder, checks it with
 /// `--validate`: the time its check took and its XML's size.
+#[allow(clippy::too_many_arguments)]
 fn make_one(
     args: &Args,
     scene: &Scene,
@@ -326,6 +376,7 @@ fn make_one(
     is_tar: bool,
     files: Option<&OutputDir>,
     validators: Option<&Validators<'_>>,
+    progress: &Progress,
 ) -> Result<(Duration, u64), String> {
     let file = format!("{i:09}.xml");
     let make = |buf: &mut String| -> Result<Params, String> {
@@ -354,8 +405,13 @@ fn make_one(
         let all = 0..text.len();
         (params, all, None)
     };
+    Progress::bump(&progress.made);
     let took = match validators {
-        Some(v) => v.check(i, &params)?,
+        Some(v) => {
+            let took = v.check(i, &params)?;
+            Progress::bump(&progress.validated);
+            took
+        }
         None => Duration::ZERO,
     };
     slot.json.clear();
@@ -434,30 +490,32 @@ impl<'s> Validators<'s> {
         Err(super::NO_MUJOCO.to_owned())
     }
 
+    /// Models compiled, and models patched from a compiled one, over all threads.
     #[cfg(mjcf_mujoco)]
-    fn compiled(&self) -> u64 {
-        self.0
-            .iter()
-            .map(|m| m.lock().unwrap_or_else(|p| p.into_inner()).compiles())
-            .sum()
+    fn counts(&self) -> (u64, u64) {
+        self.0.iter().fold((0, 0), |(c, p), m| {
+            let cache = m.lock().unwrap_or_else(|p| p.into_inner());
+            (c + cache.compiles(), p + cache.patches())
+        })
     }
 
     #[cfg(not(mjcf_mujoco))]
-    fn compiled(&self) -> u64 {
-        0
+    fn counts(&self) -> (u64, u64) {
+        (0, 0)
     }
 }
 
-fn open_sink(
-    output: &Path,
-    store: &AssetStore,
-    validate: bool,
-    (k, n): (u64, u64),
-    sharded: bool,
-) -> Result<Outputs, String> {
-    let is_tar = output == Path::new("-") || output.extension().is_some_and(|e| e == "tar");
-    if !is_tar {
-        let out = OutputDir::create(output).map_err(|e| e.to_string())?;
+fn open_sink(args: &Args, store: &AssetStore, (k, n): (u64, u64)) -> Result<Outputs, String> {
+    let output = args.output.as_path();
+    let validate = args.validate;
+    let sharded = args.shard.is_some();
+    if !is_tar_output(output) {
+        let out = if sharded {
+            refuse_strays(output, args.start..args.start.saturating_add(args.count), n)?;
+            OutputDir::create(output).map_err(|e| e.to_string())?
+        } else {
+            super::open_output_dir(output, args.replace)?
+        };
         store.write_to_dir(&out).map_err(|e| e.to_string())?;
         let name = if sharded {
             format!("manifest-{k}-of-{n}.jsonl")
@@ -505,6 +563,50 @@ fn open_sink(
         },
         check_dir,
     })
+}
+
+/// `--shard K/N` into a folder: the folder the run's shards share may hold what they
+/// write (variant files of the run's indices, the `manifest-J-of-N.jsonl` of its shards,
+/// `assets/`, and the temporary files of shards writing now), and nothing else: a file of
+/// another run is refused, naming it (the shards cannot replace a folder they share).
+fn refuse_strays(dir: &Path, indices: std::ops::Range<u64>, n: u64) -> Result<(), String> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(());
+    };
+    let belongs = |name: &str| {
+        if name == "assets" || name.starts_with(".mjcf-forge-") {
+            return true;
+        }
+        if let Some(index) = name.strip_suffix(".xml")
+            && index.len() == 9
+            && let Ok(i) = index.parse::<u64>()
+        {
+            return indices.contains(&i);
+        }
+        name.strip_prefix("manifest-")
+            .and_then(|m| m.strip_suffix(&format!("-of-{n}.jsonl")))
+            .and_then(|j| j.parse::<u64>().ok())
+            .is_some_and(|j| j < n)
+    };
+    let mut strays: Vec<String> = entries
+        .filter_map(Result::ok)
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|name| !belongs(name))
+        .collect();
+    if strays.is_empty() {
+        return Ok(());
+    }
+    strays.sort();
+    let more = match strays.len() {
+        1 => String::new(),
+        k => format!(" and {} more", k - 1),
+    };
+    Err(format!(
+        "{}: the output folder holds files that are not this run's ('{}'{more}); the shards \
+         of a run need a folder that is empty or holds only their own files",
+        dir.display(),
+        strays[0]
+    ))
 }
 
 impl Writer {

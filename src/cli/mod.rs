@@ -11,6 +11,7 @@ pub mod inline;
 pub mod merge;
 pub mod prefix;
 pub mod preview;
+pub mod progress;
 
 use std::io::Write as _;
 use std::path::Path;
@@ -62,18 +63,56 @@ pub fn emit(doc: &Document, output: Option<&Path>, options: WriteOptions) -> Res
     }
 }
 
-/// `print!` would panic on a closed pipe; a failed write is an ordinary error here.
+/// `print!` would panic on a closed pipe; a failed write is an ordinary error here, and
+/// a reader that went away ([`QUIET_END`]) is no error at all.
 pub fn write_stdout(bytes: &[u8]) -> Result<(), String> {
     let mut out = std::io::stdout().lock();
     out.write_all(bytes)
         .and_then(|()| out.flush())
-        .map_err(|e| format!("cannot write to standard output: {e}"))
+        .map_err(|e| quiet_if_stdout_closed(format!("cannot write to standard output: {e}")))
 }
 
-/// Prints the problems of all runs; success only when there were none.
+/// What a run that stopped because standard output's reader went away (`| head`) reports
+/// instead of an error: nothing. It ends with exit 0, as `head`'s writer does in a shell
+/// pipeline where SIGPIPE ends it; unlike SIGPIPE, the run still cleans up (temporary
+/// files are removed, no output file is left half written). Never printed.
+pub const QUIET_END: &str = "\0standard output closed";
+
+/// `problem` when standard output is still open, else [`QUIET_END`]: for an error met
+/// while writing to standard output, whose words (a `Broken pipe` inside a library
+/// error) are not worth telling a reader that has gone.
+pub fn quiet_if_stdout_closed(problem: String) -> String {
+    if stdout_closed() {
+        QUIET_END.to_owned()
+    } else {
+        problem
+    }
+}
+
+/// Whether standard output is a pipe or socket whose reading end is closed: polled, so
+/// the answer is the kernel's (a write there fails with EPIPE), not read off an error's
+/// text.
+pub fn stdout_closed() -> bool {
+    use rustix::event::{PollFd, PollFlags, poll};
+    let stdout = std::io::stdout();
+    let mut fds = [PollFd::new(&stdout, PollFlags::OUT)];
+    let zero = rustix::event::Timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    poll(&mut fds, Some(&zero)).is_ok()
+        && fds[0].revents().intersects(PollFlags::ERR | PollFlags::HUP)
+}
+
+/// Prints the problems of all runs; success only when there were none. A run that ended
+/// because standard output was closed ([`QUIET_END`]) prints nothing and is a success
+/// unless another run failed.
 pub fn finish(results: &[Result<(), String>]) -> ExitCode {
     let mut failed = false;
     for problem in results.iter().filter_map(|r| r.as_ref().err()) {
+        if problem == QUIET_END {
+            continue;
+        }
         eprintln!("{problem}");
         failed = true;
     }
@@ -82,6 +121,43 @@ pub fn finish(results: &[Result<(), String>]) -> ExitCode {
     } else {
         ExitCode::SUCCESS
     }
+}
+
+/// `Err` when the output folder `dir` already holds something: outputs are never mixed
+/// with a previous run's, so a folder that is not empty is replaced whole with
+/// `--replace` or refused (checked before any work, so nothing runs in vain).
+pub fn refuse_non_empty(dir: &Path, replace: bool) -> Result<(), String> {
+    if replace {
+        return Ok(());
+    }
+    let first = match std::fs::read_dir(dir) {
+        Ok(mut entries) => entries.next(),
+        Err(_) => None,
+    };
+    match first {
+        Some(entry) => Err(format!(
+            "{}: the output folder is not empty (it holds '{}'); add --replace to replace it \
+             whole, or choose another folder",
+            dir.display(),
+            entry.map_or_else(
+                |e| e.to_string(),
+                |e| e.file_name().to_string_lossy().into_owned()
+            )
+        )),
+        None => Ok(()),
+    }
+}
+
+/// The output folder a run writes: staged beside `dir` and put in place whole at
+/// [`mjcf_forge::OutputDir::finish`] (replacing a folder there with `replace`).
+pub fn open_output_dir(dir: &Path, replace: bool) -> Result<mjcf_forge::OutputDir, String> {
+    refuse_non_empty(dir, replace)?;
+    if replace {
+        mjcf_forge::OutputDir::replace(dir)
+    } else {
+        mjcf_forge::OutputDir::create_new(dir)
+    }
+    .map_err(|e| e.to_string())
 }
 
 /// With `--validate` in a build without MuJoCo: the usage error, said once before any model

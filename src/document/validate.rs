@@ -160,6 +160,24 @@ impl Document {
     /// Assets and default classes are left out: a merge shares identical ones and reports
     /// the others with both contents' positions.
     pub(crate) fn name_clashes(&self, parts: &[&Document]) -> Vec<Error> {
+        self.name_clash_list(parts)
+            .into_iter()
+            .map(|c| {
+                let msg = format!(
+                    "duplicate {} name '{}' (first at {})",
+                    c.ns.as_str(),
+                    c.name,
+                    c.first
+                );
+                parts[c.part].error_at(c.node, ErrorKind::Invalid(msg))
+            })
+            .collect()
+    }
+
+    /// What [`Document::name_clashes`] reports, as data: each clash with its part, in
+    /// part order then document order, and how many names each part declares (those a
+    /// clash can concern).
+    pub(crate) fn name_clash_list<'p>(&self, parts: &[&'p Document]) -> Vec<NameClash<'p>> {
         let shared = |ns: Ns| {
             matches!(
                 ns,
@@ -206,8 +224,14 @@ impl Document {
                 } else {
                     parts[e.0 - 1].location(at)
                 };
-                let msg = format!("duplicate {} name '{name}' (first at {first})", ns.as_str());
-                errors.push(parts[i].error_at(node, ErrorKind::Invalid(msg)));
+                errors.push(NameClash {
+                    part: i,
+                    ns,
+                    name,
+                    node,
+                    first,
+                    declared: names.len(),
+                });
             }
         }
         errors
@@ -246,6 +270,20 @@ impl Document {
         }
         out
     }
+}
+
+/// One name a merged part declares that the base or an earlier part declares too.
+pub(crate) struct NameClash<'p> {
+    /// The part's index.
+    pub(crate) part: usize,
+    pub(crate) ns: Ns,
+    pub(crate) name: &'p str,
+    /// The part's element that declares it.
+    pub(crate) node: Node,
+    /// Where it was declared first.
+    pub(crate) first: crate::error::Location,
+    /// How many names the part declares (outside the shared namespaces).
+    pub(crate) declared: usize,
 }
 
 /// The attribute that declares a kind's name, and its namespace (read off the

@@ -363,12 +363,41 @@ fn is_plain_path(link: &Path) -> bool {
 /// ```
 #[derive(Debug)]
 pub struct OutputDir {
+    /// Where the files are written: the folder itself, or a staging folder beside it.
     path: PathBuf,
     /// Held open for the one sync at the end (and, on Linux, to create files in).
     handle: File,
+    /// A folder written beside its destination and put in place whole by
+    /// [`OutputDir::finish`] ([`OutputDir::create_new`], [`OutputDir::replace`]).
+    staged: Option<Staged>,
     /// Set once unnamed temporary files turn out not to work here.
     #[cfg(target_os = "linux")]
     no_unnamed_files: std::sync::atomic::AtomicBool,
+}
+
+/// Where a staged folder goes at [`OutputDir::finish`], and how.
+#[derive(Debug)]
+struct Staged {
+    /// The folder asked for: what messages name.
+    destination: PathBuf,
+    /// The folder the staging folder is renamed to (`destination`, links followed).
+    target: PathBuf,
+    /// Whether a folder that holds files there is replaced (else refused).
+    replace: bool,
+    /// Put in place: nothing to remove on drop.
+    done: bool,
+}
+
+impl Drop for OutputDir {
+    /// A staged folder that was never put in place (an error, a panic) is removed: the
+    /// destination stays as it was.
+    fn drop(&mut self) {
+        if let Some(staged) = &self.staged
+            && !staged.done
+        {
+            let _ = std::fs::remove_dir_all(&self.path);
+        }
+    }
 }
 
 impl OutputDir {
@@ -391,14 +420,138 @@ impl OutputDir {
         Ok(OutputDir {
             path: path.to_path_buf(),
             handle,
+            staged: None,
             #[cfg(target_os = "linux")]
             no_unnamed_files: std::sync::atomic::AtomicBool::new(false),
         })
     }
 
-    /// The folder.
+    /// A folder that appears whole, only at [`OutputDir::finish`], where there was none or
+    /// an empty one: the files go into a staging folder beside it, renamed into place at
+    /// the end, so what the folder holds is one run's output, never mixed with another's
+    /// nor partial (an error or a kill before the end leaves the destination as it was;
+    /// a staging folder a killed process leaves is named `.mjcf-forge-*`). A folder that
+    /// already holds something is refused, here and (should it fill meanwhile) at the end.
+    ///
+    /// ```
+    /// let tmp = tempfile::tempdir()?;
+    /// let path = tmp.path().join("variants");
+    /// let dir = mjcf_forge::OutputDir::create_new(&path)?;
+    /// dir.write("000000000.xml", b"<mujoco/>")?;
+    /// assert!(!path.exists(), "not there before finish");
+    /// dir.finish()?;
+    /// assert!(path.join("000000000.xml").is_file());
+    /// let err = mjcf_forge::OutputDir::create_new(&path).unwrap_err();
+    /// assert!(err.to_string().ends_with("the output folder is not empty (it holds '000000000.xml')"), "{err}");
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn create_new(path: impl AsRef<Path>) -> Result<OutputDir, Error> {
+        let path = path.as_ref();
+        if let Some(entry) = first_entry(path)? {
+            return Err(not_empty(path, &entry));
+        }
+        Self::staged(path, false)
+    }
+
+    /// Like [`OutputDir::create_new`], but a folder that holds files is replaced whole at
+    /// [`OutputDir::finish`]: swapped with the staging folder in one step where the
+    /// filesystem can (Linux `renameat2(RENAME_EXCHANGE)`; elsewhere two renames, between
+    /// which the folder is briefly missing), then the old contents are removed. Until then
+    /// the old folder stays as it was. A symbolic link to a folder is followed: its target
+    /// is replaced, the link stays.
+    ///
+    /// ```
+    /// let tmp = tempfile::tempdir()?;
+    /// let path = tmp.path().join("variants");
+    /// std::fs::create_dir(&path)?;
+    /// std::fs::write(path.join("000000999.xml"), "a previous run's")?;
+    /// let dir = mjcf_forge::OutputDir::replace(&path)?;
+    /// dir.write("000000000.xml", b"<mujoco/>")?;
+    /// assert!(path.join("000000999.xml").exists(), "the old folder stays until finish");
+    /// dir.finish()?;
+    /// let names: Vec<_> = std::fs::read_dir(&path)?.map(|e| e.unwrap().file_name()).collect();
+    /// assert_eq!(names, ["000000000.xml"]);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn replace(path: impl AsRef<Path>) -> Result<OutputDir, Error> {
+        Self::staged(path.as_ref(), true)
+    }
+
+    /// A staging folder beside `destination` (links followed), for [`Self::create_new`]
+    /// and [`Self::replace`].
+    fn staged(destination: &Path, replace: bool) -> Result<OutputDir, Error> {
+        let fail = |e: std::io::Error| {
+            Error::bare(ErrorKind::Invalid(format!(
+                "{}: cannot create folder: {e}",
+                destination.display()
+            )))
+        };
+        let target = match std::fs::metadata(destination) {
+            Ok(m) if m.is_dir() => std::fs::canonicalize(destination).map_err(fail)?,
+            Ok(_) => {
+                return Err(fail(std::io::Error::new(
+                    std::io::ErrorKind::NotADirectory,
+                    "not a folder",
+                )));
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => destination.to_path_buf(),
+            Err(e) => return Err(fail(e)),
+        };
+        let name = target
+            .file_name()
+            .ok_or_else(|| fail(std::io::Error::other("not a folder name")))?;
+        let parent = folder_of(&target);
+        std::fs::create_dir_all(parent).map_err(fail)?;
+        static COUNTER: AtomicU64 = AtomicU64::new(0);
+        let pid = std::process::id();
+        let staging = loop {
+            let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+            let mut staging_name = std::ffi::OsString::from(format!("{TEMP_PREFIX}{pid}-{n}-"));
+            staging_name.push(name);
+            let staging = parent.join(staging_name);
+            match std::fs::create_dir(&staging) {
+                Ok(()) => break staging,
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+                Err(e) => return Err(fail(e)),
+            }
+        };
+        let handle = match File::open(&staging) {
+            Ok(handle) => handle,
+            Err(e) => {
+                let _ = std::fs::remove_dir(&staging);
+                return Err(fail(e));
+            }
+        };
+        Ok(OutputDir {
+            path: staging,
+            handle,
+            staged: Some(Staged {
+                destination: destination.to_path_buf(),
+                target,
+                replace,
+                done: false,
+            }),
+            #[cfg(target_os = "linux")]
+            no_unnamed_files: std::sync::atomic::AtomicBool::new(false),
+        })
+    }
+
+    /// The folder the files are written into now: the output folder, or while a staged
+    /// folder is written ([`OutputDir::create_new`], [`OutputDir::replace`]) the staging
+    /// folder beside it (files written there keep their relative names when it moves).
     pub fn path(&self) -> &Path {
         &self.path
+    }
+
+    /// The output folder as it was named, where the files are once [`OutputDir::finish`]
+    /// has run: what messages name.
+    pub fn destination(&self) -> &Path {
+        self.staged.as_ref().map_or(&self.path, |s| &s.destination)
+    }
+
+    /// What messages call `relative_name`: its path in the output folder as named.
+    fn shown(&self, relative_name: &str) -> PathBuf {
+        self.destination().join(relative_name)
     }
 
     /// The final path of `relative_name`, after checking it stays inside the folder.
@@ -410,7 +563,7 @@ impl OutputDir {
                 .all(|c| matches!(c, Component::Normal(_)));
         if !inside {
             return Err(Error::bare(ErrorKind::Write {
-                path: self.path.join(relative),
+                path: self.destination().join(relative),
                 reason: "not a file name inside the output folder".to_owned(),
             }));
         }
@@ -422,7 +575,7 @@ impl OutputDir {
     /// nothing is left behind and the error names the final file.
     pub fn write(&self, relative_name: &str, bytes: &[u8]) -> Result<(), Error> {
         let path = self.final_path(relative_name)?;
-        let fail = |e: std::io::Error| write_error(&path, &e);
+        let fail = |e: std::io::Error| write_error(&self.shown(relative_name), &e);
         #[cfg(target_os = "linux")]
         if self.write_unnamed(relative_name, bytes).map_err(fail)? {
             return Ok(());
@@ -519,7 +672,7 @@ impl OutputDir {
     /// ```
     pub fn create_file(&self, relative_name: &str) -> Result<AtomicFile, Error> {
         let path = self.final_path(relative_name)?;
-        let fail = |e: std::io::Error| write_error(&path, &e);
+        let fail = |e: std::io::Error| write_error(&self.shown(relative_name), &e);
         let folder = folder_of(&path);
         let tmp = match TempFile::create_in(folder) {
             Ok(tmp) => tmp,
@@ -530,7 +683,7 @@ impl OutputDir {
             Err(e) => return Err(fail(e)),
         };
         Ok(AtomicFile {
-            path: path.clone(),
+            path: self.shown(relative_name),
             sink: Sink::Temp {
                 tmp,
                 target: path,
@@ -547,10 +700,128 @@ impl OutputDir {
     }
 
     /// Makes everything written durable: one sync of the folder's filesystem, instead of
-    /// one per file.
-    pub fn finish(self) -> Result<(), Error> {
-        sync_filesystem(&self.handle).map_err(|e| write_error(&self.path, &e))
+    /// one per file; then puts a staged folder in place ([`OutputDir::create_new`],
+    /// [`OutputDir::replace`]).
+    pub fn finish(mut self) -> Result<(), Error> {
+        sync_filesystem(&self.handle).map_err(|e| write_error(self.destination(), &e))?;
+        let Some(staged) = &self.staged else {
+            return Ok(());
+        };
+        let fail = |e: std::io::Error| write_error(&staged.destination, &e);
+        let old = if staged.replace {
+            swap_in(&self.path, &staged.target).map_err(fail)?
+        } else {
+            match std::fs::rename(&self.path, &staged.target) {
+                Ok(()) => None,
+                // Renaming over a folder succeeds only when it is empty.
+                Err(e)
+                    if matches!(
+                        e.kind(),
+                        std::io::ErrorKind::DirectoryNotEmpty | std::io::ErrorKind::AlreadyExists
+                    ) =>
+                {
+                    let entry = first_entry(&staged.target)?.unwrap_or_default();
+                    return Err(not_empty(&staged.destination, &entry));
+                }
+                Err(e) => return Err(fail(e)),
+            }
+        };
+        // The rename is durable once the parent folder is synced.
+        if let Ok(parent) = File::open(folder_of(&staged.target)) {
+            parent.sync_all().map_err(fail)?;
+        }
+        if let Some(staged) = &mut self.staged {
+            staged.done = true;
+        }
+        // The previous run's folder, now under a staging name: best effort, the new
+        // output is in place whatever happens to it.
+        if let Some(old) = old {
+            let _ = std::fs::remove_dir_all(old);
+        }
+        Ok(())
     }
+}
+
+/// The error for an output folder that already holds something (`entry`, one of them).
+fn not_empty(path: &Path, entry: &str) -> Error {
+    Error::bare(ErrorKind::Invalid(format!(
+        "{}: the output folder is not empty (it holds '{entry}')",
+        path.display()
+    )))
+}
+
+/// The first entry of `path` in the folder's own order (any one will do), `None` for an
+/// empty folder or none at all (or a path that cannot be a folder: creating it reports
+/// that).
+fn first_entry(path: &Path) -> Result<Option<String>, Error> {
+    let fail = |e: std::io::Error| {
+        Error::bare(ErrorKind::Invalid(format!(
+            "{}: cannot read folder: {e}",
+            path.display()
+        )))
+    };
+    let entries = match std::fs::read_dir(path) {
+        Ok(entries) => entries,
+        // Nothing there to mix with; making the folder says what is wrong with the path.
+        Err(e)
+            if matches!(
+                e.kind(),
+                std::io::ErrorKind::NotFound | std::io::ErrorKind::NotADirectory
+            ) =>
+        {
+            return Ok(None);
+        }
+        Err(e) => return Err(fail(e)),
+    };
+    match entries.into_iter().next() {
+        Some(entry) => Ok(Some(
+            entry
+                .map_err(fail)?
+                .file_name()
+                .to_string_lossy()
+                .into_owned(),
+        )),
+        None => Ok(None),
+    }
+}
+
+/// Puts the folder `staging` where `target` is, replacing whatever folder is there; the
+/// replaced folder's new name (to remove) when there was one. One atomic exchange on
+/// Linux; elsewhere, or where the filesystem cannot exchange, the old folder is renamed
+/// aside first.
+fn swap_in(staging: &Path, target: &Path) -> std::io::Result<Option<PathBuf>> {
+    #[cfg(target_os = "linux")]
+    {
+        use rustix::fs::{CWD, RenameFlags, renameat_with};
+        use rustix::io::Errno;
+        match renameat_with(CWD, staging, CWD, target, RenameFlags::EXCHANGE) {
+            // The staging name now holds the old folder.
+            Ok(()) => return Ok(Some(staging.to_path_buf())),
+            Err(Errno::NOENT) if !target.exists() => {
+                std::fs::rename(staging, target)?;
+                return Ok(None);
+            }
+            Err(Errno::INVAL | Errno::NOSYS | Errno::OPNOTSUPP) => {}
+            Err(e) => return Err(e.into()),
+        }
+    }
+    let mut aside = staging.as_os_str().to_owned();
+    aside.push(".old");
+    let aside = PathBuf::from(aside);
+    match std::fs::rename(target, &aside) {
+        Ok(()) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            std::fs::rename(staging, target)?;
+            return Ok(None);
+        }
+        Err(e) => return Err(e),
+    }
+    if let Err(e) = std::fs::rename(staging, target) {
+        // Put the old folder back: the destination stays as it was.
+        let _ = std::fs::rename(&aside, target);
+        return Err(e);
+    }
+    Ok(Some(aside))
 }
 
 #[cfg(target_os = "linux")]

@@ -216,7 +216,7 @@ impl Document {
         keep_maps: bool,
         compile: Option<&mut InertiaCompiler<'_>>,
     ) -> Result<(MergeReport, Vec<NodeMap>), Errors> {
-        let clashes = self.name_clashes(&parts.iter().map(|p| p.doc).collect::<Vec<_>>());
+        let clashes = self.merge_name_clashes(&parts.iter().map(|p| p.doc).collect::<Vec<_>>());
         if !clashes.is_empty() {
             return Err(Errors(clashes));
         }
@@ -332,7 +332,8 @@ impl Document {
                     return Err(Error::at(
                         self.location(self.root),
                         ErrorKind::Invalid(format!(
-                            "merge target body '{name}' is not in the base model"
+                            "merge target body '{name}' is not in the base model{}",
+                            did_you_mean(name, &self.body_names())
                         )),
                     )
                     .into());
@@ -442,6 +443,75 @@ impl Document {
             )?;
         }
         Ok((report, map))
+    }
+
+    /// The names of the model's named bodies, in document order.
+    fn body_names(&self) -> Vec<&str> {
+        self.declared_names()
+            .into_iter()
+            .filter(|(ns, _, _)| *ns == crate::document::vocab::Ns::Body)
+            .map(|(_, name, _)| name)
+            .collect()
+    }
+
+    /// The names the parts would bring in twice, one error per part: a part with one
+    /// clash gets the usual `duplicate ... name` line; a part with several (most often the
+    /// same model merged twice, or an instance without a prefix of its own, where every
+    /// name clashes) gets one line that says so, with the fix, rather than a line per name.
+    fn merge_name_clashes(&self, parts: &[&Document]) -> Vec<Error> {
+        /// Names listed in a summary before "and N more".
+        const LISTED: usize = 5;
+        let clashes = self.name_clash_list(parts);
+        let mut errors = Vec::new();
+        let mut rest = clashes.as_slice();
+        while let Some(first) = rest.first() {
+            let n = rest.iter().take_while(|c| c.part == first.part).count();
+            let (mine, after) = rest.split_at(n);
+            rest = after;
+            let part = parts[first.part];
+            let msg = if let [one] = mine {
+                format!(
+                    "duplicate {} name '{}' (first at {})",
+                    one.ns.as_str(),
+                    one.name,
+                    one.first
+                )
+            } else {
+                let mut listed: Vec<String> = mine
+                    .iter()
+                    .take(LISTED)
+                    .enumerate()
+                    .map(|(k, c)| {
+                        if k == 0 {
+                            format!("{} '{}' first at {}", c.ns.as_str(), c.name, c.first)
+                        } else {
+                            format!("{} '{}'", c.ns.as_str(), c.name)
+                        }
+                    })
+                    .collect();
+                if n > LISTED {
+                    listed.push(format!("and {} more", n - LISTED));
+                }
+                let (how_many, fix) = if n == first.declared {
+                    (
+                        format!("all {n} names this part declares are"),
+                        "is it merged twice, or without a prefix of its own? give each \
+                         instance its own name prefix",
+                    )
+                } else {
+                    (
+                        format!("{n} of the {} names this part declares are", first.declared),
+                        "rename them, or give the part a name prefix of its own",
+                    )
+                };
+                format!(
+                    "duplicate names: {how_many} already in the model ({}); {fix}",
+                    listed.join(", ")
+                )
+            };
+            errors.push(part.error_at(first.node, ErrorKind::Invalid(msg)));
+        }
+        errors
     }
 
     /// The body named `name` anywhere in the kinematic tree.
@@ -554,5 +624,75 @@ impl Document {
             }
         }
         true
+    }
+}
+
+/// ` (did you mean 'x'?)` for a name that is not among `names` but close to one: one that
+/// ends with it (the name given without its instance's prefix: `hand` for `robot0_hand`),
+/// else the nearest by edit distance, within a third of the name's length (at least 2: a
+/// swap of two letters); empty when none is close.
+fn did_you_mean(name: &str, names: &[&str]) -> String {
+    let suffixed: Vec<&str> = names
+        .iter()
+        .copied()
+        .filter(|n| n.len() > name.len() && n.ends_with(name))
+        .collect();
+    let close: Vec<&str> = if suffixed.is_empty() {
+        let bound = (name.chars().count() / 3).max(2);
+        let scored: Vec<(usize, &str)> = names
+            .iter()
+            .map(|n| (edit_distance(name, n), *n))
+            .filter(|(d, _)| *d <= bound)
+            .collect();
+        let best = scored.iter().map(|(d, _)| *d).min();
+        scored
+            .into_iter()
+            .filter(|(d, _)| Some(*d) == best)
+            .map(|(_, n)| n)
+            .collect()
+    } else {
+        suffixed
+    };
+    match close.as_slice() {
+        [] => String::new(),
+        names => {
+            let quoted: Vec<String> = names.iter().take(3).map(|n| format!("'{n}'")).collect();
+            format!(" (did you mean {}?)", quoted.join(" or "))
+        }
+    }
+}
+
+/// Levenshtein distance in characters (names are short: one row of memory).
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut diagonal = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let next = (diagonal + usize::from(ca != *cb))
+                .min(row[j] + 1)
+                .min(row[j + 1] + 1);
+            diagonal = row[j + 1];
+            row[j + 1] = next;
+        }
+    }
+    row[b.len()]
+}
+
+#[cfg(test)]
+mod did_you_mean_tests {
+    use super::*;
+
+    #[test]
+    fn close_names_and_missing_prefixes_are_suggested() {
+        let names = ["robot0_base", "robot0_right_hand", "table"];
+        assert_eq!(did_you_mean("tabel", &names), " (did you mean 'table'?)");
+        assert_eq!(
+            did_you_mean("right_hand", &names),
+            " (did you mean 'robot0_right_hand'?)"
+        );
+        assert_eq!(did_you_mean("zzz", &names), "");
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
     }
 }
