@@ -71,11 +71,25 @@ def _egl_works() -> bool:
 
 
 def _mujoco():
+    imported_before = "mujoco" in sys.modules
     _choose_gl()
     try:
         import mujoco
     except ImportError as e:
         raise ImportError(f"Scene.preview() needs the mujoco package (pip install mujoco): {e}")
+    if (
+        imported_before
+        and not os.environ.get("MUJOCO_GL")
+        and sys.platform.startswith("linux")
+        and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+    ):
+        # mujoco chose GLFW when it was imported, which needs a display: without one it
+        # ends the process. Say what to do instead.
+        raise RuntimeError(
+            "Scene.preview(): mujoco was imported before MUJOCO_GL was set and there is no "
+            "display: set MUJOCO_GL=egl (or osmesa) before importing mujoco, for example "
+            "`MUJOCO_GL=egl python script.py`, or import mjcf_forge's preview first"
+        )
     return mujoco
 
 

@@ -15,6 +15,10 @@ from pathlib import Path
 
 import pytest
 
+# Headless rendering for the whole run (test_preview.py): mujoco reads MUJOCO_GL once, when
+# the first test module imports it.
+os.environ.setdefault("MUJOCO_GL", "egl")
+
 ROOT = Path(__file__).resolve().parents[2]
 CORPUS = ROOT / ".cache" / "corpus"
 MODELS_TXT = CORPUS / "models.txt"

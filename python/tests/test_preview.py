@@ -183,3 +183,19 @@ def test_mujoco_gl_defaults_to_egl_when_unset(tmp_path):
         [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
     )
     assert out.stdout.split()[0] in ("egl", "osmesa")
+
+
+def test_mujoco_imported_first_without_a_display_is_a_clear_error():
+    # mujoco picks GLFW when imported with MUJOCO_GL unset, and GLFW without a display
+    # ends the process: preview() says what to do instead.
+    env = {k: v for k, v in os.environ.items() if k not in ("MUJOCO_GL", "DISPLAY", "WAYLAND_DISPLAY")}
+    code = (
+        "import mujoco, mjcf_forge\n"
+        "try:\n"
+        "    mjcf_forge.Scene.load().preview([0], cell=(32, 24))\n"
+        "except RuntimeError as e:\n"
+        "    print(e)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    assert "set MUJOCO_GL=egl" in out.stdout
