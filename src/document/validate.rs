@@ -53,10 +53,7 @@ impl Document {
                     continue;
                 };
                 if let Some(problem) = value_problem(value, spec.value) {
-                    let msg = format!(
-                        "element {} attribute '{name}': {problem}",
-                        self.tag(node)
-                    );
+                    let msg = format!("element {} attribute '{name}': {problem}", self.tag(node));
                     errors.push((node, self.error_at(node, ErrorKind::Invalid(msg))));
                 }
                 match spec.kind {
@@ -196,12 +193,17 @@ fn value_problem(value: &str, ty: Value) -> Option<String> {
         }
     }
     // MuJoCo leaves an attribute with no values at its default.
-    if count == 0 || (usize::from(min)..=usize::from(max)).contains(&count) {
+    let max = if max == MANY {
+        usize::MAX
+    } else {
+        usize::from(max)
+    };
+    if count == 0 || (usize::from(min)..=max).contains(&count) {
         return None;
     }
     let what = if ints { "integer" } else { "number" };
-    let expected = match (min, max) {
-        (lo, MANY) => format!("at least {lo} {what}s"),
+    let expected = match (usize::from(min), max) {
+        (lo, usize::MAX) => format!("at least {lo} {what}s"),
         (lo, hi) if lo == hi && lo == 1 => format!("1 {what}"),
         (lo, hi) if lo == hi => format!("{lo} {what}s"),
         (lo, hi) => format!("{lo} to {hi} {what}s"),
@@ -222,10 +224,10 @@ fn number_problem(token: &str, int: bool) -> Option<String> {
         };
     }
     let lower = digits.to_ascii_lowercase();
-    if lower.starts_with("0x") {
+    if let Some(hex) = lower.strip_prefix("0x") {
         // strtod's hexadecimal form: rare, taken as MuJoCo takes it, without a range check.
-        let ok = lower.len() > 2
-            && lower[2..]
+        let ok = !hex.is_empty()
+            && hex
                 .bytes()
                 .all(|b| b.is_ascii_hexdigit() || matches!(b, b'.' | b'p' | b'+' | b'-'));
         return (!ok).then(|| format!("'{token}' is not a number"));
