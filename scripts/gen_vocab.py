@@ -74,6 +74,10 @@ EXTRA_KINDS = {
     ("flexcomp", "mesh"): ("Ref:mesh", "mesh asset name"),
 }
 
+# Value types decided here rather than read from the schema, where the pinned MuJoCo (or
+# 4.0.0) accepts more than the schema revision says. Key: (schema element, attribute).
+VALUE_OVERRIDES: dict[tuple[str, str], str] = {}
+
 # Polymorphic name pairs: type keyword attribute -> name attribute.
 OBJ_PAIRS = {"objtype": "objname", "reftype": "refname"}
 
@@ -137,6 +141,16 @@ ELEM_RE = re.compile(r"^element\s+(\w+)\s*(?::\s*(\w+))?\s*(?:\((.*)\))?\s*\{$")
 GROUP_RE = re.compile(r"^group\s+(\w+)(?:\s+variant)?\s*\{$")
 
 
+ENUM_RE = re.compile(r"^enum\s+(\w+)\s*(?::\s*\w+)?\s*\{$")
+ENUM_KEY_RE = re.compile(r'^("[^"]*"|\S+)\s*=')
+
+# The symbolic bounds of counts (`double[1..mjNREF]`), checked against the pinned MuJoCo.
+SYMBOLIC_COUNTS = {"mjNREF": 2, "mjNIMP": 5, "mjNDYN": 10, "mjNGAIN": 10, "mjNBIAS": 10}
+
+# Keywords of each schema enum, in declaration order.
+ENUMS: dict[str, list[str]] = {}
+
+
 def parse_schema(text: str) -> tuple[dict[str, SElement], set[str]]:
     groups: dict[str, list[SAttr]] = {}
     elements: dict[str, SElement] = {}
@@ -147,8 +161,9 @@ def parse_schema(text: str) -> tuple[dict[str, SElement], set[str]]:
         if not line:
             continue
         if block is None:
-            if line.startswith("enum "):
-                block = ("enum", None)
+            if m := ENUM_RE.match(line):
+                ENUMS[m[1]] = []
+                block = ("enum", ENUMS[m[1]])
             elif m := GROUP_RE.match(line):
                 groups[m[1]] = []
                 block = ("group", groups[m[1]])
@@ -167,6 +182,10 @@ def parse_schema(text: str) -> tuple[dict[str, SElement], set[str]]:
             continue
         kind, payload = block
         if kind == "enum":
+            km = ENUM_KEY_RE.match(line)
+            if not km:
+                die(f"schema line {lineno}: cannot parse enum key {line!r}")
+            payload.append(km[1].strip('"'))
             continue
         words = line.split()
         if words[0] in ("exclusive", "together", "requires", "oneof", "set"):
@@ -204,6 +223,42 @@ def schema_kind(attr: SAttr) -> str:
     if attr.type == "file":
         return "File"
     return "Plain"
+
+
+def value_type(attr: SAttr | None) -> str:
+    """What MuJoCo's reader accepts as the attribute's value, as `Value` syntax:
+    `Text` (not checked), `Reals:min:max`, `Ints:min:max` (max `MANY` = unbounded),
+    `Keyword:<enum>`."""
+    if attr is None:
+        return "Text"  # not in the schema: nothing known of its value
+    t = attr.type
+    custom = attr.facets.get("reading") == "custom"
+    if t == "bool":
+        return "Keyword:bool"
+    if m := re.fullmatch(r"enum<(\w+)>", t):
+        # Hand-read enums may take more than their keywords (general's `input`).
+        if custom or m[1] not in ENUMS:
+            return "Text"
+        return f"Keyword:{m[1]}"
+    m = re.fullmatch(r"(double|float|int)(?:\[(?:(\w+)(?:\.\.(\w+))?)?\])?", t)
+    if not m:
+        return "Text"  # string, file, chars, flags, id, ref
+    head = "Ints" if m[1] == "int" else "Reals"
+    if "[" not in t:
+        lo = hi = "1"
+    elif m[2] is None:
+        lo, hi = "0", "MANY"
+    else:
+        lo, hi = m[2], m[3] or m[2]
+    bounds = []
+    for b in (lo, hi):
+        if b == "MANY" or b.isdigit():
+            bounds.append(b)
+        elif b in SYMBOLIC_COUNTS:
+            bounds.append(str(SYMBOLIC_COUNTS[b]))
+        else:
+            die(f"attribute {attr.name}: unknown count bound {b}")
+    return f"{head}:{bounds[0]}:{bounds[1]}"
 
 
 # ----------------------------------------------------------------------------------------------
@@ -275,6 +330,7 @@ class Attr:
     kind: str
     nodefault: bool
     comment: str = ""
+    value: str = "Text"
 
 
 @dataclass
@@ -451,7 +507,10 @@ class Builder:
                     f"schema says nodefault but 3.17.0's <default> row has it: {el.name}.{n}"
                 )
                 nodefault = False
-            el.attrs.append(Attr(n, kind, nodefault, comment))
+            value = value_type(sattrs.get(n))
+            if (el.src, n) in VALUE_OVERRIDES:
+                value = VALUE_OVERRIDES[(el.src, n)]
+            el.attrs.append(Attr(n, kind, nodefault, comment, value))
 
 
 def build(schema: dict[str, SElement], tree: PNode) -> Builder:
@@ -482,6 +541,24 @@ def shortcut_params(b: Builder) -> dict[str, list[str]]:
 
 def camel(s: str) -> str:
     return "".join(p.capitalize() for p in s.split("_"))
+
+
+def rust_value(value: str) -> str:
+    head, *args = value.split(":")
+    if head == "Text":
+        return "Text"
+    if head == "Keyword":
+        return f"Keyword(KW_{args[0].upper()})"
+    return f"{head}({args[0]}, {args[1]})"
+
+
+def check_symbolic_counts(python: str) -> None:
+    code = "import mujoco; print(' '.join(str(getattr(mujoco, n)) for n in %r))" % (
+        list(SYMBOLIC_COUNTS),)
+    out = subprocess.run([python, "-c", code], check=True, capture_output=True, text=True)
+    live = [int(v) for v in out.stdout.split()]
+    if live != list(SYMBOLIC_COUNTS.values()):
+        die(f"symbolic counts {SYMBOLIC_COUNTS} differ from MuJoCo's {live}")
 
 
 def rust_kind(kind: str) -> str:
@@ -529,7 +606,7 @@ def emit(b: Builder, namespaces: list[str], args, schema_sha: str) -> str:
     w("//   attributes exist).")
     w(f"// - google-deepmind/mujoco `{SCHEMA_PATH_IN_MUJOCO}` at {rev}")
     w(f"//   (sha256 {schema_sha}):")
-    w("//   attribute kinds (id/ref/file/nodefault) and contexts.")
+    w("//   attribute kinds (id/ref/file/nodefault), value types and contexts.")
     w("// Regenerate:")
     w(f"//   python3 -m venv /tmp/vv && /tmp/vv/bin/pip install mujoco=={PINNED_MUJOCO}")
     w("//   # save mjcf.schema of that revision to /tmp/mjcf.schema, then:")
@@ -598,6 +675,26 @@ def emit(b: Builder, namespaces: list[str], args, schema_sha: str) -> str:
     w("    /// Not settable in a `<default>` class: the schema's `(nodefault)`, or absent from the")
     w(f"    /// element's `<default>` row in MuJoCo {PINNED_MUJOCO}. Always false in default rows.")
     w("    pub nodefault: bool,")
+    w("    /// What MuJoCo's reader accepts as its value (the schema's type).")
+    w("    pub value: Value,")
+    w("}")
+    w("")
+    w("/// Count bound of [`Value::Reals`] and [`Value::Ints`]: any number of values.")
+    w("pub const MANY: u16 = u16::MAX;")
+    w("")
+    w("/// What an attribute's value must be, from the schema's type (`double[3]`, `int`,")
+    w("/// `enum<geomtype>`, ...). Counts are of white-space separated values; an empty value")
+    w("/// (no values at all) is always accepted for numbers, as MuJoCo does.")
+    w("#[derive(Clone, Copy, Debug, PartialEq, Eq)]")
+    w("pub enum Value {")
+    w("    /// Not checked: names, files, free text, flags, and what the schema does not type.")
+    w("    Text,")
+    w("    /// From `.0` to `.1` real numbers (`double`, `float`).")
+    w("    Reals(u16, u16),")
+    w("    /// From `.0` to `.1` integers (`int`), each within `i32`.")
+    w("    Ints(u16, u16),")
+    w("    /// Exactly one of these keywords (`bool`, `enum<...>`), compared byte for byte.")
+    w("    Keyword(&'static [&'static str]),")
     w("}")
     w("")
     w("/// A slot of a `<default>` class: the row that element kinds with a `class` read from.")
@@ -677,35 +774,47 @@ def emit(b: Builder, namespaces: list[str], args, schema_sha: str) -> str:
     w("}")
     w("")
     w("use AttrKind::{File, Id, ObjName, ObjType, Plain, Ref, RefList};")
+    w("use Value::{Ints, Keyword, Reals, Text};")
     w("")
-    w("const fn a(name: &'static str, kind: AttrKind) -> AttrSpec {")
+    w("const fn a(name: &'static str, kind: AttrKind, value: Value) -> AttrSpec {")
     w("    AttrSpec {")
     w("        name,")
     w("        kind,")
     w("        nodefault: false,")
+    w("        value,")
     w("    }")
     w("}")
     w("")
-    w("const fn nd(name: &'static str, kind: AttrKind) -> AttrSpec {")
+    w("const fn nd(name: &'static str, kind: AttrKind, value: Value) -> AttrSpec {")
     w("    AttrSpec {")
     w("        name,")
     w("        kind,")
     w("        nodefault: true,")
+    w("        value,")
     w("    }")
     w("}")
+    w("")
+    used = sorted({x.value.split(":")[1] for e in els for x in e.attrs
+                   if x.value.startswith("Keyword:")})
+    for name in used:
+        keys = ["false", "true"] if name == "bool" else ENUMS[name]
+        what = "`bool`" if name == "bool" else f"`enum<{name}>`"
+        quoted = ", ".join('"' + k + '"' for k in keys)
+        w(f"/// The keywords of {what}.")
+        w(f"const KW_{name.upper()}: &[&str] = &[{quoted}];")
     w("")
     # Attribute rows, shared between kinds whose rows are identical.
     row_const: dict[tuple, str] = {}
     for e in els:
         if not e.attrs:
             continue
-        key = tuple((x.name, x.kind, x.nodefault, x.comment) for x in e.attrs)
+        key = tuple((x.name, x.kind, x.nodefault, x.comment, x.value) for x in e.attrs)
         if key in row_const:
             continue
         cname = f"{e.name.upper()}_ATTRS"
         row_const[key] = cname
         users = [x.name for x in els if tuple(
-            (y.name, y.kind, y.nodefault, y.comment) for y in x.attrs) == key]
+            (y.name, y.kind, y.nodefault, y.comment, y.value) for y in x.attrs) == key]
         doc = f"Attributes of {', '.join(f'`{u}`' for u in users)}."
         for piece in textwrap.wrap(doc, 94):
             w(f"/// {piece}")
@@ -713,7 +822,7 @@ def emit(b: Builder, namespaces: list[str], args, schema_sha: str) -> str:
         for x in e.attrs:
             # Uses the imported variant names (the `use AttrKind::...` above).
             fn = "nd" if x.nodefault else "a"
-            line = f'    {fn}("{x.name}", {rust_kind(x.kind)}),'
+            line = f'    {fn}("{x.name}", {rust_kind(x.kind)}, {rust_value(x.value)}),'
             if x.comment:
                 line += f" // {x.comment}"
             w(line)
@@ -721,7 +830,7 @@ def emit(b: Builder, namespaces: list[str], args, schema_sha: str) -> str:
         w("")
     w("static ELEMENTS: &[ElementSpec] = &[")
     for e in els:
-        key = tuple((x.name, x.kind, x.nodefault, x.comment) for x in e.attrs)
+        key = tuple((x.name, x.kind, x.nodefault, x.comment, x.value) for x in e.attrs)
         attrs = row_const.get(key, "&[]")
         kids = ", ".join(f'"{c}"' for c in e.children)
         slot = f"Some(DefaultSlot::{camel(e.slot)})" if e.slot else "None"
@@ -882,6 +991,7 @@ def main() -> None:
     schema_bytes = args.schema.read_bytes()
     schema, ns_set = parse_schema(schema_bytes.decode("utf-8"))
     version, tree_text = run_print_schema(args.python)
+    check_symbolic_counts(args.python)
     if version != PINNED_MUJOCO:
         die(f"{args.python} has mujoco {version}, expected {PINNED_MUJOCO}")
     tree = parse_print_schema(tree_text)

@@ -9,7 +9,7 @@ use crate::document::prefix::{
 };
 use crate::document::schema::Kind;
 use crate::document::tree::Node;
-use crate::document::vocab::{AttrKind, Ns};
+use crate::document::vocab::{AttrKind, MANY, Ns, Value};
 use crate::error::{Error, ErrorKind, Errors};
 
 /// A reference found in the document, checked once every name is known.
@@ -21,9 +21,11 @@ struct Reference {
 }
 
 impl Document {
-    /// Checks that no two objects of one namespace share a name and that every reference
-    /// names an existing object (the world body is always there). Reports every problem,
-    /// in document order, each at its element's `file:line:col`.
+    /// Checks that no two objects of one namespace share a name, that every reference
+    /// names an existing object (the world body is always there), and that every value has
+    /// the count and form MuJoCo's schema gives it (`pos` three numbers, `group` an integer,
+    /// `type` one of its keywords). Reports every problem, in document order, each at its
+    /// element's `file:line:col`.
     ///
     /// ```
     /// use mjcf_forge::Document;
@@ -50,6 +52,10 @@ impl Document {
                 else {
                     continue;
                 };
+                if let Some(problem) = value_problem(value, spec.value) {
+                    let msg = format!("element {} attribute '{name}': {problem}", self.tag(node));
+                    errors.push((node, self.error_at(node, ErrorKind::Invalid(msg))));
+                }
                 match spec.kind {
                     AttrKind::Id(ns) => {
                         // An empty name is no name (an asset is then named after its file).
@@ -150,6 +156,93 @@ impl Document {
             }
         }
     }
+}
+
+/// What is wrong with `value` for an attribute of type `ty`, as MuJoCo 3.17.0 and 4.0.0
+/// read it; `None` if they accept it. Numbers: white-space separated, each as `strtod`
+/// takes it (`inf`, `nan` and hexadecimal included), none out of range; no value at all is
+/// accepted. Keywords: exact, without trimming.
+fn value_problem(value: &str, ty: Value) -> Option<String> {
+    let (min, max, ints) = match ty {
+        Value::Text => return None,
+        Value::Keyword(keys) => {
+            if keys.contains(&value) {
+                return None;
+            }
+            let list = match keys.split_last() {
+                Some((last, [])) => format!("'{last}'"),
+                Some((last, rest)) => format!(
+                    "{} or '{last}'",
+                    rest.iter()
+                        .map(|k| format!("'{k}'"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+                None => String::new(),
+            };
+            return Some(format!("unknown keyword '{value}' (expected {list})"));
+        }
+        Value::Reals(min, max) => (min, max, false),
+        Value::Ints(min, max) => (min, max, true),
+    };
+    let mut count = 0usize;
+    for token in value.split_ascii_whitespace() {
+        count += 1;
+        if let Some(problem) = number_problem(token, ints) {
+            return Some(problem);
+        }
+    }
+    // MuJoCo leaves an attribute with no values at its default.
+    let max = if max == MANY {
+        usize::MAX
+    } else {
+        usize::from(max)
+    };
+    if count == 0 || (usize::from(min)..=max).contains(&count) {
+        return None;
+    }
+    let what = if ints { "integer" } else { "number" };
+    let expected = match (usize::from(min), max) {
+        (lo, usize::MAX) => format!("at least {lo} {what}s"),
+        (lo, hi) if lo == hi && lo == 1 => format!("1 {what}"),
+        (lo, hi) if lo == hi => format!("{lo} {what}s"),
+        (lo, hi) => format!("{lo} to {hi} {what}s"),
+    };
+    Some(format!("expected {expected}, found {count}"))
+}
+
+/// What is wrong with one number token, if anything.
+fn number_problem(token: &str, int: bool) -> Option<String> {
+    let digits = token.trim_start_matches(['+', '-']);
+    if int {
+        if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
+            return Some(format!("'{token}' is not an integer"));
+        }
+        return match token.parse::<i64>() {
+            Ok(n) if i32::try_from(n).is_ok() => None,
+            _ => Some(format!("'{token}' is out of range")),
+        };
+    }
+    let lower = digits.to_ascii_lowercase();
+    if let Some(hex) = lower.strip_prefix("0x") {
+        // strtod's hexadecimal form: rare, taken as MuJoCo takes it, without a range check.
+        let ok = !hex.is_empty()
+            && hex
+                .bytes()
+                .all(|b| b.is_ascii_hexdigit() || matches!(b, b'.' | b'p' | b'+' | b'-'));
+        return (!ok).then(|| format!("'{token}' is not a number"));
+    }
+    let Ok(x) = token.parse::<f64>() else {
+        return Some(format!("'{token}' is not a number"));
+    };
+    let literal_inf = lower.starts_with("inf");
+    // strtod reports overflow (and underflow to zero) as a range error, which MuJoCo refuses.
+    let mantissa = lower.split('e').next().unwrap_or("");
+    let underflow = x == 0.0 && mantissa.bytes().any(|b| (b'1'..=b'9').contains(&b));
+    if (x.is_infinite() && !literal_inf) || underflow {
+        return Some(format!("'{token}' is out of range"));
+    }
+    None
 }
 
 impl Document {
