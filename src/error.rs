@@ -23,7 +23,8 @@ pub struct Location {
     /// The key path of the value in a structured description (`objects[0].placement.x`;
     /// empty for the whole description), shown instead of the line and column, which are
     /// then those of the text the description was read as and serve only for ordering.
-    pub key: Option<Arc<str>>,
+    /// (An `Arc<String>`, one pointer wide: an `Error` stays small enough to return.)
+    pub key: Option<Arc<String>>,
 }
 
 impl Location {
@@ -46,11 +47,11 @@ impl fmt::Display for Location {
     /// use std::{path::Path, sync::Arc};
     /// let mut at = mjcf_forge::Location::new(Arc::from(Path::new("<scene dict>")), 9, 3);
     /// assert_eq!(at.to_string(), "<scene dict>:9:3");
-    /// at.key = Some(Arc::from("objects[0].placement.x"));
+    /// at.key = Some(Arc::new("objects[0].placement.x".to_string()));
     /// assert_eq!(at.to_string(), "<scene dict>: objects[0].placement.x");
     /// ```
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.key.as_deref() {
+        match self.key.as_deref().map(String::as_str) {
             Some("") => write!(f, "{}", self.file.display()),
             Some(key) => write!(f, "{}: {key}", self.file.display()),
             None => write!(f, "{}:{}:{}", self.file.display(), self.line, self.col),

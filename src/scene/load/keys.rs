@@ -11,7 +11,7 @@ use toml::de::{DeTable, DeValue};
 /// The key path of every key and value of a TOML text, by its byte span.
 pub(crate) struct KeyPaths {
     /// `(span, path)` of each key and value, parents before their children.
-    spans: Vec<(Range<usize>, Arc<str>)>,
+    spans: Vec<(Range<usize>, Arc<String>)>,
 }
 
 impl KeyPaths {
@@ -19,15 +19,15 @@ impl KeyPaths {
     /// so it does: the caller then reports lines and columns).
     pub(crate) fn of(text: &str) -> Option<KeyPaths> {
         let table = DeTable::parse(text).ok()?;
-        let mut spans = vec![(table.span(), Arc::from(""))];
+        let mut spans = vec![(table.span(), Arc::new(String::new()))];
         walk_table(table.get_ref(), "", &mut spans);
         Some(KeyPaths { spans })
     }
 
     /// The path of the innermost key or value that holds `span` (the whole description's
     /// empty path when none does).
-    pub(crate) fn at(&self, span: Range<usize>) -> Arc<str> {
-        let mut best: Option<&(Range<usize>, Arc<str>)> = None;
+    pub(crate) fn at(&self, span: Range<usize>) -> Arc<String> {
+        let mut best: Option<&(Range<usize>, Arc<String>)> = None;
         for entry in &self.spans {
             let (r, _) = entry;
             let holds = r.start <= span.start && span.end <= r.end.max(r.start + 1);
@@ -36,7 +36,7 @@ impl KeyPaths {
                 best = Some(entry);
             }
         }
-        best.map_or_else(|| Arc::from(""), |(_, p)| p.clone())
+        best.map_or_else(|| Arc::new(String::new()), |(_, p)| p.clone())
     }
 }
 
@@ -53,22 +53,26 @@ pub(crate) fn join(path: &str, key: &str) -> String {
     }
 }
 
-fn walk_table(table: &DeTable<'_>, path: &str, out: &mut Vec<(Range<usize>, Arc<str>)>) {
+fn walk_table(table: &DeTable<'_>, path: &str, out: &mut Vec<(Range<usize>, Arc<String>)>) {
     for (key, value) in table {
         let here = join(path, key.get_ref());
-        let here: Arc<str> = Arc::from(here);
+        let here = Arc::new(here);
         out.push((key.span(), here.clone()));
         walk(value, &here, out);
     }
 }
 
-fn walk(value: &Spanned<DeValue<'_>>, path: &Arc<str>, out: &mut Vec<(Range<usize>, Arc<str>)>) {
+fn walk(
+    value: &Spanned<DeValue<'_>>,
+    path: &Arc<String>,
+    out: &mut Vec<(Range<usize>, Arc<String>)>,
+) {
     out.push((value.span(), path.clone()));
     match value.get_ref() {
         DeValue::Table(t) => walk_table(t, path, out),
         DeValue::Array(items) => {
             for (i, item) in items.iter().enumerate() {
-                walk(item, &Arc::from(format!("{path}[{i}]")), out);
+                walk(item, &Arc::new(format!("{path}[{i}]")), out);
             }
         }
         _ => {}

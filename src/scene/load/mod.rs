@@ -70,7 +70,7 @@ impl Source<'_> {
     /// The whole description (a problem the parser gives no span for).
     fn whole(&self) -> Location {
         let mut at = Location::new(self.file.clone(), 1, 1);
-        at.key = self.keys.as_ref().map(|_| Arc::from(""));
+        at.key = self.keys.as_ref().map(|_| Arc::new(String::new()));
         at
     }
 
@@ -121,7 +121,7 @@ pub(crate) fn from_serialized(
 /// is read as TOML.
 pub(crate) fn key_location(file: Arc<Path>, key: &str) -> Location {
     let mut at = Location::new(file, 1, 1);
-    at.key = Some(Arc::from(key));
+    at.key = Some(Arc::new(key.to_string()));
     at
 }
 
