@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// Where something is in the sources: a file, a 1-based line and column, and the chain of
-/// `<include>` elements through which that file was reached (outermost first).
+/// `<include>` elements through which that file was reached (outermost first); or, for a
+/// description that has no text of its own (a scene given as a Python `dict`), the key path
+/// of the value (`objects[0].placement.x`).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Location {
     /// The file, as it was named to us (absolute for included files).
@@ -18,6 +20,11 @@ pub struct Location {
     pub col: u32,
     /// The `<include>` elements that led to `file`, outermost first.
     pub included_from: Vec<(Arc<Path>, u32, u32)>,
+    /// The key path of the value in a structured description (`objects[0].placement.x`;
+    /// empty for the whole description), shown instead of the line and column, which are
+    /// then those of the text the description was read as and serve only for ordering.
+    /// (An `Arc<String>`, one pointer wide: an `Error` stays small enough to return.)
+    pub key: Option<Arc<String>>,
 }
 
 impl Location {
@@ -28,13 +35,27 @@ impl Location {
             line,
             col,
             included_from: Vec::new(),
+            key: None,
         }
     }
 }
 
 impl fmt::Display for Location {
+    /// `file:line:col`, or `file: key.path` for a location given by its key path.
+    ///
+    /// ```
+    /// use std::{path::Path, sync::Arc};
+    /// let mut at = mjcf_forge::Location::new(Arc::from(Path::new("<scene dict>")), 9, 3);
+    /// assert_eq!(at.to_string(), "<scene dict>:9:3");
+    /// at.key = Some(Arc::new("objects[0].placement.x".to_string()));
+    /// assert_eq!(at.to_string(), "<scene dict>: objects[0].placement.x");
+    /// ```
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}:{}:{}", self.file.display(), self.line, self.col)
+        match self.key.as_deref().map(String::as_str) {
+            Some("") => write!(f, "{}", self.file.display()),
+            Some(key) => write!(f, "{}: {key}", self.file.display()),
+            None => write!(f, "{}:{}:{}", self.file.display(), self.line, self.col),
+        }
     }
 }
 

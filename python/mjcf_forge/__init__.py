@@ -14,7 +14,10 @@
 - :class:`DocumentCache`: the same for any document or MJCF text: its structure
   (``doc.structure_key``) and patch (``doc.patch``) found by reading it.
 - :class:`LoadCache`: loaded files served again, copied, while unchanged.
-- :class:`MjcfError`: the one exception type (a ``ValueError``), with ``.errors``.
+- :class:`MjcfError`: the package's exception (a ``ValueError``), with ``.errors``;
+  :class:`MjcfFileNotFoundError` is both an :class:`MjcfError` and a
+  ``FileNotFoundError``, for a file that does not exist. Arguments of the wrong type
+  raise ``TypeError``, a variant index out of range ``IndexError``.
 - :mod:`mjcf_forge.base`: robosuite's ``MujocoXML``, ``MujocoModel`` and
   ``MujocoXMLModel`` (``robosuite.models.base``) over documents, for code written for
   robosuite (its ``XMLError`` is an :class:`MjcfError`); ``mjcf_forge.robosuite.use()``,
@@ -35,6 +38,7 @@ from ._mjcf_forge import (
     VariantIterator,
     __version__,
 )
+from ._errors import MjcfFileNotFoundError
 from ._cache import ModelCache
 from ._doc_cache import DocumentCache
 from . import etree
@@ -48,6 +52,7 @@ __all__ = [
     "LoadCache",
     "MergeReport",
     "MjcfError",
+    "MjcfFileNotFoundError",
     "Model",
     "ModelCache",
     "Scene",

@@ -15,11 +15,13 @@ from __future__ import annotations
 import collections
 import copy
 import itertools
+import os
 from typing import Any, Callable
 
 import numpy as np
 
-from ._mjcf_forge import MjcfError
+from ._mjcf_forge import MjcfError, Scene
+from ._progress import progress_of
 
 # Integer arrays that, with the sizes and the names, tell one structure from another.
 _SIGNATURE_ARRAYS = (
@@ -428,7 +430,7 @@ class _Plan:
 
 class ModelCache:
     """Compiled models of a :class:`Scene`'s variants, one per structure, patched per
-    variant; bounded in count (``max_models``) and bytes (``max_bytes``: the models, their
+    variant (``scene`` is a :class:`Scene` or the path of a scene file); bounded in count (``max_models``) and bytes (``max_bytes``: the models, their
     scratch data included), least recently used first out.
 
     ``cache.model(variant)`` gives a model equal to what MuJoCo compiles from
@@ -464,6 +466,12 @@ class ModelCache:
     ) -> None:
         import mujoco
 
+        if isinstance(scene, (str, os.PathLike)):
+            scene = Scene.load(scene)
+        elif not hasattr(scene, "fixed_statistics"):  # a Scene, or code that stands for one
+            raise TypeError(
+                f"ModelCache(scene): a Scene or the path of a scene file, not {type(scene).__name__}"
+            )
         if max_models < 1:
             raise ValueError("max_models must be at least 1")
         self._mujoco = mujoco
@@ -609,17 +617,24 @@ class ModelCache:
         self.patches += 1
         return model
 
-    def batch(self, variants: Any) -> dict[str, np.ndarray]:
+    def batch(self, variants: Any, progress: Any = None) -> dict[str, np.ndarray]:
         """Per-world arrays for batched simulation (``superset=True``): for every field of
         the superset model that differs between the given variants, one row per variant
         (``{"geom_rgba": (n, ngeom, 4), "qpos0": (n, nq), "stat.meaninertia": (n,), ...}``),
         each row what the patched superset model holds for that variant: the form MJX and
         MuJoCo Warp take for per-world model fields. Fields every variant shares are left
-        out (they are the superset model's)."""
+        out (they are the superset model's).
+
+        ``progress``: ``True`` (a ``tqdm`` bar, or a line on standard error every second
+        without ``tqdm``), a ``tqdm``-like object with ``update(n)``, or a callable ``f(n)``,
+        told per variant; ``None`` (default) or ``False`` for none."""
         if self.superset is None:
             raise ValueError("batch() needs ModelCache(scene, superset=True)")
         variants = list(variants)
+        bar = progress_of(progress, len(variants), "variants")
         if not variants:
+            if bar is not None:
+                bar.close()
             return {}
         model = copy.copy(self.model(variants[0]))
         names = [
@@ -631,12 +646,18 @@ class ModelCache:
         ]
         rows: dict[str, list[np.ndarray]] = {n: [] for n in names}
         stats = {f"stat.{s}": [] for s in ("meaninertia", "meanmass", "meansize", "extent", "center")}
-        for v in variants:
-            self.apply(v, model)
-            for n in names:
-                rows[n].append(getattr(model, n).copy())
-            for s in stats:
-                stats[s].append(np.array(getattr(model.stat, s[5:]), dtype=np.float64))
+        try:
+            for v in variants:
+                self.apply(v, model)
+                for n in names:
+                    rows[n].append(getattr(model, n).copy())
+                for s in stats:
+                    stats[s].append(np.array(getattr(model.stat, s[5:]), dtype=np.float64))
+                if bar is not None:
+                    bar.update(1)
+        finally:
+            if bar is not None:
+                bar.close()
         out = {}
         for n, r in list(rows.items()) + list(stats.items()):
             stacked = np.stack(r)

@@ -214,7 +214,7 @@ class Model:
     def __init__(
         self,
         source: Union[Document, _Path],
-        idn: Optional[object] = None,
+        idn: Union[int, str, None] = None,
         *,
         prefix: Optional[str] = None,
         name: Optional[str] = None,
@@ -227,7 +227,9 @@ class Model:
     @property
     def naming_prefix(self) -> str: ...
     @property
-    def root_body(self) -> str: ...
+    def root_body(self) -> str:
+        """The top-level body (prefixed); one the file leaves unnamed is named ``root``
+        (or ``root1``...), as the same object is named in a scene's variants."""
     @property
     def bodies(self) -> list[str]: ...
     @property
@@ -294,7 +296,9 @@ class Variant:
     def xml(self) -> str: ...
     @property
     def params(self) -> dict[str, Any]:
-        """``{"objects": [...], "randomized": [...]}`` (a new dict each time)."""
+        """``{"index": i, "objects": [...], "randomized": [...]}`` (a new dict each time):
+        ``pos``/``quat`` are lists of floats; a randomized ``value`` a float, a list of
+        floats, or a ``str`` for a name or keyword."""
     @property
     def params_json(self) -> str: ...
     @property
@@ -362,4 +366,5 @@ class Scene:
         indices: Iterable[int],
         threads: Optional[int] = None,
         window: Optional[int] = None,
+        progress: Union[bool, Callable[[int], Any], Any, None] = None,
     ) -> VariantIterator: ...

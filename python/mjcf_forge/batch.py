@@ -34,6 +34,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ._cache import _STATIC_PREFIXES, ModelCache, _error
+from ._progress import progress_of
 
 # Fields mj_setConst derives from values a patch writes (so they follow the variant even
 # when no patch entry names them).
@@ -101,8 +102,11 @@ class WorldBatch:
     """``nworld`` worlds of one scene, world ``w`` holding variant ``variants[w]``, as
     per-world fields of the scene's superset model (see the module).
 
-    ``source`` is a :class:`Scene` or a ``ModelCache(scene, superset=True)``; ``variants``
-    are variant indices (or variants). Raises :class:`MjcfError` for zero worlds, a variant
+    ``source`` is a :class:`Scene` (or the path of a scene file) or a
+    ``ModelCache(scene, superset=True)``; ``variants`` are variant indices (or variants).
+    ``progress``: ``True`` (a ``tqdm`` bar, or a line on standard error every second
+    without ``tqdm``), a ``tqdm``-like object with ``update(n)`` or a callable ``f(n)``,
+    told per world built; ``None`` (default) or ``False`` for none. Raises :class:`MjcfError` for zero worlds, a variant
     the superset cannot express (it randomizes a structural value), or a parked object
     within reach of another geom; all before any simulator array is built.
 
@@ -114,7 +118,7 @@ class WorldBatch:
     bool: the geoms of objects the world parks).
     """
 
-    def __init__(self, source: Any, variants: Sequence[Any]) -> None:
+    def __init__(self, source: Any, variants: Sequence[Any], progress: Any = None) -> None:
         if isinstance(source, ModelCache):
             cache = source
         else:
@@ -146,7 +150,16 @@ class WorldBatch:
         }
         self._data: Any = None
         self._root_of_geom = model.body_rootid[model.geom_bodyid]
-        rows = [self._rows(i) for i in indices]
+        bar = progress_of(progress, len(indices), "worlds")
+        try:
+            rows = []
+            for i in indices:
+                rows.append(self._rows(i))
+                if bar is not None:
+                    bar.update(1)
+        finally:
+            if bar is not None:
+                bar.close()
         varying = sorted({n for r in rows for n in r if n in self._others})
         self.per_world = self._candidates + varying + [f"stat.{s}" for s in _STATS]
         self.arrays = {

@@ -1,16 +1,21 @@
-//! The one exception type, and the edge where Rust errors and panics become it.
+//! The exception types, and the edge where Rust errors and panics become them.
 //!
 //! Every call into the library goes through [`run`] (GIL released) or [`catch`] (GIL held):
 //! both turn a panic into an `MjcfError` instead of letting PyO3 raise its
 //! `PanicException`, which derives from `BaseException` and so escapes `except Exception`.
+//! A refusal whose every problem is a file that does not exist is an
+//! `MjcfFileNotFoundError`: an `MjcfError` and a `FileNotFoundError` at once.
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::sync::{RwLock, RwLockReadGuard, RwLockWriteGuard};
+use std::path::{Path, PathBuf};
+use std::sync::{OnceLock, RwLock, RwLockReadGuard, RwLockWriteGuard};
 
+use mjcf_forge::ErrorKind;
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyList;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyList, PyType};
 
 create_exception!(
     mjcf_forge,
@@ -23,31 +28,86 @@ create_exception!(
      a list of ``str``, one per problem, all problems of the pass at once."
 );
 
+/// `mjcf_forge.MjcfFileNotFoundError(MjcfError, FileNotFoundError)`, a Python class
+/// (`mjcf_forge/_errors.py`: `create_exception!` makes classes of one base only).
+static FILE_NOT_FOUND: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+
 /// What went wrong on the Rust side, as the lines the exception will carry.
 #[derive(Debug)]
-pub(crate) struct Failure(pub(crate) Vec<String>);
+pub(crate) struct Failure {
+    pub(crate) lines: Vec<String>,
+    /// When every problem is a file that does not exist: the first such path.
+    missing: Option<PathBuf>,
+}
+
+impl Failure {
+    /// A failure told by `lines` (an `MjcfError`).
+    pub(crate) fn new(lines: Vec<String>) -> Failure {
+        Failure {
+            lines,
+            missing: None,
+        }
+    }
+}
+
+/// The path of a file that does not exist, when `error` is about one. The library keeps
+/// the operating system's words (`No such file or directory (os error 2)`), not its error
+/// kind: they are compared with the words of the "not found" codes.
+fn missing_file(error: &mjcf_forge::Error) -> Option<&Path> {
+    static NOT_FOUND: OnceLock<Vec<String>> = OnceLock::new();
+    let words = NOT_FOUND.get_or_init(|| {
+        // ENOENT; Windows also has ERROR_PATH_NOT_FOUND.
+        let codes: &[i32] = if cfg!(windows) { &[2, 3] } else { &[2] };
+        codes
+            .iter()
+            .map(|&c| std::io::Error::from_raw_os_error(c).to_string())
+            .collect()
+    });
+    let (path, reason) = match &error.kind {
+        ErrorKind::Io { path, reason } => (path, reason),
+        ErrorKind::IncludeNotFound {
+            beside_main,
+            reason,
+            ..
+        } => (beside_main, reason),
+        _ => return None,
+    };
+    words
+        .iter()
+        .any(|w| reason.ends_with(w.as_str()))
+        .then_some(path.as_path())
+}
 
 impl From<mjcf_forge::Errors> for Failure {
     fn from(errors: mjcf_forge::Errors) -> Failure {
-        Failure(errors.0.iter().map(ToString::to_string).collect())
+        let missing: Option<Vec<&Path>> = errors.0.iter().map(missing_file).collect();
+        Failure {
+            lines: errors.0.iter().map(ToString::to_string).collect(),
+            missing: missing.and_then(|paths| paths.first().map(|p| p.to_path_buf())),
+        }
     }
 }
 
 impl From<mjcf_forge::Error> for Failure {
     fn from(error: mjcf_forge::Error) -> Failure {
-        Failure(vec![error.to_string()])
+        Failure::from(mjcf_forge::Errors(vec![error]))
     }
 }
 
 impl From<String> for Failure {
     fn from(message: String) -> Failure {
-        Failure(vec![message])
+        Failure::new(vec![message])
     }
 }
 
 impl From<Failure> for PyErr {
     fn from(failure: Failure) -> PyErr {
-        mjcf_error(failure.0)
+        match failure.missing {
+            Some(path) => {
+                Python::attach(|py| file_not_found(py, failure.lines, &path).unwrap_or_else(|e| e))
+            }
+            None => mjcf_error(failure.lines),
+        }
     }
 }
 
@@ -62,6 +122,17 @@ pub(crate) fn mjcf_error(lines: Vec<String>) -> PyErr {
         }
         err
     })
+}
+
+/// An `MjcfFileNotFoundError` told by `lines`, about `path` (an error making it is
+/// returned as the error to raise).
+fn file_not_found(py: Python<'_>, lines: Vec<String>, path: &Path) -> Result<PyErr, PyErr> {
+    let class = FILE_NOT_FOUND.import(py, "mjcf_forge._errors", "MjcfFileNotFoundError")?;
+    let value = class.call1((lines.join("\n"),))?;
+    value.setattr("errors", PyList::new(py, &lines)?)?;
+    value.setattr("errno", py.import("errno")?.getattr("ENOENT")?)?;
+    value.setattr("filename", path.as_os_str())?;
+    Ok(PyErr::from_value(value))
 }
 
 /// Runs `work` with the GIL released (other Python threads run meanwhile); a panic becomes
@@ -84,7 +155,7 @@ pub(crate) fn catch<T>(work: impl FnOnce() -> Result<T, Failure>) -> Result<T, F
                 .map(|s| s.to_string())
                 .or_else(|| payload.downcast_ref::<String>().cloned())
                 .unwrap_or_else(|| "unknown panic".to_string());
-            Err(Failure(vec![format!(
+            Err(Failure::new(vec![format!(
                 "internal error in mjcf-forge (please report it): {what}"
             )]))
         }

@@ -71,6 +71,24 @@ fn offsets(model: &XmlModel) -> Result<mjcf_forge::Offsets, Failure> {
     model.try_offsets().map_err(Failure::from)
 }
 
+/// An instance id as robosuite's models take it: a ``str``, or an integer (anything with
+/// ``__index__``, numpy's included, ``bool`` not), written in decimal. Anything else would
+/// make a prefix of its ``str()`` (``"<object object at 0x...>_"``): a ``TypeError``.
+fn instance_id(idn: &Bound<'_, PyAny>) -> PyResult<String> {
+    if let Ok(s) = idn.cast::<PyString>() {
+        return Ok(s.to_cow()?.into_owned());
+    }
+    if !idn.is_instance_of::<pyo3::types::PyBool>()
+        && let Ok(i) = idn.py().import("operator")?.getattr("index")?.call1((idn,))
+    {
+        return Ok(i.str()?.to_cow()?.into_owned());
+    }
+    Err(PyTypeError::new_err(format!(
+        "Model(source, idn): idn is an int or a str (the instance id), not {}",
+        idn.get_type().name()?
+    )))
+}
+
 fn numpy_array<'py>(py: Python<'py>, values: &[f64]) -> PyResult<Bound<'py, PyAny>> {
     py.import("numpy")?
         .getattr("array")?
@@ -105,7 +123,7 @@ impl PyModel {
         exclude_from_prefixing: Vec<String>,
     ) -> PyResult<PyModel> {
         let prefix = match (idn, prefix) {
-            (Some(idn), None) => format!("{}_", idn.str()?),
+            (Some(idn), None) => format!("{}_", instance_id(idn)?),
             (None, Some(prefix)) => prefix,
             _ => {
                 return Err(PyTypeError::new_err(
@@ -155,7 +173,10 @@ impl PyModel {
         self.lock(py).naming_prefix().to_owned()
     }
 
-    /// The one top-level body (prefixed name).
+    /// The one top-level body (prefixed name). One the file leaves unnamed (robosuite's
+    /// objects wrap theirs in one) is named ``root`` (or the first of ``root1``,
+    /// ``root2``... no body uses) before prefixing, as the same object is named in a
+    /// scene's variants: ``Model(can_xml, "object1").root_body == "object1_root"``.
     #[getter]
     fn root_body(&self, py: Python<'_>) -> String {
         self.lock(py).root_body().to_owned()

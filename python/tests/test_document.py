@@ -332,3 +332,30 @@ def test_merge_takes_lists_leaves_worldbodies_out_and_converts_inertia_with_a_ca
         base.merge(a, compile_inertia=3)
     with pytest.raises(TypeError):
         base.merge([a, 3])
+
+
+def test_missing_files_are_file_not_found_errors_with_the_same_lines(tmp_path, monkeypatch):
+    # Issue 23: a file that does not exist is a FileNotFoundError (and still an MjcfError
+    # with its lines); any other refusal is an MjcfError only.
+    import errno
+
+    from mjcf_forge import LoadCache, MjcfFileNotFoundError
+
+    monkeypatch.chdir(ROOT)
+    for load in (Document.load, LoadCache().load):
+        with pytest.raises(FileNotFoundError) as err:
+            load(tmp_path / "nope.xml")
+        assert isinstance(err.value, MjcfFileNotFoundError) and isinstance(err.value, MjcfError)
+        assert err.value.errno == errno.ENOENT and err.value.filename == str(tmp_path / "nope.xml")
+    for case in ("include_missing", "include_nested_missing"):
+        with pytest.raises(FileNotFoundError) as err:
+            Document.load(f"corpora/errors/{case}.xml")
+        expected = (ROOT / "corpora" / "errors" / f"{case}.err").read_text().rstrip("\n").split("\n")
+        assert err.value.errors == expected and str(err.value) == "\n".join(expected)
+    assert err.value.filename == "corpora/errors/missing_hand.xml"  # where MuJoCo looks first
+    with pytest.raises(MjcfError) as err:
+        Document.load("corpora/errors/unknown_class.xml")
+    assert not isinstance(err.value, OSError)
+    with pytest.raises(MjcfError) as err:
+        Document.load(tmp_path)  # a folder: not a missing file
+    assert not isinstance(err.value, OSError)

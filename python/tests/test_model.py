@@ -148,3 +148,50 @@ def test_model_tells_what_the_command_lines_info_tells(path, forge_cli):
     np.testing.assert_allclose(model.bottom_offset, cli["bottom_offset"], rtol=0, atol=1e-12)
     np.testing.assert_allclose(model.top_offset, cli["top_offset"], rtol=0, atol=1e-12)
     assert model.horizontal_radius == pytest.approx(cli["horizontal_radius"], abs=1e-12)
+
+
+def test_root_body_is_the_name_the_same_object_has_in_a_variant(tmp_path):
+    # can.xml wraps its body "object" in an unnamed one (robosuite's MujocoXMLModel raises
+    # TypeError for its root_body): named "root" before prefixing, as scenes name it.
+    from mjcf_forge import Scene
+
+    can = Model(OBJECTS[0], "object1")
+    assert can.root_body == "object1_root" and can.bodies[:2] == ["object1_root", "object1_object"]
+    m = mujoco.MjModel.from_xml_string(can.to_xml())
+    assert m.body(can.root_body).parentid[0] == 0
+    scene = Scene.from_toml(
+        f'base = "{RS_ASSETS / "arenas" / "empty_arena.xml"}"\n'
+        "[[objects]]\nname = \"object\"\n"
+        f'pool = ["{OBJECTS[0]}"]\ncount = 2\nprefix = "object{{i}}_"\nfree_joint = false\n'
+        "[objects.placement]\nx = [-1, 1]\ny = [-1, 1]\n",
+        tmp_path,
+    )
+    placed = {o["prefix"]: o["body"] for o in scene.variant(0).params["objects"]}
+    assert placed["object1_"] == can.root_body
+    # A body already named "root" keeps its name; the unnamed top one takes the next free.
+    doc = Document.from_string(
+        "<mujoco><worldbody><body><body name='root'><geom size='0.1'/></body></body></worldbody></mujoco>"
+    )
+    assert Model(doc, 0).root_body == "0_root1"
+    named = Model(PANDA, "robot0")
+    assert named.root_body == "robot0_base"
+
+
+def test_instance_ids_are_ints_or_strs():
+    assert Model(OBJECTS[0], 3).naming_prefix == "3_"
+    assert Model(OBJECTS[0], "left").naming_prefix == "left_"
+    assert Model(OBJECTS[0], np.int64(7)).naming_prefix == "7_"
+    for bad in (1.5, True, None.__class__, object(), [1], b"x"):
+        with pytest.raises(TypeError, match="idn is an int or a str"):
+            Model(OBJECTS[0], bad)
+    with pytest.raises(TypeError):
+        Model(OBJECTS[0], prefix=3)
+
+
+def test_a_missing_model_file_is_a_file_not_found_error(tmp_path):
+    from mjcf_forge import MjcfFileNotFoundError
+
+    with pytest.raises(FileNotFoundError) as err:
+        Model(tmp_path / "nope.xml", 0)
+    assert isinstance(err.value, MjcfFileNotFoundError) and isinstance(err.value, MjcfError)
+    assert err.value.filename == str(tmp_path / "nope.xml")

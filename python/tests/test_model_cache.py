@@ -426,3 +426,50 @@ def test_superset_refuses_a_variant_it_cannot_carry():
     sup = scene.superset()
     with pytest.raises(mjcf_forge.MjcfError, match="not a patch of the superset"):
         sup.patch(0)
+
+
+def test_a_cache_takes_a_scene_file_and_refuses_other_things(tmp_path):
+    # Issue 23: ModelCache("lift5.toml") used to fail with AttributeError.
+    by_path = mjcf_forge.ModelCache(PATCH / "patch.toml")
+    by_str = mjcf_forge.ModelCache(str(PATCH / "patch.toml"))
+    scene = mjcf_forge.Scene.load(PATCH / "patch.toml")
+    for cache in (by_path, by_str):
+        check_exact(scene.variant(2), cache.model(scene.variant(2)))
+    with pytest.raises(TypeError, match="a Scene or the path of a scene file"):
+        mjcf_forge.ModelCache(42)
+    with pytest.raises(FileNotFoundError):
+        mjcf_forge.ModelCache(tmp_path / "missing.toml")
+
+
+def test_batch_calls_report_progress(capsys, monkeypatch):
+    from mjcf_forge.batch import WorldBatch
+
+    scene = mjcf_forge.Scene.load(PATCH / "patch.toml")
+    cache = mjcf_forge.ModelCache(scene, superset=True)
+    told = []
+    variants = [scene.variant(i) for i in range(4)]
+    quiet = cache.batch(variants)
+    loud = cache.batch(variants, progress=told.append)
+    assert told == [1, 1, 1, 1] and quiet.keys() == loud.keys()
+    assert all(np.array_equal(quiet[k], loud[k]) for k in quiet)
+
+    class Bar:
+        n = 0
+        closed = False
+
+        def update(self, n):
+            self.n += n
+
+        def close(self):
+            self.closed = True
+
+    bar = Bar()
+    worlds = WorldBatch(cache, [0, 2, 5], progress=bar)
+    assert worlds.nworld == 3 and bar.n == 3 and not bar.closed  # the caller's bar stays open
+    monkeypatch.setitem(__import__("sys").modules, "tqdm", None)
+    WorldBatch(cache, [1, 2], progress=True)
+    assert capsys.readouterr().err.splitlines()[-1].startswith("mjcf-forge: worlds 2/2 (100%), ")
+    with pytest.raises(TypeError, match="progress is True, False, None"):
+        cache.batch(variants, progress=3)
+    # WorldBatch takes a scene file too (through ModelCache).
+    assert WorldBatch(PATCH / "patch.toml", [0]).nworld == 1

@@ -68,7 +68,7 @@ def test_every_public_member_has_a_docstring():
 
 def test_help_of_scene_reads_well():
     text = pydoc.render_doc(mjcf_forge.Scene, renderer=pydoc.plaintext)
-    for expected in ["variant(self, /, index)", "variants(self, /, indices, threads=None, window=None)",
+    for expected in ["variant(self, /, index)", "variants(self, /, indices, threads=None, window=None, progress=None)",
                      "from_dict(description, base_dir=None)", "(seed, i)", "GIL"]:
         assert expected in text, expected
 

@@ -371,6 +371,7 @@ impl Document {
             line: span.line,
             col: span.col,
             included_from,
+            key: None,
         }
     }
 

@@ -44,7 +44,11 @@ pub trait MujocoModel {
             .map(|(k, v)| (k.clone(), self.correct_naming(v)))
             .collect()
     }
-    /// The one top-level body.
+    /// The one top-level body. One the model file leaves unnamed (robosuite's objects wrap
+    /// their body in one) is named `root`, or the first of `root1`, `root2`... that no body
+    /// of the model uses, before prefixing: so it can be looked up by name in a compiled
+    /// model, and it is the name the same object has in a scene's variants. (robosuite's
+    /// own `MujocoXMLModel.root_body` raises a `TypeError` there.)
     fn root_body(&self) -> &str;
     /// Every named body, the root first.
     fn bodies(&self) -> &[String];
@@ -245,6 +249,28 @@ impl Syms {
     }
 }
 
+/// Names `root`, the top-level body of `doc`, when it has no name: `root`, or the first of
+/// `root1`, `root2`... that no body under it uses (see [`MujocoModel::root_body`]). The one
+/// rule for models and for the objects a scene places.
+pub(crate) fn name_unnamed_root(doc: &mut Document, root: Node) {
+    if doc.attr(root, "name").is_some() {
+        return;
+    }
+    let taken: Vec<&str> = doc
+        .descendants(root)
+        .filter(|&n| doc.tag(n) == "body")
+        .filter_map(|n| doc.attr(n, "name"))
+        .collect();
+    let name = (0..)
+        .map(|k| match k {
+            0 => "root".to_string(),
+            k => format!("root{k}"),
+        })
+        .find(|n| !taken.contains(&n.as_str()))
+        .expect("a free name exists");
+    doc.set_attr(root, "name", &name);
+}
+
 impl XmlModel {
     /// An instance with robosuite's default options (see [`XmlModelOptions`]).
     pub fn new(doc: Document, idn: impl std::fmt::Display) -> Result<XmlModel, Errors> {
@@ -283,6 +309,7 @@ impl XmlModel {
         // (only those that are a body's own, as MuJoCo lets those carry a name).
         let syms = Syms::get();
         let root = roots[0];
+        name_unnamed_root(&mut doc, root);
         let geoms: Vec<Node> = doc
             .descendants(world)
             .filter(|&n| doc.tag_sym(n) == Some(syms.geom) && doc.is_body_child(n))

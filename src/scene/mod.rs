@@ -204,6 +204,24 @@ impl Variant {
     }
 }
 
+/// The key paths of the nulls in `value` (`path` is its own).
+fn find_nulls(value: &serde_json::Value, path: &str, out: &mut Vec<String>) {
+    match value {
+        serde_json::Value::Null => out.push(path.to_string()),
+        serde_json::Value::Array(items) => {
+            for (i, item) in items.iter().enumerate() {
+                find_nulls(item, &format!("{path}[{i}]"), out);
+            }
+        }
+        serde_json::Value::Object(map) => {
+            for (k, v) in map {
+                find_nulls(v, &load::join_key(path, k), out);
+            }
+        }
+        _ => {}
+    }
+}
+
 impl Scene {
     /// Loads a scene file (TOML); model paths in it are relative to its folder.
     ///
@@ -246,32 +264,59 @@ impl Scene {
     }
 
     /// A scene from the same description as JSON (what a Python dictionary dumps to);
-    /// model paths are relative to `base_dir`. Positions in messages are those of the
-    /// description written as TOML, whose line is quoted.
+    /// model paths are relative to `base_dir`. A problem is told by the key path of the
+    /// value it is about, after the label `<scene dict>` (the description has no lines of
+    /// its own).
     ///
     /// ```
-    /// let scene = mjcf_forge::scene::Scene::from_json_str(
-    ///     r#"{"seed": 2, "base": "arena.xml"}"#,
-    ///     "corpora/scenes/demo",
-    /// )?;
+    /// use mjcf_forge::scene::Scene;
+    /// let scene = Scene::from_json_str(r#"{"seed": 2, "base": "arena.xml"}"#, "corpora/scenes/demo")?;
     /// assert_eq!(scene.seed(), 2);
+    /// let err = Scene::from_json_str(r#"{"base": "arena.xml", "seed": "2"}"#, "corpora/scenes/demo")
+    ///     .unwrap_err();
+    /// assert_eq!(err.to_string(), "<scene dict>: seed: invalid type: string \"2\", expected u64");
     /// # Ok::<(), mjcf_forge::Errors>(())
     /// ```
     pub fn from_json_str(json: &str, base_dir: impl AsRef<Path>) -> Result<Scene, Errors> {
-        let label: Arc<Path> = Arc::from(base_dir.as_ref().join("<scene dict>").as_path());
+        let label: Arc<Path> = Arc::from(Path::new("<scene dict>"));
         let value: serde_json::Value = serde_json::from_str(json).map_err(|e| {
             Error::at(
                 Location::new(label.clone(), e.line() as u32, e.column() as u32),
                 ErrorKind::Invalid(format!("invalid JSON: {e}")),
             )
         })?;
+        // TOML has no null: a key with no value is named here, before the TOML text
+        // (which would only say that something somewhere is unsupported).
+        let mut nulls = Vec::new();
+        find_nulls(&value, "", &mut nulls);
+        if !value.is_object() {
+            nulls.push(String::new());
+        }
+        if !nulls.is_empty() {
+            return Err(Errors(
+                nulls
+                    .iter()
+                    .map(|key| {
+                        let what = if key.is_empty() {
+                            "a scene description is a table (a dict) of its keys"
+                        } else {
+                            "null (None) is not a value: leave the key out"
+                        };
+                        Error::at(
+                            load::key_location(label.clone(), key),
+                            ErrorKind::Invalid(what.to_string()),
+                        )
+                    })
+                    .collect(),
+            ));
+        }
         let text = toml::to_string(&value).map_err(|e| {
             Error::at(
-                Location::new(label.clone(), 1, 1),
+                load::key_location(label.clone(), ""),
                 ErrorKind::Invalid(format!("not a scene description: {e}")),
             )
         })?;
-        load::from_toml(&text, label, &load::Files)
+        load::from_serialized(&text, label, base_dir.as_ref().to_path_buf(), &load::Files)
     }
 
     /// The built-in demo scene: a table arena, a two-finger arm on a mount, and boxes,

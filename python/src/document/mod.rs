@@ -550,7 +550,7 @@ impl PyDocument {
         let mut sections = Vec::with_capacity(tags.len());
         for tag in &tags {
             sections.push(Section::from_tag(tag).ok_or_else(|| {
-                Failure(vec![format!(
+                Failure::new(vec![format!(
                     "'{tag}' is not a section of an MJCF model (asset, worldbody, actuator, ...)"
                 )])
             })?);
@@ -573,7 +573,7 @@ impl PyDocument {
     /// merged into one at load, as MuJoCo reads them all in order.
     fn section<'py>(&self, py: Python<'py>, tag: &str) -> PyResult<Bound<'py, PyElement>> {
         let section = Section::from_tag(tag).ok_or_else(|| {
-            Failure(vec![format!(
+            Failure::new(vec![format!(
                 "'{tag}' is not a section of an MJCF model (asset, worldbody, actuator, ...)"
             )])
         })?;

@@ -18,7 +18,9 @@ pub(crate) fn check_xml_name(what: &str, name: &str) -> Result<(), Failure> {
     if ok {
         Ok(())
     } else {
-        Err(Failure(vec![format!("{what} {name:?} is not an XML name")]))
+        Err(Failure::new(vec![format!(
+            "{what} {name:?} is not an XML name"
+        )]))
     }
 }
 
@@ -30,7 +32,7 @@ pub(crate) fn check_xml_text(what: &str, text: &str) -> Result<(), Failure> {
         .find(|&c| c.is_control() && !matches!(c, '\t' | '\n' | '\r'))
     {
         None => Ok(()),
-        Some(c) => Err(Failure(vec![format!(
+        Some(c) => Err(Failure::new(vec![format!(
             "{what} {text:?} holds the character U+{:04X}, which XML cannot carry",
             c as u32
         )])),

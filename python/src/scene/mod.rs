@@ -18,7 +18,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use mjcf_forge::scene::Scene;
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyIndexError, PyOverflowError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
@@ -217,10 +217,12 @@ impl PyScene {
             .call((slf, indices, path), options)
     }
 
-    /// Variant ``index`` (made with the GIL released). Raises :class:`MjcfError` when it
-    /// cannot be made, e.g. a group whose objects find no place (the message names the
-    /// group, the region and the index).
-    fn variant(&self, py: Python<'_>, index: u64) -> PyResult<PyVariant> {
+    /// Variant ``index`` (made with the GIL released): an ``int`` from 0 to 2**64 - 1
+    /// (``IndexError`` outside, ``TypeError`` for another type). Raises
+    /// :class:`MjcfError` when it cannot be made, e.g. a group whose objects find no place
+    /// (the message names the group, the region and the index).
+    fn variant(&self, py: Python<'_>, index: &Bound<'_, PyAny>) -> PyResult<PyVariant> {
+        let index = variant_index(index)?;
         run(py, || make(&self.scene, index))
             .map(|made| PyVariant::new(made, Origin::Scene(self.scene.clone())))
     }
@@ -234,27 +236,45 @@ impl PyScene {
     ///
     /// A variant that cannot be made raises :class:`MjcfError` when its turn comes, and
     /// ends the iteration.
-    #[pyo3(signature = (indices, threads = None, window = None))]
+    ///
+    /// ``progress``: ``True`` for a ``tqdm`` bar (a line on standard error every second
+    /// without ``tqdm``), or your own object with ``update(n)`` (a ``tqdm`` bar) or a
+    /// callable ``f(n)``, told of the variants handed over once per batch; ``None``
+    /// (default) or ``False`` for none.
+    #[pyo3(signature = (indices, threads = None, window = None, progress = None))]
     fn variants(
         &self,
+        py: Python<'_>,
         indices: &Bound<'_, PyAny>,
         threads: Option<usize>,
         window: Option<usize>,
+        progress: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<PyVariantIter> {
         let indices: Vec<u64> = indices
             .try_iter()?
-            .map(|i| i.and_then(|i| i.extract::<u64>()))
+            .map(|i| i.and_then(|i| variant_index(&i)))
             .collect::<PyResult<_>>()?;
         if threads == Some(0) || window == Some(0) {
             return Err(PyValueError::new_err(
                 "threads and window must be at least 1",
             ));
         }
+        let progress = match progress {
+            Some(p) if !p.is_none() => {
+                let made = py
+                    .import("mjcf_forge._progress")?
+                    .getattr("progress_of")?
+                    .call1((p, indices.len(), "variants"))?;
+                (!made.is_none()).then(|| made.unbind())
+            }
+            _ => None,
+        };
         Ok(PyVariantIter::start(
             self.scene.clone(),
             indices,
             threads,
             window,
+            progress,
         )?)
     }
 
@@ -296,6 +316,25 @@ impl PyScene {
             self.scene.file().display().to_string(),
             self.scene.seed()
         )
+    }
+}
+
+/// A variant index from Python: an integer from 0 to 2**64 - 1 (anything with
+/// ``__index__``). Outside that range an ``IndexError`` (a negative index does not count
+/// from an end: a scene's variants have none); another type a ``TypeError``.
+pub(crate) fn variant_index(value: &Bound<'_, PyAny>) -> PyResult<u64> {
+    match value.extract::<u64>() {
+        Ok(i) => Ok(i),
+        Err(e) if e.is_instance_of::<PyOverflowError>(value.py()) => {
+            Err(PyIndexError::new_err(format!(
+                "variant index {} is out of range: indices run from 0 to 2**64 - 1",
+                value.repr()?
+            )))
+        }
+        Err(_) => Err(PyTypeError::new_err(format!(
+            "a variant index is an int, not {}",
+            value.get_type().name()?
+        ))),
     }
 }
 

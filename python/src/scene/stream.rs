@@ -6,6 +6,7 @@
 //! release of the GIL each: two futex calls and about one context switch per variant.
 
 use std::collections::VecDeque;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::sync::{Arc, Mutex};
 
@@ -62,6 +63,13 @@ pub(crate) struct PyVariantIter {
     taken: Mutex<Taken>,
     /// For the variants' documents, made on demand.
     scene: Arc<Scene>,
+    /// Where progress goes (`mjcf_forge._progress`), if anywhere: told of the variants
+    /// handed over once per batch, so that it costs one Python call per batch.
+    progress: Option<Py<PyAny>>,
+    /// Variants handed over since progress was last told.
+    unreported: AtomicUsize,
+    /// Progress was closed (the stream ended).
+    closed: AtomicBool,
 }
 
 /// The stream's receiving end and the batch being handed out.
@@ -99,6 +107,7 @@ impl PyVariantIter {
         indices: Vec<u64>,
         threads: Option<usize>,
         window: Option<usize>,
+        progress: Option<Py<PyAny>>,
     ) -> Result<PyVariantIter, Failure> {
         let pool = match threads {
             Some(n) => Some(
@@ -106,7 +115,7 @@ impl PyVariantIter {
                     .num_threads(n)
                     .thread_name(|i| format!("mjcf-forge-variants-{i}"))
                     .build()
-                    .map_err(|e| Failure(vec![format!("cannot start {n} threads: {e}")]))?,
+                    .map_err(|e| Failure::new(vec![format!("cannot start {n} threads: {e}")]))?,
             ),
             None => None,
         };
@@ -120,14 +129,33 @@ impl PyVariantIter {
                 let scene = scene.clone();
                 move || produce(scene, indices, pool, window, batch, tx)
             })
-            .map_err(|e| Failure(vec![format!("cannot start the producer thread: {e}")]))?;
+            .map_err(|e| Failure::new(vec![format!("cannot start the producer thread: {e}")]))?;
         Ok(PyVariantIter {
             taken: Mutex::new(Taken {
                 rx: Some(rx),
                 batch: VecDeque::new(),
             }),
             scene,
+            progress,
+            unreported: AtomicUsize::new(0),
+            closed: AtomicBool::new(false),
         })
+    }
+
+    /// Tells progress of the variants handed over since last told; and closes it when the
+    /// stream is over (once).
+    fn report(&self, py: Python<'_>, over: bool) -> PyResult<()> {
+        let Some(progress) = &self.progress else {
+            return Ok(());
+        };
+        let done = self.unreported.swap(0, Ordering::Relaxed);
+        if done > 0 {
+            progress.bind(py).call_method1("update", (done,))?;
+        }
+        if over && !self.closed.swap(true, Ordering::Relaxed) {
+            progress.bind(py).call_method0("close")?;
+        }
+        Ok(())
     }
 }
 
@@ -147,18 +175,33 @@ impl PyVariantIter {
         };
         let next = match at_hand {
             Some(made) => Some(made),
-            None => py.detach(|| {
-                let mut taken = self.taken.lock().unwrap_or_else(|p| p.into_inner());
-                taken.next(true)
-            }),
+            None => {
+                // Before waiting for the next batch: what was handed over of the last.
+                self.report(py, false)?;
+                py.detach(|| {
+                    let mut taken = self.taken.lock().unwrap_or_else(|p| p.into_inner());
+                    taken.next(true)
+                })
+            }
         };
         match next {
-            Some(Ok(made)) => Ok(Some(PyVariant::new(
-                made,
-                Origin::Scene(self.scene.clone()),
-            ))),
-            Some(Err(failure)) => Err(failure.into()),
-            None => Ok(None),
+            Some(Ok(made)) => {
+                if self.progress.is_some() {
+                    self.unreported.fetch_add(1, Ordering::Relaxed);
+                }
+                Ok(Some(PyVariant::new(
+                    made,
+                    Origin::Scene(self.scene.clone()),
+                )))
+            }
+            Some(Err(failure)) => {
+                self.report(py, true)?;
+                Err(failure.into())
+            }
+            None => {
+                self.report(py, true)?;
+                Ok(None)
+            }
         }
     }
 }

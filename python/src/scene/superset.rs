@@ -6,6 +6,7 @@ use mjcf_forge::scene::{Scene, Superset};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
+use super::variant_index;
 use crate::document::patch::patch_list;
 use crate::errors::run;
 
@@ -39,7 +40,12 @@ impl PySuperset {
     /// parked (out of reach in their own cells high above the world, invisible, held
     /// still; collision flags stay as authored). An
     /// :class:`MjcfError` when the variant randomizes a value no patch can carry.
-    fn patch<'py>(&self, py: Python<'py>, index: u64) -> PyResult<Bound<'py, PyTuple>> {
+    fn patch<'py>(
+        &self,
+        py: Python<'py>,
+        index: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let index = variant_index(index)?;
         let p = run(py, || {
             Ok(self.scene.superset_patch(&self.superset, index)?)
         })?;
@@ -48,7 +54,8 @@ impl PySuperset {
 
     /// For variant ``index``, each placed object's prefix and the tag its names carry in
     /// the superset: a superset name is tag + the variant's name.
-    fn names(&self, py: Python<'_>, index: u64) -> PyResult<Vec<(String, String)>> {
+    fn names(&self, py: Python<'_>, index: &Bound<'_, PyAny>) -> PyResult<Vec<(String, String)>> {
+        let index = variant_index(index)?;
         run(py, || {
             Ok(self.scene.superset_names(&self.superset, index)?)
         })
@@ -56,7 +63,8 @@ impl PySuperset {
 
     /// For variant ``index``, the superset names of the root bodies of the objects it does
     /// not place (parked).
-    fn parked(&self, py: Python<'_>, index: u64) -> PyResult<Vec<String>> {
+    fn parked(&self, py: Python<'_>, index: &Bound<'_, PyAny>) -> PyResult<Vec<String>> {
+        let index = variant_index(index)?;
         run(py, || {
             Ok(self.scene.superset_parked(&self.superset, index)?)
         })

@@ -7,7 +7,7 @@ use mjcf_forge::Document;
 use mjcf_forge::scene::{Scene, VariantPatch};
 use pyo3::exceptions::PyImportError;
 use pyo3::prelude::*;
-use pyo3::types::PyTuple;
+use pyo3::types::{PyList, PyTuple};
 
 use crate::document::PyDocument;
 use crate::document::patch::{PatchTuple, patch_entry, patch_list};
@@ -34,6 +34,55 @@ pub(super) fn make(scene: &Scene, index: u64) -> Result<Made, Failure> {
             xml,
         })
     })
+}
+
+/// The numbers of a variant's parameters (made from the manifest's JSON, where values are
+/// the XML's text): poses as lists of floats, a randomized value as a float or a list of
+/// them unless its attribute holds a name or a file, or it is not all numbers (a keyword).
+fn numeric_params(params: &Bound<'_, PyAny>) -> PyResult<()> {
+    let py = params.py();
+    for object in params.get_item("objects")?.try_iter()? {
+        let object = object?;
+        for key in ["pos", "quat"] {
+            let text: String = object.get_item(key)?.extract()?;
+            if let Some(numbers) = numbers(&text) {
+                object.set_item(key, PyList::new(py, numbers)?)?;
+            }
+        }
+    }
+    for value in params.get_item("randomized")?.try_iter()? {
+        let value = value?;
+        let kind: String = value.get_item("kind")?.extract()?;
+        let attribute: String = value.get_item("attribute")?.extract()?;
+        let names_something = mjcf_forge::vocab::element(&kind)
+            .and_then(|e| e.attr(&attribute))
+            .is_some_and(|a| !matches!(a.kind, mjcf_forge::vocab::AttrKind::Plain));
+        if names_something {
+            continue;
+        }
+        let text: String = value.get_item("value")?.extract()?;
+        match numbers(&text).as_deref() {
+            Some([one]) => value.set_item("value", *one)?,
+            Some(many) => value.set_item("value", PyList::new(py, many)?)?,
+            None => {}
+        }
+    }
+    Ok(())
+}
+
+/// The numbers of an attribute value's text, when it is one or more decimal numbers (not
+/// words such as `inf` that Rust's parser also reads, which may be names).
+fn numbers(text: &str) -> Option<Vec<f64>> {
+    let numbers: Vec<f64> = text
+        .split_ascii_whitespace()
+        .map(|t| {
+            t.bytes()
+                .all(|b| b.is_ascii_digit() || matches!(b, b'+' | b'-' | b'.' | b'e' | b'E'))
+                .then(|| t.parse::<f64>().ok())
+                .flatten()
+        })
+        .collect::<Option<_>>()?;
+    (!numbers.is_empty()).then_some(numbers)
 }
 
 /// One variant of a :class:`Scene`: its ``index``, its MJCF text ``xml`` (assets
@@ -136,19 +185,25 @@ impl PyVariant {
             .clone_ref(py)
     }
 
-    /// What was drawn, as a new ``dict``: ``objects`` (for each placed object its
-    /// ``group``, ``slot``, ``model``, ``prefix``, root ``body``, ``pos`` and ``quat`` as
-    /// written in the XML) and ``randomized`` (each randomized attribute with its
-    /// element's kind, name, part and value); the manifest line of ``mjcf-forge
-    /// generate`` without the file name.
+    /// What was drawn, as a new ``dict``: ``index``, ``objects`` (for each placed object
+    /// its ``group``, ``slot``, ``model``, ``prefix``, root ``body``, and ``pos`` and
+    /// ``quat`` as lists of 3 and 4 floats, the values written in the XML) and
+    /// ``randomized`` (each randomized attribute with its element's ``kind``, ``name``,
+    /// ``part``, ``attribute`` and ``value``: a ``float`` for one number, a list of floats
+    /// for several, a ``str`` for a name or keyword such as a material). The numbers are
+    /// those of the XML text, read back exactly.
     #[getter]
     fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        py.import("json")?
+        let params = py
+            .import("json")?
             .getattr("loads")?
-            .call1((self.params_json.as_str(),))
+            .call1((self.params_json.as_str(),))?;
+        numeric_params(&params)?;
+        Ok(params)
     }
 
-    /// ``params`` as the JSON text it comes from.
+    /// ``params`` as the JSON text it comes from: the manifest line of ``mjcf-forge
+    /// generate`` without the file name, whose values are the XML's text (``"0.1 0 0.8"``).
     #[getter]
     fn params_json(&self) -> &str {
         &self.params_json

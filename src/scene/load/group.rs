@@ -10,6 +10,7 @@ use crate::document::Document;
 use crate::document::tree::Node;
 use crate::error::{Error, ErrorKind, Errors};
 use crate::model::geometry::{self, Angles, Pose};
+use crate::model::instance::name_unnamed_root;
 use crate::scene::place::{self, Placement, Rotation};
 use crate::scene::spec;
 use crate::scene::{Group, PoolModel};
@@ -106,27 +107,9 @@ pub(super) fn load(
             ));
             continue;
         };
-        if doc.attr(root, "name").is_none() {
-            // The manifest names each object by its root body; an unnamed one gets the
-            // first of root, root1, root2... that no body uses (robosuite's objects
-            // wrap a body named "object" in an unnamed one).
-            let taken: Vec<&str> = doc
-                .descendants(root)
-                .filter(|&n| doc.tag(n) == "body")
-                .filter_map(|n| doc.attr(n, "name"))
-                .collect();
-            let name = (0..)
-                .map(|k| {
-                    if k == 0 {
-                        "root".to_string()
-                    } else {
-                        format!("root{k}")
-                    }
-                })
-                .find(|n| !taken.contains(&n.as_str()))
-                .expect("a free name exists");
-            doc.set_attr(root, "name", &name);
-        }
+        // The manifest names each object by its root body: an unnamed one is named as a
+        // model names it (robosuite's objects wrap a body named "object" in an unnamed one).
+        name_unnamed_root(&mut doc, root);
         let has_joint = doc
             .elements(root)
             .any(|k| matches!(doc.tag(k), "joint" | "freejoint"));

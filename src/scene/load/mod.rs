@@ -20,6 +20,7 @@ use super::spec::SceneSpec;
 use super::{Group, Instance, Scene, splice};
 
 mod group;
+mod keys;
 mod randomizer;
 
 /// The largest count a group, and all groups together, may ask for per variant (each slot
@@ -49,14 +50,28 @@ impl ModelSource for Files {
 pub(super) struct Source<'a> {
     text: &'a str,
     file: Arc<Path>,
+    /// For a description without text of its own (JSON, a Python `dict`): the key path of
+    /// each span of the TOML text it was read as, which every location then names.
+    keys: Option<keys::KeyPaths>,
 }
 
 impl Source<'_> {
+    /// Where `span` is: its line and column, and its key path when the text is not the
+    /// user's own. Every problem of a scene description is positioned here.
     pub(super) fn location(&self, span: std::ops::Range<usize>) -> Location {
         let upto = &self.text[..span.start.min(self.text.len())];
         let line = upto.matches('\n').count() as u32 + 1;
         let col = (upto.len() - upto.rfind('\n').map_or(0, |i| i + 1)) as u32 + 1;
-        Location::new(self.file.clone(), line, col)
+        let mut at = Location::new(self.file.clone(), line, col);
+        at.key = self.keys.as_ref().map(|k| k.at(span));
+        at
+    }
+
+    /// The whole description (a problem the parser gives no span for).
+    fn whole(&self) -> Location {
+        let mut at = Location::new(self.file.clone(), 1, 1);
+        at.key = self.keys.as_ref().map(|_| Arc::new(String::new()));
+        at
     }
 
     pub(super) fn error<T>(&self, at: &Spanned<T>, msg: impl Into<String>) -> Error {
@@ -86,7 +101,45 @@ pub(crate) fn from_toml(
     file: Arc<Path>,
     models: &dyn ModelSource,
 ) -> Result<Scene, Errors> {
-    build(text, file.clone(), models).map_err(|mut e| {
+    let dir = file.parent().unwrap_or(Path::new(".")).to_path_buf();
+    from_text(text, file, dir, None, models)
+}
+
+/// Builds a scene from a description without text of its own, read as the TOML text
+/// `text` it serializes to: problems are told by the key path of the value (`objects[0].x`),
+/// after the label `file`. Model paths are relative to `dir`.
+pub(crate) fn from_serialized(
+    text: &str,
+    file: Arc<Path>,
+    dir: PathBuf,
+    models: &dyn ModelSource,
+) -> Result<Scene, Errors> {
+    from_text(text, file, dir, keys::KeyPaths::of(text), models)
+}
+
+/// Where a description (or a part of it) is by its key path, for problems found before it
+/// is read as TOML.
+pub(crate) fn key_location(file: Arc<Path>, key: &str) -> Location {
+    let mut at = Location::new(file, 1, 1);
+    at.key = Some(Arc::new(key.to_string()));
+    at
+}
+
+pub(crate) use keys::join as join_key;
+
+fn from_text(
+    text: &str,
+    file: Arc<Path>,
+    dir: PathBuf,
+    keys: Option<keys::KeyPaths>,
+    models: &dyn ModelSource,
+) -> Result<Scene, Errors> {
+    let src = Source {
+        text,
+        file: file.clone(),
+        keys,
+    };
+    build(&src, dir, models).map_err(|mut e| {
         e.0.sort_by_key(|e| match &e.location {
             Some(l) if l.file == file => (0, l.line, l.col),
             _ => (1, 0, 0),
@@ -95,16 +148,12 @@ pub(crate) fn from_toml(
     })
 }
 
-fn build(text: &str, file: Arc<Path>, models: &dyn ModelSource) -> Result<Scene, Errors> {
-    let src = Source {
-        text,
-        file: file.clone(),
-    };
-    let spec: SceneSpec = toml::from_str(text).map_err(|e| {
-        let location = src.location(e.span().unwrap_or(0..0));
+fn build(src: &Source<'_>, dir: PathBuf, models: &dyn ModelSource) -> Result<Scene, Errors> {
+    let file = src.file.clone();
+    let spec: SceneSpec = toml::from_str(src.text).map_err(|e| {
+        let location = e.span().map_or_else(|| src.whole(), |s| src.location(s));
         Error::at(location, ErrorKind::Invalid(e.message().trim().to_string()))
     })?;
-    let dir = file.parent().unwrap_or(Path::new(".")).to_path_buf();
     let mut files = Vec::new();
     let mut errors = Vec::new();
 
@@ -211,7 +260,7 @@ fn build(text: &str, file: Arc<Path>, models: &dyn ModelSource) -> Result<Scene,
         .collect();
     let mut randomizers = Vec::new();
     for (k, r) in spec.randomize.iter().enumerate() {
-        match randomizer::load(&src, &dir, k, r, &prefixes, &group_names) {
+        match randomizer::load(src, &dir, k, r, &prefixes, &group_names) {
             Ok(x) => randomizers.push(x),
             Err(e) => errors.push(e),
         }
@@ -223,7 +272,7 @@ fn build(text: &str, file: Arc<Path>, models: &dyn ModelSource) -> Result<Scene,
     let mut groups: Vec<Group> = Vec::new();
     for g in &spec.objects {
         match group::load(
-            &src, &dir, g, &groups, &template, &angles, models, &mut files,
+            src, &dir, g, &groups, &template, &angles, models, &mut files,
         ) {
             Ok(x) => groups.push(x),
             Err(e) => errors.extend(e.0),
