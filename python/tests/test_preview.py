@@ -147,7 +147,7 @@ def check_every_placed_object(scene, indices, size, **options):
                 continue
             # The manifest's pose, where the compiled model has the body, projects onto
             # the object's own pixels (or next to them: the origin may sit behind an edge).
-            pos = np.array([float(p) for p in obj["pos"].split()])
+            pos = np.array(obj["pos"], dtype=float)
             body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, obj["body"])
             assert np.allclose(data.xpos[body], pos, atol=1e-9)
             u, w = project(pos, free, model.vis.global_.fovy, size)
