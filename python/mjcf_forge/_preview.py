@@ -19,10 +19,11 @@ import os
 import struct
 import sys
 import zlib
-from pathlib import Path
 from typing import Iterable, Optional, Sequence, Tuple, Union
 
 import numpy as np
+
+from ._files import write_atomic
 
 GAP = 2
 """Pixels between cells."""
@@ -178,21 +179,6 @@ def png_bytes(image: np.ndarray) -> bytes:
     )
 
 
-def _write_atomic(path: Path, data: bytes) -> None:
-    """Writes ``data`` to ``path`` through a temporary file beside it: no partial file."""
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        with open(tmp, "wb") as f:
-            f.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
-
-
 def cell_origin(k: int, columns: int, cell: Tuple[int, int]) -> Tuple[int, int]:
     """The top left corner (x, y) of cell ``k`` in a sheet of ``columns`` columns."""
     return (k % columns) * (cell[0] + GAP), (k // columns) * (cell[1] + GAP)
@@ -285,5 +271,5 @@ def preview(
             if labels:
                 _label(out, str(index), scale)
     if path is not None:
-        _write_atomic(Path(path), png_bytes(sheet))
+        write_atomic(path, png_bytes(sheet))
     return sheet

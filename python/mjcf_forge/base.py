@@ -27,7 +27,6 @@ from __future__ import annotations
 import difflib
 import os
 import sys
-import tempfile
 import xml.dom.minidom
 from typing import Any, Callable, Optional
 
@@ -35,6 +34,7 @@ import numpy as np
 
 from ._mjcf_forge import Document, Element, LoadCache, MjcfError
 from . import etree as ET
+from ._files import write_atomic
 
 __all__ = [
     "MujocoModel",
@@ -542,18 +542,7 @@ class MujocoXML(object):
             pretty (bool): indent the output
         """
         text = self.document.to_xml(pretty=bool(pretty))
-        folder = os.path.dirname(os.path.abspath(fname))
-        fd, tmp = tempfile.mkstemp(dir=folder, prefix=".mjcf-forge-", suffix=".xml")
-        try:
-            with os.fdopen(fd, "w", encoding="utf-8") as f:
-                f.write(text)
-            os.replace(tmp, fname)
-        except BaseException:
-            try:
-                os.unlink(tmp)
-            except OSError:
-                pass
-            raise
+        write_atomic(fname, text.encode("utf-8"))
 
     def merge_assets(self, other):
         """Adds ``other``'s assets (``other.asset``'s children: a MujocoXML, or any object

@@ -521,13 +521,19 @@ impl XmlModel {
 impl Document {
     /// The bodies whose parent is the world body (directly or through frames).
     pub(crate) fn top_level_bodies(&self, world: Node) -> Vec<Node> {
+        self.children_through_frames(world, "body")
+    }
+
+    /// The `tag` elements whose parent is `node`, directly or through `<frame>`s, in
+    /// document order (a body's geoms, the world's bodies).
+    pub(crate) fn children_through_frames(&self, node: Node, tag: &str) -> Vec<Node> {
         let mut out = Vec::new();
         // Document order through nested frames, from a stack (frames nest without bound).
-        let mut stack: Vec<Node> = self.elements(world).collect();
+        let mut stack: Vec<Node> = self.elements(node).collect();
         stack.reverse();
         while let Some(k) = stack.pop() {
             match self.tag(k) {
-                "body" => out.push(k),
+                t if t == tag => out.push(k),
                 "frame" => {
                     let at = stack.len();
                     stack.extend(self.elements(k));

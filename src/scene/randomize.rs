@@ -286,7 +286,7 @@ impl Randomizer {
                 }
                 // A body with neither <inertial> nor geoms weighs nothing: nothing to scale
                 // (robosuite's and LIBERO's objects hold their geoms in an inner body).
-                let geoms = body_geoms(doc, node);
+                let geoms = doc.children_through_frames(node, "geom");
                 for g in geoms {
                     out.push(Target {
                         node: g,
@@ -581,25 +581,6 @@ fn mass_from_geoms(doc: &Document, body: Node) -> bool {
         }
         _ => !has_inertial,
     }
-}
-
-/// The geoms of `body` (directly or inside `<frame>`s, not in child bodies), in order.
-fn body_geoms(doc: &Document, body: Node) -> Vec<Node> {
-    let mut out = Vec::new();
-    let mut stack: Vec<Node> = doc.elements(body).collect();
-    stack.reverse();
-    while let Some(n) = stack.pop() {
-        match doc.tag(n) {
-            "geom" => out.push(n),
-            "frame" => {
-                let mut inner: Vec<Node> = doc.elements(n).collect();
-                inner.reverse();
-                stack.extend(inner);
-            }
-            _ => {}
-        }
-    }
-    out
 }
 
 /// The attribute that holds a geom's share of its body's mass: `mass` where written (MuJoCo
