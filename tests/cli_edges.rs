@@ -7,21 +7,11 @@
 
 mod common;
 
-use std::path::Path;
 use std::process::{Command, Stdio};
 
-use common::{forge, path_arg, root, scratch, stderr, stdout};
+use common::{forge, listing, path_arg, root, scratch, stderr, stdout};
 
 const ARM: &str = "corpora/merge/arm_with_keys.xml";
-
-fn listing(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
-}
 
 /// Runs the binary with its standard output a pipe whose reader has already gone.
 fn with_closed_stdout(args: &[&str]) -> std::process::Output {

@@ -6,7 +6,7 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use common::{Pair, forge, judge, path_arg, python, root, scratch, stderr};
+use common::{Pair, forge, judge, listing, path_arg, python, root, scratch, stderr};
 
 /// Real models with meshes (STL, OBJ, MSH), textures (cube faces too), height fields,
 /// skins, assets named after their files, one file used as a texture and a height field,
@@ -22,15 +22,6 @@ const MODELS: [&str; 9] = [
     ".cache/corpus/dm_control-1.0.50/dm_control/suite/dog.xml",
     ".cache/corpus/dm_control-1.0.50/dm_control/locomotion/walkers/assets/fruitfly_v2/fruitfly.xml",
 ];
-
-fn listing(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
-}
 
 fn copy_tree(from: &Path, to: &Path) {
     std::fs::create_dir_all(to).unwrap();

@@ -5,18 +5,8 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{forge, path_arg, root, scratch, stderr, stdout};
+use common::{forge, listing, path_arg, root, scratch, stderr, stdout};
 use mjcf_forge::Document;
-
-/// The names in a folder, sorted.
-fn listing(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
-}
 
 fn feature_models() -> Vec<PathBuf> {
     let mut models: Vec<PathBuf> = std::fs::read_dir(root().join("corpora/features"))

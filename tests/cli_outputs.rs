@@ -5,10 +5,9 @@
 mod common;
 
 use std::io::Read as _;
-use std::path::Path;
 use std::process::{Command, Stdio};
 
-use common::{forge, path_arg, root, scratch, stderr};
+use common::{forge, listing, path_arg, root, scratch, stderr};
 use mjcf_forge::Document;
 
 const MODEL: &str = "corpora/features/default_childclass.xml";
@@ -17,15 +16,6 @@ fn expected() -> String {
     Document::load(root().join(MODEL))
         .unwrap()
         .to_pretty_string()
-}
-
-fn listing(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
 }
 
 #[test]

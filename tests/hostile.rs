@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-use common::{forge, path_arg, scratch, stderr};
+use common::{forge, listing, path_arg, scratch, stderr};
 use mjcf_forge::{Document, Limits, MergeOptions};
 
 /// The time every case must end in: well under a second in a release build
@@ -872,16 +872,6 @@ fn errors_in_attribute_values_point_at_the_value() {
 }
 
 // --- The command line, and its parallel paths ---------------------------------------------
-
-/// The names in a folder, sorted (to show nothing was left behind).
-fn listing(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
-}
 
 #[test]
 fn the_command_line_refuses_hostile_inputs_in_parallel_and_leaves_nothing_behind() {

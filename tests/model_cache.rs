@@ -19,6 +19,14 @@ fn compiled(scene: &Scene, i: u64) -> CompiledModel {
     compile_str(&xml, Path::new(".")).unwrap()
 }
 
+/// A variant's name as the superset has it: its candidate's tag before it (`tags` from
+/// `Scene::superset_names`), or as it is for the template's names.
+fn superset_name(tags: &[(String, String)], name: &str) -> String {
+    tags.iter()
+        .find(|(p, _)| name.starts_with(p.as_str()))
+        .map_or(name.to_string(), |(_, t)| format!("{t}{name}"))
+}
+
 fn by_structure(scene: &Scene, n: u64) -> HashMap<String, Vec<u64>> {
     let mut groups: HashMap<String, Vec<u64>> = HashMap::new();
     for i in 0..n {
@@ -142,11 +150,7 @@ fn superset_holds_every_variant() {
     for i in 0..6 {
         let want = compiled(&scene, i);
         let tags = scene.superset_names(&superset, i).unwrap();
-        let name = |n: &str| {
-            tags.iter()
-                .find(|(p, _)| n.starts_with(p.as_str()))
-                .map_or(n.to_string(), |(_, t)| format!("{t}{n}"))
-        };
+        let name = |n: &str| superset_name(&tags, n);
         let got = cache.model(i).unwrap();
         let (got_bodies, got_geoms) = (got.names(ObjType::Body), got.names(ObjType::Geom));
         for (b, n) in want.names(ObjType::Body).iter().enumerate().skip(1) {
@@ -372,11 +376,10 @@ fn mass_of_bodies_without_inertial_scales_their_geoms() {
         let got = cache.model(i).unwrap();
         let got_bodies = got.names(ObjType::Body);
         for (b, n) in want.names(ObjType::Body).iter().enumerate().skip(1) {
-            let tagged = tags
+            let k = got_bodies
                 .iter()
-                .find(|(p, _)| n.starts_with(p.as_str()))
-                .map_or(n.to_string(), |(_, t)| format!("{t}{n}"));
-            let k = got_bodies.iter().position(|x| *x == tagged).unwrap();
+                .position(|x| *x == superset_name(&tags, n))
+                .unwrap();
             assert_eq!(got.body_mass()[k], want.body_mass()[b], "variant {i}: {n}");
             assert_eq!(
                 got.body_inertia()[3 * k..3 * k + 3],

@@ -276,3 +276,13 @@ pub fn stderr(out: &std::process::Output) -> String {
 pub fn path_arg(p: &Path) -> &str {
     p.to_str().expect("UTF-8 test path")
 }
+
+/// The names in a folder, sorted.
+pub fn listing(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
