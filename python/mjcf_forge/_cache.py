@@ -127,6 +127,13 @@ _JOINT_QPOS = {0: 7, 1: 4, 2: 1, 3: 1}  # free, ball, slide, hinge
 _JOINT_DOFS = {0: 6, 1: 3, 2: 1, 3: 1}
 
 
+class _Variant:
+    """What a superset ModelCache reads of a variant: its index."""
+
+    def __init__(self, index: int) -> None:
+        self.index = index
+
+
 def _dist(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Row-wise distances, each computed as mju_dist3 computes it (same operations, same
     order, so the same bits)."""
@@ -154,6 +161,10 @@ class _Plan:
         self.data = data = mujoco.MjData(model)
         self.nbytes = model.nbuffer + data.nbuffer + data.narena
         self.fields: list[tuple[Any, Any, str]] | None = None
+        # The patch the layout was last resolved from (ModelCache._apply_world), and which
+        # of its string values are a body's little model (the others: material names).
+        self.source: Any = None
+        self.string_geoms: list[bool] = []
         self.groups: list[tuple[Any, np.ndarray, np.ndarray]] = []
         # (flat array, index, which material name of the patch) per matid entry.
         self.matids: list[tuple[Any, int, int]] = []
@@ -281,8 +292,12 @@ class _Plan:
         self.body_xml0 = body_xml
         self.body_written = [None] * len(bodies)
         self.fields = [tuple(e[:3]) for e in patch]
+        self.source = None
 
-    def apply(self, patch: list) -> None:
+    def apply(self, patch: list, derive: Callable[[Any, Any, list], None] | None = None) -> None:
+        """Writes ``patch`` and what follows from it (:meth:`finish`; ``derive(model,
+        data, layout)`` instead of ``mj_setConst`` when given, ``layout`` the patch's
+        ``(object, name, field)`` triples, one list object per layout resolved)."""
         # A structure key covers its patch's layout, so a variant's targets are resolved
         # once per structure; a superset patch's layout follows which objects are placed.
         if (
@@ -297,7 +312,7 @@ class _Plan:
         )
         materials = [e[3] for e in patch if isinstance(e[3], str) and e[2] != "geoms"]
         self.write(values, materials, [e[3] for e in patch if e[2] == "geoms"])
-        self.finish()
+        self.finish(derive)
 
     def write(self, values: np.ndarray, materials: list, bodies: list = ()) -> None:
         """Writes a patch of the resolved layout: its numbers end to end (``values``), the
@@ -374,25 +389,32 @@ class _Plan:
         hit = (at < len(self.sized_geoms)) & (self.sized_geoms[np.minimum(at, len(self.sized_geoms) - 1)] == np.arange(first, first + n))
         self.sized_geom_rbound[at[hit]] = rbound[hit]
 
-    def finish(self) -> None:
-        """What follows the values: ``mj_setConst``, the compiler's statistics, and the
-        statistics the document fixes."""
-        self.mujoco.mj_setConst(self.model, self.data)
-        self.statistics()
+    def finish(self, derive: Callable[[Any, Any, list], None] | None = None) -> None:
+        """What follows the values: ``mj_setConst`` (or ``derive(model, data, layout)``,
+        which writes the same), the compiler's statistics, and the statistics the document
+        fixes."""
+        fresh = False
+        if derive is None:
+            self.mujoco.mj_setConst(self.model, self.data)
+        else:
+            fresh = bool(derive(self.model, self.data, self.fields))
+        self.statistics(fresh)
         for stat, value in self.fixed:
             if hasattr(value, "copy"):
                 getattr(self.stat, stat)[...] = value
             else:
                 setattr(self.stat, stat, value)
 
-    def statistics(self) -> None:
+    def statistics(self, fresh: bool = False) -> None:
         """The model statistics and dof lengths, computed from the model at qpos0 as the
         compiler computes them: the same operations, sums in the same order, so the same
-        bits (minima and maxima do not depend on order, so those run vectorized)."""
+        bits (minima and maxima do not depend on order, so those run vectorized).
+        ``fresh``: the scratch data holds the kinematics and centres of mass at qpos0."""
         mujoco, model, data, stat = self.mujoco, self.model, self.data, self.stat
-        self.qpos[:] = self.qpos0
-        mujoco.mj_kinematics(model, data)
-        mujoco.mj_comPos(model, data)
+        if not fresh:
+            self.qpos[:] = self.qpos0
+            mujoco.mj_kinematics(model, data)
+            mujoco.mj_comPos(model, data)
         mujoco.mj_makeM(model, data)
         lo = np.full(3, 1e10)
         hi = np.full(3, -1e10)
@@ -523,23 +545,22 @@ class ModelCache:
         for k in extra[: max(0, len(extra) - self._max_models)]:
             del self._plans[k]
 
-    def _variant_inertia(self, model: Any, plan: "_Plan", variant: Any) -> None:
+    def _variant_inertia(self, model: Any, plan: "_Plan", variant: Any, parked: Any = None) -> None:
         """Superset: ``stat.meaninertia`` (which scales the constraint solver's tolerance)
         as the variant's own model has it: the mean of the mass matrix's diagonal over the
         dofs of what the variant places (in the superset's dof order, which is the
-        variant's), parked objects left out."""
-        roots = tuple(self.superset.parked(variant.index))
+        variant's), parked objects left out (``parked``: their root bodies' names, when
+        known)."""
+        roots = tuple(self.superset.parked(variant.index) if parked is None else parked)
         keep = self._kept_dofs.get(roots)
         if keep is None:
-            parked: set[int] = set()
-            for root in roots:
-                stack = [model.body(root).id]
-                while stack:
-                    c = stack.pop()
-                    first = model.body_dofadr[c]
-                    parked.update(range(first, first + model.body_dofnum[c]))
-                    stack.extend(np.flatnonzero(model.body_parentid == c).tolist())
-            keep = np.array([i for i in range(model.nv) if i not in parked], dtype=int)
+            parked = np.zeros(model.nbody, dtype=bool)
+            parked[[model.body(root).id for root in roots]] = True
+            for b in range(1, model.nbody):  # parents come before their children
+                parked[b] |= parked[model.body_parentid[b]]
+            keep = np.flatnonzero(~parked[model.dof_bodyid])
+            if len(self._kept_dofs) >= 4096:
+                self._kept_dofs.clear()
             self._kept_dofs[roots] = keep
         if len(keep):
             model.stat.meaninertia = _in_order_sum(plan.M[plan.M_diagonal[keep]]) / len(keep)
@@ -593,7 +614,13 @@ class ModelCache:
     def apply(self, variant: Any, model: Any) -> Any:
         """Patches ``model`` (of ``variant``'s structure) in place into ``variant``'s
         compiled model; returns it. Raises :class:`MjcfError` when its structure differs."""
-        key, patch = self._key_and_patch(variant)
+        return self._apply(variant, model)
+
+    def _apply(self, variant: Any, model: Any, derive: Any = None, patch: Any = None) -> Any:
+        """:meth:`apply`, with ``derive(model, data, layout)`` in place of ``mj_setConst``
+        when given (it must write the same), and the variant's patch when already made."""
+        key, made = self._key_and_patch(variant) if patch is None else (self.superset.structure_key, patch)
+        patch = made
         plan = self._plans.get(id(model))
         if plan is None or plan.model is not model:
             if key not in self._signatures:
@@ -611,9 +638,38 @@ class ModelCache:
                 "a patch cannot change a structure (cache.model(variant) compiles it)"
             )
         self._plans.move_to_end(id(model))
-        plan.apply(patch)
+        plan.apply(patch, derive)
         if self.superset is not None:
             self._variant_inertia(model, plan, variant)
+        self.patches += 1
+        return model
+
+    def _apply_world(self, model: Any, world: tuple, patch0: list, derive: Any = None) -> Any:
+        """Superset: ``model`` patched for one world as :meth:`Superset.worlds` gives it
+        (``world``: its index, numbers, strings and parked roots; ``patch0``: a patch of its
+        layout, resolved once), ``derive`` as in :meth:`_apply`."""
+        index, numbers, strings, parked = world
+        key = self.superset.structure_key
+        plan = self._plans.get(id(model))
+        if plan is None or plan.model is not model:
+            if key not in self._signatures:
+                self._compile(_Variant(index))
+            plan = self._plan(model, key)
+        self._plans.move_to_end(id(model))
+        if plan.source is not patch0:
+            plan.resolve(patch0)
+            plan.source = patch0
+            plan.string_geoms = [e[2] == "geoms" for e in patch0 if isinstance(e[3], str)]
+        values = np.frombuffer(numbers, dtype=np.float64)
+        if strings:
+            geoms = plan.string_geoms
+            materials = [v for v, g in zip(strings, geoms) if not g]
+            bodies = [v for v, g in zip(strings, geoms) if g]
+        else:
+            materials, bodies = [], []
+        plan.write(values, materials, bodies)
+        plan.finish(derive)
+        self._variant_inertia(model, plan, None, parked)
         self.patches += 1
         return model
 

@@ -35,6 +35,7 @@ import numpy as np
 
 from ._cache import _STATIC_PREFIXES, ModelCache, _error
 from ._progress import progress_of
+from ._trees import TreeDerivation
 
 # Fields mj_setConst derives from values a patch writes (so they follow the variant even
 # when no patch entry names them).
@@ -66,6 +67,13 @@ _WARP_SLEEP_ONLY = ("dof_length",)
 # Contacts a placed free object may have at once in MuJoCo Warp's default sizes (a box on
 # a table: 4; lift5's worlds: at most 24 for 5 objects and the gripper, measured).
 _CONTACTS_PER_OBJECT = 16
+# What a world's patch writes besides its own arrays: a body's little model
+# (_cache.compiled_body) and the same-frame flags (_trees).
+_WRITTEN = (
+    "geom_size", "geom_rbound", "geom_aabb", "geom_pos", "geom_quat",
+    "body_mass", "body_inertia", "body_ipos", "body_iquat",
+    "body_sameframe", "geom_sameframe", "site_sameframe",
+)
 # The compiler's statistics, per world (``stat.<name>`` in :attr:`WorldBatch.arrays`).
 _STATS = ("meaninertia", "meanmass", "meansize", "extent", "center")
 # A patch entry's object -> the prefix of its MjModel arrays (as ModelCache resolves them).
@@ -118,6 +126,10 @@ class WorldBatch:
     bool: the geoms of objects the world parks).
     """
 
+    # Derive what mj_setConst does tree by tree where a patch allows (False: always the
+    # whole mj_setConst; the tests compare both ways).
+    _by_tree = True
+
     def __init__(self, source: Any, variants: Sequence[Any], progress: Any = None) -> None:
         if isinstance(source, ModelCache):
             cache = source
@@ -150,11 +162,22 @@ class WorldBatch:
         }
         self._data: Any = None
         self._root_of_geom = model.body_rootid[model.geom_bodyid]
+        # mj_setConst per tree (see _trees): per patch layout, its derivation (None: the
+        # whole mj_setConst), and the body ids of parked objects' names.
+        self._derivations: dict[int, tuple[list, TreeDerivation | None]] = {}
+        # A patch of each layout Superset.worlds has given, by layout.
+        self._layouts: dict[tuple, Any] = {}
+        self._written = [n for n in _WRITTEN if n in self._others]
+        self._flags = [n for n in self._written if n.endswith("_sameframe")]
+        self._body_ids: dict[str, int] = {}
+        self._parked_ids: set[int] = set()
+        #: Worlds whose derived values came tree by tree (the others: mj_setConst).
+        self.derived_by_tree = 0
         bar = progress_of(progress, len(indices), "worlds")
         try:
             rows = []
-            for i in indices:
-                rows.append(self._rows(i))
+            for world in self._worlds(indices):
+                rows.append(self._rows(world))
                 if bar is not None:
                     bar.update(1)
         finally:
@@ -185,38 +208,106 @@ class WorldBatch:
         its free joint's ``qpos0``, as in the variant's own model)."""
         return self.arrays["qpos0"].copy()
 
-    def _rows(self, index: int) -> dict[str, np.ndarray]:
-        """Every field of the superset patched for variant ``index``, its statistics, its
-        parked geoms; a parked geom that touches anything at the initial pose is an error."""
-        model = self.cache.apply(_Index(index), self._scratch)
+    def _worlds(self, indices: Sequence[int]) -> Any:
+        """Each variant of ``indices`` as ``(index, numbers, strings, parked, patch0)``
+        (:meth:`Superset.worlds`, made in parallel a chunk at a time; ``patch0``: a patch
+        of the world's layout)."""
+        chunk = 256
+        for start in range(0, len(indices), chunk):
+            part = list(indices[start : start + chunk])
+            layouts, worlds = self.superset.worlds(part)
+            first = {}
+            for index, (layout, *_rest) in zip(part, worlds):
+                first.setdefault(layout, index)
+            patches = {}
+            for layout, index in first.items():
+                key = layouts[layout]
+                if key not in self._layouts:
+                    if len(self._layouts) >= 64:
+                        self._layouts.clear()
+                    self._layouts[key] = self.superset.patch(index)
+                patches[layout] = self._layouts[key]
+            for index, (layout, numbers, strings, parked) in zip(part, worlds):
+                yield index, numbers, strings, parked, patches[layout]
+
+    def _rows(self, world: tuple) -> dict[str, np.ndarray]:
+        """Every field of the superset patched for one world (``_worlds``), its
+        statistics, its parked geoms; a parked geom that touches anything at the initial
+        pose is an error."""
+        index, numbers, strings, parked_names, patch0 = world
+        ids = self._body_ids
+        parked_roots = []
+        for name in parked_names:
+            i = ids.get(name)
+            if i is None:
+                i = ids[name] = self._scratch.body(name).id
+            parked_roots.append(i)
+        self._parked_ids = set(parked_roots)
+        by_tree = self.derived_by_tree
+        model = self.cache._apply_world(
+            self._scratch, (index, numbers, strings, parked_names), patch0, self._derive
+        )
         out = {n: getattr(model, n).copy() for n in self._candidates}
-        for n, first in self._others.items():
+        # mj_setConst may write any field (none differs for a superset patch); derived
+        # tree by tree, only the patch and its bodies' little models write.
+        if self.derived_by_tree == by_tree:
+            others = self._others
+        elif self._plan_of_scratch().bodies:
+            others = self._written
+        else:
+            others = self._flags
+        for n in others:
             value = getattr(model, n)
-            if value.tobytes() != first:
+            if value.tobytes() != self._others[n]:
                 out[n] = value.copy()
         for s in _STATS:
             out[f"stat.{s}"] = np.array(getattr(model.stat, s), dtype=np.float64)
         mujoco = self.cache._mujoco
-        parked_roots = [model.body(r).id for r in self.superset.parked(index)]
         parked = np.isin(self._root_of_geom, parked_roots)
         out["parked_geoms"] = parked
-        if self._data is None:
-            self._data = mujoco.MjData(model)
-        data = self._data
-        mujoco.mj_resetData(model, data)
-        # The initial pose's contacts: positions and collision only.
-        mujoco.mj_kinematics(model, data)
+        # The initial pose's contacts: positions and collision only. The statistics left
+        # the patch's scratch data at qpos0's positions; mocap bodies take theirs from
+        # the data, so a model with some starts from a reset.
+        if model.nmocap:
+            if self._data is None:
+                self._data = mujoco.MjData(model)
+            data = self._data
+            mujoco.mj_resetData(model, data)
+            mujoco.mj_kinematics(model, data)
+        else:
+            data = self._plan_of_scratch().data
         mujoco.mj_collision(model, data)
-        for c in data.contact[: data.ncon]:
-            g1, g2 = int(c.geom[0]), int(c.geom[1])
-            if parked[g1] or parked[g2]:
-                a, b = (g1, g2) if parked[g1] else (g2, g1)
-                raise _error(
-                    f"variant {index}: parked geom '{model.geom(a).name or a}' (object "
-                    f"'{model.body(int(self._root_of_geom[a])).name}') touches geom "
-                    f"'{model.geom(b).name or b}': its parking cell is within reach"
-                )
+        pairs = data.contact.geom[: data.ncon]
+        if parked[pairs].any():
+            g1, g2 = (int(g) for g in pairs[np.flatnonzero(parked[pairs].any(axis=1))[0]])
+            a, b = (g1, g2) if parked[g1] else (g2, g1)
+            raise _error(
+                f"variant {index}: parked geom '{model.geom(a).name or a}' (object "
+                f"'{model.body(int(self._root_of_geom[a])).name}') touches geom "
+                f"'{model.geom(b).name or b}': its parking cell is within reach"
+            )
         return out
+
+    def _plan_of_scratch(self) -> Any:
+        return self.cache._plans[id(self._scratch)]
+
+    def _derive(self, model: Any, data: Any, layout: list) -> bool:
+        """What mj_setConst derives, tree by tree where the patch's layout allows
+        (:class:`TreeDerivation`, the same bits), else mj_setConst; whether ``data`` was
+        left at qpos0's kinematics (see :meth:`TreeDerivation.__call__`)."""
+        entry = self._derivations.get(id(layout))
+        if entry is None or entry[0] is not layout:
+            if len(self._derivations) >= 64:
+                self._derivations.clear()
+            built = TreeDerivation.build(self.cache._mujoco, model, layout) if self._by_tree else None
+            entry = (layout, built)
+            self._derivations[id(layout)] = entry
+        derivation = entry[1]
+        if derivation is None:
+            self.cache._mujoco.mj_setConst(model, data)
+            return False
+        self.derived_by_tree += 1
+        return derivation(model, data, self._parked_ids)
 
     def assign(self, worlds: Sequence[int], variants: Sequence[Any]) -> np.ndarray:
         """World ``worlds[k]`` holds variant ``variants[k]`` from now on: its rows of
@@ -233,7 +324,7 @@ class WorldBatch:
         for w in worlds:
             if not 0 <= w < self.nworld:
                 raise _error(f"world {w} is not in the batch (0 to {self.nworld - 1})")
-        rows = [self._rows(i) for i in indices]
+        rows = [self._rows(world) for world in self._worlds(indices)]
         for i, r in zip(indices, rows):
             for n in r:
                 if n not in self.arrays and n != "parked_geoms":
@@ -442,6 +533,9 @@ class WorldBatch:
         out = []
         for i in self.world_variant:
             out.append(copy.copy(self.cache.apply(_Index(int(i)), self._scratch)))
+        for _layout, derivation in self._derivations.values():
+            if derivation is not None:
+                derivation.forget()  # the scratch model was patched another way
         return out
 
 

@@ -8,6 +8,7 @@ arithmetic in its order, so nothing is left to tolerance).
 from __future__ import annotations
 
 import collections
+from pathlib import Path
 import tomllib
 import copy
 import pickle
@@ -473,3 +474,45 @@ def test_batch_calls_report_progress(capsys, monkeypatch):
         cache.batch(variants, progress=3)
     # WorldBatch takes a scene file too (through ModelCache).
     assert WorldBatch(PATCH / "patch.toml", [0]).nworld == 1
+
+
+@pytest.mark.parametrize(
+    "path, worlds, by_tree",
+    [
+        (PATCH / "mass.toml", 24, True),  # masses through little models (frames, meshes)
+        (PATCH / "fixed.toml", 24, True),  # fixed bases (no dofs) beside free objects
+        (PATCH / "boxes.toml", 24, True),
+        (PATCH / "patch.toml", 8, False),  # the robot's armature: a tree with actuators
+        (LIFT5, 64, True),
+    ],
+    ids=lambda p: p.stem if isinstance(p, Path) else str(p),
+)
+def test_worlds_derived_tree_by_tree_are_mj_setconsts(path, worlds, by_tree, monkeypatch):
+    # WorldBatch derives what mj_setConst would, per tree the patch writes into (each
+    # compiled alone as a skeleton) and on the superset for what spans trees: every
+    # per-world array and statistic must be the same bits as with mj_setConst itself.
+    if path == LIFT5 and not RS_ASSETS.is_dir():
+        pytest.skip("setup not run")
+    from mjcf_forge.batch import WorldBatch
+
+    scene = mjcf_forge.Scene.load(path)
+    cache = mjcf_forge.ModelCache(scene, superset=True)
+    fast = WorldBatch(cache, range(worlds))
+    assert fast.derived_by_tree == (worlds if by_tree else 0)
+    monkeypatch.setattr(WorldBatch, "_by_tree", False)
+    whole = WorldBatch(cache, range(worlds))
+    assert whole.derived_by_tree == 0
+    assert fast.per_world == whole.per_world
+    for name in whole.per_world:
+        assert np.array_equal(fast.arrays[name], whole.arrays[name]), name
+    assert np.array_equal(fast.parked_geoms, whole.parked_geoms)
+    # Reassigned worlds and models for MuJoCo's batch API after them: the same too.
+    fast.assign([1, 0], [worlds + 3, worlds + 5])
+    whole.assign([1, 0], [worlds + 3, worlds + 5])
+    for name in whole.per_world:
+        assert np.array_equal(fast.arrays[name], whole.arrays[name]), name
+    ours = fast.mujoco_models()
+    fast.assign([2], [worlds + 7])
+    whole.assign([2], [worlds + 7])
+    assert all(np.array_equal(fast.arrays[n], whole.arrays[n]) for n in whole.per_world)
+    assert np.array_equal(ours[0].body_invweight0, whole.mujoco_models()[0].body_invweight0)

@@ -2,9 +2,10 @@
 
 use std::sync::Arc;
 
-use mjcf_forge::scene::{Scene, Superset};
+use mjcf_forge::scene::{PatchEntry, PatchValue, Scene, Superset};
 use pyo3::prelude::*;
-use pyo3::types::PyTuple;
+use pyo3::types::{PyBytes, PyTuple};
+use rayon::prelude::*;
 
 use super::variant_index;
 use crate::document::patch::patch_list;
@@ -70,6 +71,80 @@ impl PySuperset {
         })
     }
 
+    /// Variants ``indices`` as superset patches at once, made in parallel (what a batch of
+    /// worlds needs; the same patches as :meth:`patch`, split apart). Returns ``(layouts,
+    /// worlds)``: ``layouts``, the distinct layouts of the patches, each a tuple of
+    /// ``(object, name or id, field, width)`` per entry (``width``: how many numbers, -1
+    /// for a string value); ``worlds``, per index, ``(layout, numbers, strings, parked)``:
+    /// its layout's position in ``layouts``, its numbers end to end (``bytes`` of
+    /// native-endian ``float64``, for ``numpy.frombuffer``), its string values in order,
+    /// and the root bodies it parks (as :meth:`parked`). An :class:`MjcfError` names a
+    /// variant no patch can carry.
+    #[allow(clippy::type_complexity)]
+    fn worlds<'py>(
+        &self,
+        py: Python<'py>,
+        indices: Vec<u64>,
+    ) -> PyResult<(
+        Vec<Bound<'py, PyTuple>>,
+        Vec<(usize, Bound<'py, PyBytes>, Vec<String>, Vec<String>)>,
+    )> {
+        let made = run(py, || {
+            indices
+                .par_iter()
+                .map(|&i| {
+                    let patch = self.scene.superset_patch(&self.superset, i)?;
+                    let parked = self.scene.superset_parked(&self.superset, i)?;
+                    Ok((patch.entries, parked))
+                })
+                .collect::<Result<Vec<_>, mjcf_forge::Errors>>()
+                .map_err(Into::into)
+        })?;
+        let mut layouts: Vec<Vec<(&'static str, Option<usize>, String, &'static str, i64)>> =
+            Vec::new();
+        let mut worlds = Vec::with_capacity(made.len());
+        for (entries, parked) in &made {
+            let layout: Vec<_> = entries.iter().map(layout_entry).collect();
+            let at = match layouts.iter().position(|l| *l == layout) {
+                Some(at) => at,
+                None => {
+                    layouts.push(layout);
+                    layouts.len() - 1
+                }
+            };
+            let mut numbers: Vec<u8> = Vec::new();
+            let mut strings = Vec::new();
+            for e in entries {
+                match &e.value {
+                    PatchValue::Numbers(v) => {
+                        numbers.extend(v.iter().flat_map(|x| x.to_ne_bytes()));
+                    }
+                    PatchValue::Id { name, .. } | PatchValue::Compiled(name) => {
+                        strings.push(name.clone());
+                    }
+                }
+            }
+            worlds.push((at, PyBytes::new(py, &numbers), strings, parked.clone()));
+        }
+        let layouts = layouts
+            .iter()
+            .map(|l| {
+                let items = l
+                    .iter()
+                    .map(|(object, id, name, field, width)| {
+                        let name = match id {
+                            Some(id) => id.into_pyobject(py)?.into_any(),
+                            None => name.as_str().into_pyobject(py)?.into_any(),
+                        };
+                        (*object, name, *field, *width).into_pyobject(py)
+                    })
+                    .collect::<PyResult<Vec<_>>>()?;
+                PyTuple::new(py, items)
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        Ok((layouts, worlds))
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "<mjcf_forge.Superset key={} xml_bytes={}>",
@@ -77,4 +152,14 @@ impl PySuperset {
             self.xml.len()
         )
     }
+}
+
+/// An entry's place in a patch's layout: object, id or name, field, and its width (how
+/// many numbers; -1 for a string).
+fn layout_entry(e: &PatchEntry) -> (&'static str, Option<usize>, String, &'static str, i64) {
+    let width = match &e.value {
+        PatchValue::Numbers(v) => v.len() as i64,
+        _ => -1,
+    };
+    (e.object, e.id, e.name.clone(), e.field, width)
 }
