@@ -127,6 +127,22 @@ _JOINT_QPOS = {0: 7, 1: 4, 2: 1, 3: 1}  # free, ball, slide, hinge
 _JOINT_DOFS = {0: 6, 1: 3, 2: 1, 3: 1}
 
 
+class _Groups:
+    """Rows grouped by an index (``np.maximum.at`` without its slow per-row loop)."""
+
+    def __init__(self, index: np.ndarray) -> None:
+        self.order = np.argsort(index, kind="stable")
+        ordered = index[self.order]
+        self.starts = np.flatnonzero(np.r_[True, ordered[1:] != ordered[:-1]]) if len(index) else index
+        self.targets = ordered[self.starts] if len(index) else index
+
+    def maximum(self, out: np.ndarray, values: np.ndarray) -> None:
+        """``out[i] = max(out[i], values of rows indexed i)`` (a maximum: any order)."""
+        if len(self.order):
+            best = np.maximum.reduceat(values[self.order], self.starts)
+            out[self.targets] = np.maximum(out[self.targets], best)
+
+
 class _Variant:
     """What a superset ModelCache reads of a variant: its index."""
 
@@ -207,9 +223,12 @@ class _Plan:
         self.box_radius0 = self.box_radius.copy()
         self.joint_body = model.jnt_bodyid.copy()
         self.joint_parent = model.body_parentid[self.joint_body]
+        self.by_joint_body = _Groups(self.joint_body)
+        self.by_joint_parent = _Groups(self.joint_parent)
         geoms = np.flatnonzero((model.geom_rbound > 0) & (model.geom_bodyid > 0))
         self.sized_geoms = geoms
         self.sized_geom_body = model.geom_bodyid[geoms]
+        self.by_geom_body = _Groups(self.sized_geom_body)
         self.sized_geom_rbound = model.geom_rbound[geoms].copy()
         self.sized_geom_rbound0 = self.sized_geom_rbound.copy()
         jnt = model.dof_jntid
@@ -418,10 +437,12 @@ class _Plan:
         mujoco.mj_makeM(model, data)
         lo = np.full(3, 1e10)
         hi = np.full(3, -1e10)
-        for points in self.points + (self.geom_xpos - self.box_radius, self.geom_xpos + self.box_radius):
-            if len(points):
-                lo = np.minimum(lo, points.min(axis=0))
-                hi = np.maximum(hi, points.max(axis=0))
+        points = np.concatenate(
+            self.points + (self.geom_xpos - self.box_radius, self.geom_xpos + self.box_radius)
+        )
+        if len(points):
+            lo = np.minimum(lo, points.min(axis=0))
+            hi = np.maximum(hi, points.max(axis=0))
         stat.center[:] = (lo + hi) * 0.5
         extent = stat.extent
         if hi[0] > lo[0]:
@@ -432,13 +453,13 @@ class _Plan:
         body = np.zeros(self.nbody)
         if len(self.joint_body):
             xipos, xanchor = self.xipos, self.xanchor
-            np.maximum.at(body, self.joint_body, _dist(xipos[self.joint_body], xanchor))
-            np.maximum.at(body, self.joint_parent, _dist(xipos[self.joint_parent], xanchor))
+            self.by_joint_body.maximum(body, _dist(xipos[self.joint_body], xanchor))
+            self.by_joint_parent.maximum(body, _dist(xipos[self.joint_parent], xanchor))
         body[0] = 0.0
         if len(self.sized_geoms):
             gb = self.sized_geom_body
             far = self.sized_geom_rbound + _dist(self.xipos[gb], self.geom_xpos[self.sized_geoms])
-            np.maximum.at(body, gb, far)
+            self.by_geom_body.maximum(body, far)
         if self.nbody > 1:
             body[1:] = np.maximum(body[1:], 1e-5)
             stat.meansize = _in_order_sum(body[1:] / (self.nbody - 1))
@@ -503,8 +524,9 @@ class ModelCache:
         self._max_bytes = max_bytes
         #: The scene's :class:`Superset` when every variant is a patch of it, else None.
         self.superset = scene.superset() if superset else None
-        # Superset: per set of parked objects, the dofs the variant's own model has.
-        self._kept_dofs: dict[tuple[str, ...], np.ndarray] = {}
+        # Superset: the dofs of each candidate's subtree, by its root's name (one
+        # structure: the same in every model of it).
+        self._subtree_dofs: dict[str, np.ndarray] = {}
         # Cached models by structure key, least recently used first.
         self._entries: collections.OrderedDict[str, Any] = collections.OrderedDict()
         # How to patch each model seen (cached ones and the caller's), by id; holding the
@@ -551,17 +573,19 @@ class ModelCache:
         dofs of what the variant places (in the superset's dof order, which is the
         variant's), parked objects left out (``parked``: their root bodies' names, when
         known)."""
-        roots = tuple(self.superset.parked(variant.index) if parked is None else parked)
-        keep = self._kept_dofs.get(roots)
-        if keep is None:
-            parked = np.zeros(model.nbody, dtype=bool)
-            parked[[model.body(root).id for root in roots]] = True
-            for b in range(1, model.nbody):  # parents come before their children
-                parked[b] |= parked[model.body_parentid[b]]
-            keep = np.flatnonzero(~parked[model.dof_bodyid])
-            if len(self._kept_dofs) >= 4096:
-                self._kept_dofs.clear()
-            self._kept_dofs[roots] = keep
+        roots = self.superset.parked(variant.index) if parked is None else parked
+        of = self._subtree_dofs
+        for root in roots:
+            if root not in of:
+                inside = np.zeros(model.nbody, dtype=bool)
+                inside[model.body(root).id] = True
+                for b in range(1, model.nbody):  # parents come before their children
+                    inside[b] |= inside[model.body_parentid[b]]
+                of[root] = np.flatnonzero(inside[model.dof_bodyid])
+        mask = np.ones(model.nv, dtype=bool)
+        if roots:
+            mask[np.concatenate([of[root] for root in roots])] = False
+        keep = np.flatnonzero(mask)
         if len(keep):
             model.stat.meaninertia = _in_order_sum(plan.M[plan.M_diagonal[keep]]) / len(keep)
 

@@ -192,15 +192,9 @@ class TreeDerivation:
         # world: nothing to derive but its flags), and its bodies, geoms and sites whose
         # same-frame flags its patch may change (``framed``: those of the whole model).
         self.trees = {root: _Tree(mujoco, model, root) if root in moving else None for root in roots}
-        bodies, geoms, sites = (np.array(sorted(f), dtype=int) for f in framed)
-        self.elements = {
-            root: (
-                bodies[model.body_rootid[bodies] == root],
-                geoms[model.body_rootid[model.geom_bodyid[geoms]] == root],
-                sites[model.body_rootid[model.site_bodyid[sites]] == root],
-            )
-            for root in roots
-        }
+        # Set again in every world that changes a tree (a few vectorized passes: cheaper
+        # than picking the changed trees' elements).
+        self.framed = tuple(np.array(sorted(f), dtype=int) for f in framed)
         # Each tree's values as last written ("parked" or "placed"), and the derived
         # values of parked trees (the same in every world).
         self.state: dict[int, str] = {}
@@ -250,14 +244,21 @@ class TreeDerivation:
             if body is None:
                 return None
             roots.add(int(model.body_rootid[body]))
-            if field == "geoms" or target in ("body_ipos", "body_iquat"):
+            if field == "geoms":  # a little model writes the geoms' frames too
+                framed_bodies.add(body)
+                framed.update(("geom", int(g)) for g in np.flatnonzero(model.geom_bodyid == body))
+            elif target in ("body_ipos", "body_iquat"):
                 framed_bodies.add(body)
         roots.discard(0)
-        in_bodies = set(framed_bodies)
+        # A geom or site whose own frame no patch writes and whose orientation is its
+        # body's keeps its flag (BODY or BODYROT) whatever the body's inertial frame.
+        turned_geoms = ~_same_quat(model.geom_quat, _UNIT)
+        turned_sites = ~_same_quat(model.site_quat, _UNIT)
+        in_bodies = list(framed_bodies)
         geoms = {i for o, i in framed if o == "geom"}
-        geoms |= set(np.flatnonzero(np.isin(model.geom_bodyid, list(in_bodies))).tolist())
+        geoms |= set(np.flatnonzero(np.isin(model.geom_bodyid, in_bodies) & turned_geoms).tolist())
         sites = {i for o, i in framed if o == "site"}
-        sites |= set(np.flatnonzero(np.isin(model.site_bodyid, list(in_bodies))).tolist())
+        sites |= set(np.flatnonzero(np.isin(model.site_bodyid, in_bodies) & turned_sites).tolist())
         # A frame written outside the trees followed here: its flags would go stale.
         for b in [*framed_bodies, *model.geom_bodyid[list(geoms)], *model.site_bodyid[list(sites)]]:
             if int(model.body_rootid[b]) not in roots:
@@ -288,8 +289,7 @@ class TreeDerivation:
             if now != "parked" or self.state.get(root) != "parked":
                 changed.append((root, now))
         if self.sameframe and changed:
-            parts = [self.elements[root] for root, _ in changed]
-            _sameframe(model, *(np.concatenate([p[k] for p in parts]) for k in range(3)))
+            _sameframe(model, *self.framed)
         for root, now in changed:
             tree = self.trees[root]
             if tree is not None:
