@@ -404,3 +404,83 @@ fn absolute_mass_of_a_body_without_inertial_is_refused_with_the_fix() {
     assert!(err.contains("its mass comes from its geoms"), "{err}");
     assert!(err.contains("scale = true"), "{err}");
 }
+
+#[test]
+fn per_world_arrays_hold_each_worlds_superset_model() {
+    use mjcf_forge::compiled::Dtype;
+    let scene = Scene::load(root().join("corpora/scenes/patch/boxes.toml")).unwrap();
+    let mut cache = ModelCache::new(&scene, 2, None).with_superset().unwrap();
+    let worlds = [3u64, 0, 5, 3, 7];
+    let batch = cache.worlds(&worlds).unwrap();
+    assert_eq!(batch.world_variant, worlds);
+    assert_eq!(batch.parked.len(), worlds.len());
+    // Objects stand in different places, have their own colours and frictions per world.
+    for name in [
+        "qpos0",
+        "body_pos",
+        "geom_rgba",
+        "geom_friction",
+        "body_invweight0",
+    ] {
+        let f = batch
+            .field(name)
+            .unwrap_or_else(|| panic!("{name} is not per world"));
+        assert_eq!(f.to_f64().unwrap().len(), worlds.len() * f.len, "{name}");
+    }
+    assert_eq!(batch.field("geom_rgba").unwrap().dtype, Dtype::F32);
+    assert_eq!(batch.field("body_pos").unwrap().dtype, Dtype::F64);
+    assert!(batch.field("geom_type").is_none()); // shared by every world
+    // Each world's rows are its variant's superset model, bit for bit, and that model is
+    // the variant's own compile (superset_holds_every_variant).
+    for (w, &i) in worlds.iter().enumerate() {
+        let want = cache.model(i).unwrap().clone();
+        let bytes = |v: &[f64]| v.iter().flat_map(|x| x.to_ne_bytes()).collect::<Vec<u8>>();
+        let f32s = |v: &[f32]| v.iter().flat_map(|x| x.to_ne_bytes()).collect::<Vec<u8>>();
+        // A per-world field's row, or the shared model's array.
+        let rows = |name: &str, shared: Vec<u8>| {
+            batch
+                .field(name)
+                .map_or(shared, |f| f.row_bytes(w).to_vec())
+        };
+        let m = &batch.model;
+        assert_eq!(
+            rows("body_pos", bytes(m.body_pos())),
+            bytes(want.body_pos()),
+            "world {w}"
+        );
+        assert_eq!(
+            rows("body_mass", bytes(m.body_mass())),
+            bytes(want.body_mass()),
+            "world {w}"
+        );
+        assert_eq!(
+            rows("body_inertia", bytes(m.body_inertia())),
+            bytes(want.body_inertia()),
+            "world {w}"
+        );
+        assert_eq!(
+            rows("geom_rgba", f32s(m.geom_rgba())),
+            f32s(want.geom_rgba()),
+            "world {w}"
+        );
+        assert_eq!(
+            rows("geom_friction", bytes(m.geom_friction())),
+            bytes(want.geom_friction()),
+            "world {w}"
+        );
+        assert_eq!(
+            batch.parked[w],
+            scene
+                .superset_parked(&scene.superset().unwrap(), i)
+                .unwrap()
+        );
+    }
+    // The same variant in two worlds: the same rows.
+    for f in &batch.fields {
+        assert_eq!(f.row_bytes(0), f.row_bytes(3), "{}", f.name);
+    }
+    // Bad input, before any array: zero worlds; no superset.
+    assert!(cache.worlds(&[]).unwrap_err().contains("0 worlds"));
+    let mut plain = ModelCache::new(&scene, 2, None);
+    assert!(plain.worlds(&[0]).unwrap_err().contains("with_superset"));
+}

@@ -146,6 +146,21 @@ impl<'s> ModelCache<'s> {
         Ok(self)
     }
 
+    /// Whether every variant is a patch of the superset ([`ModelCache::with_superset`]).
+    pub(super) fn has_superset(&self) -> bool {
+        self.superset.is_some()
+    }
+
+    /// The root bodies of the objects variant `index` parks in the superset.
+    pub(super) fn parked(&self, index: u64) -> Result<Vec<String>, String> {
+        let Some(s) = &self.superset else {
+            return Err("no superset".to_string());
+        };
+        self.scene
+            .superset_parked(&s.superset, index)
+            .map_err(|e| e.to_string())
+    }
+
     /// The variant's patch: of its own structure, or of the superset.
     fn patch_of(&self, index: u64) -> Result<VariantPatch, String> {
         match &self.superset {

@@ -31,9 +31,11 @@ mod cache;
 mod document;
 mod little;
 mod store;
+mod worlds;
 
 pub use cache::ModelCache;
 pub use document::DocumentCache;
+pub use worlds::{Dtype, WorldArrays, WorldField, WorldStatistics};
 
 /// The statistics a `<statistic>` fixes as the bits `patch.c`'s `mjf_patch_finish` takes.
 fn fixed_bits(names: &[&str]) -> std::ffi::c_int {

@@ -209,6 +209,20 @@ const char* mjf_patch_array_name(int i) {
   return names[i];
 }
 
+// The C type of mjModel's array number `i` as MuJoCo declares it ("mjtNum", "float", "int",
+// "mjtByte"...); NULL past the last.
+const char* mjf_patch_array_type(int i) {
+  static const char* types[] = {
+#define X(type, field, nr, nc) #type,
+#define XNV X
+    MJMODEL_POINTERS
+#undef XNV
+#undef X
+  };
+  if (i < 0 || (size_t)i >= sizeof(types) / sizeof(types[0])) return NULL;
+  return types[i];
+}
+
 // Superset: stat.meaninertia as the variant's own model has it, the mean of the mass
 // matrix's diagonal (at qpos0, as the statistics left it in `d`) over the `n` dofs in
 // `keep` (the variant's, in order).

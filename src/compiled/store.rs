@@ -46,6 +46,7 @@ unsafe extern "C" {
         values: *const f64,
     );
     pub(super) fn mjf_patch_array_name(i: c_int) -> *const c_char;
+    pub(super) fn mjf_patch_array_type(i: c_int) -> *const c_char;
     fn mjf_patch_option(
         m: *mut MjModel,
         name: *const c_char,
