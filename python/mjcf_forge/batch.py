@@ -60,6 +60,11 @@ _DERIVED = (
 # geoms' own margins): where a simulator holds one for all worlds, the largest of the
 # worlds' values is exact.
 _BOUNDS = ("body_margin",)
+# Shortcuts MJX takes per body, geom or site where its frame is its body's or inertial
+# frame (kept as static arrays by put_model): where the worlds differ, the general
+# computation (0, mjSAMEFRAME_NONE) serves every world (the same numbers where a frame
+# is exactly its body's; MuJoCo's flags allow 1e-6 of difference for a shortcut).
+_FLAGS = ("body_sameframe", "geom_sameframe", "site_sameframe")
 # Fields MuJoCo Warp holds for all worlds but reads only when sleeping is enabled (a
 # rotational dof's length is its body's size, which for a massless root body depends on
 # where the body stands: parked or placed).
@@ -74,6 +79,8 @@ _WRITTEN = (
     "body_mass", "body_inertia", "body_ipos", "body_iquat",
     "body_sameframe", "geom_sameframe", "site_sameframe",
 )
+# A model's keyframe arrays (each world's rows: WorldBatch.keys).
+_KEYS = ("key_qpos", "key_qvel", "key_act", "key_ctrl", "key_mpos", "key_mquat", "key_time")
 # The compiler's statistics, per world (``stat.<name>`` in :attr:`WorldBatch.arrays`).
 _STATS = ("meaninertia", "meanmass", "meansize", "extent", "center")
 # A patch entry's object -> the prefix of its MjModel arrays (as ModelCache resolves them).
@@ -114,23 +121,28 @@ class WorldBatch:
     ``ModelCache(scene, superset=True)``; ``variants`` are variant indices (or variants).
     ``progress``: ``True`` (a ``tqdm`` bar, or a line on standard error every second
     without ``tqdm``), a ``tqdm``-like object with ``update(n)`` or a callable ``f(n)``,
-    told per world built; ``None`` (default) or ``False`` for none. Raises :class:`MjcfError` for zero worlds, a variant
-    the superset cannot express (it randomizes a structural value), or a parked object
-    within reach of another geom; all before any simulator array is built.
+    told per world built; ``None`` (default) or ``False`` for none. ``key``: a
+    keyframe's name or id: every world starts at its own rows of it (:meth:`initial`;
+    None: at ``qpos0``). Raises :class:`MjcfError` for zero worlds, an unknown keyframe,
+    a variant the superset cannot express (it randomizes a structural value), or a parked
+    object within reach of another geom; all before any simulator array is built.
 
     Attributes: ``model`` (the superset ``MjModel``, patched for world 0: every shared
     field), ``arrays`` (per-world field -> ``(nworld, ...)`` array in MuJoCo's dtypes;
     ``stat.<name>`` for the statistics), ``per_world`` (their names), ``world_variant``
     (``(nworld,)`` variant index per world), ``qpos0`` and ``qpos`` (``(nworld, nq)``: the
-    worlds' reference and initial joint positions), ``parked_geoms`` (``(nworld, ngeom)``
-    bool: the geoms of objects the world parks).
+    worlds' reference and initial joint positions), ``keys`` (every world's keyframe
+    rows), ``parked_geoms`` (``(nworld, ngeom)`` bool: the geoms of objects the world
+    parks).
     """
 
     # Derive what mj_setConst does tree by tree where a patch allows (False: always the
     # whole mj_setConst; the tests compare both ways).
     _by_tree = True
 
-    def __init__(self, source: Any, variants: Sequence[Any], progress: Any = None) -> None:
+    def __init__(
+        self, source: Any, variants: Sequence[Any], progress: Any = None, key: Any = None
+    ) -> None:
         if isinstance(source, ModelCache):
             cache = source
         else:
@@ -144,6 +156,8 @@ class WorldBatch:
         self.superset = cache.superset
         # A variant the superset cannot express fails (in its patch), with its index.
         self.model = copy.copy(cache.model(_Index(indices[0])))
+        #: The keyframe every world starts at (its id), or None: ``qpos0``.
+        self.key = self._key_id(key)
         self._scratch = copy.copy(self.model)
         self._patched = _patched_arrays(self.superset.patch(indices[0]))
         model = self.model
@@ -189,9 +203,15 @@ class WorldBatch:
             n: np.stack([r[n] if n in r else getattr(model, n) for r in rows]) for n in self.per_world
         }
         self.parked_geoms = np.stack([r["parked_geoms"] for r in rows])
+        #: Every world's keyframes as its own patched model holds them (a key's rows for
+        #: an object's free joint are its pose in that world, placed or parked):
+        #: ``key_qpos`` ``(nworld, nkey, nq)``, ``key_qvel``, ``key_act``, ``key_ctrl``,
+        #: ``key_mpos``, ``key_mquat``, ``key_time``; empty without keyframes.
+        self.keys = {n: np.stack([r[n] for r in rows]) for n in _KEYS if n in rows[0]}
         self.world_variant = np.array(indices, dtype=np.int64)
         self._warp: Any = None
         self._mjx: Any = None
+        self._mjx_shared: Any = None
         self._mjx_impl: str | None = None
 
     @property
@@ -205,8 +225,55 @@ class WorldBatch:
     @property
     def qpos(self) -> np.ndarray:
         """The worlds' initial joint positions: each world's ``qpos0`` (an object's pose is
-        its free joint's ``qpos0``, as in the variant's own model)."""
-        return self.arrays["qpos0"].copy()
+        its free joint's ``qpos0``, as in the variant's own model), or with ``key`` each
+        world's row of that keyframe."""
+        return self.initial()["qpos"]
+
+    def _key_id(self, key: Any) -> int | None:
+        if key is None:
+            return None
+        model = self.model
+        if isinstance(key, str):
+            i = self.cache._mujoco.mj_name2id(model, self.cache._mujoco.mjtObj.mjOBJ_KEY, key)
+            if i < 0:
+                names = [model.key(k).name for k in range(model.nkey)]
+                raise _error(f"the scene has no keyframe '{key}' (its keyframes: {names})")
+            return int(i)
+        i = int(key)
+        if not 0 <= i < model.nkey:
+            raise _error(f"keyframe {i} is out of range: the scene has {model.nkey}")
+        return i
+
+    def initial(self) -> dict[str, np.ndarray]:
+        """Each world's initial state, one row per world, as ``mj_resetData`` (or with
+        ``key``, ``mj_resetDataKeyframe``) sets it in the world's own model: ``qpos``,
+        ``qvel``, ``act``, ``ctrl``, ``mocap_pos``, ``mocap_quat``, ``time``."""
+        m, n = self.model, self.nworld
+        k = self.key
+        if k is not None:
+            keys = self.keys
+            return {
+                "qpos": keys["key_qpos"][:, k].copy(),
+                "qvel": keys["key_qvel"][:, k].copy(),
+                "act": keys["key_act"][:, k].copy(),
+                "ctrl": keys["key_ctrl"][:, k].copy(),
+                "mocap_pos": keys["key_mpos"][:, k].reshape(n, -1, 3).copy(),
+                "mocap_quat": keys["key_mquat"][:, k].reshape(n, -1, 4).copy(),
+                "time": keys["key_time"][:, k].copy(),
+            }
+        mocap = m.body_mocapid >= 0
+        order = np.argsort(m.body_mocapid[mocap])
+        pos = self.arrays["body_pos"] if "body_pos" in self.arrays else np.broadcast_to(m.body_pos, (n,) + m.body_pos.shape)
+        quat = self.arrays["body_quat"] if "body_quat" in self.arrays else np.broadcast_to(m.body_quat, (n,) + m.body_quat.shape)
+        return {
+            "qpos": self.arrays["qpos0"].copy(),
+            "qvel": np.zeros((n, m.nv)),
+            "act": np.zeros((n, m.na)),
+            "ctrl": np.zeros((n, m.nu)),
+            "mocap_pos": pos[:, mocap][:, order].copy(),
+            "mocap_quat": quat[:, mocap][:, order].copy(),
+            "time": np.zeros(n),
+        }
 
     def _worlds(self, indices: Sequence[int]) -> Any:
         """Each variant of ``indices`` as ``(index, numbers, strings, parked, patch0)``
@@ -262,6 +329,9 @@ class WorldBatch:
                 out[n] = value.copy()
         for s in _STATS:
             out[f"stat.{s}"] = np.array(getattr(model.stat, s), dtype=np.float64)
+        if model.nkey:
+            for n in _KEYS:
+                out[n] = getattr(model, n).copy()
         mujoco = self.cache._mujoco
         parked = np.isin(self._root_of_geom, parked_roots)
         out["parked_geoms"] = parked
@@ -327,7 +397,7 @@ class WorldBatch:
         rows = [self._rows(world) for world in self._worlds(indices)]
         for i, r in zip(indices, rows):
             for n in r:
-                if n not in self.arrays and n != "parked_geoms":
+                if n not in self.arrays and n != "parked_geoms" and n not in self.keys:
                     raise _error(
                         f"variant {i}: field {n} differs from the batch's, where all worlds "
                         "share one value (build a new WorldBatch)"
@@ -335,6 +405,8 @@ class WorldBatch:
         for w, i, r in zip(worlds, indices, rows):
             for n in self.per_world:
                 self.arrays[n][w] = r[n] if n in r else getattr(self.model, n)
+            for n in self.keys:
+                self.keys[n][w] = r[n]
             self.parked_geoms[w] = r["parked_geoms"]
             self.world_variant[w] = i
         mask = np.zeros(self.nworld, dtype=bool)
@@ -346,8 +418,30 @@ class WorldBatch:
             m, d, specs = self._warp
             for name, rows_ in self._warp_rows(specs).items():
                 getattr(m, name).assign(wp.array(rows_, dtype=specs[name].dtype))
-            mjw.reset_data(m, d, reset=wp.array(mask, dtype=bool))
+            self.reset_mjwarp(mask)
         return mask
+
+    def reset_mjwarp(self, worlds: Any = None) -> None:
+        """The MuJoCo Warp data of :meth:`to_mjwarp` back at the initial state of the
+        worlds given (a mask or indices; None: every world): ``reset_data``, then with
+        ``key`` each world's own rows of the keyframe (MuJoCo Warp's
+        ``reset_data_keyframe`` would give every world world 0's rows: its ``key_qpos``
+        is one for all worlds, and a key's rows for an object are its pose in that
+        world, placed or parked)."""
+        import mujoco_warp as mjw
+        import warp as wp
+
+        if self._warp is None:
+            raise ValueError("reset_mjwarp() needs to_mjwarp() first")
+        mask = np.zeros(self.nworld, dtype=bool)
+        if worlds is None:
+            mask[:] = True
+        else:
+            worlds = np.asarray(worlds)
+            mask[worlds if worlds.dtype != bool else np.flatnonzero(worlds)] = True
+        m, d, _specs = self._warp
+        mjw.reset_data(m, d, reset=wp.array(mask, dtype=bool))
+        self._warp_start(d, mask)
 
     # ---------------------------------------------------------------- MuJoCo Warp
     def _warp_specs(self) -> dict[str, Any]:
@@ -452,9 +546,26 @@ class WorldBatch:
             arr._is_batched = True
             setattr(m, name, arr)
         d = mjw.make_data(self.model, nworld=self.nworld, **make_data)
-        mjw.reset_data(m, d)
         self._warp = (m, d, specs)
+        self.reset_mjwarp()
         return m, d
+
+    def _warp_start(self, d: Any, mask: np.ndarray) -> None:
+        """With ``key``: the worlds of ``mask`` at their own rows of the keyframe (after
+        ``reset_data``, which sets ``qpos0``). MuJoCo Warp's ``reset_data_keyframe``
+        would not do: its ``key_qpos`` is one for all worlds (world 0's, whose object
+        poses are other worlds' parked or placed ones)."""
+        if self.key is None:
+            return
+        import warp as wp
+
+        for name, rows in self.initial().items():
+            arr = getattr(d, name, None)
+            if arr is None or rows.size == 0:
+                continue
+            value = arr.numpy()
+            value[mask] = rows[mask].reshape(value[mask].shape)
+            arr.assign(wp.array(value, dtype=arr.dtype))
 
     # ---------------------------------------------------------------- MJX
     def to_mjx(self, impl: str | None = None) -> tuple[Any, Any]:
@@ -469,12 +580,19 @@ class WorldBatch:
         import jax.numpy as jnp
         from mujoco import mjx
 
+        if self._mjx is not None and not self._mjx_flags_hold():
+            self._mjx = None  # a reassigned world needs the general path somewhere new
         if self._mjx is None:
             shared = copy.copy(self.model)
             for name in _BOUNDS:
                 if name in self.arrays:
                     getattr(shared, name)[...] = self.arrays[name].max(axis=0)
+            for name in _FLAGS:
+                if name in self.arrays:
+                    rows = self.arrays[name]
+                    getattr(shared, name)[...] = np.where((rows == rows[0]).all(axis=0), rows[0], 0)
             self._mjx = mjx.put_model(shared, impl=impl)
+            self._mjx_shared = shared
             self._mjx_impl = impl
         base = self._mjx
         replace: dict[str, Any] = {}
@@ -485,7 +603,7 @@ class WorldBatch:
                 continue
             rows = self.arrays[name]
             if not isinstance(leaf, jax.Array):
-                if (rows == rows[0]).all() or name in _BOUNDS:
+                if (rows == rows[0]).all() or name in _BOUNDS or name in _FLAGS:
                     continue
                 raise _error(
                     f"MJX cannot vary {name} per world (put_model keeps it as a static NumPy "
@@ -496,6 +614,16 @@ class WorldBatch:
         in_axes = jax.tree_util.tree_map(lambda _: None, base)
         in_axes = in_axes.tree_replace({k: 0 for k in replace})
         return model, in_axes
+
+    def _mjx_flags_hold(self) -> bool:
+        """Whether the same-frame flags MJX was put with hold in every world: each one
+        either every world's or 0 (the general computation)."""
+        for name in _FLAGS:
+            if name in self.arrays:
+                put = getattr(self._mjx_shared, name)
+                if not ((put == 0) | (self.arrays[name] == put).all(axis=0)).all():
+                    return False
+        return True
 
     def mjx_data(self, **make_data: Any) -> Any:
         """An MJX ``Data`` of ``nworld`` worlds (leading axis) at their initial pose, of the
@@ -508,7 +636,16 @@ class WorldBatch:
             self.to_mjx()
         one = mjx.make_data(self.model, impl=self._mjx_impl, **make_data)
         data = jax.tree_util.tree_map(lambda x: jnp.broadcast_to(x, (self.nworld,) + x.shape), one)
-        return data.replace(qpos=jnp.asarray(self.qpos, dtype=one.qpos.dtype))
+        start = self.initial()
+        if self.key is None:
+            start = {"qpos": start["qpos"]}
+        return data.replace(
+            **{
+                name: jnp.asarray(rows.reshape((self.nworld,) + getattr(one, name).shape), dtype=getattr(one, name).dtype)
+                for name, rows in start.items()
+                if hasattr(one, name)
+            }
+        )
 
     def mjx_reset(self, data: Any, mask: np.ndarray) -> Any:
         """``data`` with the worlds of ``mask`` back at their initial pose (after

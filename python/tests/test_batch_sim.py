@@ -291,17 +291,6 @@ def key_rows(batch: WorldBatch, keyframe: str) -> dict[str, np.ndarray]:
     return {f: np.stack([getattr(m, "key_" + f)[k] for m in models]) for f in ("qpos", "ctrl")}
 
 
-def warp_start_at(d, rows: dict[str, np.ndarray], worlds) -> None:
-    """The worlds' Warp data set to their keyframe rows (the others left as they are)."""
-    import warp as wp
-
-    for f, r in rows.items():
-        arr = getattr(d, f)
-        value = arr.numpy()
-        value[list(worlds)] = r[list(worlds)]
-        arr.assign(wp.array(value, dtype=arr.dtype))
-
-
 @pytest.mark.skipif(not (LIBERO_ASSETS.is_dir() and MENAGERIE_ASSETS.is_dir()), reason="setup not run")
 def test_mujoco_warp_menagerie_worlds_agree_with_each_variant():
     """MuJoCo Menagerie's UR5e with its keyframe and a Robotiq 2F-85, LIBERO's objects on
@@ -313,23 +302,25 @@ def test_mujoco_warp_menagerie_worlds_agree_with_each_variant():
 
     wp.config.quiet = True
     scene = mjcf_forge.Scene.load(MENAGERIE)
-    batch = WorldBatch(scene, range(WORLDS))
-    m, d = batch.to_mjwarp()
+    batch = WorldBatch(scene, range(WORLDS), key=MENAGERIE_KEY)
+    m, d = batch.to_mjwarp()  # every world at its own rows of the key
     rows = key_rows(batch, MENAGERIE_KEY)
-    # Warp's key_qpos is one for all worlds: world 0's object poses everywhere else.
+    assert np.array_equal(batch.qpos, rows["qpos"]) and np.array_equal(batch.initial()["ctrl"], rows["ctrl"])
+    assert np.allclose(d.qpos.numpy(), rows["qpos"], atol=1e-6)
+    # Warp's own key_qpos is one for all worlds: world 0's object poses everywhere else.
     mjw.reset_data_keyframe(m, d, batch.model.key(MENAGERIE_KEY).id)
     assert not np.allclose(d.qpos.numpy()[1:], rows["qpos"][1:], atol=1e-3)
-    mjw.reset_data(m, d)
-    warp_start_at(d, rows, range(WORLDS))
+    batch.reset_mjwarp()
+    assert np.allclose(d.qpos.numpy(), rows["qpos"], atol=1e-6)
     run, contacts = warp_step(m, d)
     pinch = batch.model.site("gripper0_pinch").id
     report = {}
     for worlds in (range(WORLDS), REASSIGN[0]):
         if worlds is REASSIGN[0]:
-            batch.assign(*REASSIGN)  # resets those worlds to qpos0: back to the key
-            warp_start_at(d, key_rows(batch, MENAGERIE_KEY), worlds)
+            batch.assign(*REASSIGN)  # those worlds reset to their new variants' key rows
         start = run(0)
         assert np.allclose(d.qpos.numpy()[list(worlds)], key_rows(batch, MENAGERIE_KEY)["qpos"][list(worlds)], atol=1e-6)
+        assert np.allclose(d.ctrl.numpy()[list(worlds)], key_rows(batch, MENAGERIE_KEY)["ctrl"][list(worlds)], atol=1e-6)
         parked = {w: parked_bodies(batch, w) for w in worlds}
         xpos = run(STEPS)
         alone, cpu = deviations(batch, scene, worlds, xpos, STEPS, MENAGERIE_KEY)

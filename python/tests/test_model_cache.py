@@ -590,3 +590,41 @@ def test_worlds_derived_tree_by_tree_are_mj_setconsts(path, worlds, by_tree, mon
     whole.assign([2], [worlds + 7])
     assert all(np.array_equal(fast.arrays[n], whole.arrays[n]) for n in whole.per_world)
     assert np.array_equal(ours[0].body_invweight0, whole.mujoco_models()[0].body_invweight0)
+
+
+def test_worlds_start_at_their_own_keyframe_rows():
+    # A robot with keyframes, objects placed around it: each world's key rows are its own
+    # patched model's (an object's rows are its pose there, placed or parked), which is the
+    # variant's own compile; WorldBatch(key=...) starts each world there.
+    from mjcf_forge.batch import WorldBatch
+
+    scene = mjcf_forge.Scene.load(ROOT / "corpora" / "scenes" / "keyframe" / "keyframe.toml")
+    cache = mjcf_forge.ModelCache(scene, superset=True)
+    batch = WorldBatch(cache, [2, 0, 3, 1], key="robot0_home")
+    assert batch.key == batch.model.key("robot0_home").id and batch.keys["key_qpos"].shape[:2] == (4, 2)
+    start = batch.initial()
+    for w, i in enumerate(batch.world_variant):
+        v = scene.variant(int(i))
+        model = cache.model(v)
+        for name, rows in batch.keys.items():
+            assert np.array_equal(rows[w], getattr(model, name)), (w, name)
+        # The same state as MuJoCo's own reset to the key in the variant's own model, joint
+        # by joint (the superset holds more joints: the parked candidates').
+        ref = mujoco.MjModel.from_xml_string(v.xml)
+        d = mujoco.MjData(ref)
+        mujoco.mj_resetDataKeyframe(ref, d, ref.key("robot0_home").id)
+        tags = cache.superset.names(int(i))
+        for j in range(ref.njnt):
+            n = ref.joint(j).name
+            ours = model.joint(next((t + n for p, t in tags if n.startswith(p)), n))
+            width = {0: 7, 1: 4}.get(int(ref.jnt_type[j]), 1)
+            a, b = ref.jnt_qposadr[j], ours.qposadr[0]
+            assert np.array_equal(start["qpos"][w, b : b + width], d.qpos[a : a + width]), (w, n)
+        assert np.array_equal(start["ctrl"][w], d.ctrl)
+    # Without a key: qpos0; a key by id; unknown keys refused before any array.
+    assert np.array_equal(WorldBatch(cache, [2, 0]).qpos, batch.qpos0[:2])
+    assert np.array_equal(WorldBatch(cache, [2], key=1).qpos[0], batch.keys["key_qpos"][0, 1])
+    with pytest.raises(mjcf_forge.MjcfError, match="no keyframe 'away'.*robot0_home"):
+        WorldBatch(cache, [0], key="away")
+    with pytest.raises(mjcf_forge.MjcfError, match="keyframe 5 is out of range"):
+        WorldBatch(cache, [0], key=5)
