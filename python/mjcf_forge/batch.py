@@ -154,11 +154,14 @@ class WorldBatch:
             raise _error("a batch needs at least one world: no variant was given (0 worlds)")
         self.cache = cache
         self.superset = cache.superset
-        # A variant the superset cannot express fails (in its patch), with its index.
-        self.model = copy.copy(cache.model(_Index(indices[0])))
+        # A variant the superset cannot express fails (in its patch), with its index. The
+        # worlds are patched into the cache's own model (it is the cache's to patch: no
+        # copy of a superset that may hold hundreds of megabytes of meshes); a copy of
+        # world 0 keeps the shared fields.
+        self._scratch = cache.model(_Index(indices[0]))
+        self.model = copy.copy(self._scratch)
         #: The keyframe every world starts at (its id), or None: ``qpos0``.
         self.key = self._key_id(key)
-        self._scratch = copy.copy(self.model)
         self._patched = _patched_arrays(self.superset.patch(indices[0]))
         model = self.model
         self._fields = [
@@ -184,6 +187,9 @@ class WorldBatch:
         self._written = [n for n in _WRITTEN if n in self._others]
         self._flags = [n for n in self._written if n.endswith("_sameframe")]
         self._body_ids: dict[str, int] = {}
+        # The cache's patch count after this batch's last patch (another count: the
+        # scratch model was patched by someone else since, see _rows).
+        self._patches_seen = -1
         self._parked_ids: set[int] = set()
         #: Worlds whose derived values came tree by tree (the others: mj_setConst).
         self.derived_by_tree = 0
@@ -311,9 +317,12 @@ class WorldBatch:
             parked_roots.append(i)
         self._parked_ids = set(parked_roots)
         by_tree = self.derived_by_tree
+        if self.cache.patches != self._patches_seen:
+            self._forget()  # the model was patched by someone else since
         model = self.cache._apply_world(
             self._scratch, (index, numbers, strings, parked_names), patch0, self._derive
         )
+        self._patches_seen = self.cache.patches
         out = {n: getattr(model, n).copy() for n in self._candidates}
         # mj_setConst may write any field (none differs for a superset patch); derived
         # tree by tree, only the patch and its bodies' little models write.
@@ -670,10 +679,13 @@ class WorldBatch:
         out = []
         for i in self.world_variant:
             out.append(copy.copy(self.cache.apply(_Index(int(i)), self._scratch)))
+        return out
+
+    def _forget(self) -> None:
+        """The scratch model was patched another way: every tree is derived again."""
         for _layout, derivation in self._derivations.values():
             if derivation is not None:
-                derivation.forget()  # the scratch model was patched another way
-        return out
+                derivation.forget()
 
 
 def _mjx_path(model: Any, name: str) -> str:
