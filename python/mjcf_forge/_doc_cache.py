@@ -20,8 +20,10 @@ from typing import Any
 
 import numpy as np
 
-from ._cache import _Plan, _copy, _error, _evict
+from ._cache import _copy, _evict
+from ._errors import _error
 from ._mjcf_forge import Document
+from ._plan import _Plan
 
 # The sizes that count rows of mesh, texture, height field, skin and bounding-volume data:
 # no patch writes them and they are most of a model's bytes (70 MB of lift5's 70.5), so

@@ -1,7 +1,7 @@
 """The exception that is two standard ones at once: :class:`MjcfFileNotFoundError`.
 
 The compiled module raises it (``errors.rs``) where every problem of a refusal is a file
-that does not exist.
+that does not exist. And ``_error``: an :class:`MjcfError` made on the Python side.
 """
 
 from __future__ import annotations
@@ -32,3 +32,9 @@ class MjcfFileNotFoundError(MjcfError, FileNotFoundError):
         # message: the message, then the attributes.
         state = dict(self.__dict__, errno=self.errno, filename=self.filename)
         return (type(self), self.args[:1], state)
+
+
+def _error(message: str) -> MjcfError:
+    err = MjcfError(message)
+    err.errors = [message]
+    return err

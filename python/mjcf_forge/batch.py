@@ -15,7 +15,8 @@ gives its fields in the shapes each simulator takes:
 - :meth:`WorldBatch.assign`: other variants in some worlds, at reset, without rebuilding
   the simulator's model.
 
-``mujoco_warp`` and ``jax`` are optional: imported only by the method that needs them.
+``mujoco_warp`` and ``jax`` are optional: imported only by the method that needs them
+(each simulator's side is a mixin of its own module: ``_warp.py``, ``_mjx.py``).
 
 The superset keeps every candidate's collision flags as authored, so the pairs of geoms
 a batched simulator fixes once (``put_model``) hold in every world; parking is geometric
@@ -27,15 +28,17 @@ naming it. What parked bodies still change in a world is in docs/compiled.md.
 from __future__ import annotations
 
 import copy
-import dataclasses
 from collections.abc import Sequence
 from typing import Any, NamedTuple
 
 import numpy as np
 
-from ._cache import _STATIC_PREFIXES, ModelCache, _error
+from ._cache import _STATIC_PREFIXES, ModelCache
+from ._errors import _error
+from ._mjx import MjxWorlds
 from ._progress import progress_of
 from ._trees import TreeDerivation
+from ._warp import WarpWorlds
 
 # Fields mj_setConst derives from values a patch writes (so they follow the variant even
 # when no patch entry names them).
@@ -56,24 +59,8 @@ _DERIVED = (
     "light_dir0",
     "dof_length",
 )
-# Bounds a simulator reads only to cull collision candidates (the narrow phase reads the
-# geoms' own margins): where a simulator holds one for all worlds, the largest of the
-# worlds' values is exact.
-_BOUNDS = ("body_margin",)
-# Shortcuts MJX takes per body, geom or site where its frame is its body's or inertial
-# frame (kept as static arrays by put_model): where the worlds differ, the general
-# computation (0, mjSAMEFRAME_NONE) serves every world (the same numbers where a frame
-# is exactly its body's; MuJoCo's flags allow 1e-6 of difference for a shortcut).
-_FLAGS = ("body_sameframe", "geom_sameframe", "site_sameframe")
-# Fields MuJoCo Warp holds for all worlds but reads only when sleeping is enabled (a
-# rotational dof's length is its body's size, which for a massless root body depends on
-# where the body stands: parked or placed).
-_WARP_SLEEP_ONLY = ("dof_length",)
-# Contacts a placed free object may have at once in MuJoCo Warp's default sizes (a box on
-# a table: 4; lift5's worlds: at most 24 for 5 objects and the gripper, measured).
-_CONTACTS_PER_OBJECT = 16
 # What a world's patch writes besides its own arrays: a body's little model
-# (_cache.compiled_body) and the same-frame flags (_trees).
+# (_plan._Plan.compiled_body) and the same-frame flags (_trees).
 _WRITTEN = (
     "geom_size", "geom_rbound", "geom_aabb", "geom_pos", "geom_quat",
     "body_mass", "body_inertia", "body_ipos", "body_iquat",
@@ -113,7 +100,7 @@ def _patched_arrays(patch: Sequence) -> set[str]:
     return out
 
 
-class WorldBatch:
+class WorldBatch(WarpWorlds, MjxWorlds):
     """``nworld`` worlds of one scene, world ``w`` holding variant ``variants[w]``, as
     per-world fields of the scene's superset model (see the module).
 
@@ -421,255 +408,8 @@ class WorldBatch:
         mask = np.zeros(self.nworld, dtype=bool)
         mask[worlds] = True
         if self._warp is not None:
-            import mujoco_warp as mjw
-            import warp as wp
-
-            m, d, specs = self._warp
-            for name, rows_ in self._warp_rows(specs).items():
-                getattr(m, name).assign(wp.array(rows_, dtype=specs[name].dtype))
-            self.reset_mjwarp(mask)
+            self._warp_reassigned(mask)
         return mask
-
-    def reset_mjwarp(self, worlds: Any = None) -> None:
-        """The MuJoCo Warp data of :meth:`to_mjwarp` back at the initial state of the
-        worlds given (a mask or indices; None: every world): ``reset_data``, then with
-        ``key`` each world's own rows of the keyframe (MuJoCo Warp's
-        ``reset_data_keyframe`` would give every world world 0's rows: its ``key_qpos``
-        is one for all worlds, and a key's rows for an object are its pose in that
-        world, placed or parked)."""
-        import mujoco_warp as mjw
-        import warp as wp
-
-        if self._warp is None:
-            raise ValueError("reset_mjwarp() needs to_mjwarp() first")
-        mask = np.zeros(self.nworld, dtype=bool)
-        if worlds is None:
-            mask[:] = True
-        else:
-            worlds = np.asarray(worlds)
-            mask[worlds if worlds.dtype != bool else np.flatnonzero(worlds)] = True
-        m, d, _specs = self._warp
-        mjw.reset_data(m, d, reset=wp.array(mask, dtype=bool))
-        self._warp_start(d, mask)
-
-    # ---------------------------------------------------------------- MuJoCo Warp
-    def _warp_specs(self) -> dict[str, Any]:
-        """Per-world fields MuJoCo Warp reads, by name, with their array specs; an error
-        naming a per-world field Warp has but cannot vary per world. Fields Warp does not
-        have (``dof_M0``, the statistics: Warp scales its solver by each world's mass
-        matrix instead) are left out."""
-        import mujoco_warp as mjw
-
-        types = {f.name: f.type for f in dataclasses.fields(mjw.Model)}
-        specs = {}
-        for name in self.per_world + ["geom_dataid"]:
-            spec = types.get(name)
-            if spec is None:
-                continue
-            shape = getattr(spec, "shape", ())
-            batched = bool(shape) and shape[0] == "*"
-            if not batched:
-                sleep = self.model.opt.enableflags & self.cache._mujoco.mjtEnableBit.mjENBL_SLEEP
-                if name in _WARP_SLEEP_ONLY and not sleep:
-                    continue
-                rows = self.arrays.get(name)
-                if rows is not None and not (rows == rows[0]).all():
-                    raise _error(
-                        f"MuJoCo Warp cannot vary {name} per world (its Model field is shared "
-                        "by all worlds), and the batch's worlds differ in it"
-                    )
-                continue
-            specs[name] = spec
-        return specs
-
-    def _warp_rows(self, specs: dict[str, Any]) -> dict[str, np.ndarray]:
-        out = {}
-        for name, spec in specs.items():
-            if name == "geom_dataid":
-                # A parked mesh geom is absent from its world (mjlab's switch for padded
-                # slots): no collision work for it, whatever its pose.
-                rows = np.tile(self.model.geom_dataid, (self.nworld, 1))
-                mesh = self.model.geom_type == self.cache._mujoco.mjtGeom.mjGEOM_MESH
-                rows[self.parked_geoms & mesh[None, :]] = -1
-            else:
-                rows = self.arrays[name]
-            dtype_shape = getattr(spec.dtype, "_shape_", ())
-            rows = rows.reshape((self.nworld,) + rows.shape[1:-1] + (-1,)) if dtype_shape else rows
-            out[name] = rows
-        return out
-
-    def warp_sizes(self) -> dict[str, int]:
-        """``nconmax`` and ``njmax`` for :meth:`to_mjwarp` when not given, from the model.
-
-        MuJoCo Warp's own defaults count none of the superset's objects (48 contacts and
-        64 constraint rows for a model without height fields, whatever it holds): lift5's
-        worlds need up to 24 contacts and 140 rows (measured, scripts/sim_gap.py). Here:
-        Warp's default contacts plus ``_CONTACTS_PER_OBJECT`` for each free body a world
-        places (its largest count over the worlds); rows: that many contacts times the
-        rows a contact of the model's largest ``condim`` takes (``2 (condim - 1)``
-        pyramidal, ``condim`` elliptic), plus a row for every equality's
-        (6: a weld), limited joint or tendon and dof or tendon with friction loss. An
-        estimate, not a bound: a world past it sets its bit of Warp's ``d.overflow``
-        (contacts beyond are dropped); give ``nconmax``/``njmax`` then."""
-        mujoco = self.cache._mujoco
-        m = self.model
-        free = m.jnt_bodyid[m.jnt_type == mujoco.mjtJoint.mjJNT_FREE]
-        placed = 0
-        for w in range(self.nworld):
-            parked_roots = set(m.body_rootid[m.geom_bodyid[self.parked_geoms[w]]].tolist())
-            placed = max(placed, sum(int(m.body_rootid[b]) not in parked_roots for b in free))
-        colliding = (m.geom_contype != 0) | (m.geom_conaffinity != 0)
-        condim = int(max(m.geom_condim[colliding].max(initial=1), m.pair_dim.max(initial=1)))
-        elliptic = m.opt.cone == mujoco.mjtCone.mjCONE_ELLIPTIC
-        rows = condim if elliptic or condim == 1 else 2 * (condim - 1)
-        fixed = (
-            6 * m.neq
-            + int(m.jnt_limited.sum())
-            + int(m.tendon_limited.sum())
-            + int((m.dof_frictionloss > 0).sum())
-            + int((m.tendon_frictionloss > 0).sum())
-        )
-        from mujoco_warp._src.io import _default_nconmax
-
-        nconmax = _default_nconmax(m) + _CONTACTS_PER_OBJECT * placed
-        return {"nconmax": int(nconmax), "njmax": int(nconmax * rows + fixed)}
-
-    def to_mjwarp(self, **make_data: Any) -> tuple[Any, Any]:
-        """A ``mujoco_warp`` ``Model`` with every per-world field one row per world (its
-        dtypes: float32 vectors and quaternions, int32 ids) and a ``Data`` of ``nworld``
-        worlds at their initial pose (``reset_data``: each world's ``qpos0``).
-        ``make_data`` goes to ``mujoco_warp.make_data``; ``nconmax`` and ``njmax`` default
-        to :meth:`warp_sizes` (Warp's own fit one robot alone)."""
-        import mujoco_warp as mjw
-        import warp as wp
-
-        if "naconmax" not in make_data:
-            for key, value in self.warp_sizes().items():
-                make_data.setdefault(key, value)
-        specs = self._warp_specs()
-        rows = self._warp_rows(specs)
-        m = mjw.put_model(self.model)
-        for name, r in rows.items():
-            # Warp converts MuJoCo's float64 and int32 rows to the field's own dtype.
-            arr = wp.array(r, dtype=specs[name].dtype)
-            arr._is_batched = True
-            setattr(m, name, arr)
-        d = mjw.make_data(self.model, nworld=self.nworld, **make_data)
-        self._warp = (m, d, specs)
-        self.reset_mjwarp()
-        return m, d
-
-    def _warp_start(self, d: Any, mask: np.ndarray) -> None:
-        """With ``key``: the worlds of ``mask`` at their own rows of the keyframe (after
-        ``reset_data``, which sets ``qpos0``). MuJoCo Warp's ``reset_data_keyframe``
-        would not do: its ``key_qpos`` is one for all worlds (world 0's, whose object
-        poses are other worlds' parked or placed ones)."""
-        if self.key is None:
-            return
-        import warp as wp
-
-        for name, rows in self.initial().items():
-            arr = getattr(d, name, None)
-            if arr is None or rows.size == 0:
-                continue
-            value = arr.numpy()
-            value[mask] = rows[mask].reshape(value[mask].shape)
-            arr.assign(wp.array(value, dtype=arr.dtype))
-
-    # ---------------------------------------------------------------- MJX
-    def to_mjx(self, impl: str | None = None) -> tuple[Any, Any]:
-        """An MJX model whose per-world leaves have a leading world axis (MJX's dtypes:
-        float32 unless JAX runs in x64) and the matching ``in_axes`` (0 for those leaves,
-        None elsewhere): ``jax.vmap(mjx.step, in_axes=(in_axes, 0))(model, data)``. The
-        first call runs ``mjx.put_model``; later ones (after :meth:`assign`) only replace
-        the per-world leaves. Fields MJX does not have are left out; one it holds as a
-        static (NumPy) array cannot vary per world: an error names it. ``impl`` goes to
-        ``mjx.put_model`` ("jax", "warp"...)."""
-        import jax
-        import jax.numpy as jnp
-        from mujoco import mjx
-
-        if self._mjx is not None and not self._mjx_flags_hold():
-            self._mjx = None  # a reassigned world needs the general path somewhere new
-        if self._mjx is None:
-            shared = copy.copy(self.model)
-            for name in _BOUNDS:
-                if name in self.arrays:
-                    getattr(shared, name)[...] = self.arrays[name].max(axis=0)
-            for name in _FLAGS:
-                if name in self.arrays:
-                    rows = self.arrays[name]
-                    getattr(shared, name)[...] = np.where((rows == rows[0]).all(axis=0), rows[0], 0)
-            self._mjx = mjx.put_model(shared, impl=impl)
-            self._mjx_shared = shared
-            self._mjx_impl = impl
-        base = self._mjx
-        replace: dict[str, Any] = {}
-        for name in self.per_world:
-            path = name if not name.startswith("stat.") else name
-            leaf = _mjx_leaf(base, path)
-            if leaf is None:
-                continue
-            rows = self.arrays[name]
-            if not isinstance(leaf, jax.Array):
-                if (rows == rows[0]).all() or name in _BOUNDS or name in _FLAGS:
-                    continue
-                raise _error(
-                    f"MJX cannot vary {name} per world (put_model keeps it as a static NumPy "
-                    "array), and the batch's worlds differ in it"
-                )
-            replace[_mjx_path(base, path)] = jnp.asarray(rows.reshape((self.nworld,) + leaf.shape), dtype=leaf.dtype)
-        model = base.tree_replace(replace)
-        in_axes = jax.tree_util.tree_map(lambda _: None, base)
-        in_axes = in_axes.tree_replace({k: 0 for k in replace})
-        return model, in_axes
-
-    def _mjx_flags_hold(self) -> bool:
-        """Whether the same-frame flags MJX was put with hold in every world: each one
-        either every world's or 0 (the general computation)."""
-        for name in _FLAGS:
-            if name in self.arrays:
-                put = getattr(self._mjx_shared, name)
-                if not ((put == 0) | (self.arrays[name] == put).all(axis=0)).all():
-                    return False
-        return True
-
-    def mjx_data(self, **make_data: Any) -> Any:
-        """An MJX ``Data`` of ``nworld`` worlds (leading axis) at their initial pose, of the
-        model's ``impl``; ``make_data`` goes to ``mjx.make_data`` (``nconmax``...)."""
-        import jax
-        import jax.numpy as jnp
-        from mujoco import mjx
-
-        if self._mjx is None:
-            self.to_mjx()
-        one = mjx.make_data(self.model, impl=self._mjx_impl, **make_data)
-        data = jax.tree_util.tree_map(lambda x: jnp.broadcast_to(x, (self.nworld,) + x.shape), one)
-        start = self.initial()
-        if self.key is None:
-            start = {"qpos": start["qpos"]}
-        return data.replace(
-            **{
-                name: jnp.asarray(rows.reshape((self.nworld,) + getattr(one, name).shape), dtype=getattr(one, name).dtype)
-                for name, rows in start.items()
-                if hasattr(one, name)
-            }
-        )
-
-    def mjx_reset(self, data: Any, mask: np.ndarray) -> Any:
-        """``data`` with the worlds of ``mask`` back at their initial pose (after
-        :meth:`assign`); the others as they were."""
-        import jax
-        import jax.numpy as jnp
-
-        fresh = self.mjx_data()
-        keep = jnp.asarray(mask)
-
-        def pick(new, old):
-            m = keep.reshape((-1,) + (1,) * (old.ndim - 1))
-            return jnp.where(m, new, old)
-
-        return jax.tree_util.tree_map(pick, fresh, data)
 
     # ---------------------------------------------------------------- MuJoCo (CPU)
     def mujoco_models(self) -> list[Any]:
@@ -686,21 +426,3 @@ class WorldBatch:
         for _layout, derivation in self._derivations.values():
             if derivation is not None:
                 derivation.forget()
-
-
-def _mjx_path(model: Any, name: str) -> str:
-    if name.startswith("stat."):
-        return name
-    if name in {f.name for f in dataclasses.fields(model)}:
-        return name
-    return f"_impl.{name}"
-
-
-def _mjx_leaf(model: Any, name: str) -> Any:
-    obj = model
-    for part in _mjx_path(model, name).split("."):
-        fields = {f.name for f in dataclasses.fields(obj)} if dataclasses.is_dataclass(obj) else set()
-        if part not in fields:
-            return None
-        obj = object.__getattribute__(obj, part)
-    return obj

@@ -1,0 +1,393 @@
+"""How one compiled model is patched in place: :class:`_Plan`, made once per model (the
+model caches, ``_cache.py`` and ``_doc_cache.py``, hold one per model they patch).
+
+A plan resolves where each entry of a patch lands (per target array, the flat indices and
+where the numbers come from, once per layout), writes a patch's numbers, material ids and
+the bodies' little models, then what follows from the values: ``mj_setConst`` (or a
+caller's derivation that writes the same, see ``_trees.py``), the model statistics the
+compiler derives at ``qpos0`` (which ``mj_setConst`` of 3.17 and 4.0 leaves), computed with
+the compiler's operations in its order, and the statistics the document fixes.
+"""
+
+from __future__ import annotations
+
+import itertools
+from typing import Any, Callable
+
+import numpy as np
+
+from ._errors import _error
+
+# The array prefix of each accessor's fields in MjModel, its object type and its count.
+_PREFIX = {
+    "body": "body_",
+    "joint": "jnt_",
+    "geom": "geom_",
+    "site": "site_",
+    "camera": "cam_",
+    "light": "light_",
+    "material": "mat_",
+    "actuator": "actuator_",
+}
+_OBJ = {
+    "body": "mjOBJ_BODY",
+    "joint": "mjOBJ_JOINT",
+    "geom": "mjOBJ_GEOM",
+    "site": "mjOBJ_SITE",
+    "camera": "mjOBJ_CAMERA",
+    "light": "mjOBJ_LIGHT",
+    "material": "mjOBJ_MATERIAL",
+    "actuator": "mjOBJ_ACTUATOR",
+}
+_COUNT = {
+    "body": "nbody",
+    "joint": "njnt",
+    "geom": "ngeom",
+    "site": "nsite",
+    "camera": "ncam",
+    "light": "nlight",
+    "material": "nmat",
+    "actuator": "nu",
+}
+# Joint fields that are per degree of freedom or per qpos coordinate.
+_DOF_FIELDS = ("damping", "armature", "frictionloss")
+_QPOS_FIELDS = ("qpos0", "qpos_spring")
+_JOINT_QPOS = {0: 7, 1: 4, 2: 1, 3: 1}  # free, ball, slide, hinge
+_JOINT_DOFS = {0: 6, 1: 3, 2: 1, 3: 1}
+
+
+class _Groups:
+    """Rows grouped by an index (``np.maximum.at`` without its slow per-row loop)."""
+
+    def __init__(self, index: np.ndarray) -> None:
+        self.order = np.argsort(index, kind="stable")
+        ordered = index[self.order]
+        self.starts = np.flatnonzero(np.r_[True, ordered[1:] != ordered[:-1]]) if len(index) else index
+        self.targets = ordered[self.starts] if len(index) else index
+
+    def maximum(self, out: np.ndarray, values: np.ndarray) -> None:
+        """``out[i] = max(out[i], values of rows indexed i)`` (a maximum: any order)."""
+        if len(self.order):
+            best = np.maximum.reduceat(values[self.order], self.starts)
+            out[self.targets] = np.maximum(out[self.targets], best)
+
+
+def _dist(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise distances, each computed as mju_dist3 computes it (same operations, same
+    order, so the same bits)."""
+    d = a - b
+    return np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] + d[:, 2] * d[:, 2])
+
+
+def _in_order_sum(values: np.ndarray) -> float:
+    """A left-to-right sum, as a C loop adds (``np.add.accumulate`` is sequential; ``sum``
+    is pairwise and may differ in the last bits)."""
+    return float(np.add.accumulate(values)[-1]) if len(values) else 0.0
+
+
+class _Plan:
+    """Everything patching one model object takes, made once per model: its structure key,
+    a scratch ``MjData`` (``mj_setConst`` overwrites the qpos of the data it is given), the
+    array views of the last patch's entries, and the views and constants of the statistics
+    the compiler derives (``mj_setConst`` of 3.17 and 4.0 leaves them)."""
+
+    def __init__(self, mujoco: Any, model: Any, key: str, fixed: list, superset: bool) -> None:
+        self.mujoco = mujoco
+        self.superset = superset
+        self.model = model
+        self.key = key
+        self.data = data = mujoco.MjData(model)
+        self.nbytes = model.nbuffer + data.nbuffer + data.narena
+        self.fields: list[tuple[Any, Any, str]] | None = None
+        # The patch the layout was last resolved from (ModelCache._apply_world), and which
+        # of its string values are a body's little model (the others: material names).
+        self.source: Any = None
+        self.string_geoms: list[bool] = []
+        self.groups: list[tuple[Any, np.ndarray, np.ndarray]] = []
+        # (flat array, index, which material name of the patch) per matid entry.
+        self.matids: list[tuple[Any, int, int]] = []
+        # (field of model.opt, first of its numbers, how many) per option entry.
+        self.options: list[tuple[str, int, int]] = []
+        # The bodies of the patch's "geoms" entries, in order, and the little models of
+        # their geoms compiled so far (MJCF text -> model), the newest last.
+        self.bodies: list[int] = []
+        self.body_models: dict[str, Any] = {}
+        # Per "geoms" entry: its little model as the structure compiled it (what the
+        # snapshot's arrays hold), and the one last written into this model (None: not
+        # known; the bounding volumes are not restored before a patch).
+        self.body_xml0: list[str] = []
+        self.body_written: list[Any] = []
+        # The <statistic> values the scene sets: MuJoCo keeps them over what it computes.
+        self.fixed = fixed
+        # Views (fetching one from the bindings costs microseconds) and constants.
+        self.stat = model.stat
+        self.qpos0, self.qpos = model.qpos0, data.qpos
+        self.points = (data.xpos[1:], data.xipos[1:], data.xanchor, data.site_xpos)
+        self.geom_xpos, self.xipos, self.xanchor = data.geom_xpos, data.xipos, data.xanchor
+        self.body_mass, self.M = model.body_mass[1:], data.M
+        self.M_diagonal = model.M_rowadr + model.M_rownnz - 1
+        self.nbody, self.nv = model.nbody, model.nv
+        self.dof_length = model.dof_length
+        # Geom radii for the bounding box: a plane or height field (rbound 0) counts a
+        # tenth of its largest size. Sizes are patched only through "geoms" entries, which
+        # update these (compiled_body()).
+        size, kind = model.geom_size, model.geom_type
+        rbound = model.geom_rbound.copy()
+        plane = (rbound <= 0) & (kind == mujoco.mjtGeom.mjGEOM_PLANE)
+        finite = (size[:, 0] != 0) | (size[:, 1] != 0)
+        rbound[plane & finite] = np.maximum(size[:, 0], size[:, 1])[plane & finite] * 0.1
+        rbound[plane & ~finite] = 0.01
+        for g in np.flatnonzero((rbound <= 0) & (kind == mujoco.mjtGeom.mjGEOM_HFIELD)):
+            h = model.hfield_size[model.geom_dataid[g]]
+            rbound[g] = max(h[0], max(h[1], max(h[2], h[3]))) * 0.1
+        rbound[rbound < 0] = 0.0
+        self.box_radius = rbound[:, None]
+        self.box_radius0 = self.box_radius.copy()
+        self.joint_body = model.jnt_bodyid.copy()
+        self.joint_parent = model.body_parentid[self.joint_body]
+        self.by_joint_body = _Groups(self.joint_body)
+        self.by_joint_parent = _Groups(self.joint_parent)
+        geoms = np.flatnonzero((model.geom_rbound > 0) & (model.geom_bodyid > 0))
+        self.sized_geoms = geoms
+        self.sized_geom_body = model.geom_bodyid[geoms]
+        self.by_geom_body = _Groups(self.sized_geom_body)
+        self.sized_geom_rbound = model.geom_rbound[geoms].copy()
+        self.sized_geom_rbound0 = self.sized_geom_rbound.copy()
+        jnt = model.dof_jntid
+        jtype = model.jnt_type[jnt]
+        offset = np.arange(model.nv) - model.jnt_dofadr[jnt]
+        self.rotational = (jtype == 1) | (jtype == 3) | ((jtype == 0) & (offset >= 3))
+        self.dof_body = model.dof_bodyid.copy()
+
+    def resolve(self, patch: list) -> None:
+        """Where every entry of ``patch`` lands: per target array, the flat indices its
+        numbers go to and where they come from in the patch's numbers laid end to end
+        (a one-number entry fills all its rows, as a joint's damping fills each of its
+        dofs); material names apart."""
+        mujoco, model = self.mujoco, self.model
+        groups: dict[str, tuple[Any, list[int], list[int]]] = {}
+        matids: list[tuple[Any, int, int]] = []
+        options: list[tuple[str, int, int]] = []
+        bodies: list[int] = []
+        body_xml: list[str] = []
+        numbers = 0
+        for obj, name, field, value in patch:
+            if obj == "option":
+                if isinstance(value, str) or not hasattr(model.opt, field):
+                    raise _error(f"this MuJoCo's mjOption has no field {field}")
+                options.append((field, numbers, len(value)))
+                numbers += len(value)
+                continue
+            if isinstance(name, int):
+                i = name if name < getattr(model, _COUNT[obj]) else -1
+            else:
+                i = mujoco.mj_name2id(model, getattr(mujoco.mjtObj, _OBJ[obj]), name)
+            if i < 0:
+                raise _error(
+                    f"the patch names {obj} '{name}', which the compiled model does not have"
+                )
+            if field == "geoms":
+                bodies.append(int(i))
+                body_xml.append(value)
+                continue
+            if obj == "joint" and field in _DOF_FIELDS:
+                array = f"dof_{field}"
+                first = int(model.jnt_dofadr[i])
+                rows = range(first, first + _JOINT_DOFS[int(model.jnt_type[i])])
+            elif obj == "joint" and field in _QPOS_FIELDS:
+                array = field
+                first = int(model.jnt_qposadr[i])
+                rows = range(first, first + _JOINT_QPOS[int(model.jnt_type[i])])
+            elif obj == "joint" and field == "key_qpos":
+                # The joint's rows of every keyframe (one row of nq per key).
+                array = field
+                first = int(model.jnt_qposadr[i])
+                width = _JOINT_QPOS[int(model.jnt_type[i])]
+                _, targets, sources = groups.setdefault(array, (model.key_qpos.reshape(-1), [], []))
+                for k in range(model.nkey):
+                    targets.extend(range(k * model.nq + first, k * model.nq + first + width))
+                    sources.extend(range(numbers, numbers + len(value)))
+                numbers += len(value)
+                continue
+            else:
+                array = _PREFIX[obj] + field
+                width = 1 if isinstance(value, str) else len(value)
+                rows = range(i * width, (i + 1) * width)
+            whole = getattr(model, array)
+            flat = whole.reshape(-1)
+            if not np.shares_memory(flat, whole):
+                raise _error(f"mjModel.{array} is not one contiguous array here")
+            if isinstance(value, str):
+                matids.append((flat, rows[0], len(matids)))
+                continue
+            _, targets, sources = groups.setdefault(array, (flat, [], []))
+            targets.extend(rows)
+            sources.extend(
+                [numbers] * len(rows) if len(value) == 1 else range(numbers, numbers + len(value))
+            )
+            numbers += len(value)
+        self.groups = [(flat, np.array(t), np.array(s)) for flat, t, s in groups.values()]
+        self.matids = matids
+        self.options = options
+        self.bodies = bodies
+        self.body_xml0 = body_xml
+        self.body_written = [None] * len(bodies)
+        self.fields = [tuple(e[:3]) for e in patch]
+        self.source = None
+
+    def apply(self, patch: list, derive: Callable[[Any, Any, list], None] | None = None) -> None:
+        """Writes ``patch`` and what follows from it (:meth:`finish`; ``derive(model,
+        data, layout)`` instead of ``mj_setConst`` when given, ``layout`` the patch's
+        ``(object, name, field)`` triples, one list object per layout resolved)."""
+        # A structure key covers its patch's layout, so a variant's targets are resolved
+        # once per structure; a superset patch's layout follows which objects are placed.
+        if (
+            self.fields is None
+            or len(self.fields) != len(patch)
+            or (self.superset and any(f != e[:3] for f, e in zip(self.fields, patch)))
+        ):
+            self.resolve(patch)
+        values = np.fromiter(
+            itertools.chain.from_iterable(e[3] for e in patch if not isinstance(e[3], str)),
+            dtype=np.float64,
+        )
+        materials = [e[3] for e in patch if isinstance(e[3], str) and e[2] != "geoms"]
+        self.write(values, materials, [e[3] for e in patch if e[2] == "geoms"])
+        self.finish(derive)
+
+    def write(self, values: np.ndarray, materials: list, bodies: list = ()) -> None:
+        """Writes a patch of the resolved layout: its numbers end to end (``values``), the
+        names of its materials in order, and the little models of its bodies' geoms."""
+        for flat, targets, sources in self.groups:
+            # A float32 array takes the numbers rounded as MuJoCo rounds them (they are).
+            flat[targets] = values[sources]
+        for flat, index, k in self.matids:
+            i = self.mujoco.mj_name2id(self.model, self.mujoco.mjtObj.mjOBJ_MATERIAL, materials[k])
+            if i < 0:
+                raise _error(f"no material named '{materials[k]}'")
+            flat[index] = i
+        opt = self.model.opt
+        for field, first, n in self.options:
+            if n == 1:
+                setattr(opt, field, float(values[first]))
+            else:
+                getattr(opt, field)[:] = values[first : first + n]
+        if self.bodies:
+            # The statistics' radii as compiled, then each body's as written below.
+            self.box_radius[:] = self.box_radius0
+            self.sized_geom_rbound[:] = self.sized_geom_rbound0
+            for k, (body, xml) in enumerate(zip(self.bodies, bodies)):
+                # As compiled and as last written: the arrays already hold it.
+                if xml == self.body_xml0[k] and self.body_written[k] == xml:
+                    continue
+                self.body_written[k] = None
+                self.compiled_body(body, xml)
+                self.body_written[k] = xml
+
+    def compiled_body(self, body: int, xml: str) -> None:
+        """Writes what MuJoCo derives from ``body``'s geoms, read off its compile of their
+        little model ``xml`` (the same computation on the same numbers: each geom's size,
+        bounding radius and box, the body's mass, inertia and inertial frame, its bounding
+        volumes). Raises when the little model's layout is not the body's (the document is
+        then compiled)."""
+        mini = self.body_models.get(xml)
+        if mini is None:
+            mini = self.mujoco.MjModel.from_xml_string(xml)
+            if len(self.body_models) >= 64:
+                del self.body_models[next(iter(self.body_models))]
+            self.body_models[xml] = mini
+        model = self.model
+        first, n = int(model.body_geomadr[body]), int(model.body_geomnum[body])
+        mfirst = int(mini.body_geomadr[1]) if mini.nbody == 2 else -1
+        bvh, nbvh = int(model.body_bvhadr[body]), int(model.body_bvhnum[body])
+        mbvh = int(mini.body_bvhadr[1]) if mini.nbody == 2 else -1
+        if (
+            mini.nbody != 2
+            or int(mini.body_geomnum[1]) != n
+            or int(mini.body_sameframe[1]) != int(model.body_sameframe[body])
+            or int(mini.body_bvhnum[1]) != nbvh
+            or not np.array_equal(mini.geom_type[mfirst : mfirst + n], model.geom_type[first : first + n])
+            or not np.array_equal(mini.geom_sameframe[mfirst : mfirst + n], model.geom_sameframe[first : first + n])
+            or not np.array_equal(mini.bvh_child[mbvh : mbvh + nbvh], model.bvh_child[bvh : bvh + nbvh])
+            or not np.array_equal(mini.bvh_depth[mbvh : mbvh + nbvh], model.bvh_depth[bvh : bvh + nbvh])
+            or not np.array_equal(mini.bvh_nodeid[mbvh : mbvh + nbvh] + (first - mfirst) * (mini.bvh_nodeid[mbvh : mbvh + nbvh] >= 0), model.bvh_nodeid[bvh : bvh + nbvh])
+        ):
+            raise _error(
+                f"body '{model.body(body).name}': its geoms compile to another layout than "
+                "this structure's (sizes, frames or densities that move or turn its inertial "
+                "frame off its own, or another bounding-volume tree): not a patch of it"
+            )
+        geoms, mgeoms = slice(first, first + n), slice(mfirst, mfirst + n)
+        for field in ("geom_size", "geom_rbound", "geom_aabb", "geom_pos", "geom_quat"):
+            getattr(model, field)[geoms] = getattr(mini, field)[mgeoms]
+        for field in ("body_mass", "body_inertia", "body_ipos", "body_iquat"):
+            getattr(model, field)[body] = getattr(mini, field)[1]
+        model.bvh_aabb[bvh : bvh + nbvh] = mini.bvh_aabb[mbvh : mbvh + nbvh]
+        # The bounding radii the statistics take (primitives: rbound > 0).
+        rbound = mini.geom_rbound[mgeoms]
+        self.box_radius[geoms, 0] = rbound
+        at = np.searchsorted(self.sized_geoms, np.arange(first, first + n))
+        hit = (at < len(self.sized_geoms)) & (self.sized_geoms[np.minimum(at, len(self.sized_geoms) - 1)] == np.arange(first, first + n))
+        self.sized_geom_rbound[at[hit]] = rbound[hit]
+
+    def finish(self, derive: Callable[[Any, Any, list], None] | None = None) -> None:
+        """What follows the values: ``mj_setConst`` (or ``derive(model, data, layout)``,
+        which writes the same), the compiler's statistics, and the statistics the document
+        fixes."""
+        fresh = False
+        if derive is None:
+            self.mujoco.mj_setConst(self.model, self.data)
+        else:
+            fresh = bool(derive(self.model, self.data, self.fields))
+        self.statistics(fresh)
+        for stat, value in self.fixed:
+            if hasattr(value, "copy"):
+                getattr(self.stat, stat)[...] = value
+            else:
+                setattr(self.stat, stat, value)
+
+    def statistics(self, fresh: bool = False) -> None:
+        """The model statistics and dof lengths, computed from the model at qpos0 as the
+        compiler computes them: the same operations, sums in the same order, so the same
+        bits (minima and maxima do not depend on order, so those run vectorized).
+        ``fresh``: the scratch data holds the kinematics and centres of mass at qpos0."""
+        mujoco, model, data, stat = self.mujoco, self.model, self.data, self.stat
+        if not fresh:
+            self.qpos[:] = self.qpos0
+            mujoco.mj_kinematics(model, data)
+            mujoco.mj_comPos(model, data)
+        mujoco.mj_makeM(model, data)
+        lo = np.full(3, 1e10)
+        hi = np.full(3, -1e10)
+        points = np.concatenate(
+            self.points + (self.geom_xpos - self.box_radius, self.geom_xpos + self.box_radius)
+        )
+        if len(points):
+            lo = np.minimum(lo, points.min(axis=0))
+            hi = np.maximum(hi, points.max(axis=0))
+        stat.center[:] = (lo + hi) * 0.5
+        extent = stat.extent
+        if hi[0] > lo[0]:
+            d = hi - lo
+            extent = max(1e-5, max(d[0], max(d[1], d[2])))
+        # Body sizes: the largest com-joint distance (the joint's body and its parent),
+        # then geom bounds around the com.
+        body = np.zeros(self.nbody)
+        if len(self.joint_body):
+            xipos, xanchor = self.xipos, self.xanchor
+            self.by_joint_body.maximum(body, _dist(xipos[self.joint_body], xanchor))
+            self.by_joint_parent.maximum(body, _dist(xipos[self.joint_parent], xanchor))
+        body[0] = 0.0
+        if len(self.sized_geoms):
+            gb = self.sized_geom_body
+            far = self.sized_geom_rbound + _dist(self.xipos[gb], self.geom_xpos[self.sized_geoms])
+            self.by_geom_body.maximum(body, far)
+        if self.nbody > 1:
+            body[1:] = np.maximum(body[1:], 1e-5)
+            stat.meansize = _in_order_sum(body[1:] / (self.nbody - 1))
+            stat.meanmass = _in_order_sum(self.body_mass) / (self.nbody - 1)
+        # Rotational dofs take their body's size.
+        if self.nv:
+            self.dof_length[:] = np.where(self.rotational, body[self.dof_body], 1.0)
+            stat.meaninertia = _in_order_sum(self.M[self.M_diagonal]) / self.nv
+        stat.extent = max(extent, 2 * stat.meansize)
