@@ -23,6 +23,7 @@ from ._errors import _error
 from ._mjcf_forge import MjcfError, Scene
 from ._plan import _Plan, _in_order_sum
 from ._progress import progress_of
+from ._trees import TreeDerivation
 
 # Integer arrays that, with the sizes and the names, tell one structure from another.
 _SIGNATURE_ARRAYS = (
@@ -147,6 +148,13 @@ class ModelCache:
         # Superset: the dofs of each candidate's subtree, by its root's name (one
         # structure: the same in every model of it).
         self._subtree_dofs: dict[str, np.ndarray] = {}
+        # Superset: per model patched, its tree-by-tree derivations by patch layout and
+        # the patch count after its last derived patch (another count: the model was
+        # patched another way since); body ids by name (one structure).
+        self._trees: dict[int, tuple[Any, dict, list[int]]] = {}
+        self._body_ids: dict[str, int] = {}
+        #: Superset patches whose derived values came tree by tree (not mj_setConst).
+        self.by_tree = 0
         # Cached models by structure key, least recently used first.
         self._entries: collections.OrderedDict[str, Any] = collections.OrderedDict()
         # How to patch each model seen (cached ones and the caller's), by id; holding the
@@ -242,8 +250,9 @@ class ModelCache:
             return self._compile(variant)
         self._entries.move_to_end(key)
         plan = self._plans.get(id(model)) or self._plan(model, key)
+        parked = self.superset.parked(variant.index) if self.superset is not None else None
         try:
-            plan.apply(patch)
+            plan.apply(patch, self._tree_derive(model, parked))
         except MjcfError:
             if self.superset is not None:
                 raise
@@ -251,9 +260,53 @@ class ModelCache:
             # axes): not a patch of this structure, so the variant is compiled (and kept).
             return self._compile(variant)
         if self.superset is not None:
-            self._variant_inertia(model, plan, variant)
+            self._variant_inertia(model, plan, variant, parked)
         self.patches += 1
         return model
+
+    # Superset: derive what mj_setConst does tree by tree (see _trees; the same bits)
+    # where a patch allows. False: always the whole mj_setConst (the tests compare both).
+    _by_tree = True
+
+    def _tree_derive(self, model: Any, parked: Any) -> Any:
+        """Superset: ``derive(model, data, layout)`` for :meth:`_Plan.apply`, deriving
+        tree by tree (:class:`TreeDerivation`, per model and patch layout) what
+        ``mj_setConst`` would, or None (``mj_setConst``): no superset, or turned off."""
+        if self.superset is None or not self._by_tree or parked is None:
+            return None
+        state = self._trees.get(id(model))
+        if state is None or state[0] is not model:
+            if len(self._trees) >= 2 * self._max_models:
+                self._trees.clear()
+            state = self._trees[id(model)] = (model, {}, [-1])
+        _model, derivations, seen = state
+        ids = self._body_ids
+        roots = set()
+        for name in parked:
+            i = ids.get(name)
+            if i is None:
+                i = ids[name] = model.body(name).id
+            roots.add(i)
+
+        def derive(model: Any, data: Any, layout: list) -> bool:
+            entry = derivations.get(id(layout))
+            if entry is None or entry[0] is not layout:
+                if len(derivations) >= 64:
+                    derivations.clear()
+                entry = derivations[id(layout)] = (layout, TreeDerivation.build(self._mujoco, model, layout))
+            derivation = entry[1]
+            if derivation is None:
+                self._mujoco.mj_setConst(model, data)
+                return False
+            if seen[0] != self.patches:
+                derivation.forget()  # patched another way since this derivation's last
+            self.by_tree += 1
+            # The caller counts this patch next (self.patches + 1): nothing between.
+            seen[0] = self.patches + 1
+            return derivation(model, data, roots)
+
+        return derive
+
 
     def apply(self, variant: Any, model: Any) -> Any:
         """Patches ``model`` (of ``variant``'s structure) in place into ``variant``'s
@@ -282,9 +335,14 @@ class ModelCache:
                 "a patch cannot change a structure (cache.model(variant) compiles it)"
             )
         self._plans.move_to_end(id(model))
+        parked = None
+        if self.superset is not None:
+            parked = self.superset.parked(variant.index)
+            if derive is None:
+                derive = self._tree_derive(model, parked)
         plan.apply(patch, derive)
         if self.superset is not None:
-            self._variant_inertia(model, plan, variant)
+            self._variant_inertia(model, plan, variant, parked)
         self.patches += 1
         return model
 

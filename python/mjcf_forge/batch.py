@@ -37,7 +37,6 @@ from ._cache import _STATIC_PREFIXES, ModelCache
 from ._errors import _error
 from ._mjx import MjxWorlds
 from ._progress import progress_of
-from ._trees import TreeDerivation
 from ._warp import WarpWorlds
 
 # Fields mj_setConst derives from values a patch writes (so they follow the variant even
@@ -123,10 +122,6 @@ class WorldBatch(WarpWorlds, MjxWorlds):
     parks).
     """
 
-    # Derive what mj_setConst does tree by tree where a patch allows (False: always the
-    # whole mj_setConst; the tests compare both ways).
-    _by_tree = True
-
     def __init__(
         self, source: Any, variants: Sequence[Any], progress: Any = None, key: Any = None
     ) -> None:
@@ -166,19 +161,13 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         }
         self._data: Any = None
         self._root_of_geom = model.body_rootid[model.geom_bodyid]
-        # mj_setConst per tree (see _trees): per patch layout, its derivation (None: the
-        # whole mj_setConst), and the body ids of parked objects' names.
-        self._derivations: dict[int, tuple[list, TreeDerivation | None]] = {}
         # A patch of each layout Superset.worlds has given, by layout.
         self._layouts: dict[tuple, Any] = {}
         self._written = [n for n in _WRITTEN if n in self._others]
         self._flags = [n for n in self._written if n.endswith("_sameframe")]
         self._body_ids: dict[str, int] = {}
-        # The cache's patch count after this batch's last patch (another count: the
-        # scratch model was patched by someone else since, see _rows).
-        self._patches_seen = -1
-        self._parked_ids: set[int] = set()
-        #: Worlds whose derived values came tree by tree (the others: mj_setConst).
+        #: Worlds whose derived values came tree by tree (the others: mj_setConst; see
+        #: ``_trees.py``: the same bits).
         self.derived_by_tree = 0
         bar = progress_of(progress, len(indices), "worlds")
         try:
@@ -302,18 +291,20 @@ class WorldBatch(WarpWorlds, MjxWorlds):
             if i is None:
                 i = ids[name] = self._scratch.body(name).id
             parked_roots.append(i)
-        self._parked_ids = set(parked_roots)
-        by_tree = self.derived_by_tree
-        if self.cache.patches != self._patches_seen:
-            self._forget()  # the model was patched by someone else since
-        model = self.cache._apply_world(
-            self._scratch, (index, numbers, strings, parked_names), patch0, self._derive
+        cache = self.cache
+        before = cache.by_tree
+        model = cache._apply_world(
+            self._scratch,
+            (index, numbers, strings, parked_names),
+            patch0,
+            cache._tree_derive(self._scratch, parked_names),
         )
-        self._patches_seen = self.cache.patches
+        by_tree = cache.by_tree != before
+        self.derived_by_tree += by_tree
         out = {n: getattr(model, n).copy() for n in self._candidates}
         # mj_setConst may write any field (none differs for a superset patch); derived
         # tree by tree, only the patch and its bodies' little models write.
-        if self.derived_by_tree == by_tree:
+        if not by_tree:
             others = self._others
         elif self._plan_of_scratch().bodies:
             others = self._written
@@ -356,24 +347,6 @@ class WorldBatch(WarpWorlds, MjxWorlds):
 
     def _plan_of_scratch(self) -> Any:
         return self.cache._plans[id(self._scratch)]
-
-    def _derive(self, model: Any, data: Any, layout: list) -> bool:
-        """What mj_setConst derives, tree by tree where the patch's layout allows
-        (:class:`TreeDerivation`, the same bits), else mj_setConst; whether ``data`` was
-        left at qpos0's kinematics (see :meth:`TreeDerivation.__call__`)."""
-        entry = self._derivations.get(id(layout))
-        if entry is None or entry[0] is not layout:
-            if len(self._derivations) >= 64:
-                self._derivations.clear()
-            built = TreeDerivation.build(self.cache._mujoco, model, layout) if self._by_tree else None
-            entry = (layout, built)
-            self._derivations[id(layout)] = entry
-        derivation = entry[1]
-        if derivation is None:
-            self.cache._mujoco.mj_setConst(model, data)
-            return False
-        self.derived_by_tree += 1
-        return derivation(model, data, self._parked_ids)
 
     def assign(self, worlds: Sequence[int], variants: Sequence[Any]) -> np.ndarray:
         """World ``worlds[k]`` holds variant ``variants[k]`` from now on: its rows of
@@ -421,8 +394,3 @@ class WorldBatch(WarpWorlds, MjxWorlds):
             out.append(copy.copy(self.cache.apply(_Index(int(i)), self._scratch)))
         return out
 
-    def _forget(self) -> None:
-        """The scratch model was patched another way: every tree is derived again."""
-        for _layout, derivation in self._derivations.values():
-            if derivation is not None:
-                derivation.forget()

@@ -578,7 +578,19 @@ def test_worlds_derived_tree_by_tree_are_mj_setconsts(path, worlds, by_tree, mon
     cache.model(scene.variant(worlds + 100))
     fast.assign([2, 3, 4], [worlds + 101, worlds + 102, worlds + 103])
     assert fast.derived_by_tree == (worlds + 3 if by_tree else 0)
-    monkeypatch.setattr(WorldBatch, "_by_tree", False)
+    # The cache's own models (a variant ready on CPU MuJoCo) derive tree by tree too, also
+    # right after a patch made with mj_setConst (the trees' values then are that one's).
+    by_tree_before = cache.by_tree
+    ready = []
+    for k in (200, 201, 202):
+        monkeypatch.setattr(mjcf_forge.ModelCache, "_by_tree", False)
+        cache.model(scene.variant(worlds + 300 + k))
+        monkeypatch.setattr(mjcf_forge.ModelCache, "_by_tree", True)
+        ready.append(copy.copy(cache.model(scene.variant(worlds + k))))
+    assert cache.by_tree == by_tree_before + (3 if by_tree else 0)
+    monkeypatch.setattr(mjcf_forge.ModelCache, "_by_tree", False)
+    for k, model in zip((200, 201, 202), ready):
+        assert not_bit_identical(cache.model(scene.variant(worlds + k)), model) == [], k
     whole = WorldBatch(cache, range(worlds))
     assert whole.derived_by_tree == 0
     whole.assign([2, 3, 4], [worlds + 101, worlds + 102, worlds + 103])
