@@ -443,31 +443,24 @@ fn per_world_arrays_hold_each_worlds_superset_model() {
                 .map_or(shared, |f| f.row_bytes(w).to_vec())
         };
         let m = &batch.model;
-        assert_eq!(
-            rows("body_pos", bytes(m.body_pos())),
-            bytes(want.body_pos()),
-            "world {w}"
-        );
-        assert_eq!(
-            rows("body_mass", bytes(m.body_mass())),
-            bytes(want.body_mass()),
-            "world {w}"
-        );
-        assert_eq!(
-            rows("body_inertia", bytes(m.body_inertia())),
-            bytes(want.body_inertia()),
-            "world {w}"
-        );
-        assert_eq!(
-            rows("geom_rgba", f32s(m.geom_rgba())),
-            f32s(want.geom_rgba()),
-            "world {w}"
-        );
-        assert_eq!(
-            rows("geom_friction", bytes(m.geom_friction())),
-            bytes(want.geom_friction()),
-            "world {w}"
-        );
+        let arrays = [
+            ("body_pos", bytes(m.body_pos()), bytes(want.body_pos())),
+            ("body_mass", bytes(m.body_mass()), bytes(want.body_mass())),
+            (
+                "body_inertia",
+                bytes(m.body_inertia()),
+                bytes(want.body_inertia()),
+            ),
+            ("geom_rgba", f32s(m.geom_rgba()), f32s(want.geom_rgba())),
+            (
+                "geom_friction",
+                bytes(m.geom_friction()),
+                bytes(want.geom_friction()),
+            ),
+        ];
+        for (name, shared, wanted) in arrays {
+            assert_eq!(rows(name, shared), wanted, "world {w}: {name}");
+        }
         assert_eq!(
             batch.parked[w],
             scene

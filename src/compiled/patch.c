@@ -196,31 +196,28 @@ void mjf_patch_finish(mjModel* m, mjData* d, int fixed, const double values[7]) 
   }
 }
 
-// The name of mjModel's array number `i` (MJMODEL_POINTERS order); NULL past the last.
-const char* mjf_patch_array_name(int i) {
-  static const char* names[] = {
-#define X(type, field, nr, nc) #field,
+// mjModel's arrays in MJMODEL_POINTERS order: each one's name and C type as MuJoCo
+// declares it ("mjtNum", "float", "int", "mjtByte"...).
+static const struct {
+  const char* name;
+  const char* type;
+} kArrays[] = {
+#define X(type, field, nr, nc) {#field, #type},
 #define XNV X
     MJMODEL_POINTERS
 #undef XNV
 #undef X
-  };
-  if (i < 0 || (size_t)i >= sizeof(names) / sizeof(names[0])) return NULL;
-  return names[i];
+};
+static const int kNumArrays = (int)(sizeof(kArrays) / sizeof(kArrays[0]));
+
+// The name of mjModel's array number `i`; NULL past the last.
+const char* mjf_patch_array_name(int i) {
+  return i >= 0 && i < kNumArrays ? kArrays[i].name : NULL;
 }
 
-// The C type of mjModel's array number `i` as MuJoCo declares it ("mjtNum", "float", "int",
-// "mjtByte"...); NULL past the last.
+// The C type of mjModel's array number `i`; NULL past the last.
 const char* mjf_patch_array_type(int i) {
-  static const char* types[] = {
-#define X(type, field, nr, nc) #type,
-#define XNV X
-    MJMODEL_POINTERS
-#undef XNV
-#undef X
-  };
-  if (i < 0 || (size_t)i >= sizeof(types) / sizeof(types[0])) return NULL;
-  return types[i];
+  return i >= 0 && i < kNumArrays ? kArrays[i].type : NULL;
 }
 
 // Superset: stat.meaninertia as the variant's own model has it, the mean of the mass
