@@ -148,10 +148,7 @@ class ModelCache:
         # Superset: the dofs of each candidate's subtree, by its root's name (one
         # structure: the same in every model of it).
         self._subtree_dofs: dict[str, np.ndarray] = {}
-        # Superset: per model patched, its tree-by-tree derivations by patch layout and
-        # the patch count after its last derived patch (another count: the model was
-        # patched another way since); body ids by name (one structure).
-        self._trees: dict[int, tuple[Any, dict, list[int]]] = {}
+        # Superset: body ids by name (one structure).
         self._body_ids: dict[str, int] = {}
         #: Superset patches whose derived values came tree by tree (not mj_setConst).
         self.by_tree = 0
@@ -252,7 +249,7 @@ class ModelCache:
         plan = self._plans.get(id(model)) or self._plan(model, key)
         parked = self.superset.parked(variant.index) if self.superset is not None else None
         try:
-            plan.apply(patch, self._tree_derive(model, parked))
+            plan.apply(patch, self._tree_derive(plan, parked))
         except MjcfError:
             if self.superset is not None:
                 raise
@@ -268,24 +265,19 @@ class ModelCache:
     # where a patch allows. False: always the whole mj_setConst (the tests compare both).
     _by_tree = True
 
-    def _tree_derive(self, model: Any, parked: Any) -> Any:
+    def _tree_derive(self, plan: _Plan, parked: Any) -> Any:
         """Superset: ``derive(model, data, layout)`` for :meth:`_Plan.apply`, deriving
-        tree by tree (:class:`TreeDerivation`, per model and patch layout) what
+        tree by tree (:class:`TreeDerivation`, per plan and patch layout) what
         ``mj_setConst`` would, or None (``mj_setConst``): no superset, or turned off."""
         if self.superset is None or not self._by_tree or parked is None:
             return None
-        state = self._trees.get(id(model))
-        if state is None or state[0] is not model:
-            if len(self._trees) >= 2 * self._max_models:
-                self._trees.clear()
-            state = self._trees[id(model)] = (model, {}, [-1])
-        _model, derivations, seen = state
+        derivations = plan.derivations
         ids = self._body_ids
         roots = set()
         for name in parked:
             i = ids.get(name)
             if i is None:
-                i = ids[name] = model.body(name).id
+                i = ids[name] = plan.model.body(name).id
             roots.add(i)
 
         def derive(model: Any, data: Any, layout: list) -> bool:
@@ -298,26 +290,19 @@ class ModelCache:
             if derivation is None:
                 self._mujoco.mj_setConst(model, data)
                 return False
-            if seen[0] != self.patches:
-                derivation.forget()  # patched another way since this derivation's last
+            if plan.derived_at != self.patches:
+                derivation.forget()  # patched another way since this plan's last derivation
             self.by_tree += 1
             # The caller counts this patch next (self.patches + 1): nothing between.
-            seen[0] = self.patches + 1
+            plan.derived_at = self.patches + 1
             return derivation(model, data, roots)
 
         return derive
 
-
     def apply(self, variant: Any, model: Any) -> Any:
         """Patches ``model`` (of ``variant``'s structure) in place into ``variant``'s
         compiled model; returns it. Raises :class:`MjcfError` when its structure differs."""
-        return self._apply(variant, model)
-
-    def _apply(self, variant: Any, model: Any, derive: Any = None, patch: Any = None) -> Any:
-        """:meth:`apply`, with ``derive(model, data, layout)`` in place of ``mj_setConst``
-        when given (it must write the same), and the variant's patch when already made."""
-        key, made = self._key_and_patch(variant) if patch is None else (self.superset.structure_key, patch)
-        patch = made
+        key, patch = self._key_and_patch(variant)
         plan = self._plans.get(id(model))
         if plan is None or plan.model is not model:
             if key not in self._signatures:
@@ -335,21 +320,17 @@ class ModelCache:
                 "a patch cannot change a structure (cache.model(variant) compiles it)"
             )
         self._plans.move_to_end(id(model))
-        parked = None
-        if self.superset is not None:
-            parked = self.superset.parked(variant.index)
-            if derive is None:
-                derive = self._tree_derive(model, parked)
-        plan.apply(patch, derive)
+        parked = self.superset.parked(variant.index) if self.superset is not None else None
+        plan.apply(patch, self._tree_derive(plan, parked))
         if self.superset is not None:
             self._variant_inertia(model, plan, variant, parked)
         self.patches += 1
         return model
 
-    def _apply_world(self, model: Any, world: tuple, patch0: list, derive: Any = None) -> Any:
+    def _apply_world(self, model: Any, world: tuple, patch0: list) -> Any:
         """Superset: ``model`` patched for one world as :meth:`Superset.worlds` gives it
         (``world``: its index, numbers, strings and parked roots; ``patch0``: a patch of its
-        layout, resolved once), ``derive`` as in :meth:`_apply`."""
+        layout, resolved once), as :meth:`apply` patches it."""
         index, numbers, strings, parked = world
         key = self.superset.structure_key
         plan = self._plans.get(id(model))
@@ -370,7 +351,7 @@ class ModelCache:
         else:
             materials, bodies = [], []
         plan.write(values, materials, bodies)
-        plan.finish(derive)
+        plan.finish(self._tree_derive(plan, parked))
         self._variant_inertia(model, plan, None, parked)
         self.patches += 1
         return model

@@ -56,6 +56,17 @@ _JOINT_QPOS = {0: 7, 1: 4, 2: 1, 3: 1}  # free, ball, slide, hinge
 _JOINT_DOFS = {0: 6, 1: 3, 2: 1, 3: 1}
 
 
+def _target_array(obj: str, field: str) -> str | None:
+    """The MjModel array a patch entry of an ``obj``'s ``field`` writes (a joint's dof and
+    qpos fields and its keyframe rows have arrays of their own); None for the options."""
+    if obj == "joint" and field in _DOF_FIELDS:
+        return "dof_" + field
+    if obj == "joint" and (field in _QPOS_FIELDS or field == "key_qpos"):
+        return field
+    prefix = _PREFIX.get(obj)
+    return None if prefix is None else prefix + field
+
+
 class _Groups:
     """Rows grouped by an index (``np.maximum.at`` without its slow per-row loop)."""
 
@@ -99,6 +110,11 @@ class _Plan:
         self.data = data = mujoco.MjData(model)
         self.nbytes = model.nbuffer + data.nbuffer + data.narena
         self.fields: list[tuple[Any, Any, str]] | None = None
+        # Superset: the tree-by-tree derivations of mj_setConst (TreeDerivation, by patch
+        # layout), and the cache's patch count after the last one (another count: the
+        # model was patched another way since; ModelCache._tree_derive).
+        self.derivations: dict[int, tuple[list, Any]] = {}
+        self.derived_at = -1
         # The patch the layout was last resolved from (ModelCache._apply_world), and which
         # of its string values are a body's little model (the others: material names).
         self.source: Any = None

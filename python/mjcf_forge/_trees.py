@@ -24,9 +24,12 @@ reads (a robot's armature, an actuated tree, a tendon) gets ``None`` from
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import numpy as np
+
+from ._plan import _OBJ, _target_array
 
 # Patch targets (MjModel arrays) that mj_setConst reads: a tree written into through
 # them is derived again per world.
@@ -228,7 +231,7 @@ class TreeDerivation:
         for obj, name, field in layout:
             if obj == "option":
                 continue
-            target = _target(obj, field)
+            target = _target_array(obj, field)
             if field == "geoms":
                 target = "body_mass"
             if target in ("geom_pos", "geom_quat", "site_pos", "site_quat"):
@@ -339,27 +342,8 @@ class TreeDerivation:
             model.light_dir0[:] = data.light_xdir
 
 
-_ARRAYS = {
-    "body": "body_", "joint": "jnt_", "geom": "geom_", "site": "site_", "camera": "cam_",
-    "light": "light_", "material": "mat_", "actuator": "actuator_",
-}
-_JOINT_ARRAYS = {
-    "damping": "dof_damping", "armature": "dof_armature", "frictionloss": "dof_frictionloss",
-    "qpos0": "qpos0", "qpos_spring": "qpos_spring", "key_qpos": "key_qpos",
-}
-
-
-def _target(obj: str, field: str) -> str | None:
-    if obj == "joint" and field in _JOINT_ARRAYS:
-        return _JOINT_ARRAYS[field]
-    prefix = _ARRAYS.get(obj)
-    return None if prefix is None else prefix + field
-
-
 def _id_of(mujoco: Any, model: Any, obj: str, name: Any) -> int | None:
-    kind = {
-        "body": "mjOBJ_BODY", "joint": "mjOBJ_JOINT", "geom": "mjOBJ_GEOM", "site": "mjOBJ_SITE",
-    }.get(obj)
+    kind = _OBJ.get(obj)
     if kind is None:
         return None
     i = name if isinstance(name, int) else mujoco.mj_name2id(model, getattr(mujoco.mjtObj, kind), name)
@@ -432,6 +416,7 @@ _FRAME_EPS = 1e-6
 _UNIT = np.array([1.0, 0.0, 0.0, 0.0])
 
 
+@functools.lru_cache(maxsize=None)
 def _recomputes_sameframe(mujoco: Any) -> bool:
     """Whether this MuJoCo's mj_setConst sets the bodies', geoms' and sites' same-frame
     flags again from their frames (4.0 does; 3.17 keeps the compiler's)."""

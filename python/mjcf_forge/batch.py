@@ -36,6 +36,7 @@ import numpy as np
 from ._cache import _STATIC_PREFIXES, ModelCache
 from ._errors import _error
 from ._mjx import MjxWorlds
+from ._plan import _target_array
 from ._progress import progress_of
 from ._warp import WarpWorlds
 
@@ -69,17 +70,6 @@ _WRITTEN = (
 _KEYS = ("key_qpos", "key_qvel", "key_act", "key_ctrl", "key_mpos", "key_mquat", "key_time")
 # The compiler's statistics, per world (``stat.<name>`` in :attr:`WorldBatch.arrays`).
 _STATS = ("meaninertia", "meanmass", "meansize", "extent", "center")
-# A patch entry's object -> the prefix of its MjModel arrays (as ModelCache resolves them).
-_ARRAY_PREFIX = {
-    "body": "body_", "joint": "jnt_", "geom": "geom_", "site": "site_", "camera": "cam_",
-    "light": "light_", "material": "mat_", "actuator": "actuator_",
-}
-_JOINT_ARRAYS = {
-    "damping": "dof_damping", "armature": "dof_armature", "frictionloss": "dof_frictionloss",
-    "qpos0": "qpos0", "qpos_spring": "qpos_spring",
-}
-
-
 class _Index(NamedTuple):
     """What a superset ModelCache reads of a variant: its index."""
 
@@ -88,15 +78,8 @@ class _Index(NamedTuple):
 
 def _patched_arrays(patch: Sequence) -> set[str]:
     """The MjModel arrays a superset patch writes (``matid`` included)."""
-    out = set()
-    for obj, _name, field, _value in patch:
-        if obj == "option":
-            continue
-        if obj == "joint" and field in _JOINT_ARRAYS:
-            out.add(_JOINT_ARRAYS[field])
-        elif obj in _ARRAY_PREFIX:
-            out.add(_ARRAY_PREFIX[obj] + field)
-    return out
+    targets = (_target_array(obj, field) for obj, _name, field, _value in patch)
+    return {t for t in targets if t is not None}
 
 
 class WorldBatch(WarpWorlds, MjxWorlds):
@@ -293,12 +276,7 @@ class WorldBatch(WarpWorlds, MjxWorlds):
             parked_roots.append(i)
         cache = self.cache
         before = cache.by_tree
-        model = cache._apply_world(
-            self._scratch,
-            (index, numbers, strings, parked_names),
-            patch0,
-            cache._tree_derive(self._scratch, parked_names),
-        )
+        model = cache._apply_world(self._scratch, (index, numbers, strings, parked_names), patch0)
         by_tree = cache.by_tree != before
         self.derived_by_tree += by_tree
         out = {n: getattr(model, n).copy() for n in self._candidates}
