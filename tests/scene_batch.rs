@@ -657,3 +657,37 @@ overlap = "allow"
         assert!(checked >= 20, "{checked} blocks");
     }
 }
+
+#[test]
+fn written_inertials_need_mujoco_and_problems_name_the_pool_entry() {
+    use mjcf_forge::{CompiledInertia, Document};
+    let path = root().join("corpora/scenes/patch/inertials.toml");
+    // The caller's MuJoCo failing: each pool entry's problem at its position.
+    let mut compile =
+        |_: &Document| -> Result<CompiledInertia, String> { Err("no MuJoCo here".to_string()) };
+    let err = Scene::load_with(&path, &mut compile).unwrap_err();
+    assert_eq!(err.0.len(), 3, "{err}");
+    let first = err.0[0].to_string();
+    assert!(
+        first.ends_with(
+            "inertials.toml:12:9: cannot write the inertials of '../demo/box.xml': no MuJoCo here"
+        ),
+        "{first}"
+    );
+    // The build's own MuJoCo, when it has one.
+    let own = Scene::load(&path);
+    #[cfg(mjcf_mujoco)]
+    assert!(
+        own.unwrap()
+            .variant_xml(0)
+            .unwrap()
+            .0
+            .contains("<inertial ")
+    );
+    #[cfg(not(mjcf_mujoco))]
+    assert!(
+        own.unwrap_err()
+            .to_string()
+            .contains("write_inertials needs MuJoCo to compile '../demo/box.xml'")
+    );
+}

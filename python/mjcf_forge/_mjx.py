@@ -42,13 +42,19 @@ class MjxWorlds:
         first call runs ``mjx.put_model``; later ones (after :meth:`assign`) only replace
         the per-world leaves. Fields MJX does not have are left out; one it holds as a
         static (NumPy) array cannot vary per world: an error names it. ``impl`` goes to
-        ``mjx.put_model`` ("jax", "warp"...)."""
+        ``mjx.put_model``: "jax" (MJX's own, the default on CPU) or "warp" (MuJoCo Warp's
+        kernels under MJX, on CPU too: its collisions include the cylinder and mesh pairs
+        MJX's JAX collision lacks); with "warp" the per-world leaves are those MuJoCo Warp
+        reads per world (:meth:`to_mjwarp`'s), ``geom_dataid`` aside (MJX holds one for
+        all worlds)."""
         import jax
         import jax.numpy as jnp
         from mujoco import mjx
 
-        if self._mjx is not None and not self._mjx_flags_hold():
-            self._mjx = None  # a reassigned world needs the general path somewhere new
+        if self._mjx is not None and (impl != self._mjx_impl or not self._mjx_flags_hold()):
+            # Another implementation, or a reassigned world needs the general path
+            # somewhere new.
+            self._mjx = None
         if self._mjx is None:
             shared = copy.copy(self.model)
             for name in _BOUNDS:
@@ -63,9 +69,8 @@ class MjxWorlds:
             self._mjx_impl = impl
         base = self._mjx
         replace: dict[str, Any] = {}
-        for name in self.per_world:
-            path = name if not name.startswith("stat.") else name
-            leaf = _mjx_leaf(base, path)
+        for name in self._mjx_per_world():
+            leaf = _mjx_leaf(base, name)
             if leaf is None:
                 continue
             rows = self.arrays[name]
@@ -76,11 +81,25 @@ class MjxWorlds:
                     f"MJX cannot vary {name} per world (put_model keeps it as a static NumPy "
                     "array), and the batch's worlds differ in it"
                 )
-            replace[_mjx_path(base, path)] = jnp.asarray(rows.reshape((self.nworld,) + leaf.shape), dtype=leaf.dtype)
+            replace[_mjx_path(base, name)] = jnp.asarray(rows.reshape((self.nworld,) + leaf.shape), dtype=leaf.dtype)
         model = base.tree_replace(replace)
         in_axes = jax.tree_util.tree_map(lambda _: None, base)
         in_axes = in_axes.tree_replace({k: 0 for k in replace})
         return model, in_axes
+
+    def _mjx_warp(self) -> bool:
+        """Whether the MJX model runs MuJoCo Warp's kernels (``impl="warp"``)."""
+        return str(getattr(self._mjx_impl, "value", self._mjx_impl)) == "warp"
+
+    def _mjx_per_world(self) -> list[str]:
+        """The per-world fields the MJX model's implementation reads per world."""
+        if not self._mjx_warp():
+            return self.per_world
+        from mujoco.mjx.third_party import mujoco_warp
+
+        # MJX's put_model keeps one geom_dataid for all worlds: parked objects stand in
+        # their own cells out of reach, so their mesh geoms find no partner anyway.
+        return [n for n in self._warp_specs(mujoco_warp) if n != "geom_dataid"]
 
     def _mjx_flags_hold(self) -> bool:
         """Whether the same-frame flags MJX was put with hold in every world: each one
@@ -94,25 +113,31 @@ class MjxWorlds:
 
     def mjx_data(self, **make_data: Any) -> Any:
         """An MJX ``Data`` of ``nworld`` worlds (leading axis) at their initial pose, of the
-        model's ``impl``; ``make_data`` goes to ``mjx.make_data`` (``nconmax``...)."""
+        model's ``impl``; ``make_data`` goes to ``mjx.make_data``. With ``impl="warp"``,
+        ``naconmax`` (contacts of all worlds together) and ``njmax`` (rows per world)
+        default to :meth:`warp_sizes`'s."""
         import jax
         import jax.numpy as jnp
         from mujoco import mjx
 
         if self._mjx is None:
             self.to_mjx()
+        if self._mjx_warp():
+            sizes = self.warp_sizes()
+            make_data.setdefault("naconmax", sizes["nconmax"] * self.nworld)
+            make_data.setdefault("njmax", sizes["njmax"])
         one = mjx.make_data(self.model, impl=self._mjx_impl, **make_data)
-        data = jax.tree_util.tree_map(lambda x: jnp.broadcast_to(x, (self.nworld,) + x.shape), one)
         start = self.initial()
         if self.key is None:
             start = {"qpos": start["qpos"]}
-        return data.replace(
-            **{
-                name: jnp.asarray(rows.reshape((self.nworld,) + getattr(one, name).shape), dtype=getattr(one, name).dtype)
-                for name, rows in start.items()
-                if hasattr(one, name)
-            }
-        )
+        rows = {
+            name: jnp.asarray(r.reshape((self.nworld,) + getattr(one, name).shape), dtype=getattr(one, name).dtype)
+            for name, r in start.items()
+            if hasattr(one, name)
+        }
+        # vmap, not a broadcast of every leaf: MJX keeps some leaves (empty buffers) as
+        # static shapes, which must stay as make_data gave them.
+        return jax.vmap(lambda world: one.replace(**world))(rows)
 
     def mjx_reset(self, data: Any, mask: np.ndarray) -> Any:
         """``data`` with the worlds of ``mask`` back at their initial pose (after
@@ -121,13 +146,9 @@ class MjxWorlds:
         import jax.numpy as jnp
 
         fresh = self.mjx_data()
-        keep = jnp.asarray(mask)
-
-        def pick(new, old):
-            m = keep.reshape((-1,) + (1,) * (old.ndim - 1))
-            return jnp.where(m, new, old)
-
-        return jax.tree_util.tree_map(pick, fresh, data)
+        # MJX's Data.where, world by world: with impl="warp" the worlds' joint contact and
+        # constraint buffers stay as they are.
+        return jax.vmap(lambda reset, new, old: old.where(reset, new))(jnp.asarray(mask), fresh, data)
 
 
 def _mjx_path(model: Any, name: str) -> str:

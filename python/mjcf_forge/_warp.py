@@ -64,12 +64,14 @@ class WarpWorlds:
         mjw.reset_data(m, d, reset=wp.array(mask, dtype=bool))
         self._warp_start(d, mask)
 
-    def _warp_specs(self) -> dict[str, Any]:
+    def _warp_specs(self, mjw: Any = None) -> dict[str, Any]:
         """Per-world fields MuJoCo Warp reads, by name, with their array specs; an error
         naming a per-world field Warp has but cannot vary per world. Fields Warp does not
         have (``dof_M0``, the statistics: Warp scales its solver by each world's mass
-        matrix instead) are left out."""
-        import mujoco_warp as mjw
+        matrix instead) are left out. ``mjw``: the ``mujoco_warp`` module (MJX bundles
+        its own)."""
+        if mjw is None:
+            import mujoco_warp as mjw
 
         types = {f.name: f.type for f in dataclasses.fields(mjw.Model)}
         specs = {}
@@ -133,6 +135,10 @@ class WarpWorlds:
         condim = int(max(m.geom_condim[colliding].max(initial=1), m.pair_dim.max(initial=1)))
         elliptic = m.opt.cone == mujoco.mjtCone.mjCONE_ELLIPTIC
         rows = condim if elliptic or condim == 1 else 2 * (condim - 1)
+        try:
+            from mujoco_warp._src.io import _default_nconmax
+        except ImportError:  # MJX's own copy of MuJoCo Warp (to_mjx(impl="warp"))
+            from mujoco.mjx.third_party.mujoco_warp._src.io import _default_nconmax
         fixed = (
             6 * m.neq
             + int(m.jnt_limited.sum())
@@ -140,8 +146,6 @@ class WarpWorlds:
             + int((m.dof_frictionloss > 0).sum())
             + int((m.tendon_frictionloss > 0).sum())
         )
-        from mujoco_warp._src.io import _default_nconmax
-
         nconmax = _default_nconmax(m) + _CONTACTS_PER_OBJECT * placed
         return {"nconmax": int(nconmax), "njmax": int(nconmax * rows + fixed)}
 

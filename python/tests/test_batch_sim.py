@@ -237,25 +237,35 @@ LIBERO_VS_CPU = 1e-3
 LIBERO_PARKED = 1e-9
 
 
-def judge_both(scene, vs_warp: float, vs_cpu: float, parked_tolerance: float = 0.0) -> dict:
-    """Every world of ``scene`` (and two reassigned at reset) stepped in MuJoCo Warp
-    against its variant alone in Warp (``vs_warp``: the superset's own part) and on CPU
-    MuJoCo (``vs_cpu``: Warp's float32 against CPU float64 as well); parked bodies move
-    at most ``parked_tolerance``, touch nothing; no world overflows."""
+def warp_sim(batch: WorldBatch):
+    """``batch`` in MuJoCo Warp (to_mjwarp's default sizes): ``run``, ``contacts`` and
+    whether any world overflowed."""
     import warp as wp
 
     wp.config.quiet = True
-    batch = WorldBatch(scene, range(WORLDS))
     m, d = batch.to_mjwarp()
     run, contacts = warp_step(m, d)
+    return run, contacts, lambda: bool(d.overflow.numpy().any())
+
+
+def judge_both(
+    scene, vs_warp: float, vs_cpu: float, parked_tolerance: float = 0.0, simulator=warp_sim, key=None, steps=STEPS
+) -> dict:
+    """Every world of ``scene`` (and two reassigned at reset) stepped in ``simulator``
+    (MuJoCo Warp unless given) against its variant alone in MuJoCo Warp (``vs_warp``: the
+    superset's own part) and on CPU MuJoCo (``vs_cpu``: Warp's float32 against CPU float64
+    as well), all started at ``key`` when given; parked bodies move at most
+    ``parked_tolerance``, touch nothing; no world overflows."""
+    batch = WorldBatch(scene, range(WORLDS), key=key)
+    run, contacts, overflow = simulator(batch)
     report = {}
     for worlds in (range(WORLDS), REASSIGN[0]):
         if worlds is REASSIGN[0]:
             batch.assign(*REASSIGN)
         start = run(0)
         parked = {w: parked_bodies(batch, w) for w in worlds}
-        xpos = run(STEPS)
-        alone, cpu = deviations(batch, scene, worlds, xpos, STEPS)
+        xpos = run(steps)
+        alone, cpu = deviations(batch, scene, worlds, xpos, steps, key)
         report[len(report)] = {"vs_warp_alone": alone, "vs_cpu": cpu}
         assert alone <= vs_warp and cpu <= vs_cpu, report
         for w in worlds:
@@ -263,7 +273,7 @@ def judge_both(scene, vs_warp: float, vs_cpu: float, parked_tolerance: float = 0
             assert moved <= parked_tolerance, (w, moved)
         for w, g1, g2 in contacts():
             assert not (batch.parked_geoms[w, g1] or batch.parked_geoms[w, g2]), (w, g1, g2)
-    assert not d.overflow.numpy().any()
+    assert not overflow()
     return report
 
 
@@ -421,56 +431,111 @@ def test_bad_input_is_refused_before_any_array():
         batch.assign([5], [3])
 
 
+def mjx_sim(impl: str):
+    """A simulator for :func:`judge`/:func:`judge_both`: the batch in MJX on JAX's CPU
+    backend (``impl``: "jax", MJX's own, or "warp", MuJoCo Warp's kernels under MJX),
+    vmapped over the worlds with the batch's ``in_axes``; after ``assign`` the next
+    ``run(0)`` takes the new rows (no new put_model) and resets those worlds."""
+
+    def simulator(batch: WorldBatch):
+        import jax
+        from mujoco import mjx
+
+        state: dict = {}
+
+        def rebuild():
+            model, in_axes = batch.to_mjx(impl=impl)
+            state["model"] = model
+            step = jax.vmap(mjx.step, in_axes=(in_axes, 0))
+            state["step"] = jax.jit(
+                lambda m, d, n: jax.lax.scan(lambda d, _: (step(m, d), None), d, None, length=n)[0],
+                static_argnums=2,
+            )
+            state["forward"] = jax.jit(jax.vmap(mjx.forward, in_axes=(in_axes, 0)))
+
+        rebuild()
+        state["data"] = batch.mjx_data()
+
+        def run(steps):
+            if steps == 0:
+                if "mask" in state:
+                    rebuild()
+                    state["data"] = batch.mjx_reset(state["data"], state.pop("mask"))
+                state["data"] = state["forward"](state["model"], state["data"])
+            else:
+                state["data"] = state["step"](state["model"], state["data"], steps)
+            return np.asarray(state["data"].xpos, dtype=np.float64)
+
+        def contacts():
+            c = state["data"]._impl
+            if impl == "warp":  # one buffer for all worlds
+                n = int(np.asarray(c.nacon).ravel()[0])
+                geom = np.asarray(c.contact__geom).reshape(-1, 2)[:n]
+                world = np.asarray(c.contact__worldid).ravel()[:n]
+                return [(int(w), int(g[0]), int(g[1])) for w, g in zip(world, geom)]
+            geom, dist = np.asarray(c.contact.geom), np.asarray(c.contact.dist)
+            return [(w, int(g[0]), int(g[1])) for w in range(batch.nworld) for g, x in zip(geom[w], dist[w]) if x < 0]
+
+        def overflow():
+            return impl == "warp" and bool(np.asarray(state["data"]._impl.overflow).any())
+
+        original = batch.assign
+
+        def assign(worlds, variants):
+            state["mask"] = original(worlds, variants)
+            return state["mask"]
+
+        batch.assign = assign
+        return run, contacts, overflow
+
+    return simulator
+
+
 @pytest.mark.parametrize("path", [BOXES, FIXED], ids=["boxes", "fixed"])
 def test_mjx_worlds_agree_with_each_variant(path):
-    """MJX on JAX's CPU backend, vmapped over the worlds with the batch's in_axes. Its JAX
-    collision has no cylinder-box pair (the patch scene's arm and clutter need it; lift5's
-    meshes make its compile take minutes on CPU), so it runs the patch arena with boxes."""
-    import jax
-    from mujoco import mjx
-
+    """MJX's own implementation (impl="jax") on JAX's CPU backend: every world within
+    1e-4 m of its variant on CPU MuJoCo. Its JAX collision has no cylinder-box or
+    cylinder-mesh pair, so it runs the patch arena with boxes; the scenes that need those
+    run in MJX with impl="warp" below."""
     scene = mjcf_forge.Scene.load(path)
     batch = WorldBatch(scene, range(WORLDS))
-    step = jax.vmap(mjx.step, in_axes=None)  # replaced per model below
-    state: dict = {}
-
-    def rebuild():
-        model, in_axes = batch.to_mjx()
-        state["model"] = model
-        state["step"] = jax.jit(
-            lambda m, d: jax.lax.scan(
-                lambda d, _: (jax.vmap(mjx.step, in_axes=(in_axes, 0))(m, d), None), d, None, length=STEPS
-            )[0]
-        )
-        state["forward"] = jax.jit(jax.vmap(mjx.forward, in_axes=(in_axes, 0)))
-
-    rebuild()
-    state["data"] = batch.mjx_data()
-    del step
-
-    def run(steps):
-        if steps == 0:
-            if "mask" in state:
-                # After assign(): the new rows (no new put_model), the worlds reset.
-                rebuild()
-                state["data"] = batch.mjx_reset(state["data"], state.pop("mask"))
-            state["data"] = state["forward"](state["model"], state["data"])
-        else:
-            state["data"] = state["step"](state["model"], state["data"])
-        return np.asarray(state["data"].xpos, dtype=np.float64)
-
-    def contacts():
-        d = state["data"]
-        contact = d._impl.contact
-        geom, dist = np.asarray(contact.geom), np.asarray(contact.dist)
-        return [(w, int(g[0]), int(g[1])) for w in range(WORLDS) for g, x in zip(geom[w], dist[w]) if x < 0]
-
-    original = batch.assign
-
-    def assign(worlds, variants):
-        state["mask"] = original(worlds, variants)
-        return state["mask"]
-
-    batch.assign = assign
+    run, contacts, _ = mjx_sim("jax")(batch)
     report = judge(scene, batch, run, contacts)
     print("mjx", path.stem, report)
+
+
+def test_mjx_warp_worlds_agree_with_each_variant():
+    """The patch scene (a cylinder arm, cylinder and box clutter) in MJX with
+    impl="warp": every world within 1e-4 m of its variant on CPU MuJoCo."""
+    scene = mjcf_forge.Scene.load(PATCH)
+    batch = WorldBatch(scene, range(WORLDS))
+    run, contacts, overflow = mjx_sim("warp")(batch)
+    report = judge(scene, batch, run, contacts)
+    assert not overflow()
+    print("mjx warp patch", report)
+
+
+def test_mjx_warp_demo_worlds_agree_with_each_variant():
+    """The built-in demo in MJX with impl="warp": as in MuJoCo Warp itself."""
+    report = judge_both(mjcf_forge.Scene.demo(), DEMO_VS_WARP, DEMO_VS_CPU, simulator=mjx_sim("warp"))
+    print("mjx warp demo", report)
+
+
+@pytest.mark.skipif(not RS_ASSETS.is_dir(), reason="setup not run")
+def test_mjx_warp_lift5_worlds_agree_with_each_variant():
+    """lift5 (robosuite's Panda, five mesh objects) in MJX with impl="warp", judged at
+    100 steps as in MuJoCo Warp itself (LIFT5_EARLY)."""
+    scene = mjcf_forge.Scene.load(LIFT5)
+    report = judge_both(scene, LIFT5_VS_WARP, TOLERANCE, simulator=mjx_sim("warp"), steps=LIFT5_EARLY)
+    print("mjx warp lift5", report)
+
+
+@pytest.mark.skipif(not (LIBERO_ASSETS.is_dir() and MENAGERIE_ASSETS.is_dir()), reason="setup not run")
+def test_mjx_warp_menagerie_worlds_agree_with_each_variant():
+    """The Menagerie scene (UR5e at its keyframe, Robotiq 2F-85, LIBERO's objects) in MJX
+    with impl="warp", every world started at its own rows of the key."""
+    scene = mjcf_forge.Scene.load(MENAGERIE)
+    report = judge_both(
+        scene, MENAGERIE_VS_WARP, TOLERANCE, simulator=mjx_sim("warp"), key=MENAGERIE_KEY
+    )
+    print("mjx warp menagerie", report)

@@ -146,6 +146,43 @@ def test_mass_of_bodies_without_inertial_is_a_patch():
     _superset_check(scene, range(4), trajectory_tolerance=0.0)
 
 
+def test_written_inertials_make_masses_patches_without_compiles(monkeypatch):
+    # write_inertials = true: each object body whose mass MuJoCo infers from its geoms gets
+    # MuJoCo's own <inertial> when the scene loads (the file compiled alone), so a mass
+    # randomizer scales that <inertial>: no geom density changes, no little model to
+    # compile, every variant a patch, exact.
+    text = (PATCH / "inertials.toml").read_text()
+    scene = mjcf_forge.Scene.load(PATCH / "inertials.toml")
+    variants = [scene.variant(i) for i in range(24)]
+    assert {(r["kind"], r["attribute"]) for v in variants for r in v.params["randomized"]} == {("body", "mass")}
+    # Written out, the inertials compile to the same model as the geoms did (bit for bit):
+    # the same scene without the mass randomizer, with and without write_inertials.
+    still = text[: text.index("[[randomize]]")]
+    plain = mjcf_forge.Scene.from_toml(still.replace("write_inertials = true\n", ""), base_dir=PATCH)
+    written = mjcf_forge.Scene.from_toml(still, base_dir=PATCH)
+    for i in range(6):
+        a, b = plain.variant(i), written.variant(i)
+        assert "<inertial" not in a.xml.split("clutter0_")[1] and "<inertial" in b.xml
+        ref, ours = mujoco.MjModel.from_xml_string(a.xml), mujoco.MjModel.from_xml_string(b.xml)
+        assert judge.compare_models(ref, ours) == [] and not_bit_identical(ref, ours) == [], i
+    compiled = []
+    monkeypatch.setattr(mjcf_forge._plan._Plan, "compiled_body", lambda *a: compiled.append(a))
+    cache = mjcf_forge.ModelCache(scene)
+    for v in variants:
+        check_exact(v, cache.model(v))
+    assert cache.patches >= 12, cache.patches
+    _superset_check(scene, range(4), trajectory_tolerance=0.0)
+    assert compiled == []
+    # Absolute masses too (a body without <inertial> refuses them, saying why).
+    absolute = text.replace("scale = true\nlog_uniform = [0.5, 2.0]", "uniform = [0.05, 0.5]")
+    masses = mjcf_forge.Scene.from_toml(absolute, base_dir=PATCH)
+    v = masses.variant(3)
+    assert all(0.05 <= r["value"] <= 0.5 for r in v.params["randomized"])
+    check_exact(v, mjcf_forge.ModelCache(masses).model(v))
+    with pytest.raises(mjcf_forge.MjcfError, match="has no <inertial>: its mass comes from its geoms"):
+        mjcf_forge.Scene.from_toml(absolute.replace("write_inertials = true\n", ""), base_dir=PATCH)
+
+
 def test_superset_varies_fixed_base_objects_per_world():
     # A group placed without free joints (fixed bases: the placement is the body's pos and
     # quat), present in some variants and not others, beside free boxes.

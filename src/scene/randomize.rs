@@ -277,7 +277,7 @@ impl Randomizer {
                     errors.push(doc.error_at(
                         node,
                         ErrorKind::Invalid(format!(
-                            "randomizer at {}: body {} has no <inertial>: its mass comes from its geoms, so it can only be scaled (add `scale = true`, without `components`), or give the body an <inertial>",
+                            "randomizer at {}: body {} has no <inertial>: its mass comes from its geoms, so it can only be scaled (add `scale = true`, without `components`), or give the body an <inertial> (`write_inertials = true` on its group writes MuJoCo's own)",
                             self.location,
                             quoted(name)
                         )),

@@ -72,6 +72,11 @@ pub(crate) struct GroupSpec {
     pub(crate) collision_rgba: Option<[f64; 4]>,
     #[serde(default)]
     pub(crate) name_unnamed_geoms: bool,
+    /// Give every body of the pool's models whose mass MuJoCo infers from its geoms an
+    /// explicit `<inertial>`, as MuJoCo compiles the model file alone (needs MuJoCo when
+    /// the scene loads): its mass randomization then scales that `<inertial>`.
+    #[serde(default)]
+    pub(crate) write_inertials: bool,
 }
 
 fn yes() -> bool {

@@ -700,7 +700,10 @@ fn tree_path(py: Python<'_>, path: &str) -> PyResult<String> {
 
 /// The inertias of `part` as the Python callable `compile` says MuJoCo compiles it alone
 /// (`Document.merge`'s `compile_inertia`), called with the GIL taken for the call.
-fn python_inertia(compile: &Py<PyAny>, part: &Document) -> Result<CompiledInertia, String> {
+pub(crate) fn python_inertia(
+    compile: &Py<PyAny>,
+    part: &Document,
+) -> Result<CompiledInertia, String> {
     let xml = part.to_xml_string();
     let dir = part.model_dir().to_path_buf();
     type Arrays = (Vec<String>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>);

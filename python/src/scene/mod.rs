@@ -17,12 +17,13 @@ pub(crate) use variant::PyVariant;
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use mjcf_forge::Document;
 use mjcf_forge::scene::Scene;
 use pyo3::exceptions::{PyIndexError, PyOverflowError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
-use crate::document::PyDocument;
+use crate::document::{PyDocument, python_inertia};
 use crate::errors::run;
 use variant::{Origin, make};
 
@@ -71,6 +72,15 @@ impl PyScene {
     }
 }
 
+/// The installed ``mujoco``, as the package calls it, for the inertials an object group
+/// writes out (``write_inertials = true``): called only when a group asks.
+fn python_mujoco(py: Python<'_>) -> PyResult<Py<PyAny>> {
+    Ok(py
+        .import("mjcf_forge.base")?
+        .getattr("_compile_inertia")?
+        .unbind())
+}
+
 #[pymethods]
 impl PyScene {
     /// Loads a TOML scene file (paths in it are relative to it); without ``path``, the
@@ -82,9 +92,10 @@ impl PyScene {
             Some(p) => Source::File(absolute(p.clone())),
             None => Source::Demo,
         };
+        let mujoco = python_mujoco(py)?;
         let scene = run(py, || {
             Ok(match &path {
-                Some(path) => Scene::load(path)?,
+                Some(path) => Scene::load_with(path, &mut |d| python_inertia(&mujoco, d))?,
                 None => Scene::demo()?,
             })
         })?;
@@ -104,7 +115,11 @@ impl PyScene {
     fn from_toml(py: Python<'_>, text: &str, base_dir: Option<PathBuf>) -> PyResult<PyScene> {
         let text = text.to_owned();
         let base_dir = base_dir.unwrap_or_else(|| PathBuf::from("."));
-        let scene = run(py, || Ok(Scene::from_toml_str(&text, &base_dir)?))?;
+        let mujoco = python_mujoco(py)?;
+        let scene = run(py, || {
+            let mut compile = |d: &Document| python_inertia(&mujoco, d);
+            Ok(Scene::from_toml_str_with(&text, &base_dir, &mut compile)?)
+        })?;
         Ok(PyScene::new(scene, Source::Toml(text, absolute(base_dir))))
     }
 
@@ -128,7 +143,11 @@ impl PyScene {
                 PyValueError::new_err(format!("the scene description is not JSON data: {e}"))
             })?
             .extract()?;
-        let scene = run(py, || Ok(Scene::from_json_str(&json, &base_dir)?))?;
+        let mujoco = python_mujoco(py)?;
+        let scene = run(py, || {
+            let mut compile = |d: &Document| python_inertia(&mujoco, d);
+            Ok(Scene::from_json_str_with(&json, &base_dir, &mut compile)?)
+        })?;
         Ok(PyScene::new(scene, Source::Json(json, absolute(base_dir))))
     }
 

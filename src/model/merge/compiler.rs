@@ -99,10 +99,10 @@ fn no_conversion_reason(attr: &str, base: &str, default: &str, compiles: bool) -
 }
 
 /// An [`InertiaCompiler`] that is a plain function.
-type CompileFn = fn(&Document) -> Result<CompiledInertia, String>;
+pub(crate) type CompileFn = fn(&Document) -> Result<CompiledInertia, String>;
 
 /// The build's own MuJoCo as an [`InertiaCompiler`], if it has one (the `mujoco` feature).
-pub(super) fn builtin_compiler() -> Option<CompileFn> {
+pub(crate) fn builtin_compiler() -> Option<CompileFn> {
     #[cfg(mjcf_mujoco)]
     {
         Some(|doc: &Document| crate::mujoco::compiled_inertia(doc).map_err(|e| e.to_string()))

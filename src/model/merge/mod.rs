@@ -47,6 +47,7 @@ use crate::document::tree::Node;
 use crate::document::{Document, Section};
 use crate::error::{Error, ErrorKind, Errors};
 
+pub(crate) use compiler::builtin_compiler;
 use keys::{implicit_keys, keys_of};
 use layout::Layout;
 

@@ -7,6 +7,7 @@ use std::sync::OnceLock;
 use toml::Spanned;
 
 use crate::document::Document;
+use crate::document::inertia::InertiaCompiler;
 use crate::document::tree::Node;
 use crate::error::{Error, ErrorKind, Errors};
 use crate::model::geometry::{self, Angles, Pose};
@@ -17,8 +18,9 @@ use crate::scene::{Group, PoolModel};
 
 use super::{MAX_COUNT, ModelSource, Source, model_options, root_body};
 
-/// Checks and loads group `g` (its models read once, their files recorded in `files`),
-/// against the template and the groups before it; every problem at its key.
+/// Checks and loads group `g` (its models read once, their files recorded in `files`,
+/// their inertials written out with `inertias` when the group asks), against the template
+/// and the groups before it; every problem at its key.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn load(
     src: &Source<'_>,
@@ -28,6 +30,7 @@ pub(super) fn load(
     template: &Document,
     angles: &Angles,
     models: &dyn ModelSource,
+    mut inertias: Option<&mut InertiaCompiler<'_>>,
     files: &mut Vec<PathBuf>,
 ) -> Result<Group, Errors> {
     let mut errors = Vec::new();
@@ -100,6 +103,22 @@ pub(super) fn load(
             }
         };
         files.extend(path);
+        if g.write_inertials {
+            // MuJoCo's own masses and inertias of the file alone, written out: a mass
+            // randomizer then scales an <inertial> (a patch) instead of the geoms' densities
+            // (which only MuJoCo can turn into masses).
+            let written = match inertias.as_deref_mut() {
+                Some(compile) => doc.write_compiled_inertials(false, true, compile),
+                None => Err(format!(
+                    "write_inertials needs MuJoCo to compile '{file}': load the scene from \
+                     Python, or build mjcf-forge with the `mujoco` feature"
+                )),
+            };
+            if let Err(e) = written {
+                errors.push(src.error(&at, format!("cannot write the inertials of '{file}': {e}")));
+                continue;
+            }
+        }
         let Some(root) = root_body(&doc) else {
             errors.push(src.error(
                 &at,

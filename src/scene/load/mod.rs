@@ -8,6 +8,7 @@ use std::sync::{Arc, OnceLock};
 use toml::Spanned;
 
 use crate::document::Document;
+use crate::document::inertia::InertiaCompiler;
 use crate::document::tree::{Node, Tree};
 use crate::error::{Error, ErrorKind, Errors, Location};
 use crate::model::geometry::{Angles, Pose};
@@ -21,6 +22,7 @@ use super::{Group, Instance, Scene, splice};
 
 mod group;
 mod keys;
+mod open;
 mod randomizer;
 
 /// The largest count a group, and all groups together, may ask for per variant (each slot
@@ -100,9 +102,10 @@ pub(crate) fn from_toml(
     text: &str,
     file: Arc<Path>,
     models: &dyn ModelSource,
+    inertias: Option<&mut InertiaCompiler<'_>>,
 ) -> Result<Scene, Errors> {
     let dir = file.parent().unwrap_or(Path::new(".")).to_path_buf();
-    from_text(text, file, dir, None, models)
+    from_text(text, file, dir, None, models, inertias)
 }
 
 /// Builds a scene from a description without text of its own, read as the TOML text
@@ -113,8 +116,9 @@ pub(crate) fn from_serialized(
     file: Arc<Path>,
     dir: PathBuf,
     models: &dyn ModelSource,
+    inertias: Option<&mut InertiaCompiler<'_>>,
 ) -> Result<Scene, Errors> {
-    from_text(text, file, dir, keys::KeyPaths::of(text), models)
+    from_text(text, file, dir, keys::KeyPaths::of(text), models, inertias)
 }
 
 /// Where a description (or a part of it) is by its key path, for problems found before it
@@ -133,13 +137,20 @@ fn from_text(
     dir: PathBuf,
     keys: Option<keys::KeyPaths>,
     models: &dyn ModelSource,
+    inertias: Option<&mut InertiaCompiler<'_>>,
 ) -> Result<Scene, Errors> {
     let src = Source {
         text,
         file: file.clone(),
         keys,
     };
-    build(&src, dir, models).map_err(|mut e| {
+    // The caller's MuJoCo for the inertials a group writes out, else the build's own.
+    let mut builtin = crate::model::merge::builtin_compiler();
+    let inertias = match inertias {
+        Some(c) => Some(c),
+        None => builtin.as_mut().map(|f| f as &mut InertiaCompiler<'_>),
+    };
+    build(&src, dir, models, inertias).map_err(|mut e| {
         e.0.sort_by_key(|e| match &e.location {
             Some(l) if l.file == file => (0, l.line, l.col),
             _ => (1, 0, 0),
@@ -148,7 +159,12 @@ fn from_text(
     })
 }
 
-fn build(src: &Source<'_>, dir: PathBuf, models: &dyn ModelSource) -> Result<Scene, Errors> {
+fn build(
+    src: &Source<'_>,
+    dir: PathBuf,
+    models: &dyn ModelSource,
+    mut inertias: Option<&mut InertiaCompiler<'_>>,
+) -> Result<Scene, Errors> {
     let file = src.file.clone();
     let spec: SceneSpec = toml::from_str(src.text).map_err(|e| {
         let location = e.span().map_or_else(|| src.whole(), |s| src.location(s));
@@ -271,8 +287,9 @@ fn build(src: &Source<'_>, dir: PathBuf, models: &dyn ModelSource) -> Result<Sce
         .map_err(|e| Error::at(src.location(spec.base.span()), ErrorKind::Invalid(e)))?;
     let mut groups: Vec<Group> = Vec::new();
     for g in &spec.objects {
+        let compile = inertias.as_deref_mut();
         match group::load(
-            src, &dir, g, &groups, &template, &angles, models, &mut files,
+            src, &dir, g, &groups, &template, &angles, models, compile, &mut files,
         ) {
             Ok(x) => groups.push(x),
             Err(e) => errors.extend(e.0),
