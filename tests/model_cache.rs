@@ -366,32 +366,55 @@ fn mass_of_bodies_without_inertial_scales_their_geoms() {
     let superset = scene.superset().unwrap();
     let mut cache = ModelCache::new(&scene, 2, None).with_superset().unwrap();
     for i in 0..6 {
-        let patch = scene.superset_patch(&superset, i).unwrap();
-        assert!(
-            patch.entries.iter().any(|e| e.field == "geoms"),
-            "variant {i}"
-        );
-        let want = compiled(&scene, i);
-        let tags = scene.superset_names(&superset, i).unwrap();
-        let got = cache.model(i).unwrap();
-        let got_bodies = got.names(ObjType::Body);
-        for (b, n) in want.names(ObjType::Body).iter().enumerate().skip(1) {
-            let k = got_bodies
-                .iter()
-                .position(|x| *x == superset_name(&tags, n))
-                .unwrap();
-            assert_eq!(got.body_mass()[k], want.body_mass()[b], "variant {i}: {n}");
+        superset_masses_are_the_variants(&scene, &superset, &mut cache, i, true);
+    }
+    assert_eq!(cache.compiles(), 1);
+}
+
+/// One of a compiled model's body arrays.
+type BodyArray = fn(&CompiledModel) -> &[f64];
+
+/// Variant `i` patched into the superset `cache`: every body's mass, inertia and inertial
+/// frame are the variant's own compile's, bit for bit; `little`: whether its patch carries
+/// bodies' little models.
+fn superset_masses_are_the_variants(
+    scene: &Scene,
+    superset: &mjcf_forge::scene::Superset,
+    cache: &mut ModelCache<'_>,
+    i: u64,
+    little: bool,
+) {
+    use mjcf_forge::mujoco::ObjType;
+    let patch = scene.superset_patch(superset, i).unwrap();
+    assert_eq!(
+        patch.entries.iter().any(|e| e.field == "geoms"),
+        little,
+        "variant {i}"
+    );
+    let want = compiled(scene, i);
+    let tags = scene.superset_names(superset, i).unwrap();
+    let got = cache.model(i).unwrap();
+    let got_bodies = got.names(ObjType::Body);
+    for (b, n) in want.names(ObjType::Body).iter().enumerate().skip(1) {
+        let k = got_bodies
+            .iter()
+            .position(|x| *x == superset_name(&tags, n))
+            .unwrap();
+        assert_eq!(got.body_mass()[k], want.body_mass()[b], "variant {i}: {n}");
+        let arrays: [(BodyArray, usize); 3] = [
+            (CompiledModel::body_inertia, 3),
+            (CompiledModel::body_ipos, 3),
+            (CompiledModel::body_iquat, 4),
+        ];
+        for (array, width) in arrays {
+            let (g, w) = (array(got), array(&want));
             assert_eq!(
-                got.body_inertia()[3 * k..3 * k + 3],
-                want.body_inertia()[3 * b..3 * b + 3]
-            );
-            assert_eq!(
-                got.body_ipos()[3 * k..3 * k + 3],
-                want.body_ipos()[3 * b..3 * b + 3]
+                g[width * k..width * (k + 1)],
+                w[width * b..width * (b + 1)],
+                "variant {i}: {n}"
             );
         }
     }
-    assert_eq!(cache.compiles(), 1);
 }
 
 #[test]
@@ -405,43 +428,15 @@ fn absolute_mass_of_a_body_without_inertial_is_refused_with_the_fix() {
     assert!(err.contains("scale = true"), "{err}");
 }
 
-/// One of a compiled model's body arrays.
-type BodyArray = fn(&CompiledModel) -> &[f64];
-
 #[test]
 fn written_inertials_make_masses_patches_of_the_superset() {
-    use mjcf_forge::mujoco::ObjType;
     // write_inertials: the objects' bodies carry MuJoCo's own <inertial>, so a mass scale
     // is a patch of that <inertial> (no little model), bit for bit.
     let scene = Scene::load(root().join("corpora/scenes/patch/inertials.toml")).unwrap();
     let superset = scene.superset().unwrap();
     let mut cache = ModelCache::new(&scene, 2, None).with_superset().unwrap();
     for i in 0..6 {
-        let patch = scene.superset_patch(&superset, i).unwrap();
-        assert!(
-            !patch.entries.iter().any(|e| e.field == "geoms"),
-            "variant {i}"
-        );
-        let want = compiled(&scene, i);
-        let tags = scene.superset_names(&superset, i).unwrap();
-        let got = cache.model(i).unwrap();
-        let got_bodies = got.names(ObjType::Body);
-        for (b, n) in want.names(ObjType::Body).iter().enumerate().skip(1) {
-            let k = got_bodies
-                .iter()
-                .position(|x| *x == superset_name(&tags, n))
-                .unwrap();
-            assert_eq!(got.body_mass()[k], want.body_mass()[b], "variant {i}: {n}");
-            let arrays: [(BodyArray, usize); 3] = [
-                (CompiledModel::body_inertia, 3),
-                (CompiledModel::body_ipos, 3),
-                (CompiledModel::body_iquat, 4),
-            ];
-            for (array, width) in arrays {
-                let (g, w) = (array(got), array(&want));
-                assert_eq!(g[width * k..width * (k + 1)], w[width * b..width * (b + 1)]);
-            }
-        }
+        superset_masses_are_the_variants(&scene, &superset, &mut cache, i, false);
     }
     assert_eq!(cache.compiles(), 1);
 }

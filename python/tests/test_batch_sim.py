@@ -1,5 +1,6 @@
 """WorldBatch judged by the simulators themselves, on CPU (run in .cache/venv-sim, made by
-scripts/setup_sim_env.sh: MuJoCo 4.0.0, MuJoCo Warp 4.0.0, MJX, JAX's CPU backend).
+scripts/setup_sim_env.sh: MuJoCo 4.0.0, MuJoCo Warp 4.0.0, MJX on JAX's CPU backend, both
+its own JAX implementation and MuJoCo Warp's kernels under it, impl="warp").
 
 Per scene: 8 worlds, each holding a variant of the scene's superset, stepped 500 steps;
 every placed body within 1e-4 m of its variant compiled alone and stepped on CPU MuJoCo
