@@ -1,6 +1,7 @@
 //! From a scene description to a [`Scene`]: models loaded once, the template assembled,
 //! every name, body, attribute and distribution checked, with the scene file's positions.
-//! An object group is checked in `group.rs`, a randomizer in `randomizer.rs`.
+//! An object group is checked in `group.rs`, a randomizer in `randomizer.rs`; `open.rs`
+//! holds [`Scene`]'s constructors (a file, TOML or JSON text, the demo).
 
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};

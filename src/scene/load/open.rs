@@ -42,14 +42,15 @@ impl Scene {
     /// group writes out (`write_inertials = true`) instead of the build's own (feature
     /// `mujoco`): what the Python package passes its `mujoco` through.
     ///
-    /// ```no_run
+    /// ```
     /// use mjcf_forge::{CompiledInertia, Document, scene::Scene};
     ///
-    /// let mut compile = |doc: &Document| -> Result<CompiledInertia, String> {
-    ///     Err(format!("no MuJoCo here to compile {}", doc.model_dir().display()))
-    /// };
-    /// let scene = Scene::load_with("corpora/scenes/demo/demo.toml", &mut compile)?;
-    /// # Ok::<(), mjcf_forge::Errors>(())
+    /// // A MuJoCo of the caller's that cannot compile: each pool model says so, at its place.
+    /// let mut compile =
+    ///     |_: &Document| -> Result<CompiledInertia, String> { Err("no MuJoCo here".into()) };
+    /// let err = Scene::load_with("corpora/scenes/patch/inertials.toml", &mut compile).unwrap_err();
+    /// assert_eq!(err.0.len(), 3);
+    /// assert!(err.to_string().contains("cannot write the inertials of '../demo/box.xml': no MuJoCo here"));
     /// ```
     pub fn load_with(
         path: impl AsRef<Path>,
