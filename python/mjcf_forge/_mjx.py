@@ -46,11 +46,13 @@ class MjxWorlds:
         kernels under MJX, on CPU too: its collisions include the cylinder and mesh pairs
         MJX's JAX collision lacks); with "warp" the per-world leaves are those MuJoCo Warp
         reads per world (:meth:`to_mjwarp`'s), ``geom_dataid`` aside (MJX holds one for
-        all worlds)."""
+        all worlds). Without ``impl``, the one of the model put before, if any."""
         import jax
         import jax.numpy as jnp
         from mujoco import mjx
 
+        if impl is None and self._mjx is not None:
+            impl = self._mjx_impl  # after assign(): the implementation put before
         if self._mjx is not None and (impl != self._mjx_impl or not self._mjx_flags_hold()):
             # Another implementation, or a reassigned world needs the general path
             # somewhere new.

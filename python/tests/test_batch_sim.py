@@ -513,6 +513,8 @@ def test_mjx_warp_worlds_agree_with_each_variant():
     run, contacts, overflow = mjx_sim("warp")(batch)
     report = judge(scene, batch, run, contacts)
     assert not overflow()
+    # Without impl, to_mjx keeps the implementation it was put with.
+    assert str(batch.to_mjx()[0].impl.value) == "warp"
     print("mjx warp patch", report)
 
 
