@@ -688,6 +688,6 @@ fn written_inertials_need_mujoco_and_problems_name_the_pool_entry() {
     assert!(
         own.unwrap_err()
             .to_string()
-            .contains("write_inertials needs MuJoCo to compile '../demo/box.xml'")
+            .contains("cannot write the inertials of '../demo/box.xml': write_inertials needs MuJoCo: load the scene from Python")
     );
 }

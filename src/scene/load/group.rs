@@ -109,10 +109,11 @@ pub(super) fn load(
             // (which only MuJoCo can turn into masses).
             let written = match inertias.as_deref_mut() {
                 Some(compile) => doc.write_compiled_inertials(false, true, compile),
-                None => Err(format!(
-                    "write_inertials needs MuJoCo to compile '{file}': load the scene from \
-                     Python, or build mjcf-forge with the `mujoco` feature"
-                )),
+                None => Err(
+                    "write_inertials needs MuJoCo: load the scene from Python, or \
+                     build mjcf-forge with the `mujoco` feature"
+                        .to_string(),
+                ),
             };
             if let Err(e) = written {
                 errors.push(src.error(&at, format!("cannot write the inertials of '{file}': {e}")));
