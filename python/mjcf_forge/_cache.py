@@ -272,13 +272,7 @@ class ModelCache:
         if self.superset is None or not self._by_tree or parked is None:
             return None
         derivations = plan.derivations
-        ids = self._body_ids
-        roots = set()
-        for name in parked:
-            i = ids.get(name)
-            if i is None:
-                i = ids[name] = plan.model.body(name).id
-            roots.add(i)
+        roots = set(self._body_ids_of(plan.model, parked))
 
         def derive(model: Any, data: Any, layout: list) -> bool:
             entry = derivations.get(id(layout))
@@ -298,6 +292,18 @@ class ModelCache:
             return derivation(model, data, roots)
 
         return derive
+
+    def _body_ids_of(self, model: Any, names: Any) -> list[int]:
+        """Superset: the ids of the bodies ``names`` in ``model`` (of the superset's one
+        structure), looked up once per name."""
+        ids = self._body_ids
+        out = []
+        for name in names:
+            i = ids.get(name)
+            if i is None:
+                i = ids[name] = model.body(name).id
+            out.append(i)
+        return out
 
     def apply(self, variant: Any, model: Any) -> Any:
         """Patches ``model`` (of ``variant``'s structure) in place into ``variant``'s

@@ -148,7 +148,6 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         self._layouts: dict[tuple, Any] = {}
         self._written = [n for n in _WRITTEN if n in self._others]
         self._flags = [n for n in self._written if n.endswith("_sameframe")]
-        self._body_ids: dict[str, int] = {}
         #: Worlds whose derived values came tree by tree (the others: mj_setConst; see
         #: ``_trees.py``: the same bits).
         self.derived_by_tree = 0
@@ -267,14 +266,8 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         statistics, its parked geoms; a parked geom that touches anything at the initial
         pose is an error."""
         index, numbers, strings, parked_names, patch0 = world
-        ids = self._body_ids
-        parked_roots = []
-        for name in parked_names:
-            i = ids.get(name)
-            if i is None:
-                i = ids[name] = self._scratch.body(name).id
-            parked_roots.append(i)
         cache = self.cache
+        parked_roots = cache._body_ids_of(self._scratch, parked_names)
         before = cache.by_tree
         model = cache._apply_world(self._scratch, (index, numbers, strings, parked_names), patch0)
         by_tree = cache.by_tree != before

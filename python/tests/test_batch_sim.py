@@ -106,6 +106,14 @@ def judge(scene, batch: WorldBatch, run, contacts, tolerance: float = TOLERANCE)
     return report
 
 
+def listed_contacts(nacon, geom, worldid) -> list[tuple[int, int, int]]:
+    """(world, geom1, geom2) of MuJoCo Warp's contact buffer, one for all worlds (``nacon``:
+    its count, which may pass the buffer's size when it overflowed)."""
+    geom, worldid = np.asarray(geom).reshape(-1, 2), np.asarray(worldid).ravel()
+    n = min(int(np.asarray(nacon).ravel()[0]), len(geom))
+    return [(int(w), int(g[0]), int(g[1])) for w, g in zip(worldid[:n], geom[:n])]
+
+
 def warp_step(m, d):
     import mujoco_warp as mjw
     import warp as wp
@@ -119,10 +127,7 @@ def warp_step(m, d):
         return d.xpos.numpy().astype(np.float64)
 
     def contacts():
-        n = min(int(d.nacon.numpy()[0]), d.contact.geom.shape[0])
-        geom = d.contact.geom.numpy()[:n]
-        world = d.contact.worldid.numpy()[:n]
-        return [(int(w), int(g[0]), int(g[1])) for w, g in zip(world, geom)]
+        return listed_contacts(d.nacon.numpy(), d.contact.geom.numpy(), d.contact.worldid.numpy())
 
     return run, contacts
 
@@ -469,11 +474,8 @@ def mjx_sim(impl: str):
 
         def contacts():
             c = state["data"]._impl
-            if impl == "warp":  # one buffer for all worlds
-                n = int(np.asarray(c.nacon).ravel()[0])
-                geom = np.asarray(c.contact__geom).reshape(-1, 2)[:n]
-                world = np.asarray(c.contact__worldid).ravel()[:n]
-                return [(int(w), int(g[0]), int(g[1])) for w, g in zip(world, geom)]
+            if impl == "warp":
+                return listed_contacts(c.nacon, c.contact__geom, c.contact__worldid)
             geom, dist = np.asarray(c.contact.geom), np.asarray(c.contact.dist)
             return [(w, int(g[0]), int(g[1])) for w in range(batch.nworld) for g, x in zip(geom[w], dist[w]) if x < 0]
 

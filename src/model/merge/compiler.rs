@@ -99,7 +99,7 @@ fn no_conversion_reason(attr: &str, base: &str, default: &str, compiles: bool) -
 }
 
 /// An [`InertiaCompiler`] that is a plain function.
-pub(crate) type CompileFn = fn(&Document) -> Result<CompiledInertia, String>;
+type CompileFn = fn(&Document) -> Result<CompiledInertia, String>;
 
 /// The build's own MuJoCo as an [`InertiaCompiler`], if it has one (the `mujoco` feature).
 pub(crate) fn builtin_compiler() -> Option<CompileFn> {
