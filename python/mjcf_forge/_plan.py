@@ -140,10 +140,15 @@ class _Plan:
         self.qpos0, self.qpos = model.qpos0, data.qpos
         self.points = (data.xpos[1:], data.xipos[1:], data.xanchor, data.site_xpos)
         self.geom_xpos, self.xipos, self.xanchor = data.geom_xpos, data.xipos, data.xanchor
-        self.body_mass, self.M = model.body_mass[1:], data.M
-        self.M_diagonal = model.M_rowadr + model.M_rownnz - 1
+        self.body_mass = model.body_mass[1:]
+        # The mass matrix's diagonal: the last of each row of data.M where MuJoCo has
+        # it (3.9 does), else data.qM at dof_Madr (3.3: the same numbers).
+        if hasattr(data, "M"):
+            self.M, self.M_diagonal = data.M, model.M_rowadr + model.M_rownnz - 1
+        else:
+            self.M, self.M_diagonal = data.qM, model.dof_Madr.copy()
         self.nbody, self.nv = model.nbody, model.nv
-        self.dof_length = model.dof_length
+        self.dof_length = getattr(model, "dof_length", None)  # not in MuJoCo 3.3
         # Geom radii for the bounding box: a plane or height field (rbound 0) counts a
         # tenth of its largest size. Sizes are patched only through "geoms" entries, which
         # update these (compiled_body()).
@@ -404,6 +409,7 @@ class _Plan:
             stat.meanmass = _in_order_sum(self.body_mass) / (self.nbody - 1)
         # Rotational dofs take their body's size.
         if self.nv:
-            self.dof_length[:] = np.where(self.rotational, body[self.dof_body], 1.0)
+            if self.dof_length is not None:
+                self.dof_length[:] = np.where(self.rotational, body[self.dof_body], 1.0)
             stat.meaninertia = _in_order_sum(self.M[self.M_diagonal]) / self.nv
         stat.extent = max(extent, 2 * stat.meansize)

@@ -105,6 +105,9 @@ class _Tree:
         md = slice(before, before + count)
         # The mass matrix's sparsity, as the superset's (the dofs' own rows).
         rows = slice(start, start + count)
+        if not hasattr(sk, "M_rownnz"):
+            # MuJoCo 3.3 has no M_rownnz to compare (mj_setConst on the whole model then).
+            raise ValueError("this MuJoCo has no M_rownnz")
         if not (
             np.array_equal(sk.M_rownnz[md], model.M_rownnz[rows])
             and all(

@@ -33,6 +33,7 @@ from typing import Any, Callable, Optional
 import numpy as np
 
 from ._mjcf_forge import Document, Element, LoadCache, MjcfError
+from . import _stock
 from . import etree as ET
 from ._files import write_atomic
 
@@ -44,7 +45,9 @@ __all__ = [
     "USING_INSTANCE_RANDOMIZATION",
     "XMLError",
     "model_cache",
+    "rules",
     "set_model_cache",
+    "set_rules",
     "sort_elements",
 ]
 
@@ -58,6 +61,48 @@ USING_INSTANCE_RANDOMIZATION = False
 #: reads the same robot, gripper, arena and object files at every environment reset).
 #: ``None``: every file is read anew. Either way the document is the file as it is now.
 FILE_CACHE: Optional[LoadCache] = LoadCache(256)
+
+# The rules MujocoXML reads and merges by (see set_rules).
+RULES = ("mujoco", "robosuite")
+_rules = "mujoco"
+
+
+def rules() -> str:
+    """The rules :class:`MujocoXML` reads default classes and merges models by:
+    ``"mujoco"`` (the default) or ``"robosuite"`` (see :func:`set_rules`)."""
+    return _rules
+
+
+def set_rules(rules: str) -> str:
+    """Sets the rules :class:`MujocoXML` reads and merges by, for the models made from then
+    on, and returns the rules it replaces.
+
+    - ``"mujoco"``: MuJoCo's. Default classes inlined exactly; a merge converts a part's
+      compiler settings (angles, Euler sequences, mass settings with the installed
+      ``mujoco``) so that every part compiles to what it compiles to alone, shares
+      identical assets and refuses a name clash, and carries every section. A merged
+      model can differ from stock robosuite's: the table's mass, joint ranges of parts
+      written in degrees, a clashing asset refused (docs/model-hierarchy.md).
+    - ``"robosuite"``: stock robosuite's (1.4.0 and 1.5.2 alike), so that a model compiles
+      to the one stock robosuite builds: only the top-level default classes inlined, a
+      part's ``<compiler>`` dropped (its values read under the base's), the base's asset
+      kept where a part repeats a name, seven sections carried (module
+      ``mjcf_forge._stock``). What :func:`mjcf_forge.robosuite.use` sets by default.
+
+    >>> from mjcf_forge import base
+    >>> previous = base.set_rules("robosuite")
+    >>> base.rules()
+    'robosuite'
+    >>> _ = base.set_rules(previous)
+
+    Raises:
+        ValueError: rules other than ``"mujoco"`` and ``"robosuite"``
+    """
+    global _rules
+    if rules not in RULES:
+        raise ValueError(f"rules are 'mujoco' or 'robosuite', not {rules!r}")
+    previous, _rules = _rules, rules
+    return previous
 
 
 # --------------------------------------------------------------------------------------
@@ -372,6 +417,11 @@ def set_model_cache(cache: Any) -> Optional[Any]:
 # MujocoXML
 # --------------------------------------------------------------------------------------
 
+def _load_exact(fname: str) -> Any:
+    files = FILE_CACHE
+    return Document.load(fname) if files is None else files.load(fname)
+
+
 # The sections MujocoXML holds, in robosuite's order (created in that order when missing).
 _SECTIONS = ["worldbody", "actuator", "sensor", "asset", "tendon", "equality", "contact"]
 
@@ -402,8 +452,10 @@ class MujocoXML(object):
         self.file = fname
         self.folder = os.path.dirname(fname)
         try:
-            files = FILE_CACHE
-            self.document = Document.load(fname) if files is None else files.load(fname)
+            if _rules == "robosuite":
+                self.document = _stock.load(fname, _load_exact, xml_error)
+            else:
+                self.document = _load_exact(fname)
         except MjcfError as e:
             raise _reraised(e) from None
         self.root = self.document.root
@@ -489,6 +541,12 @@ class MujocoXML(object):
                 raise xml_error(
                     "merge_body {!r} is not a body of {}{}".format(body, self._label(), hint)
                 )
+        if _rules == "robosuite":
+            into = None if body is None and not worldbody else (
+                self.worldbody if body is None else self.worldbody.find_named("body", body))
+            for other in others:
+                _stock.merge(self, other, into)
+            return
         try:
             self.document.merge(
                 [other.document for other in others],
@@ -555,7 +613,13 @@ class MujocoXML(object):
 
         Raises:
             XMLError: an asset whose name is taken here by a different asset
+
+        With ``rules="robosuite"`` (:func:`set_rules`), robosuite's rule instead: an asset
+        whose tag and ``name`` are here already is left out, whatever its content.
         """
+        if _rules == "robosuite":
+            _stock.merge_assets(self, other)
+            return
         names = {}
         for asset in self.asset:
             name = _asset_name(asset)
@@ -861,7 +925,9 @@ class MujocoXMLModel(MujocoXML, MujocoModel):
         """Prefixes every name of the model and every reference to it (the library's
         prefixing, by MuJoCo's schema), keeping those ``exclude_from_prefixing`` excludes:
         a name it returns True for, and the name of an element it returns True for, stay
-        as they are where declared and wherever referenced."""
+        as they are where declared and wherever referenced. With ``rules="robosuite"``, a
+        name that already begins with the prefix stays too, as robosuite's ``add_prefix``
+        leaves it."""
         exclude = self.exclude_from_prefixing
         kept = set()
         keep = None
@@ -874,6 +940,13 @@ class MujocoXMLModel(MujocoXML, MujocoModel):
 
             def keep(name):
                 return name in kept or bool(exclude(name))
+
+        if _rules == "robosuite":
+            # robosuite's add_prefix leaves a value that already begins with the prefix.
+            excluded = keep
+
+            def keep(name):
+                return name.startswith(prefix) or (excluded is not None and excluded(name))
 
         try:
             self.document.prefix(prefix, exclude=keep)

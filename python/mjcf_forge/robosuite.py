@@ -179,16 +179,27 @@ def in_use() -> bool:
     return _FINDER in sys.meta_path
 
 
-def use() -> None:
+def use(rules: str = "robosuite") -> None:
     """Makes robosuite's model classes build on :mod:`mjcf_forge.base` and its ``ET`` be
     :mod:`mjcf_forge.etree` (see the module's documentation). Call it once, before
-    robosuite is imported; calling it again does nothing.
+    robosuite is imported; calling it again changes only the rules.
+
+    Args:
+        rules: ``"robosuite"`` (the default): every model compiles to the one stock
+            robosuite builds, bit for bit, its merge rules included (a part's
+            ``<compiler>`` dropped, the base's asset kept where a part repeats its name).
+            ``"mujoco"``: MuJoCo's rules, where each merged part compiles to what it
+            compiles to alone (another model than stock's where robosuite's rules differ:
+            the table's mass, the joint ranges of parts written in degrees). Sets
+            :func:`mjcf_forge.base.set_rules`.
 
     Raises:
         RuntimeError: robosuite's models are already imported (their classes already
             derive from robosuite's own ``MujocoXML``)
+        ValueError: other rules
     """
     if in_use():
+        _base.set_rules(rules)
         return
     loaded = sorted(
         name
@@ -200,4 +211,5 @@ def use() -> None:
             "mjcf_forge.robosuite.use() must come before robosuite is imported: "
             f"{loaded[0]} is already imported"
         )
+    _base.set_rules(rules)
     sys.meta_path.insert(0, _FINDER)

@@ -1,0 +1,148 @@
+"""Runs LIBERO's own tasks with LIBERO's own code, stock or on the switch
+(``mjcf_forge.robosuite.use()``), and records what a comparison needs: run by
+test_libero.py and scripts/bench_libero.py in the LIBERO venv (.cache/venv-libero:
+LIBERO 0.1.1, robosuite 1.4.0, MuJoCo 3.3.1; scripts/setup_libero_env.sh).
+
+    python libero_run.py {stock|switch} OUT_DIR SUITE:INDEX [SUITE:INDEX ...]
+        [--steps N] [--resets N] [--cameras] [--model-only]
+
+Per task, ``OUT_DIR/<suite>-<index>.npz`` holds:
+
+- ``model/<field>``: every array of the ``MjModel`` the environment simulates, after its
+  first reset (names as the raw ``names`` buffer, which holds every name in order), and
+  ``model/sizes`` (every ``n*`` size);
+- unless ``--model-only``: the observations after ``set_init_state`` (LIBERO's first init
+  state of the task, read from its init file without torch) and after each of ``--steps``
+  steps of actions drawn by ``np.random.default_rng(0)`` from [-1, 1] (``obs/<key>``,
+  stacked), LIBERO's success predicate after each (``success``), and the simulator state
+  (``state``); then ``--resets`` more hard resets, each followed by ``set_init_state`` and
+  the same actions for 5 steps (``again/<key>``: the observations after them);
+- ``error``: the exception's type and message, if LIBERO's code raised.
+
+With ``--cameras`` the environment renders LIBERO's agentview and wrist images at 128x128
+(``MUJOCO_GL`` chooses the GL platform; egl by default).
+"""
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import os
+import pickle
+import sys
+import traceback
+import zipfile
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+ap = argparse.ArgumentParser()
+ap.add_argument("mode", choices=["stock", "switch"])
+ap.add_argument("out")
+ap.add_argument("tasks", nargs="+")
+ap.add_argument("--steps", type=int, default=50)
+ap.add_argument("--resets", type=int, default=1)
+ap.add_argument("--cameras", action="store_true")
+ap.add_argument("--model-only", action="store_true")
+args = ap.parse_args()
+
+if args.mode == "switch":
+    import mjcf_forge.robosuite
+
+    mjcf_forge.robosuite.use()
+
+import mujoco  # noqa: E402
+import numpy as np  # noqa: E402
+from libero.libero import get_libero_path  # noqa: E402
+from libero.libero.envs import OffScreenRenderEnv  # noqa: E402
+
+
+def task_map() -> dict:
+    """LIBERO's suites and their tasks in order (libero.libero.benchmark's own map; its
+    package imports torch, so the module is loaded alone)."""
+    path = os.path.join(os.path.dirname(get_libero_path("bddl_files")), "benchmark", "libero_suite_task_map.py")
+    spec = importlib.util.spec_from_file_location("libero_suite_task_map", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.libero_task_map
+
+
+def init_states(suite: str, task: str) -> np.ndarray:
+    """The task's init states: a torch.save zip whose pickle holds one numpy array."""
+    path = os.path.join(get_libero_path("init_states"), suite, task + ".pruned_init")
+    with zipfile.ZipFile(path) as z:
+        name = next(n for n in z.namelist() if n.endswith("/data.pkl"))
+        return pickle.loads(z.read(name))
+
+
+def model_arrays(model) -> dict:
+    out = {}
+    sizes = {}
+    for name in dir(model):
+        if name.startswith("_"):
+            continue
+        value = getattr(model, name)
+        if isinstance(value, np.ndarray):
+            out["model/" + name] = value.copy()
+        elif name.startswith("n") and isinstance(value, int):
+            sizes[name] = value
+    out["model/sizes"] = np.array([sizes[k] for k in sorted(sizes)], dtype=np.int64)
+    out["model/size_names"] = np.array(sorted(sizes))
+    for group in ("opt", "stat", "vis"):
+        obj = getattr(model, group)
+        for name in dir(obj):
+            if not name.startswith("_"):
+                v = getattr(obj, name)
+                if isinstance(v, (int, float, np.ndarray)):
+                    out[f"model/{group}.{name}"] = np.asarray(v).copy()
+    return out
+
+
+def run(suite: str, index: int) -> dict:
+    task = task_map()[suite][index]
+    bddl = os.path.join(get_libero_path("bddl_files"), suite, task + ".bddl")
+    size = 128
+    env = OffScreenRenderEnv(
+        bddl_file_name=bddl, camera_heights=size, camera_widths=size,
+        has_offscreen_renderer=args.cameras, use_camera_obs=args.cameras,
+    )
+    env.seed(0)
+    env.reset()
+    out = model_arrays(env.sim.model)
+    if args.model_only:
+        env.close()
+        return out
+    state0 = init_states(suite, task)[0]
+    actions = np.random.default_rng(0).uniform(-1.0, 1.0, size=(args.steps, env.env.action_dim))
+    obs = env.set_init_state(state0)
+    frames = [obs]
+    success = []
+    for a in actions:
+        obs, _reward, done, _info = env.step(a)
+        frames.append(obs)
+        success.append(bool(env.check_success()))
+    for key in frames[0]:
+        out["obs/" + key] = np.stack([np.asarray(f[key]) for f in frames])
+    out["success"] = np.array(success)
+    out["state"] = env.sim.get_state().flatten()
+    again = []
+    for _ in range(args.resets):
+        env.reset()
+        obs = env.set_init_state(state0)
+        for a in actions[:5]:
+            obs, *_ = env.step(a)
+        again.append(obs)
+    for key in (again[0] if again else {}):
+        out["again/" + key] = np.stack([np.asarray(f[key]) for f in again])
+    env.close()
+    return out
+
+
+os.makedirs(args.out, exist_ok=True)
+for spec in args.tasks:
+    suite, _, index = spec.partition(":")
+    try:
+        record = run(suite, int(index))
+    except Exception as e:  # noqa: BLE001 - the record says what LIBERO's code raised
+        traceback.print_exc()
+        record = {"error": np.array(f"{type(e).__name__}: {e}")}
+    np.savez(os.path.join(args.out, f"{suite}-{index}.npz"), **record)
+    print(spec, "error" if "error" in record else "ok", flush=True)
