@@ -13,6 +13,9 @@ bash scripts/setup.sh
 # robosuite 1.5.2 with MuJoCo 3.9.0, where python/tests/test_robosuite_use.py builds
 # robosuite's own classes both ways (idempotent; about 300 MB of wheels the first time).
 bash scripts/setup_robosuite_env.sh
+# LIBERO 0.1.1 with robosuite 1.4.0 and MuJoCo 3.3.1 in .cache/venv-libero, with its assets,
+# for python/tests/test_libero.py (idempotent; about 550 MB of wheels the first time).
+bash scripts/setup_libero_env.sh
 # MuJoCo Warp, MJX and JAX on CPU in .cache/venv-sim, with mjcf_forge built into it, for
 # python/tests/test_batch_sim.py (idempotent; Warp's kernels cached in .cache/warp-kernels).
 bash scripts/setup_sim_env.sh
@@ -39,6 +42,7 @@ echo "== judge self-tests (MuJoCo 3.17.0 and 4.0.0)"
 .cache/venv-mj4/bin/python -m pytest tests/judge -q -p no:cacheprovider
 echo "== python package (pytest: API, errors, threads, MuJoCo judge, Gymnasium, Ray)"
 # (test_batch_sim.py needs MuJoCo Warp and JAX: it runs in .cache/venv-sim below.)
+# (test_libero.py runs LIBERO in .cache/venv-libero, MuJoCo 3.3.1, stock and on the switch.)
 .cache/venv/bin/python -m pytest python/tests -q -p no:cacheprovider --ignore=python/tests/test_batch_sim.py
 echo "== ModelCache and DocumentCache under MuJoCo 4.0.0 (patched models judged against 4.0.0's compile)"
 .cache/venv-mj4/bin/python -m pytest python/tests/test_model_cache.py python/tests/test_document_cache.py -q -p no:cacheprovider

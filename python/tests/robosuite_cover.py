@@ -3,7 +3,9 @@ robosuite as it is or on mjcf_forge.base (``mjcf_forge.robosuite.use()``): run b
 test_robosuite_cover.py in the robosuite venv (.cache/venv-robosuite-env: robosuite 1.5.2,
 MuJoCo 3.9.0), once each way per group of cases.
 
-    python robosuite_cover.py {robosuite|forge} OUT.json {models|envs} [CASE ...]
+    python robosuite_cover.py {robosuite|forge|forge-mujoco} OUT.json {models|envs} [CASE ...]
+
+(``forge``: ``use()``, robosuite's rules; ``forge-mujoco``: ``use(rules="mujoco")``.)
 
 OUT.json maps a case name to a record: ``{"xml": ...}`` (the model's ``get_xml()``; for
 robots also ``"parts"``: each gripper's), or ``{"error": "<type>: <message>"}`` when
@@ -38,10 +40,10 @@ import mujoco  # noqa: E402
 # robosuite 1.5.2's environments run on MuJoCo 3.9.0 only (see
 # scripts/requirements-robosuite-env.txt): another MuJoCo here means a path shadowed it.
 assert mujoco.__version__ == "3.9.0", (mujoco.__version__, mujoco.__file__)
-if mode == "forge":
+if mode.startswith("forge"):
     import mjcf_forge.robosuite
 
-    mjcf_forge.robosuite.use()
+    mjcf_forge.robosuite.use(rules="mujoco" if mode == "forge-mujoco" else "robosuite")
 
 import numpy as np  # noqa: E402
 import robosuite  # noqa: E402
@@ -96,7 +98,7 @@ def case(name, build):
     np.random.seed(0)  # what robosuite draws from numpy's global generator
     try:
         out[name] = build()
-        if "parts" in out[name]:
+        if "parts" in out[name] and mode == "forge-mujoco":
             out[name]["parts_own"] = [own_values(x) for x in out[name]["parts"]]
     except Exception as e:  # noqa: BLE001 - written out and compared
         traceback.print_exc()

@@ -1,12 +1,15 @@
 """robosuite's own code on ours, across robosuite: every robot with its default base and
 grippers, every gripper, base, object class and arena, every environment with Panda (two
 for the two-arm ones) and Lift with every robot, built by robosuite_cover.py in the
-robosuite venv (robosuite 1.5.2, MuJoCo 3.9.0) with robosuite as it is and with
-``mjcf_forge.robosuite.use()``, and compared here: the errors, the models MuJoCo compiles
-from each (judge.compare_models), and the observations of each environment reset and
-stepped with the same actions.
+robosuite venv (robosuite 1.5.2, MuJoCo 3.9.0) with robosuite as it is, with
+``mjcf_forge.robosuite.use()`` (robosuite's rules, the default) and with
+``use(rules="mujoco")``, and compared here: the errors, the models MuJoCo compiles from
+each, and the observations of each environment reset and stepped with the same actions.
 
-Where the models differ, the difference is one of robosuite's named in
+With robosuite's rules every case is stock's: the same errors, models equal bit for bit
+(every array, names included), the same observations and rewards.
+
+With MuJoCo's rules, where the models differ, the difference is one of robosuite's named in
 docs/model-hierarchy.md ("Where we differ from robosuite"), checked here by its rule:
 
 - row 5, ``<compiler>`` applies to the whole model: robosuite drops a merged part's
@@ -104,8 +107,10 @@ def run_all(tmp: Path) -> dict:
     only = tmp / "path"
     only.mkdir()
     (only / "mjcf_forge").symlink_to(Path(mjcf_forge.__file__).resolve().parent)
-    env = dict(os.environ, PYTHONPATH=str(only))
-    out = {"robosuite": {}, "forge": {}}
+    # One string hash for all: robosuite's single-object environments pick their object
+    # through a set of names, so two processes agree only with the same PYTHONHASHSEED.
+    env = dict(os.environ, PYTHONPATH=str(only), PYTHONHASHSEED="0")
+    out = {"robosuite": {}, "forge": {}, "forge-mujoco": {}}
     for group in ("models", "envs"):
         runs = {}
         for mode in out:
@@ -137,8 +142,71 @@ def compiled(xml: str):
         return re.sub(r",? ?line \d+", "", str(e)).strip()
 
 
-def test_every_case_is_built_both_ways(covered):
+def bit_equal(a, b) -> list:
+    """The arrays, sizes and option, statistic and visual fields in which two compiled
+    models differ, compared byte for byte (names included)."""
+    out = []
+    for n in dir(a):
+        if n.startswith("_"):
+            continue
+        va, vb = getattr(a, n), getattr(b, n)
+        if isinstance(va, np.ndarray):
+            if va.shape != vb.shape or va.dtype != vb.dtype or va.tobytes() != vb.tobytes():
+                out.append(n)
+        elif isinstance(va, int) and va != vb:
+            out.append(n)
+    for group in ("opt", "stat", "vis"):
+        for n in dir(getattr(a, group)):
+            if n.startswith("_"):
+                continue
+            va, vb = getattr(getattr(a, group), n), getattr(getattr(b, group), n)
+            if isinstance(va, (int, float, np.ndarray)) and np.asarray(va).tobytes() != np.asarray(vb).tobytes():
+                out.append(f"{group}.{n}")
+    return out
+
+
+def test_with_robosuites_rules_every_case_fails_as_stock(covered):
     theirs, ours = covered["robosuite"], covered["forge"]
+    assert set(ours) == set(theirs)
+    assert {k: v.get("error") for k, v in ours.items()} == {k: v.get("error") for k, v in theirs.items()}
+    assert {k for k, v in ours.items() if "error" in v} == FAILS_BOTH_WAYS.keys()
+
+
+@pytest.fixture(scope="module")
+def stock_cases(covered):
+    return sorted(n for n in covered["robosuite"] if n not in FAILS_BOTH_WAYS)
+
+
+def test_with_robosuites_rules_every_model_is_stocks_bit_for_bit(covered, stock_cases):
+    theirs, ours = covered["robosuite"], covered["forge"]
+    refused = 0
+    for name in stock_cases:
+        a, b = compiled(theirs[name]["xml"]), compiled(ours[name]["xml"])
+        if isinstance(a, str):  # MuJoCo refuses stock's model: ours too, with its message
+            assert a == b and name in REFUSED_BOTH_WAYS, (name, a, b)
+            refused += 1
+            continue
+        assert isinstance(b, mujoco.MjModel), (name, b)
+        assert bit_equal(a, b) == [], name
+    assert refused == len(REFUSED_BOTH_WAYS)
+    # The robots with the Robotiq 85 gripper build as stock builds them.
+    assert REPEATED_MESH <= set(stock_cases)
+
+
+def test_with_robosuites_rules_every_environment_steps_as_stocks(covered):
+    theirs, ours = covered["robosuite"], covered["forge"]
+    stepped = 0
+    for name in theirs:
+        if name.split("/")[0] in ("env", "lift") and name not in FAILS_BOTH_WAYS:
+            assert len(ours[name]["obs"]) == len(theirs[name]["obs"]) > 1, name
+            assert ours[name]["obs"] == theirs[name]["obs"], name
+            assert ours[name]["reward"] == theirs[name]["reward"], name
+            stepped += 1
+    assert stepped == COUNTS["env"] + COUNTS["lift"] - len(FAILS_BOTH_WAYS)
+
+
+def test_every_case_is_built_both_ways(covered):
+    theirs, ours = covered["robosuite"], covered["forge-mujoco"]
     assert set(ours) == set(theirs)
     kinds = {}
     for name in ours:
@@ -190,7 +258,7 @@ CASES = {
 
 
 def test_the_listing_is_the_scripts(covered):
-    built = {n for n in covered["forge"] if n not in FAILS_BOTH_WAYS}
+    built = {n for n in covered["forge-mujoco"] if n not in FAILS_BOTH_WAYS}
     assert built == {f"{k}/{n}" for k, names in CASES.items() for n in names}
 
 
@@ -259,7 +327,7 @@ def moving(model, changed: set) -> set:
 
 @cases({"robot", "gripper", "base", "object", "arena", "env", "lift"})
 def test_robosuites_models_compile_as_robosuites_but_for_named_differences(covered, name):
-    theirs, ours = covered["robosuite"][name], covered["forge"][name]
+    theirs, ours = covered["robosuite"][name], covered["forge-mujoco"][name]
     if name in REPEATED_MESH and name.startswith("lift/"):
         assert isinstance(compiled(theirs["xml"]), mujoco.MjModel) and "error" in ours
         return  # row 6: robosuite's own make refused it on ours (the test above)
@@ -282,7 +350,7 @@ def test_robosuites_models_compile_as_robosuites_but_for_named_differences(cover
 
 @cases({"env", "lift"})
 def test_robosuites_environments_step_as_robosuites(covered, name):
-    theirs, ours = covered["robosuite"][name], covered["forge"][name]
+    theirs, ours = covered["robosuite"][name], covered["forge-mujoco"][name]
     if name in REPEATED_MESH:
         assert "error" in ours  # never made: row 6, see the model test
         return

@@ -1,0 +1,89 @@
+"""LIBERO's own tasks, unmodified, stock and on the switch (``mjcf_forge.robosuite.use()``,
+robosuite's rules): one task of each of LIBERO's five suites, built by libero_run.py in
+the LIBERO venv (.cache/venv-libero: LIBERO 0.1.1, robosuite 1.4.0, MuJoCo 3.3.1, the
+oldest MuJoCo the package supports), once each way, and compared here bit for bit:
+
+- the model the environment simulates (every array of the ``MjModel``, names included,
+  every size, option, statistic and visual field);
+- with LIBERO's first init state of the task (``set_init_state``) and the same 50 actions,
+  every observation (robot state, object states, agentview and wrist images at 128x128)
+  and LIBERO's success predicate after each step, and the simulator's state at the end;
+- after one more hard reset and ``set_init_state``, the observations after 5 steps.
+
+The other 125 tasks: scripts/libero_check.sh (results in docs/fidelity.md).
+"""
+from __future__ import annotations
+
+import os
+import subprocess
+from pathlib import Path
+
+import mjcf_forge
+import numpy as np
+import pytest
+
+from conftest import ROOT
+
+LIBERO_PY = ROOT / ".cache" / "venv-libero" / "bin" / "python"
+CONFIG = ROOT / ".cache" / "libero-config"
+SCRIPT = Path(__file__).with_name("libero_run.py")
+# One task of each suite; three with LIBERO's flat stove, whose part repeats an asset name
+# of the scene with other content (stock keeps the scene's: robosuite's asset rule).
+TASKS = ["libero_spatial:0", "libero_object:0", "libero_goal:1", "libero_10:2", "libero_90:20"]
+
+
+def run(mode: str, out: Path, tmp: Path) -> subprocess.Popen:
+    assert LIBERO_PY.exists(), f"{LIBERO_PY} missing: run scripts/setup_libero_env.sh"
+    only = tmp / "path"
+    only.mkdir(exist_ok=True)
+    if not (only / "mjcf_forge").exists():
+        (only / "mjcf_forge").symlink_to(Path(mjcf_forge.__file__).resolve().parent)
+    env = dict(os.environ, PYTHONPATH=str(only), PYTHONHASHSEED="0", LIBERO_CONFIG_PATH=str(CONFIG))
+    env.setdefault("MUJOCO_GL", "egl")
+    return subprocess.Popen(
+        [str(LIBERO_PY), str(SCRIPT), mode, str(out), *TASKS, "--cameras", "--steps", "50", "--resets", "1"],
+        cwd=tmp, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )
+
+
+@pytest.fixture(scope="module")
+def records(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("libero")
+    procs = {mode: run(mode, tmp / mode, tmp) for mode in ("stock", "switch")}
+    for mode, proc in procs.items():
+        out, err = proc.communicate(timeout=1800)
+        assert proc.returncode == 0, err[-3000:]
+        assert out.split() == [w for t in TASKS for w in (t, "ok")], (mode, out, err[-3000:])
+    return {
+        mode: {t: dict(np.load(tmp / mode / (t.replace(":", "-") + ".npz"))) for t in TASKS}
+        for mode in procs
+    }
+
+
+def differing(a: dict, b: dict, prefix: str) -> list:
+    keys = {k for k in a if k.startswith(prefix)} | {k for k in b if k.startswith(prefix)}
+    out = []
+    for k in sorted(keys):
+        x, y = a.get(k), b.get(k)
+        if x is None or y is None or x.shape != y.shape or x.dtype != y.dtype or x.tobytes() != y.tobytes():
+            out.append(k)
+    return out
+
+
+@pytest.mark.parametrize("task", TASKS)
+def test_a_libero_tasks_model_is_stocks_bit_for_bit(records, task):
+    stock, switch = records["stock"][task], records["switch"][task]
+    assert len([k for k in stock if k.startswith("model/")]) > 300
+    assert differing(stock, switch, "model/") == []
+
+
+@pytest.mark.parametrize("task", TASKS)
+def test_a_libero_task_observes_and_succeeds_as_stock(records, task):
+    stock, switch = records["stock"][task], records["switch"][task]
+    images = [k for k in stock if k.endswith("_image")]
+    assert sorted(images) == ["obs/agentview_image", "obs/robot0_eye_in_hand_image"]
+    assert stock["obs/agentview_image"].shape == (51, 128, 128, 3)
+    assert stock["obs/agentview_image"].std() > 10  # a scene, not a blank frame
+    assert len(stock["success"]) == 50
+    for prefix in ("obs/", "success", "state", "again/"):
+        assert differing(stock, switch, prefix) == [], prefix
