@@ -2,7 +2,9 @@
 mjcf_forge.base (``mjcf_forge.robosuite.use()``): run by test_robosuite_use.py in the
 robosuite venv (.cache/venv-robosuite-env, scripts/setup_robosuite_env.sh), once each way.
 
-    python robosuite_build.py {robosuite|forge} OUT.json
+    python robosuite_build.py {robosuite|forge|forge-mujoco} OUT.json
+
+(``forge``: ``use()``, robosuite's rules; ``forge-mujoco``: ``use(rules="mujoco")``.)
 
 OUT.json maps a case name to its XML (``get_xml()``), or to "ERROR <type>: <message>".
 With ``--env`` it also makes robosuite's Lift environment and steps it (case "lift_env":
@@ -20,10 +22,10 @@ import mujoco  # noqa: E402
 # robosuite 1.5.2's environments run on MuJoCo 3.9.0 only (see
 # scripts/requirements-robosuite-env.txt): another MuJoCo here means a path shadowed it.
 assert mujoco.__version__ == "3.9.0", (mujoco.__version__, mujoco.__file__)
-if mode == "forge":
+if mode.startswith("forge"):
     import mjcf_forge.robosuite
 
-    mjcf_forge.robosuite.use()
+    mjcf_forge.robosuite.use(rules="mujoco" if mode == "forge-mujoco" else "robosuite")
 
 import numpy as np  # noqa: E402
 import robosuite  # noqa: E402,F401

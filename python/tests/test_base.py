@@ -749,3 +749,63 @@ def test_merge_converts_a_part_that_refers_to_materials_it_gets_later(tmp_path):
     merged = scene.get_model()
     assert merged.body("arm").mass == alone.body("arm").mass  # both geoms count, as alone
     assert np.array_equal(merged.body("arm").inertia, alone.body("arm").inertia)
+
+
+# --------------------------------------------------------------------------------------
+# The rules: MuJoCo's (the default of mjcf_forge.base) or robosuite's (the switch's)
+# --------------------------------------------------------------------------------------
+
+
+@pytest.fixture
+def robosuite_rules():
+    previous = base.set_rules("robosuite")
+    yield
+    base.set_rules(previous)
+
+
+def merged_rules_case():
+    world = MujocoXML(str(CASES / "rules_base.xml"))
+    world.merge(MujocoXML(str(CASES / "rules_part.xml")))
+    return world
+
+
+def test_mujocos_rules_keep_the_parts_physics_and_refuse_a_clashing_asset():
+    assert base.rules() == "mujoco"
+    world = MujocoXML(str(CASES / "rules_base.xml"))
+    with pytest.raises(XMLError, match="asset <texture> 'tex' differs from the base's"):
+        world.merge(MujocoXML(str(CASES / "rules_part.xml")))
+
+
+def test_robosuites_rules_build_what_robosuite_builds(robosuite_rules):
+    model = merged_rules_case().get_model()
+    alone = mujoco.MjModel.from_xml_path(str(CASES / "rules_part.xml"))
+    # The part's <compiler> (none: degrees) is dropped: its range is read as radians.
+    assert model.joint("hinge").range.tolist() == [0.0, 90.0]
+    assert alone.joint("hinge").range.tolist() == pytest.approx([0.0, np.pi / 2])
+    # The main class's density is dropped with the <default>: MuJoCo's 1000.
+    assert model.body("door").mass[0] == pytest.approx(1000 * 0.2**3 + 1000 * 4 / 3 * np.pi * 0.02**3)
+    assert alone.body("door").mass[0] == pytest.approx(500 * 0.2**3 + 500 * 4 / 3 * np.pi * 0.02**3)
+    # The top-level class is inlined with its own attributes.
+    assert model.geom("knob").group == 1 and model.geom("knob").rgba.tolist() == [0, 0, 1, 1]
+    # The base's texture is kept, and the part's material takes it.
+    assert model.ntex == 1 and model.tex_width[0] == 8
+    assert model.mat_texid[model.material("mat").id].max() == 0
+    red = model.tex_data[: 3].tolist()
+    assert red == [255, 0, 0]
+
+
+def test_robosuites_rules_name_a_class_robosuite_cannot_inline(robosuite_rules):
+    with pytest.raises(XMLError) as e:
+        MujocoXML(str(CASES / "defaults.xml"))
+    assert "<geom name='g1'> has class 'finger', which is not a class directly under the first <default>" in str(e.value)
+    assert str(CASES / "defaults.xml") in str(e.value)
+
+
+def test_robosuites_rules_leave_names_that_begin_with_the_prefix(robosuite_rules):
+    class Part(MujocoXMLModel):
+        contact_geom_rgba = None
+
+    part = Part(str(CASES / "names_with_the_prefix.xml"), idn="b")
+    names = sorted(e.get("name") for e in part.root.iter() if e.get("name"))
+    # robosuite's add_prefix leaves "b_x" and "b_g"; MuJoCo's rules would write "b_b_x".
+    assert names == ["b_g", "b_g", "b_j", "b_x", "b_x"]

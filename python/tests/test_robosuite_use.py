@@ -35,7 +35,9 @@ def clean_imports(monkeypatch):
     """sys.meta_path and robosuite's modules as they were, after the test."""
     monkeypatch.setattr(sys, "meta_path", list(sys.meta_path))
     before = set(sys.modules)
+    rules = base.rules()
     yield
+    base.set_rules(rules)
     for name in set(sys.modules) - before:
         if name.split(".")[0] in ("robosuite", "PIL", "termcolor"):
             del sys.modules[name]
@@ -44,9 +46,14 @@ def clean_imports(monkeypatch):
 def test_use_rebinds_robosuites_base_classes_and_et(clean_imports):
     assert not forge_robosuite.in_use()
     stub_robosuite()
+    assert base.rules() == "mujoco"  # mjcf_forge.base on its own: MuJoCo's rules
     forge_robosuite.use()
-    forge_robosuite.use()  # once is enough; again does nothing
+    assert base.rules() == "robosuite"  # the switch: stock robosuite's models
+    forge_robosuite.use(rules="mujoco")  # again: only the rules change
     assert forge_robosuite.in_use() and sys.meta_path.count(forge_robosuite._FINDER) == 1
+    assert base.rules() == "mujoco"
+    with pytest.raises(ValueError, match="rules are 'mujoco' or 'robosuite', not 'exact'"):
+        forge_robosuite.use(rules="exact")
     import robosuite.models.base as rs_base
     import robosuite.utils.mjcf_utils as rs_utils
     from robosuite.models.world import MujocoWorldBase
@@ -98,7 +105,7 @@ def built(tmp_path_factory):
     (only / "mjcf_forge").symlink_to(Path(mjcf_forge.__file__).resolve().parent)
     env = dict(os.environ, PYTHONPATH=str(only))
     out = {}
-    for mode in ("robosuite", "forge"):
+    for mode in ("robosuite", "forge", "forge-mujoco"):
         path = tmp / f"{mode}.json"
         run = subprocess.run(
             [str(RS_ENV), str(Path(__file__).with_name("robosuite_build.py")), mode, str(path), "--env"],
@@ -110,12 +117,24 @@ def built(tmp_path_factory):
 
 
 def test_robosuite_builds_every_case_on_ours(built):
-    theirs, ours = built["robosuite"], built["forge"]
+    theirs, ours = built["robosuite"], built["forge-mujoco"]
     assert set(ours) == set(theirs) and len(ours) >= 16
     assert [k for k, v in ours.items() if v.startswith("ERROR")] == []
     assert [k for k, v in theirs.items() if v.startswith("ERROR")] == []
     # robosuite's Lift environment makes, resets and steps on ours.
     assert json.loads(ours["lift_env"]) == json.loads(theirs["lift_env"]) == {"nbody": 26, "steps": 10}
+
+
+def test_with_robosuites_rules_every_case_compiles_to_stocks_model(built):
+    theirs, ours = built["robosuite"], built["forge"]
+    assert set(ours) == set(theirs)
+    for name, text in theirs.items():
+        if name == "lift_env":
+            assert json.loads(ours[name]) == json.loads(text)
+            continue
+        a, b = mujoco.MjModel.from_xml_string(text), mujoco.MjModel.from_xml_string(ours[name])
+        assert judge.compare_models(a, b) == [], name
+        assert a.names == b.names and a.body_mass.tobytes() == b.body_mass.tobytes(), name
 
 
 @pytest.mark.parametrize("name", [
@@ -125,14 +144,14 @@ def test_robosuite_builds_every_case_on_ours(built):
 ])
 def test_robosuites_models_compile_the_same_on_ours(built, name):
     theirs = mujoco.MjModel.from_xml_string(built["robosuite"][name])
-    ours = mujoco.MjModel.from_xml_string(built["forge"][name])
+    ours = mujoco.MjModel.from_xml_string(built["forge-mujoco"][name])
     assert judge.compare_models(theirs, ours) == []
 
 
 def test_the_lift_task_differs_only_by_the_arenas_own_inertias(built):
     theirs = mujoco.MjModel.from_xml_string(built["robosuite"]["lift_task"])
-    ours = mujoco.MjModel.from_xml_string(built["forge"]["lift_task"])
-    arena = mujoco.MjModel.from_xml_string(built["forge"]["lift_task_arena"])
+    ours = mujoco.MjModel.from_xml_string(built["forge-mujoco"]["lift_task"])
+    arena = mujoco.MjModel.from_xml_string(built["forge-mujoco"]["lift_task_arena"])
     diffs = judge.compare_models(theirs, ours)
     assert diffs and {d.split("[")[0].split(":")[0] for d in diffs} <= INERTIA_ARRAYS, diffs
     assert theirs.nbody == ours.nbody and theirs.ngeom == ours.ngeom

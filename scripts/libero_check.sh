@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# LIBERO's 130 tasks stock and on the switch, compared bit for bit (what
+# python/tests/test_libero.py checks on five of them in CI). Results: docs/fidelity.md.
+#
+#   bash scripts/libero_check.sh [--model-only] [SUITE:INDEX ...]
+#
+# Without tasks: every task of libero_spatial, libero_object, libero_goal, libero_10 and
+# libero_90. Each way runs in its own process (two at once); each task's record is
+# .cache/libero-check/{stock,switch}/<suite>-<index>.npz (python/tests/libero_run.py), and
+# the last line says how many tasks were built, how many have equal models, and how many
+# equal observations (50 steps with cameras, unless --model-only).
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+ROOT="$(pwd)"
+bash scripts/setup.sh >/dev/null
+bash scripts/setup_libero_env.sh >/dev/null
+PY="$ROOT/.cache/venv-libero/bin/python"
+OUT="$ROOT/.cache/libero-check"
+only="$OUT/path"
+mkdir -p "$only"
+ln -sfn "$("$ROOT/.cache/venv/bin/python" -c 'import mjcf_forge, os; print(os.path.dirname(mjcf_forge.__file__))')" "$only/mjcf_forge"
+flags=(--cameras --steps 50 --resets 0)
+if [[ "${1:-}" == "--model-only" ]]; then
+  flags=(--model-only)
+  shift
+fi
+tasks=("$@")
+if [[ ${#tasks[@]} -eq 0 ]]; then
+  read -r -a tasks <<<"$(LIBERO_CONFIG_PATH="$ROOT/.cache/libero-config" "$PY" - <<'PY'
+import importlib.util, os
+from libero.libero import get_libero_path
+path = os.path.join(os.path.dirname(get_libero_path("bddl_files")), "benchmark", "libero_suite_task_map.py")
+spec = importlib.util.spec_from_file_location("m", path)
+m = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(m)
+print(" ".join(f"{s}:{i}" for s, tasks in m.libero_task_map.items() for i in range(len(tasks))))
+PY
+)"
+fi
+rm -rf "$OUT/stock" "$OUT/switch"
+for mode in stock switch; do
+  PYTHONPATH="$only" PYTHONHASHSEED=0 LIBERO_CONFIG_PATH="$ROOT/.cache/libero-config" MUJOCO_GL="${MUJOCO_GL:-egl}" \
+    "$PY" python/tests/libero_run.py "$mode" "$OUT/$mode" "${tasks[@]}" "${flags[@]}" >"$OUT/$mode.log" 2>&1 &
+done
+wait
+"$ROOT/.cache/venv/bin/python" - "$OUT" <<'PY'
+import glob, os, sys
+import numpy as np
+out = sys.argv[1]
+built = models = observed = 0
+for path in sorted(glob.glob(f"{out}/stock/*.npz")):
+    a = dict(np.load(path))
+    b = dict(np.load(path.replace("/stock/", "/switch/")))
+    name = os.path.basename(path)[:-4]
+    if "error" in a or "error" in b:
+        print(name, "error:", a.get("error"), b.get("error"))
+        continue
+    built += 1
+    def same(prefix):
+        keys = {k for k in a if k.startswith(prefix)} | {k for k in b if k.startswith(prefix)}
+        return [k for k in sorted(keys) if k not in a or k not in b or a[k].dtype != b[k].dtype
+                or a[k].shape != b[k].shape or a[k].tobytes() != b[k].tobytes()]
+    bad = same("model/")
+    models += not bad
+    obs = [k for p in ("obs/", "success", "state") for k in same(p)]
+    observed += not obs and any(k.startswith("obs/") for k in a)
+    if bad or obs:
+        print(name, "differs:", (bad + obs)[:10])
+n = len(glob.glob(f"{out}/stock/*.npz"))
+print(f"libero_check: {n} tasks, {built} built both ways, {models} models bit-equal, {observed} with every observation bit-equal")
+PY
