@@ -10,7 +10,7 @@ With robosuite's rules every case is stock's: the same errors, models equal bit 
 (every array, names included), the same observations and rewards.
 
 With MuJoCo's rules, where the models differ, the difference is one of robosuite's named in
-docs/model-hierarchy.md ("Where we differ from robosuite"), checked here by its rule:
+docs/model-hierarchy.md ("Where MuJoCo's rules differ from robosuite's"), checked here by its rule:
 
 - row 5, ``<compiler>`` applies to the whole model: robosuite drops a merged part's
   compiler. Its world (``base.xml``) has ``inertiagrouprange="0 0"``, its arenas and

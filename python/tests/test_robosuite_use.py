@@ -81,7 +81,7 @@ def test_use_refuses_to_come_after_robosuite(monkeypatch, clean_imports):
 # Bodies of robosuite's table arena that robosuite's world (base.xml, inertiagrouprange
 # "0 0") makes lighter than the arena compiles alone ("0 5"): the table's visual geoms and
 # the mocap targets' geoms (group 2) count alone. Ours keep their masses (docs: row 5 of
-# "Where we differ from robosuite").
+# "Where MuJoCo's rules differ from robosuite's").
 ARENA_BODIES = {"table", "left_eef_target", "right_eef_target"}
 # What a body's mass and inertia change in the compiled model.
 INERTIA_ARRAYS = {

@@ -1,0 +1,101 @@
+"""LIBERO's environment creation and hard reset, stock against the switch
+(``mjcf_forge.robosuite.use()``), same run: processes alternate between the two, and each
+figure is the median over its runs. Results: docs/speed.md.
+
+    bash scripts/setup_libero_env.sh
+    .cache/venv/bin/python scripts/bench_libero.py [--tasks SUITE:INDEX ...] [--resets N]
+        [--rounds N] [--cameras]
+
+Each process makes one task's environment (LIBERO's ``OffScreenRenderEnv``, with the
+agentview and wrist cameras at 128x128 when ``--cameras``) and hard-resets it ``--resets``
+times (``env.reset()``, every LIBERO reset is a hard one); ``--rounds`` processes each way
+per task, alternating.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+LIBERO_PY = ROOT / ".cache" / "venv-libero" / "bin" / "python"
+
+CHILD = r"""
+import json, os, sys, time
+mode, task, resets, cameras = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4] == "1"
+if mode == "switch":
+    import mjcf_forge.robosuite
+    mjcf_forge.robosuite.use()
+import importlib.util
+from libero.libero import get_libero_path
+from libero.libero.envs import OffScreenRenderEnv
+suite, _, index = task.partition(":")
+path = os.path.join(os.path.dirname(get_libero_path("bddl_files")), "benchmark", "libero_suite_task_map.py")
+spec = importlib.util.spec_from_file_location("m", path)
+m = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(m)
+name = m.libero_task_map[suite][int(index)]
+bddl = os.path.join(get_libero_path("bddl_files"), suite, name + ".bddl")
+t = time.perf_counter()
+env = OffScreenRenderEnv(bddl_file_name=bddl, camera_heights=128, camera_widths=128,
+                         has_offscreen_renderer=cameras, use_camera_obs=cameras)
+env.seed(0)
+env.reset()
+make = time.perf_counter() - t
+times = []
+for _ in range(resets):
+    t = time.perf_counter()
+    env.reset()
+    times.append(time.perf_counter() - t)
+print(json.dumps({"make": make, "resets": times}))
+"""
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--tasks", nargs="+", default=["libero_spatial:0", "libero_object:0", "libero_goal:1",
+                                                   "libero_10:2", "libero_90:20"])
+    ap.add_argument("--resets", type=int, default=10)
+    ap.add_argument("--rounds", type=int, default=2)
+    ap.add_argument("--cameras", action="store_true")
+    args = ap.parse_args()
+    only = ROOT / ".cache" / "bench-libero-path"
+    only.mkdir(parents=True, exist_ok=True)
+    import mjcf_forge
+
+    link = only / "mjcf_forge"
+    if link.is_symlink() or link.exists():
+        link.unlink()
+    link.symlink_to(Path(mjcf_forge.__file__).resolve().parent)
+    env = dict(os.environ, PYTHONPATH=str(only), PYTHONHASHSEED="0",
+               LIBERO_CONFIG_PATH=str(ROOT / ".cache" / "libero-config"))
+    env.setdefault("MUJOCO_GL", "egl")
+    print(f"LIBERO hard reset, {'with' if args.cameras else 'without'} cameras; "
+          f"{args.rounds} processes each way per task, {args.resets} resets each; medians")
+    print("| task | make: stock s | switch s | x | reset: stock ms | switch ms | x |")
+    print("| --- | --- | --- | --- | --- | --- | --- |")
+    for task in args.tasks:
+        runs: dict[str, dict[str, list]] = {"stock": {"make": [], "resets": []}, "switch": {"make": [], "resets": []}}
+        for _ in range(args.rounds):
+            for mode in ("stock", "switch"):
+                out = subprocess.run(
+                    [str(LIBERO_PY), "-c", CHILD, mode, task, str(args.resets), "1" if args.cameras else "0"],
+                    env=env, capture_output=True, text=True, cwd=only, check=False,
+                )
+                if out.returncode != 0:
+                    sys.exit(out.stderr[-3000:])
+                record = json.loads(out.stdout.strip().splitlines()[-1])
+                runs[mode]["make"].append(record["make"])
+                runs[mode]["resets"].extend(record["resets"])
+        med = {m: {k: statistics.median(v) for k, v in r.items()} for m, r in runs.items()}
+        s, w = med["stock"], med["switch"]
+        print(f"| {task} | {s['make']:.2f} | {w['make']:.2f} | {s['make'] / w['make']:.1f} "
+              f"| {s['resets'] * 1e3:.0f} | {w['resets'] * 1e3:.0f} | {s['resets'] / w['resets']:.1f} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
