@@ -141,6 +141,13 @@ class _Plan:
         self.points = (data.xpos[1:], data.xipos[1:], data.xanchor, data.site_xpos)
         self.geom_xpos, self.xipos, self.xanchor = data.geom_xpos, data.xipos, data.xanchor
         self.body_mass = model.body_mass[1:]
+        # A body its geoms give no mass has its inertial frame where MuJoCo puts a massless
+        # body's (not a function of its geoms alone: a little model at the origin has
+        # another): the frames as compiled, kept while the body's own frame is (below).
+        self.massless0 = {
+            b: (model.body_pos[b].copy(), model.body_quat[b].copy(), model.body_ipos[b].copy(), model.body_iquat[b].copy(), int(model.body_sameframe[b]))
+            for b in np.flatnonzero((model.body_mass == 0) & ~model.body_inertia.any(axis=1))
+        }
         # The mass matrix's diagonal: the last of each row of data.M where MuJoCo has
         # it (3.9 does), else data.qM at dof_Madr (3.3: the same numbers).
         if hasattr(data, "M"):
@@ -322,10 +329,17 @@ class _Plan:
         mfirst = int(mini.body_geomadr[1]) if mini.nbody == 2 else -1
         bvh, nbvh = int(model.body_bvhadr[body]), int(model.body_bvhnum[body])
         mbvh = int(mini.body_bvhadr[1]) if mini.nbody == 2 else -1
+        kept = self.massless0.get(body)
+        if kept is not None and mini.nbody == 2 and (mini.body_mass[1] != 0 or mini.body_inertia[1].any()):
+            kept = None  # it has a mass now: its geoms place its inertial frame
+        if kept is not None and not (
+            np.array_equal(model.body_pos[body], kept[0]) and np.array_equal(model.body_quat[body], kept[1])
+        ):
+            raise _error(f"body '{model.body(body).name}' has no mass and another frame: not a patch of it")
         if (
             mini.nbody != 2
             or int(mini.body_geomnum[1]) != n
-            or int(mini.body_sameframe[1]) != int(model.body_sameframe[body])
+            or (kept is None and int(mini.body_sameframe[1]) != int(model.body_sameframe[body]))
             or int(mini.body_bvhnum[1]) != nbvh
             or not np.array_equal(mini.geom_type[mfirst : mfirst + n], model.geom_type[first : first + n])
             or not np.array_equal(mini.geom_sameframe[mfirst : mfirst + n], model.geom_sameframe[first : first + n])
@@ -343,6 +357,9 @@ class _Plan:
             getattr(model, field)[geoms] = getattr(mini, field)[mgeoms]
         for field in ("body_mass", "body_inertia", "body_ipos", "body_iquat"):
             getattr(model, field)[body] = getattr(mini, field)[1]
+        if kept is not None:
+            model.body_ipos[body], model.body_iquat[body] = kept[2], kept[3]
+            model.body_sameframe[body] = kept[4]
         model.bvh_aabb[bvh : bvh + nbvh] = mini.bvh_aabb[mbvh : mbvh + nbvh]
         # The bounding radii the statistics take (primitives: rbound > 0).
         rbound = mini.geom_rbound[mgeoms]
