@@ -6,8 +6,9 @@ figure is the median over its runs. Results: docs/speed.md.
     .cache/venv/bin/python scripts/bench_libero.py [--tasks SUITE:INDEX ...] [--resets N]
         [--rounds N] [--cameras]
 
-Each process makes one task's environment (LIBERO's ``OffScreenRenderEnv``, with the
-agentview and wrist cameras at 128x128 when ``--cameras``) and hard-resets it ``--resets``
+Each process makes one task's environment (LIBERO's ``OffScreenRenderEnv``, which always
+makes the offscreen render context; with the agentview and wrist camera observations at
+128x128 when ``--cameras``) and hard-resets it ``--resets``
 times (``env.reset()``, every LIBERO reset is a hard one); ``--rounds`` processes each way
 per task, alternating.
 """
