@@ -8,7 +8,8 @@
 # libero_90. Each way runs in its own process (two at once); each task's record is
 # .cache/libero-check/{stock,switch}/<suite>-<index>.npz (python/tests/libero_run.py), and
 # the last line says how many tasks were built, how many have equal models, and how many
-# equal observations (50 steps with cameras, unless --model-only).
+# equal observations (50 steps with cameras, then a hard reset and 5 steps, unless
+# --model-only). Model arrays are recorded as digests (--digest).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 ROOT="$(pwd)"
@@ -19,9 +20,9 @@ OUT="$ROOT/.cache/libero-check"
 only="$OUT/path"
 mkdir -p "$only"
 ln -sfn "$("$ROOT/.cache/venv/bin/python" -c 'import mjcf_forge, os; print(os.path.dirname(mjcf_forge.__file__))')" "$only/mjcf_forge"
-flags=(--cameras --steps 50 --resets 0)
+flags=(--digest --cameras --steps 50 --resets 1)
 if [[ "${1:-}" == "--model-only" ]]; then
-  flags=(--model-only)
+  flags=(--digest --model-only)
   shift
 fi
 tasks=("$@")
@@ -47,7 +48,7 @@ wait
 import glob, os, sys
 import numpy as np
 out = sys.argv[1]
-built = models = observed = 0
+built = models = observed = kept = 0
 for path in sorted(glob.glob(f"{out}/stock/*.npz")):
     a = dict(np.load(path))
     b = dict(np.load(path.replace("/stock/", "/switch/")))
@@ -56,16 +57,18 @@ for path in sorted(glob.glob(f"{out}/stock/*.npz")):
         print(name, "error:", a.get("error"), b.get("error"))
         continue
     built += 1
+    kept += int(b.get("kept", 0))
     def same(prefix):
         keys = {k for k in a if k.startswith(prefix)} | {k for k in b if k.startswith(prefix)}
         return [k for k in sorted(keys) if k not in a or k not in b or a[k].dtype != b[k].dtype
                 or a[k].shape != b[k].shape or a[k].tobytes() != b[k].tobytes()]
     bad = same("model/")
     models += not bad
-    obs = [k for p in ("obs/", "success", "state") for k in same(p)]
+    obs = [k for p in ("obs/", "success", "state", "reset/", "again/") for k in same(p)]
     observed += not obs and any(k.startswith("obs/") for k in a)
     if bad or obs:
         print(name, "differs:", (bad + obs)[:10])
 n = len(glob.glob(f"{out}/stock/*.npz"))
-print(f"libero_check: {n} tasks, {built} built both ways, {models} models bit-equal, {observed} with every observation bit-equal")
+print(f"libero_check: {n} tasks, {built} built both ways, {models} models bit-equal, "
+      f"{observed} with every observation bit-equal, {kept} hard resets on the switch kept the simulation")
 PY

@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # The batched simulators' venv, .cache/venv-sim, for python/tests/test_batch_sim.py: the
 # packages pinned in scripts/requirements-sim.txt (MuJoCo 4.0.0, MuJoCo Warp 4.0.0, Warp
-# 1.19.0, MJX and JAX on CPU), and mjcf_forge built from this checkout into it (maturin
-# develop --release). Idempotent: the install reruns only when the requirements change,
-# the build when maturin finds the sources changed. Needs python3.11 (or PYTHON) and PyPI.
+# 1.19.0, MJX and JAX on CPU), and mjcf_forge from the wheel scripts/setup.sh built (run
+# it first). Idempotent: the install reruns only when the requirements or the wheel
+# change. Needs python3.11 (or PYTHON) and PyPI.
 # Warp's compiled kernels go to .cache/warp-kernels (the tests set WARP_CACHE_PATH), so
 # only the first run pays their compile (about a minute on CPU).
 set -euo pipefail
@@ -34,5 +34,19 @@ else
   echo "$req_sha" > "$stamp"
 fi
 mkdir -p "$ROOT/.cache/warp-kernels"
-echo "setup_sim_env: building mjcf_forge into $VENV"
-VIRTUAL_ENV="$VENV" PATH="$VENV/bin:$PATH" "$VENV/bin/maturin" develop --release
+# The package: the wheel scripts/setup.sh built (abi3, so any CPython 3 takes it), installed
+# again only when it changed; no second release build of the bindings.
+wheel="$(ls "$ROOT"/.cache/mjcf-forge-wheel/mjcf_forge-*.whl 2>/dev/null | head -n1 || true)"
+if [[ -z "$wheel" ]]; then
+  echo "setup_sim_env: no wheel in .cache/mjcf-forge-wheel: run scripts/setup.sh first" >&2
+  exit 1
+fi
+wheel_sha="$(sha256sum "$wheel" | cut -d' ' -f1)"
+wstamp="$VENV/.mjcf_forge-wheel.sha256"
+if [[ -f "$wstamp" && "$(cat "$wstamp")" == "$wheel_sha" ]] && "$PY" -c "import mjcf_forge" 2>/dev/null; then
+  echo "setup_sim_env: mjcf_forge up to date"
+else
+  echo "setup_sim_env: installing $(basename "$wheel") into $VENV"
+  "$PY" -m pip install --quiet --disable-pip-version-check --no-deps --force-reinstall "$wheel"
+  echo "$wheel_sha" > "$wstamp"
+fi

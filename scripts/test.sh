@@ -4,8 +4,9 @@
 # MuJoCo version the feature links (3.17.0 from .cache/venv, as .cargo/config.toml sets
 # MJCF_FORGE_PYTHON, and 4.0.0 from .cache/venv-mj4 through MJCF_FORGE_MUJOCO_DIR; real
 # MuJoCo 3.17.0 and 4.0.0 judge every output in each run), the judge's own tests under both
-# versions, the Python package's tests (setup has built and installed it into .cache/venv)
-# and a short run of each fuzz target. Sets up first (idempotent).
+# versions, the Python package's tests (setup has built and installed it into .cache/venv).
+# Fuzzing is not part of it (tests/fuzz_regressions.rs replays what it found; campaigns:
+# scripts/fuzz.sh). Sets up first (idempotent).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
@@ -50,5 +51,3 @@ echo "== ModelCache and DocumentCache under MuJoCo 4.0.0 (patched models judged 
 .cache/venv-mj4/bin/python -m pytest python/tests/test_robosuite_resets.py -k task_xmls -q -p no:cacheprovider
 echo "== batched simulators (MuJoCo Warp, MJX on JAX's CPU backend, CPU MuJoCo) judge WorldBatch"
 .cache/venv-sim/bin/python -m pytest python/tests/test_batch_sim.py -q -p no:cacheprovider
-echo "== fuzz smoke run (5 s per target; long campaigns: bash scripts/fuzz.sh SECONDS)"
-bash scripts/fuzz.sh 5

@@ -22,7 +22,7 @@ import numpy as np
 
 from ._cache import _copy, _evict
 from ._errors import _error
-from ._mjcf_forge import Document
+from ._mjcf_forge import Document, MjcfError
 from ._plan import _Plan
 
 # The sizes that count rows of mesh, texture, height field, skin and bounding-volume data:
@@ -248,13 +248,43 @@ class DocumentCache:
     def _nbytes(self) -> int:
         return sum(s.nbytes for s in self._entries.values())
 
-    def model(self, source: Any, base_dir: Any = None) -> Any:
+    def model(self, source: Any, base_dir: Any = None, *, into: Any = None) -> Any:
         """The ``mujoco.MjModel`` MuJoCo compiles from ``source`` (a :class:`Document`,
-        MJCF text read from ``base_dir``, or a path); see the class."""
+        MJCF text read from ``base_dir``, or a path); see the class.
+
+        ``into``: a model this cache gave you that you still hold and no longer need as
+        it is (a simulation about to be made again). When ``source`` has its structure
+        and the cache still keeps it, ``into`` itself is patched and returned; otherwise
+        the call is as without ``into`` (``result is into`` says which).
+
+        >>> import mjcf_forge
+        >>> cache = mjcf_forge.DocumentCache()
+        >>> xml = "<mujoco><worldbody><geom name='g' size='.1' rgba='{}'/></worldbody></mujoco>"
+        >>> held = cache.model(xml.format("1 0 0 1"))
+        >>> cache.model(xml.format("0 0 1 1"), into=held) is held, held.geom("g").rgba.tolist()
+        (True, [0.0, 0.0, 1.0, 1.0])
+        """
         doc = _document(source, base_dir)
         key, numbers, materials, fixed, bodies = doc._split()
         values = np.frombuffer(numbers, dtype="<f8")
         me = threading.get_ident()
+        if into is not None:
+            with self._lock:
+                structure = self._entries.get(key)
+                working = None
+                if structure is not None:
+                    working = next((w for w in structure.workings() if w.model is into), None)
+                    if working is not None:
+                        self._entries.move_to_end(key)
+            if working is not None:
+                try:
+                    working.patch(values, materials, bodies)
+                except MjcfError:
+                    # Not a patch of the structure after all (see below): compiled.
+                    return self._compile(doc, key, fixed, replace=True)
+                with self._lock:
+                    self.patches += 1
+                return into
         while True:
             with self._lock:
                 structure = self._entries.get(key)
@@ -275,7 +305,7 @@ class DocumentCache:
             working = self._adopt(structure, me, other)
         try:
             working.patch(values, materials, bodies)
-        except Exception:
+        except MjcfError:
             # A value the model cannot take (a material that does not exist): MuJoCo's
             # own verdict. The model is whole again after its next patch, which writes
             # every entry of the structure.

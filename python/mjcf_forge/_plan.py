@@ -320,7 +320,10 @@ class _Plan:
         then compiled)."""
         mini = self.body_models.get(xml)
         if mini is None:
-            mini = self.mujoco.MjModel.from_xml_string(xml)
+            try:
+                mini = self.mujoco.MjModel.from_xml_string(xml)
+            except ValueError as e:
+                raise _error(f"body '{self.model.body(body).name}': its geoms alone: {e}") from None
             if len(self.body_models) >= 64:
                 del self.body_models[next(iter(self.body_models))]
             self.body_models[xml] = mini
@@ -394,7 +397,9 @@ class _Plan:
             self.qpos[:] = self.qpos0
             mujoco.mj_kinematics(model, data)
             mujoco.mj_comPos(model, data)
-        mujoco.mj_makeM(model, data)
+        # The joint-space inertia: mj_makeM where this MuJoCo has it, else mj_crb (3.3.1),
+        # which fills qM the same way.
+        (getattr(mujoco, "mj_makeM", None) or mujoco.mj_crb)(model, data)
         lo = np.full(3, 1e10)
         hi = np.full(3, -1e10)
         points = np.concatenate(

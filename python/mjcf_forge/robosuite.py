@@ -26,6 +26,13 @@ modules has run:
   the cache has not seen, and otherwise patches that structure's model, a model no
   earlier simulation still holds, with every array written back as compiled first (so
   ``DomainRandomizationWrapper``'s changes do not outlive the reset);
+- ``MjSim.free`` keeps the simulation a hard reset frees, and the next
+  ``from_xml_string`` of its thread makes it the new one when the XML has its structure:
+  its own model patched in place, its data reset, its render context kept with what it
+  uploaded (when the patched model gives a new context the same inputs), and
+  ``MujocoEnv.reset`` then leaves robosuite's observables their sensors instead of
+  making them again (:mod:`mjcf_forge._sims`; docs/compiled.md says why each kept
+  thing gives stock's result);
 - ``RobotModel.mujoco_model``, the robot compiled alone at every load
   (``set_mujoco_model()``), which robosuite never reads, is compiled on first read, from
   the robot as it was when ``set_mujoco_model()`` was called.
@@ -48,6 +55,7 @@ import xml.etree.ElementTree as _XET
 from typing import Any, Optional
 
 from . import base as _base
+from . import _sims
 from . import etree as _etree
 
 __all__ = ["use", "in_use"]
@@ -65,24 +73,12 @@ def _adapt(module: Any) -> None:
         module.MujocoModel = _base.MujocoModel
         module.MujocoXMLModel = _base.MujocoXMLModel
     elif module.__name__ == "robosuite.utils.binding_utils":
-        _cache_simulations(module.MjSim)
+        _sims.keep_simulations(module.MjSim)
+        _sims.keep_render_inputs(module.MjRenderContext)
+    elif module.__name__ == "robosuite.environments.base":
+        _sims.keep_observables(module.MujocoEnv)
     elif module.__name__ == "robosuite.models.robots.robot_model":
         _lazy_robot_model(module.RobotModel)
-
-
-def _cache_simulations(sim_class: Any) -> None:
-    """``MjSim.from_xml_string`` through the process's model cache (when it is on)."""
-    compile_sim = sim_class.__dict__["from_xml_string"].__func__
-
-    def from_xml_string(cls: Any, xml: str) -> Any:
-        cache = _base.model_cache()
-        if cache is None:
-            return compile_sim(cls, xml)
-        return cls(cache.model(xml))
-
-    from_xml_string.__doc__ = compile_sim.__doc__
-    from_xml_string.__wrapped__ = compile_sim  # type: ignore[attr-defined]
-    sim_class.from_xml_string = classmethod(from_xml_string)
 
 
 class _Pending:

@@ -4,7 +4,7 @@ test_libero.py and scripts/bench_libero.py in the LIBERO venv (.cache/venv-liber
 LIBERO 0.1.1, robosuite 1.4.0, MuJoCo 3.3.1; scripts/setup_libero_env.sh).
 
     python libero_run.py {stock|switch} OUT_DIR SUITE:INDEX [SUITE:INDEX ...]
-        [--steps N] [--resets N] [--cameras] [--model-only]
+        [--steps N] [--resets N] [--cameras] [--model-only] [--digest]
 
 Per task, ``OUT_DIR/<suite>-<index>.npz`` holds:
 
@@ -16,8 +16,13 @@ Per task, ``OUT_DIR/<suite>-<index>.npz`` holds:
   steps of actions drawn by ``np.random.default_rng(0)`` from [-1, 1] (``obs/<key>``,
   stacked), LIBERO's success predicate after each (``success``), and the simulator state
   (``state``); then ``--resets`` more hard resets, each followed by ``set_init_state`` and
-  the same actions for 5 steps (``again/<key>``: the observations after them);
+  the same actions for 5 steps (``reset/<key>``: the observations ``reset()`` returned,
+  ``again/<key>``: those after the 5 steps), and how many of those resets kept the
+  simulation object (``kept``);
 - ``error``: the exception's type and message, if LIBERO's code raised.
+
+With ``--digest`` each ``model/`` array is its SHA-256 instead (of its dtype, shape and
+bytes; scripts/libero_check.sh: 130 models' textures and meshes would be tens of GB).
 
 With ``--cameras`` the environment renders LIBERO's agentview and wrist images at 128x128
 (``MUJOCO_GL`` chooses the GL platform; egl by default).
@@ -25,6 +30,7 @@ With ``--cameras`` the environment renders LIBERO's agentview and wrist images a
 from __future__ import annotations
 
 import argparse
+import hashlib
 import importlib.util
 import os
 import pickle
@@ -42,6 +48,7 @@ ap.add_argument("--steps", type=int, default=50)
 ap.add_argument("--resets", type=int, default=1)
 ap.add_argument("--cameras", action="store_true")
 ap.add_argument("--model-only", action="store_true")
+ap.add_argument("--digest", action="store_true")
 args = ap.parse_args()
 
 if args.mode == "switch":
@@ -73,6 +80,13 @@ def init_states(suite: str, task: str) -> np.ndarray:
         return pickle.loads(z.read(name))
 
 
+def _digest(value: np.ndarray) -> np.ndarray:
+    """An array's SHA-256 (of its dtype, shape and bytes): equal digests, equal arrays."""
+    h = hashlib.sha256(f"{value.dtype.str}{value.shape}".encode())
+    h.update(np.ascontiguousarray(value).tobytes())
+    return np.frombuffer(h.digest(), dtype=np.uint8)
+
+
 def model_arrays(model) -> dict:
     out = {}
     sizes = {}
@@ -84,6 +98,8 @@ def model_arrays(model) -> dict:
             out["model/" + name] = value.copy()
         elif name.startswith("n") and isinstance(value, int):
             sizes[name] = value
+    if args.digest:
+        out = {k: _digest(v) for k, v in out.items()}
     out["model/sizes"] = np.array([sizes[k] for k in sorted(sizes)], dtype=np.int64)
     out["model/size_names"] = np.array(sorted(sizes))
     for group in ("opt", "stat", "vis"):
@@ -123,15 +139,20 @@ def run(suite: str, index: int) -> dict:
         out["obs/" + key] = np.stack([np.asarray(f[key]) for f in frames])
     out["success"] = np.array(success)
     out["state"] = env.sim.get_state().flatten()
-    again = []
+    again, first, kept = [], [], 0
     for _ in range(args.resets):
-        env.reset()
+        sim = env.sim
+        first.append(env.reset())
+        kept += env.sim is sim
         obs = env.set_init_state(state0)
         for a in actions[:5]:
             obs, *_ = env.step(a)
         again.append(obs)
     for key in (again[0] if again else {}):
         out["again/" + key] = np.stack([np.asarray(f[key]) for f in again])
+        out["reset/" + key] = np.stack([np.asarray(f[key]) for f in first])
+    # Hard resets that kept the simulation (the switch's, when the structure is the same).
+    out["kept"] = np.array(kept)
     env.close()
     return out
 

@@ -14,8 +14,8 @@ the simulation gets is compared, before robosuite touches it, with MuJoCo compil
 same XML (tests/judge compare_models, then bit for bit on every array): equal means that
 the cache's patch is exact and that nothing of an earlier reset (the wrapper's
 randomization, robosuite's site colours) outlived it. OUT.json: per environment and mode,
-the number of models judged, of compiles and patches, the differences found (none
-expected), and whether the wrapper changed the model it was given (it must, or the check
+the number of models judged, of compiles and patches, of hard resets that kept the
+simulation (its model patched in place), the differences found (none expected), and whether the wrapper changed the model it was given (it must, or the check
 proves nothing). Also: robosuite never read a robot's ``mujoco_model`` (none compiled).
 
 ``xml``: the XML of each environment's hard resets (robosuite's placements differ per
@@ -114,7 +114,7 @@ def judge_env(name: str, resets: int, dr: bool) -> dict:
     cache = base.model_cache()
     compiles, patches = cache.compiles, cache.patches
     recorder = Recorder()
-    changed = 0
+    changed = kept = 0
     try:
         env = make(name)
         target = env
@@ -125,8 +125,10 @@ def judge_env(name: str, resets: int, dr: bool) -> dict:
                 randomize_every_n_steps=0,
             )
         for _ in range(resets):
+            sim = env.sim
             with contextlib.redirect_stdout(sys.stderr):
                 target.reset()
+            kept += env.sim is sim
             if dr:
                 # The wrapper randomized the model the reset was given, in place: compiled
                 # again from the XML of the sim's last compile, it must differ.
@@ -146,6 +148,7 @@ def judge_env(name: str, resets: int, dr: bool) -> dict:
         "compiles": cache.compiles - compiles,
         "patches": cache.patches - patches,
         "randomized_resets": changed,
+        "kept_simulations": kept,
         "robot_models_compiled": robots_compiled,
     }
 

@@ -8,7 +8,9 @@ oldest MuJoCo the package supports), once each way, and compared here bit for bi
 - with LIBERO's first init state of the task (``set_init_state``) and the same 50 actions,
   every observation (robot state, object states, agentview and wrist images at 128x128)
   and LIBERO's success predicate after each step, and the simulator's state at the end;
-- after one more hard reset and ``set_init_state``, the observations after 5 steps.
+- after one more hard reset, the observations it returns and, after ``set_init_state``,
+  those after 5 steps; on the switch that reset keeps the simulation and its render
+  context (its model patched in place), and stock's makes them again.
 
 The other 125 tasks: scripts/libero_check.sh (results in docs/fidelity.md).
 """
@@ -85,5 +87,13 @@ def test_a_libero_task_observes_and_succeeds_as_stock(records, task):
     assert stock["obs/agentview_image"].shape == (51, 128, 128, 3)
     assert stock["obs/agentview_image"].std() > 10  # a scene, not a blank frame
     assert len(stock["success"]) == 50
-    for prefix in ("obs/", "success", "state", "again/"):
+    for prefix in ("obs/", "success", "state", "reset/", "again/"):
         assert differing(stock, switch, prefix) == [], prefix
+
+
+@pytest.mark.parametrize("task", TASKS)
+def test_a_libero_hard_reset_on_the_switch_keeps_the_simulation(records, task):
+    """The hard reset above (its observations, images included, are stock's) kept the
+    simulation, its model patched and its render context as it was; stock's never does."""
+    assert int(records["stock"][task]["kept"]) == 0
+    assert int(records["switch"][task]["kept"]) == 1

@@ -86,6 +86,10 @@ def test_resets_of_a_fixed_structure_are_patches(judged):
     # PickPlace and NutAssembly place their objects after the compile: one structure.
     for name in ("PickPlace", "NutAssembly", "Door", "TwoArmLift"):
         assert judged[name]["patches"] >= RESETS, (name, judged[name])
+        # Each such reset kept the simulation, its own model patched in place (the model
+        # judged above), with and without the wrapper.
+        for mode in ("", "+dr"):
+            assert judged[name + mode]["kept_simulations"] == RESETS, (name, mode, judged[name + mode])
 
 
 @pytest.fixture(scope="module")

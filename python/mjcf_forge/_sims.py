@@ -1,0 +1,196 @@
+"""robosuite's simulations kept across hard resets, for :mod:`mjcf_forge.robosuite`.
+
+A robosuite hard reset frees its ``MjSim`` (``MjSim.free``: the render context and its
+OpenGL context, the data, the model, then ``gc.collect()``), builds its task again and
+makes a new ``MjSim`` from the task's XML (``MjSim.from_xml_string``), and later a new
+render context, which uploads every texture, mesh, height field and skin again. With the
+switch, :func:`free` keeps the freed simulation instead (one per thread, until that
+thread's next ``from_xml_string``), and :func:`from_xml_string` makes the next simulation
+out of it when it can:
+
+- the model cache patches the kept simulation's own model in place, when the new XML has
+  its structure (``DocumentCache.model(xml, into=...)``): the model MuJoCo compiles from
+  the XML, every array and size, in the model the simulation already holds;
+- its data is made again (a new ``MjData``, as stock's new simulation makes);
+- its render context stays, with everything it has uploaded, when the patched model
+  gives what a new context would take from it (:func:`_render_inputs`: the visual
+  options, the extent, the texture, material, plane, mesh, height-field and skin values
+  that ``mjr_makeContext`` reads; the bulk data, never written by a patch, is the data
+  the context uploaded); its scene, camera, options and perturbation are made new, as a
+  new context makes them. Otherwise the context is freed and robosuite makes a new one.
+
+Anything else (another structure, no model cache, a simulation class robosuite did not
+make this way) does what stock does. What a kept simulation saves is the compile, the
+``gc.collect()`` and the render context: docs/model-hierarchy.md says why each kept thing
+gives stock's result.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import Any, Callable
+
+import numpy as np
+
+from . import base as _base
+
+_KEPT = threading.local()
+
+# Arrays ``mjr_makeContext`` reads outside the bulk data (which a patch never writes):
+# materials with textures, textures, meshes, height fields and skins.
+_RENDER_ARRAYS = (
+    "mat_texid", "mat_texuniform", "mat_texrepeat",
+    "tex_type", "tex_width", "tex_height", "tex_nchannel", "tex_colorspace", "tex_adr",
+    "mesh_vertadr", "mesh_vertnum", "mesh_normaladr", "mesh_texcoordadr", "mesh_faceadr",
+    "mesh_facenum", "mesh_graphadr",
+    "hfield_size", "hfield_nrow", "hfield_ncol", "hfield_adr",
+    "skin_texcoordadr", "skin_vertnum", "skin_faceadr", "skin_facenum",
+)
+_VISUAL = ("global_", "quality", "headlight", "map", "scale", "rgba")
+
+
+def _render_inputs(mujoco: Any, model: Any) -> bytes:
+    """What a new render context takes from ``model`` besides the bulk data, as bytes:
+    equal bytes, equal context."""
+    parts = [np.float64(model.stat.extent).tobytes()]
+    for group in _VISUAL:
+        obj = getattr(model.vis, group)
+        for name in sorted(dir(obj)):
+            if not name.startswith("_"):
+                value = getattr(obj, name)
+                if isinstance(value, (int, float, np.ndarray)):
+                    parts.append(np.asarray(value).tobytes())
+    for name in _RENDER_ARRAYS:
+        value = getattr(model, name, None)
+        if value is not None:
+            parts.append(value.tobytes())
+    # Planes: their grid is built from their size and their material's repeat.
+    planes = model.geom_type == mujoco.mjtGeom.mjGEOM_PLANE
+    parts += [model.geom_size[planes].tobytes(), model.geom_matid[planes].tobytes()]
+    return b"".join(parts)
+
+
+def keep_render_inputs(context_class: Any) -> None:
+    """Makes robosuite's render context remember what it was made from, each time its
+    MuJoCo context is made (at creation and when robosuite enlarges its buffers)."""
+    make = context_class.__dict__["_set_mujoco_context_and_buffers"]
+
+    def _set_mujoco_context_and_buffers(self: Any) -> None:
+        make(self)
+        import mujoco
+
+        self._mjcf_forge_inputs = _render_inputs(mujoco, self.model._model)
+
+    _set_mujoco_context_and_buffers.__doc__ = make.__doc__
+    context_class._set_mujoco_context_and_buffers = _set_mujoco_context_and_buffers
+
+
+def keep_simulations(sim_class: Any) -> None:
+    """``MjSim.free`` and ``MjSim.from_xml_string`` as the module says."""
+    compile_sim = sim_class.__dict__["from_xml_string"].__func__
+    free_sim: Callable[[Any], None] = sim_class.__dict__["free"]
+
+    def free(self: Any) -> None:
+        if _base.model_cache() is None:
+            return free_sim(self)
+        previous, _KEPT.sim = getattr(_KEPT, "sim", None), self
+        if previous is not None and previous is not self:
+            free_sim(previous)
+
+    def from_xml_string(cls: Any, xml: str) -> Any:
+        kept, _KEPT.sim = getattr(_KEPT, "sim", None), None
+        cache = _base.model_cache()
+        if cache is None:
+            if kept is not None:
+                free_sim(kept)
+            return compile_sim(cls, xml)
+        if kept is None or type(kept) is not cls:
+            if kept is not None:
+                free_sim(kept)
+            return cls(cache.model(xml))
+        held = kept.model._model
+        model = cache.model(xml, into=held)
+        if model is not held:
+            free_sim(kept)
+            return cls(model)
+        _renew(kept)
+        _KEPT.renewed = kept
+        return kept
+
+    free.__doc__ = free_sim.__doc__
+    from_xml_string.__doc__ = compile_sim.__doc__
+    from_xml_string.__wrapped__ = compile_sim  # type: ignore[attr-defined]
+    sim_class.free = free
+    sim_class.from_xml_string = classmethod(from_xml_string)
+
+
+def keep_observables(env_class: Any) -> None:
+    """``MujocoEnv.reset``: when the hard reset kept the simulation, robosuite's
+    observables keep their sensors (see :func:`_kept_observables`); and
+    ``MujocoEnv._reset_internal``: where stock makes the render context again, which
+    runs ``sim.forward()`` first, a kept context has the simulation run it too: without
+    that forward, LIBERO's libero_object 0 steps to other object poses in the last bits
+    (a forward's results seed the next step's)."""
+    reset = env_class.__dict__["reset"]
+    reset_internal = env_class.__dict__["_reset_internal"]
+
+    def _reset_internal(self: Any) -> Any:
+        sim = getattr(_KEPT, "renewed", None)
+        if sim is not None and sim is self.sim and sim._render_context_offscreen is not None:
+            sim.forward()
+        return reset_internal(self)
+
+    _reset_internal.__doc__ = reset_internal.__doc__
+    env_class._reset_internal = _reset_internal
+
+    def reset_env(self: Any) -> Any:
+        _KEPT.renewed = None
+        self._setup_observables = lambda: _kept_observables(self)
+        try:
+            return reset(self)
+        finally:
+            del self._setup_observables
+            _KEPT.renewed = None
+
+    reset_env.__doc__ = reset.__doc__
+    env_class.reset = reset_env
+
+
+def _kept_observables(env: Any) -> Any:
+    """What ``reset`` gets from ``env._setup_observables()``: the observables made again
+    (stock: each sensor called once to check it, a render per camera, then once more when
+    ``reset`` installs it in the observable of its name), or, when this reset kept the
+    simulation, none, so that each observable keeps its sensor: a sensor reads the
+    environment's simulation and references as they are when it runs, and this reset
+    kept the simulation object and its names and ids (same structure)."""
+    if getattr(_KEPT, "renewed", None) is not None and _KEPT.renewed is env.sim:
+        return {}
+    return type(env)._setup_observables(env)
+
+
+def _renew(sim: Any) -> None:
+    """A kept simulation whose model was patched: as robosuite makes a new one."""
+    import mujoco
+
+    model = sim.model._model
+    # A new MjData, as stock's new simulation has.
+    sim.data = type(sim.data)(sim.model)
+    context = sim._render_context_offscreen
+    if context is None:
+        return
+    context.data = sim.data
+    if getattr(context, "_mjcf_forge_inputs", None) != _render_inputs(mujoco, model):
+        # Another context than this model makes: robosuite makes a new one.
+        sim._render_context_offscreen = None
+        del context
+        return
+    context.gl_ctx.make_current()
+    context.scn = mujoco.MjvScene(model, maxgeom=context.scn.maxgeom)
+    context.cam = mujoco.MjvCamera()
+    context.cam.fixedcamid = 0
+    context.cam.type = mujoco.mjtCamera.mjCAMERA_FIXED
+    context.vopt = mujoco.MjvOption()
+    context.pert = mujoco.MjvPerturb()
+    context.pert.active = 0
+    context.pert.select = 0
+    context.pert.skinselect = -1
