@@ -34,10 +34,12 @@ echo "== cargo test --features mujoco, MuJoCo 3.17.0 (with doctests)"
 cargo test --features mujoco
 # From 4.0 on the wheel `mujoco` depends on `mujoco-core`, which puts libmujoco.so.4.0.0 and
 # include/ into the same `mujoco` folder; the venv's Python says where that is. Its own
-# target folder, so the two MuJoCo builds do not evict each other's artifacts.
+# target folder, so the two MuJoCo builds do not evict each other's artifacts (CI, which
+# builds each once, sets MJCF_FORGE_MJ4_TARGET=target: the dependencies build once).
 echo "== cargo test --features mujoco, MuJoCo 4.0.0 (with doctests)"
 MJ4_DIR="$(.cache/venv-mj4/bin/python -c 'import mujoco, os; print(os.path.dirname(mujoco.__file__))')"
-MJCF_FORGE_MUJOCO_DIR="$MJ4_DIR" CARGO_TARGET_DIR=target/mujoco-4 cargo test --features mujoco
+MJCF_FORGE_MUJOCO_DIR="$MJ4_DIR" CARGO_TARGET_DIR="${MJCF_FORGE_MJ4_TARGET:-target/mujoco-4}" \
+  cargo test --features mujoco
 echo "== judge self-tests (MuJoCo 3.17.0 and 4.0.0)"
 .cache/venv/bin/python -m pytest tests/judge -q -p no:cacheprovider
 .cache/venv-mj4/bin/python -m pytest tests/judge -q -p no:cacheprovider

@@ -4,14 +4,15 @@ A robosuite hard reset frees its ``MjSim`` (``MjSim.free``: the render context a
 OpenGL context, the data, the model, then ``gc.collect()``), builds its task again and
 makes a new ``MjSim`` from the task's XML (``MjSim.from_xml_string``), and later a new
 render context, which uploads every texture, mesh, height field and skin again. With the
-switch, :func:`free` keeps the freed simulation instead (one per thread, until that
-thread's next ``from_xml_string``), and :func:`from_xml_string` makes the next simulation
-out of it when it can:
+switch, ``MjSim.free`` keeps the freed simulation instead (one per thread, until that
+thread's next ``from_xml_string``; robosuite 1.5, unless its renderer is ``"mujoco"``,
+does not free it but lets go of it as ``_initialize_sim`` makes the next: offered the
+same way), and ``MjSim.from_xml_string`` makes the next simulation out of it when it can:
 
 - the model cache patches the kept simulation's own model in place, when the new XML has
   its structure (``DocumentCache.model(xml, into=...)``): the model MuJoCo compiles from
   the XML, every array and size, in the model the simulation already holds;
-- its data is made again (a new ``MjData``, as stock's new simulation makes);
+- its data is reset in place (``mj_resetData``: what a new ``MjData`` holds);
 - its render context stays, with everything it has uploaded, when the patched model
   gives what a new context would take from it (:func:`_render_inputs`: the visual
   options, the extent, the texture, material, plane, mesh, height-field and skin values
@@ -20,13 +21,16 @@ out of it when it can:
   new context makes them. Otherwise the context is freed and robosuite makes a new one.
 
 Anything else (another structure, no model cache, a simulation class robosuite did not
-make this way) does what stock does. What a kept simulation saves is the compile, the
+make this way) does what stock does. A process forked while a simulation is kept (LIBERO's
+``SubprocVectorEnv`` forks its workers) starts with none: the child holds the inherited
+one untouched, since its OpenGL context is the parent's. What a kept simulation saves is the compile, the
 ``gc.collect()`` and the render context: docs/model-hierarchy.md says why each kept thing
 gives stock's result.
 """
 
 from __future__ import annotations
 
+import os
 import threading
 from typing import Any, Callable
 
@@ -35,6 +39,19 @@ import numpy as np
 from . import base as _base
 
 _KEPT = threading.local()
+# Simulations a forked child inherited kept: never used (their OpenGL contexts belong to
+# the parent) and never freed (freeing would call into those contexts), only held.
+_INHERITED: list = []
+
+
+def _forget_after_fork() -> None:
+    kept = getattr(_KEPT, "sim", None)
+    if kept is not None:
+        _INHERITED.append(kept)
+    _KEPT.sim = _KEPT.renewed = None
+
+
+os.register_at_fork(after_in_child=_forget_after_fork)
 
 # Arrays ``mjr_makeContext`` reads outside the bulk data (which a patch never writes):
 # materials with textures, textures, meshes, height fields and skins.
@@ -90,28 +107,31 @@ def keep_simulations(sim_class: Any) -> None:
     compile_sim = sim_class.__dict__["from_xml_string"].__func__
     free_sim: Callable[[Any], None] = sim_class.__dict__["free"]
 
+    def release(sim: Any, freed: bool) -> None:
+        """What stock does with a simulation not made again: frees the one robosuite
+        freed, drops the one it let go of."""
+        if freed:
+            free_sim(sim)
+
     def free(self: Any) -> None:
         if _base.model_cache() is None:
             return free_sim(self)
-        previous, _KEPT.sim = getattr(_KEPT, "sim", None), self
-        if previous is not None and previous is not self:
-            free_sim(previous)
+        previous, _KEPT.sim = getattr(_KEPT, "sim", None), (self, True)
+        if previous is not None and previous[0] is not self:
+            release(*previous)
 
     def from_xml_string(cls: Any, xml: str) -> Any:
-        kept, _KEPT.sim = getattr(_KEPT, "sim", None), None
+        offered, _KEPT.sim = getattr(_KEPT, "sim", None), None
         cache = _base.model_cache()
-        if cache is None:
-            if kept is not None:
-                free_sim(kept)
-            return compile_sim(cls, xml)
-        if kept is None or type(kept) is not cls:
-            if kept is not None:
-                free_sim(kept)
-            return cls(cache.model(xml))
+        if cache is None or offered is None or type(offered[0]) is not cls:
+            if offered is not None:
+                release(*offered)
+            return compile_sim(cls, xml) if cache is None else cls(cache.model(xml))
+        kept = offered[0]
         held = kept.model._model
         model = cache.model(xml, into=held)
         if model is not held:
-            free_sim(kept)
+            release(*offered)
             return cls(model)
         _renew(kept)
         _KEPT.renewed = kept
@@ -124,8 +144,9 @@ def keep_simulations(sim_class: Any) -> None:
     sim_class.from_xml_string = classmethod(from_xml_string)
 
 
-def keep_observables(env_class: Any) -> None:
-    """``MujocoEnv.reset``: when the hard reset kept the simulation, robosuite's
+def keep_environment(env_class: Any) -> None:
+    """``MujocoEnv._initialize_sim``: the simulation it lets go of is offered (see the
+    module); ``MujocoEnv.reset``: when the hard reset kept the simulation, robosuite's
     observables keep their sensors (see :func:`_kept_observables`); and
     ``MujocoEnv._reset_internal``: where stock makes the render context again, which
     runs ``sim.forward()`` first, a kept context has the simulation run it too: without
@@ -133,6 +154,18 @@ def keep_observables(env_class: Any) -> None:
     (a forward's results seed the next step's)."""
     reset = env_class.__dict__["reset"]
     reset_internal = env_class.__dict__["_reset_internal"]
+    initialize_sim = env_class.__dict__["_initialize_sim"]
+
+    def _initialize_sim(self: Any, xml_string: Any = None) -> Any:
+        # A hard reset that does not free the simulation (robosuite 1.5's, unless its
+        # renderer is "mujoco") lets go of it as the new one is made: offered too.
+        sim = getattr(self, "sim", None)
+        if sim is not None and getattr(_KEPT, "sim", None) is None and _base.model_cache() is not None:
+            _KEPT.sim = (sim, False)
+        return initialize_sim(self, xml_string)
+
+    _initialize_sim.__doc__ = initialize_sim.__doc__
+    env_class._initialize_sim = _initialize_sim
 
     def _reset_internal(self: Any) -> Any:
         sim = getattr(_KEPT, "renewed", None)
@@ -173,12 +206,13 @@ def _renew(sim: Any) -> None:
     import mujoco
 
     model = sim.model._model
-    # A new MjData, as stock's new simulation has.
-    sim.data = type(sim.data)(sim.model)
+    # The data reset in place (what a new MjData holds: MuJoCo makes one by resetting
+    # it), not made again: robosuite's sensors keep views of its arrays
+    # (ToolHang's ``pos_lookup = self.sim.data.body_xpos``).
+    mujoco.mj_resetData(model, sim.data._data)
     context = sim._render_context_offscreen
     if context is None:
         return
-    context.data = sim.data
     if getattr(context, "_mjcf_forge_inputs", None) != _render_inputs(mujoco, model):
         # Another context than this model makes: robosuite makes a new one.
         sim._render_context_offscreen = None

@@ -76,7 +76,7 @@ def _adapt(module: Any) -> None:
         _sims.keep_simulations(module.MjSim)
         _sims.keep_render_inputs(module.MjRenderContext)
     elif module.__name__ == "robosuite.environments.base":
-        _sims.keep_observables(module.MujocoEnv)
+        _sims.keep_environment(module.MujocoEnv)
     elif module.__name__ == "robosuite.models.robots.robot_model":
         _lazy_robot_model(module.RobotModel)
 

@@ -2,6 +2,11 @@
 scripts/setup_sim_env.sh: MuJoCo 4.0.0, MuJoCo Warp 4.0.0, MJX on JAX's CPU backend, both
 its own JAX implementation and MuJoCo Warp's kernels under it, impl="warp").
 
+CI runs MuJoCo Warp on the patch scene, MJX's JAX implementation on the fixed-base one
+and MJX over MuJoCo Warp on the patch scene, CPU MuJoCo and the refusals; the others
+(marked ``full``: the big scenes, lift5, LIBERO, the demo, Menagerie's UR5e, and the
+other small ones) run with MJCF_FORGE_FULL=1 (scripts/test_full.sh).
+
 Per scene: 8 worlds, each holding a variant of the scene's superset, stepped 500 steps;
 every placed body within 1e-4 m of its variant compiled alone and stepped on CPU MuJoCo
 (float64); parked bodies never move and touch nothing; then two worlds reassigned to other
@@ -132,7 +137,9 @@ def warp_step(m, d):
     return run, contacts
 
 
-@pytest.mark.parametrize("path", [PATCH, FIXED], ids=["patch", "fixed"])
+@pytest.mark.parametrize(
+    "path", [PATCH, pytest.param(FIXED, marks=pytest.mark.full)], ids=["patch", "fixed"]
+)
 def test_mujoco_warp_worlds_agree_with_each_variant(path):
     """The patch scene (and fixed-base objects varying per world) in MuJoCo Warp, with
     to_mjwarp's default sizes: every world within 1e-4 m of its variant compiled alone on
@@ -196,6 +203,7 @@ LIFT5_VS_WARP = 3e-5
 
 
 @pytest.mark.skipif(not RS_ASSETS.is_dir(), reason="setup not run")
+@pytest.mark.full
 def test_mujoco_warp_lift5_worlds_agree_with_each_variant():
     import warp as wp
 
@@ -284,6 +292,7 @@ def judge_both(
 
 
 @pytest.mark.skipif(not LIBERO_ASSETS.is_dir(), reason="setup not run")
+@pytest.mark.full
 def test_mujoco_warp_libero_worlds_agree_with_each_variant():
     """A real scene of package files (robosuite's Panda, LIBERO's objects: meshes, unnamed
     geoms, no <inertial>, friction, colour and mass randomized) in MuJoCo Warp: each
@@ -300,6 +309,7 @@ DEMO_VS_WARP = 5e-5
 DEMO_VS_CPU = 3e-4
 
 
+@pytest.mark.full
 def test_mujoco_warp_demo_worlds_agree_with_each_variant():
     """The built-in demo scene in MuJoCo Warp: each world, and two reassigned at reset,
     steps as its variant alone in Warp, and near it on CPU MuJoCo."""
@@ -331,6 +341,7 @@ def key_rows(batch: WorldBatch, keyframe: str) -> dict[str, np.ndarray]:
 
 
 @pytest.mark.skipif(not (LIBERO_ASSETS.is_dir() and MENAGERIE_ASSETS.is_dir()), reason="setup not run")
+@pytest.mark.full
 def test_mujoco_warp_menagerie_worlds_agree_with_each_variant():
     """MuJoCo Menagerie's UR5e with its keyframe and a Robotiq 2F-85, LIBERO's objects on
     the table, in MuJoCo Warp, every world started at the robot's keyframe: each world, and
@@ -494,7 +505,9 @@ def mjx_sim(impl: str):
     return simulator
 
 
-@pytest.mark.parametrize("path", [BOXES, FIXED], ids=["boxes", "fixed"])
+@pytest.mark.parametrize(
+    "path", [pytest.param(BOXES, marks=pytest.mark.full), FIXED], ids=["boxes", "fixed"]
+)
 def test_mjx_worlds_agree_with_each_variant(path):
     """MJX's own implementation (impl="jax") on JAX's CPU backend: every world within
     1e-4 m of its variant on CPU MuJoCo. Its JAX collision has no cylinder-box or
@@ -520,6 +533,7 @@ def test_mjx_warp_worlds_agree_with_each_variant():
     print("mjx warp patch", report)
 
 
+@pytest.mark.full
 def test_mjx_warp_demo_worlds_agree_with_each_variant():
     """The built-in demo in MJX with impl="warp": as in MuJoCo Warp itself."""
     report = judge_both(mjcf_forge.Scene.demo(), DEMO_VS_WARP, DEMO_VS_CPU, simulator=mjx_sim("warp"))
@@ -527,6 +541,7 @@ def test_mjx_warp_demo_worlds_agree_with_each_variant():
 
 
 @pytest.mark.skipif(not RS_ASSETS.is_dir(), reason="setup not run")
+@pytest.mark.full
 def test_mjx_warp_lift5_worlds_agree_with_each_variant():
     """lift5 (robosuite's Panda, five mesh objects) in MJX with impl="warp", judged at
     100 steps as in MuJoCo Warp itself (LIFT5_EARLY)."""
@@ -536,6 +551,7 @@ def test_mjx_warp_lift5_worlds_agree_with_each_variant():
 
 
 @pytest.mark.skipif(not (LIBERO_ASSETS.is_dir() and MENAGERIE_ASSETS.is_dir()), reason="setup not run")
+@pytest.mark.full
 def test_mjx_warp_menagerie_worlds_agree_with_each_variant():
     """The Menagerie scene (UR5e at its keyframe, Robotiq 2F-85, LIBERO's objects) in MJX
     with impl="warp", every world started at its own rows of the key."""

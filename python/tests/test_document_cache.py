@@ -328,6 +328,36 @@ def test_a_model_someone_holds_is_never_patched_again():
     assert len(ids) == 1 and len(pool) <= 4
 
 
+def test_a_held_model_given_back_is_patched_in_place():
+    """``into=``: a held model of the document's structure is patched itself (what a
+    robosuite hard reset that keeps its simulation asks); any other is left alone and
+    the call is as without it."""
+    doc = robot_doc()
+    cache = mjcf_forge.DocumentCache()
+    other = doc.copy()
+    other.find(".//joint").attrib["damping"] = "0.25"
+    held = cache.model(doc)
+    data = mujoco.MjData(held)  # a simulation on it: held, so never patched without into=
+    held.geom_rgba[:] = 0.5  # the caller's change, written back before the patch
+    assert cache.model(other, into=held) is held
+    check_exact(other, held, "patched in place")
+    assert cache.model(doc, into=held) is held
+    check_exact(doc, held, "patched in place again")
+    # Another structure: a model of its own, the held one untouched.
+    changed = doc.copy()
+    changed.find(".//joint").attrib["type"] = "slide"
+    before = copy.copy(held)
+    got = cache.model(changed, into=held)
+    assert got is not held
+    check_exact(changed, got, "another structure")
+    assert judge.compare_models(before, held) == []
+    # A model the cache never gave: as without into=.
+    stranger = mujoco.MjModel.from_xml_string(doc.to_xml())
+    assert cache.model(other, into=stranger) is not stranger
+    assert cache.compiles == 2 and cache.patches == 3
+    del data
+
+
 def test_threads_compile_a_structure_once_and_each_get_their_own_model():
     doc = robot_doc()
     cache = mjcf_forge.DocumentCache()

@@ -97,3 +97,59 @@ def test_a_libero_hard_reset_on_the_switch_keeps_the_simulation(records, task):
     simulation, its model patched and its render context as it was; stock's never does."""
     assert int(records["stock"][task]["kept"]) == 0
     assert int(records["switch"][task]["kept"]) == 1
+
+
+EVAL = Path(__file__).with_name("libero_eval.py")
+EVAL_TASK = "libero_object:0"
+
+
+@pytest.fixture(scope="module")
+def evaluations(tmp_path_factory):
+    """libero_eval.py on one task: twice on the switch (two processes, each with two
+    evaluations in one environment and one in LIBERO's SubprocVectorEnv of two workers),
+    and once stock without the vector environment."""
+    tmp = tmp_path_factory.mktemp("libero_eval")
+    only = tmp / "path"
+    only.mkdir()
+    (only / "mjcf_forge").symlink_to(Path(mjcf_forge.__file__).resolve().parent)
+    env = dict(os.environ, PYTHONPATH=str(only), LIBERO_CONFIG_PATH=str(CONFIG))
+    env.setdefault("MUJOCO_GL", "egl")
+    runs = {"switch-a": [], "switch-b": [], "stock": ["--stock", "--no-vector"]}
+    procs = {
+        name: subprocess.Popen(
+            [str(LIBERO_PY), str(EVAL), str(tmp / f"{name}.npz"), EVAL_TASK, *flags],
+            cwd=tmp, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        )
+        for name, flags in runs.items()
+    }
+    for name, proc in procs.items():
+        out, err = proc.communicate(timeout=900)
+        assert proc.returncode == 0 and out.split() == ["ok"], (name, err[-3000:])
+    return {name: dict(np.load(tmp / f"{name}.npz")) for name in runs}
+
+
+def episodes(record: dict, source: str) -> dict:
+    return {k[len(source):]: v for k, v in record.items() if k.startswith(source)}
+
+
+def test_evaluations_with_the_same_seeds_roll_out_bit_equal_on_the_switch(evaluations):
+    """Each hard reset on the switch restores what stock's does (the data reset, the model as
+    compiled from the task, LIBERO's placements from its seeded generator): evaluations
+    with the same seed, one after the other in one environment, in two processes, and in
+    the worker of LIBERO's SubprocVectorEnv with that seed, give the same rollouts, bit for
+    bit, and stock's. With another seed they differ, from the same init states: what a
+    reset drew outlives LIBERO's set_init_state (it writes qpos and qvel only)."""
+    a = evaluations["switch-a"]
+    by_seed = {0: episodes(a, "single/0/"), 1: episodes(a, "single/2/")}
+    assert len([k for k in by_seed[0] if k.endswith("/obs/robot0_joint_pos")]) == 2
+    for record in (evaluations["switch-a"], evaluations["switch-b"]):
+        for source, seed in (("single/0/", 0), ("single/1/", 0), ("single/2/", 1),
+                             ("vector/0/", 0), ("vector/1/", 1)):
+            assert differing(by_seed[seed], episodes(record, source), "") == [], source
+        # Every hard reset of the single evaluations kept the simulation.
+        assert int(record["kept"]) == 6
+    stock = evaluations["stock"]
+    for source, seed in (("single/0/", 0), ("single/1/", 0), ("single/2/", 1)):
+        assert differing(episodes(stock, source), by_seed[seed], "") == [], source
+    assert int(stock["kept"]) == 0
+    assert differing(by_seed[0], by_seed[1], "") != []
