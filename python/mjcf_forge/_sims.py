@@ -20,12 +20,15 @@ same way), and ``MjSim.from_xml_string`` makes the next simulation out of it whe
   the context uploaded); its scene, camera, options and perturbation are made new, as a
   new context makes them. Otherwise the context is freed and robosuite makes a new one.
 
-Anything else (another structure, no model cache, a simulation class robosuite did not
-make this way) does what stock does. A process forked while a simulation is kept (LIBERO's
-``SubprocVectorEnv`` forks its workers) starts with none: the child holds the inherited
-one untouched, since its OpenGL context is the parent's. What a kept simulation saves is the compile, the
-``gc.collect()`` and the render context: docs/model-hierarchy.md says why each kept thing
-gives stock's result.
+Then ``MujocoEnv._reset_internal`` runs the ``sim.forward()`` a new render context would
+run, and ``MujocoEnv.reset`` leaves robosuite's observables their sensors
+(:func:`keep_environment`). Anything else (another structure, no model cache, a
+simulation class robosuite did not make this way) does what stock does. A process forked
+while a simulation is kept (LIBERO's ``SubprocVectorEnv`` forks its workers) starts with
+none: the child holds the inherited one untouched, since its OpenGL context is the
+parent's. What a kept simulation saves is the compile, the ``gc.collect()``, the render
+context and the observables' checks (a render per camera): docs/compiled.md says why
+each kept thing gives stock's result.
 """
 
 from __future__ import annotations

@@ -45,11 +45,63 @@ __all__ = [
 
 ParseError = _ET.ParseError
 # Serializing is duck-typed in xml.etree (tag, items(), text, tail, len, iteration), so its
-# own functions write our elements as they write theirs.
-tostring = _ET.tostring
+# own functions write our elements as they write theirs; tostring writes ours natively
+# (the same text) where it can.
 tostringlist = _ET.tostringlist
 dump = _ET.dump
 indent = _ET.indent
+
+
+def _native_agrees() -> bool:
+    """Whether the native writer gives this Python's xml.etree text, on a probe holding
+    every character the two escape (they changed across Python versions)."""
+    probe = Element("a", {"b": "&<>\"\r\n\t'x", "c": ""})
+    child = probe.append("d", {})
+    child.text = "&<>\"'"
+    probe.append("e", {"f": "1"}).append("g", {})
+    child.tail = "t&<>"
+    return probe._etree_xml() == _ET.tostring(probe, encoding="unicode")
+
+
+_NATIVE = _native_agrees()
+
+
+def tostring(
+    element: Any,
+    encoding: Optional[str] = None,
+    method: Optional[str] = None,
+    *,
+    xml_declaration: Optional[bool] = None,
+    default_namespace: Optional[str] = None,
+    short_empty_elements: bool = True,
+) -> Any:
+    """``ET.tostring``: the same text (or bytes, as ``encoding`` says), written natively
+    for our elements with the defaults (xml.etree's own writer otherwise)."""
+    text = None
+    if (
+        _NATIVE
+        and isinstance(element, Element)
+        and method in (None, "xml")
+        and default_namespace is None
+        and short_empty_elements
+        and not (xml_declaration and (encoding or "").lower() == "unicode")
+    ):
+        text = element._etree_xml()
+    if text is None:
+        return _ET.tostring(
+            element, encoding, method, xml_declaration=xml_declaration,
+            default_namespace=default_namespace, short_empty_elements=short_empty_elements,
+        )
+    if encoding is None:
+        encoding = "us-ascii"
+    if encoding.lower() == "unicode":
+        return text
+    if xml_declaration or (
+        xml_declaration is None and encoding.lower() not in ("utf-8", "us-ascii")
+    ):
+        text = f"<?xml version='1.0' encoding='{encoding}'?>\n" + text
+    return text.encode(encoding, "xmlcharrefreplace")
+
 
 
 def iselement(element: Any) -> bool:

@@ -251,6 +251,13 @@ impl PyElement {
         self.read(py, |d, n| d.attrs(n).map(|(k, _)| k.to_owned()).collect())
     }
 
+    /// This element and its subtree as ``xml.etree.ElementTree.tostring(element,
+    /// encoding="unicode")`` writes them (its tail included), or ``None`` where a name is
+    /// namespaced (``{uri}local``): what :func:`mjcf_forge.etree.tostring` writes.
+    fn _etree_xml(&self, py: Python<'_>) -> Option<String> {
+        self.read(py, super::etree_text::etree_xml)
+    }
+
     /// The (name, value) pairs, in order.
     fn items(&self, py: Python<'_>) -> Vec<(String, String)> {
         self.read(py, |d, n| {

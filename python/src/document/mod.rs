@@ -16,6 +16,7 @@ mod attrib;
 mod cell;
 mod children;
 mod element;
+mod etree_text;
 mod load_cache;
 pub(crate) mod patch;
 mod path;
