@@ -21,35 +21,36 @@ bash scripts/setup_libero_env.sh
 # python/tests/test_batch_sim.py (idempotent; Warp's kernels cached in .cache/warp-kernels).
 bash scripts/setup_sim_env.sh
 
-echo "== cargo fmt --check"
+echo "== cargo fmt --check [${SECONDS}s in]"
 cargo fmt --all -- --check
-echo "== cargo clippy"
+echo "== cargo clippy [${SECONDS}s in]"
 cargo clippy --all-targets -- -D warnings
 cargo clippy --all-targets --features mujoco -- -D warnings
 # The Python bindings crate (the workspace's other member; not built by the commands above).
 PYO3_PYTHON="$PWD/.cache/venv/bin/python" cargo clippy -p mjcf-forge-python --all-targets -- -D warnings
-echo "== cargo test (default features)"
+echo "== cargo test (default features) [${SECONDS}s in]"
 cargo test --all-targets
-echo "== cargo test --features mujoco, MuJoCo 3.17.0 (with doctests)"
+echo "== cargo test --features mujoco, MuJoCo 3.17.0 (with doctests) [${SECONDS}s in]"
 cargo test --features mujoco
 # From 4.0 on the wheel `mujoco` depends on `mujoco-core`, which puts libmujoco.so.4.0.0 and
 # include/ into the same `mujoco` folder; the venv's Python says where that is. Its own
 # target folder, so the two MuJoCo builds do not evict each other's artifacts (CI, which
 # builds each once, sets MJCF_FORGE_MJ4_TARGET=target: the dependencies build once).
-echo "== cargo test --features mujoco, MuJoCo 4.0.0 (with doctests)"
+echo "== cargo test --features mujoco, MuJoCo 4.0.0 (with doctests) [${SECONDS}s in]"
 MJ4_DIR="$(.cache/venv-mj4/bin/python -c 'import mujoco, os; print(os.path.dirname(mujoco.__file__))')"
 MJCF_FORGE_MUJOCO_DIR="$MJ4_DIR" CARGO_TARGET_DIR="${MJCF_FORGE_MJ4_TARGET:-target/mujoco-4}" \
   cargo test --features mujoco
-echo "== judge self-tests (MuJoCo 3.17.0 and 4.0.0)"
+echo "== judge self-tests (MuJoCo 3.17.0 and 4.0.0) [${SECONDS}s in]"
 .cache/venv/bin/python -m pytest tests/judge -q -p no:cacheprovider
 .cache/venv-mj4/bin/python -m pytest tests/judge -q -p no:cacheprovider
-echo "== python package (pytest: API, errors, threads, MuJoCo judge, Gymnasium, Ray)"
+echo "== python package (pytest: API, errors, threads, MuJoCo judge, Gymnasium, Ray) [${SECONDS}s in]"
 # (test_batch_sim.py needs MuJoCo Warp and JAX: it runs in .cache/venv-sim below.)
 # (test_libero.py runs LIBERO in .cache/venv-libero, MuJoCo 3.3.1, stock and on the switch.)
 .cache/venv/bin/python -m pytest python/tests -q -p no:cacheprovider --ignore=python/tests/test_batch_sim.py
-echo "== ModelCache and DocumentCache under MuJoCo 4.0.0 (patched models judged against 4.0.0's compile)"
+echo "== ModelCache and DocumentCache under MuJoCo 4.0.0 (patched models judged against 4.0.0's compile) [${SECONDS}s in]"
 .cache/venv-mj4/bin/python -m pytest python/tests/test_model_cache.py python/tests/test_document_cache.py -q -p no:cacheprovider
 # robosuite's task XMLs (written by the robosuite venv) through a DocumentCache, judged by 4.0.0.
 .cache/venv-mj4/bin/python -m pytest python/tests/test_robosuite_resets.py -k task_xmls -q -p no:cacheprovider
-echo "== batched simulators (MuJoCo Warp, MJX on JAX's CPU backend, CPU MuJoCo) judge WorldBatch"
+echo "== batched simulators (MuJoCo Warp, MJX on JAX's CPU backend, CPU MuJoCo) judge WorldBatch [${SECONDS}s in]"
 .cache/venv-sim/bin/python -m pytest python/tests/test_batch_sim.py -q -p no:cacheprovider
+echo "== all tests passed [${SECONDS}s]"
