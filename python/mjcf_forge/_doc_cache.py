@@ -277,14 +277,7 @@ class DocumentCache:
                     if working is not None:
                         self._entries.move_to_end(key)
             if working is not None:
-                try:
-                    working.patch(values, materials, bodies)
-                except MjcfError:
-                    # Not a patch of the structure after all (see below): compiled.
-                    return self._compile(doc, key, fixed, replace=True)
-                with self._lock:
-                    self.patches += 1
-                return into
+                return self._patched(working, doc, key, fixed, values, materials, bodies)
         while True:
             with self._lock:
                 structure = self._entries.get(key)
@@ -303,12 +296,18 @@ class DocumentCache:
             waiting.wait()
         if working is None:
             working = self._adopt(structure, me, other)
+        return self._patched(working, doc, key, fixed, values, materials, bodies)
+
+    def _patched(self, working: _Working, doc: Any, key: str, fixed: list, values: np.ndarray,
+                 materials: list, bodies: list) -> Any:
+        """``working``'s model patched for ``doc``, or ``doc`` compiled where the patch
+        fails."""
         try:
             working.patch(values, materials, bodies)
         except MjcfError:
-            # A value the model cannot take (a material that does not exist): MuJoCo's
-            # own verdict. The model is whole again after its next patch, which writes
-            # every entry of the structure.
+            # A value the model cannot take (a material that does not exist, a body's
+            # geoms that compile to another layout): MuJoCo's own verdict. The model is
+            # whole again after its next patch, which writes every entry of the structure.
             return self._compile(doc, key, fixed, replace=True)
         with self._lock:
             self.patches += 1
