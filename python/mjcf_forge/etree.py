@@ -103,7 +103,6 @@ def tostring(
     return text.encode(encoding, "xmlcharrefreplace")
 
 
-
 def iselement(element: Any) -> bool:
     """Whether ``element`` looks like an element (has a ``tag``), as ``ET.iselement``."""
     return hasattr(element, "tag")
