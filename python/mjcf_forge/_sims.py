@@ -40,6 +40,7 @@ from typing import Any, Callable
 import numpy as np
 
 from . import base as _base
+from ._doc_cache import _VISUAL
 
 _KEPT = threading.local()
 # Simulations a forked child inherited kept: never used (their OpenGL contexts belong to
@@ -66,7 +67,6 @@ _RENDER_ARRAYS = (
     "hfield_size", "hfield_nrow", "hfield_ncol", "hfield_adr",
     "skin_texcoordadr", "skin_vertnum", "skin_faceadr", "skin_facenum",
 )
-_VISUAL = ("global_", "quality", "headlight", "map", "scale", "rgba")
 
 
 def _render_inputs(mujoco: Any, model: Any) -> bytes:
@@ -172,7 +172,7 @@ def keep_environment(env_class: Any) -> None:
 
     def _reset_internal(self: Any) -> Any:
         sim = getattr(_KEPT, "renewed", None)
-        if sim is not None and sim is self.sim and sim._render_context_offscreen is not None:
+        if sim is self.sim and sim._render_context_offscreen is not None:
             sim.forward()
         return reset_internal(self)
 
@@ -199,7 +199,7 @@ def _kept_observables(env: Any) -> Any:
     simulation, none, so that each observable keeps its sensor: a sensor reads the
     environment's simulation and references as they are when it runs, and this reset
     kept the simulation object and its names and ids (same structure)."""
-    if getattr(_KEPT, "renewed", None) is not None and _KEPT.renewed is env.sim:
+    if getattr(_KEPT, "renewed", None) is env.sim:
         return {}
     return type(env)._setup_observables(env)
 
