@@ -25,7 +25,8 @@ mod with_mujoco {
     use criterion::{Criterion, Throughput};
     use mjcf_forge::compiled::{DocumentCache, ModelCache};
     use mjcf_forge::mujoco::compile_str;
-    use mjcf_forge::scene::{Scene, split_document};
+    use mjcf_forge::scene::Scene;
+    use mjcf_forge::split::split_document;
 
     fn lift5_fixed() -> Scene {
         Scene::load(concat!(

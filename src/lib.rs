@@ -9,6 +9,7 @@
 //! | `document/` | one model in an arena: read, inline defaults, prefix, validate, write |
 //! | `mujoco/` | the MuJoCo FFI (builds with the `mujoco` feature): compile, inertias |
 //! | `model/` | instances with a prefix, merging, geometry and placement offsets |
+//! | `split/` | a model as a structure key and a patch: what a model cache patches |
 //! | `scene/` | the batch tier: a scene file in, seeded variants out |
 //! | `compiled/` | compiled variants at patch cost (builds with the `mujoco` feature) |
 //! | `preview/` | contact sheets of variants, drawn by MuJoCo's renderer (`mujoco` feature) |
@@ -47,8 +48,6 @@ pub mod compiled;
 mod doc_pages;
 mod document;
 mod error;
-#[doc(hidden)]
-pub mod fuzzing;
 mod model;
 #[cfg(mjcf_mujoco)]
 pub mod mujoco;
@@ -56,7 +55,11 @@ pub mod output;
 #[cfg(mjcf_mujoco)]
 pub mod preview;
 pub mod scene;
+pub mod split;
 
+/// Entry points for the fuzz targets in `fuzz/`: internals they compare, not a supported API.
+#[doc(hidden)]
+pub use document::fuzzing;
 pub use document::import::NodeMap;
 pub use document::inertia::{CompiledInertia, InertiaCompiler};
 pub use document::limits::Limits;

@@ -10,7 +10,8 @@ use std::path::{Path, PathBuf};
 
 use mjcf_forge::compiled::DocumentCache;
 use mjcf_forge::mujoco::{CompiledModel, compile_document};
-use mjcf_forge::scene::{Scene, split_document};
+use mjcf_forge::scene::Scene;
+use mjcf_forge::split::split_document;
 use mjcf_forge::{Document, Node, Section};
 
 fn root() -> PathBuf {
@@ -459,7 +460,7 @@ fn derived_values_mujoco_set_const_leaves_stay_structure() {
 }
 
 #[test]
-fn sizes_of_primitive_geoms_are_patched_through_their_bodies_little_models() {
+fn sizes_of_primitive_geoms_are_patched_through_their_bodies_body_models() {
     let xml = |a: &str, r: &str, b: &str| {
         format!(
             r#"<mujoco><compiler angle="degree"/><asset><material name="m" rgba="1 0 0 1"/></asset>
@@ -493,11 +494,9 @@ fn sizes_of_primitive_geoms_are_patched_through_their_bodies_little_models() {
         b.sort_by(f64::total_cmp);
         let doc = Document::from_str(&xml(&a, &r, &list(&b)), ".").unwrap();
         keys.insert(
-            mjcf_forge::scene::split_document_with(
+            mjcf_forge::split::split_document_with(
                 &doc,
-                mjcf_forge::scene::SplitOptions {
-                    compiled_bodies: true,
-                },
+                mjcf_forge::split::SplitOptions { body_models: true },
             )
             .structure_key,
         );

@@ -4,12 +4,13 @@
 use std::path::{Path, PathBuf};
 
 /// The tiers from the bottom up: a file of a tier may name itself and anything earlier.
-const TIERS: [&str; 8] = [
-    "error", "output", "document", "mujoco", "model", "scene", "compiled", "preview",
+const TIERS: [&str; 9] = [
+    "error", "output", "document", "mujoco", "model", "split", "scene", "compiled", "preview",
 ];
 
 /// The Python bindings' modules (`python/src/`), which mirror the tiers, from the bottom up.
-const PY_TIERS: [&str; 4] = ["errors", "document", "model", "scene"];
+/// `upcalls` (the one way into the package's Python code) sits below them all.
+const PY_TIERS: [&str; 5] = ["upcalls", "errors", "document", "model", "scene"];
 
 /// The crate root's re-exports (`crate::Document`) and the tier each belongs to.
 const ROOT_ITEMS: [(&str, &str); 20] = [
@@ -138,5 +139,56 @@ fn the_check_sees_every_form_of_a_path() {
     assert_eq!(
         tiers_used(text, &TIERS),
         [(1, "scene"), (2, "document"), (2, "model"), (3, "compiled")]
+    );
+}
+
+/// Hand-written sources and the longest each may grow before it is split along its
+/// concepts (generated files, `vocab.rs`, excepted).
+const MAX_LINES: usize = 900;
+
+fn long_files(dir: &Path, exts: &[&str], out: &mut Vec<String>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        if path.is_dir() {
+            if !name.starts_with('.') && name != "target" && name != "__pycache__" {
+                long_files(&path, exts, out);
+            }
+        } else if exts.iter().any(|e| name.ends_with(e)) && name != "vocab.rs" {
+            let n = std::fs::read_to_string(&path).unwrap().lines().count();
+            if n > MAX_LINES {
+                out.push(format!("{} ({n} lines)", path.display()));
+            }
+        }
+    }
+}
+
+#[test]
+fn no_hand_written_source_is_over_900_lines() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut long = Vec::new();
+    for dir in ["src", "python/src", "python/mjcf_forge"] {
+        long_files(&root.join(dir), &[".rs", ".py", ".c"], &mut long);
+    }
+    assert!(
+        long.is_empty(),
+        "split along their concepts:\n{}",
+        long.join("\n")
+    );
+}
+
+#[test]
+fn the_crate_root_holds_at_most_four_files() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files: Vec<String> = std::fs::read_dir(&root)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_file())
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    files.sort();
+    assert!(
+        files.len() <= 4,
+        "src/ holds {files:?}: move one into its tier"
     );
 }

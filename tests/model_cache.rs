@@ -286,7 +286,7 @@ fn armature_beside_a_damping_ratio_is_compiled() {
 }
 
 #[test]
-fn geom_sizes_frames_and_densities_are_carried_by_little_models() {
+fn geom_sizes_frames_and_densities_are_carried_by_body_models() {
     // What MuJoCo derives from them comes from compiling the body's geoms alone: one
     // structure, every variant exact (a variant whose geoms turn the body's inertial frame
     // is compiled instead).
@@ -375,20 +375,20 @@ fn mass_of_bodies_without_inertial_scales_their_geoms() {
 type BodyArray = fn(&CompiledModel) -> &[f64];
 
 /// Variant `i` patched into the superset `cache`: every body's mass, inertia and inertial
-/// frame are the variant's own compile's, bit for bit; `little`: whether its patch carries
-/// bodies' little models.
+/// frame are the variant's own compile's, bit for bit; `body_models`: whether its patch carries
+/// body models.
 fn superset_masses_are_the_variants(
     scene: &Scene,
     superset: &mjcf_forge::scene::Superset,
     cache: &mut ModelCache<'_>,
     i: u64,
-    little: bool,
+    body_models: bool,
 ) {
     use mjcf_forge::mujoco::ObjType;
     let patch = scene.superset_patch(superset, i).unwrap();
     assert_eq!(
         patch.entries.iter().any(|e| e.field == "geoms"),
-        little,
+        body_models,
         "variant {i}"
     );
     let want = compiled(scene, i);
@@ -431,7 +431,7 @@ fn absolute_mass_of_a_body_without_inertial_is_refused_with_the_fix() {
 #[test]
 fn written_inertials_make_masses_patches_of_the_superset() {
     // write_inertials: the objects' bodies carry MuJoCo's own <inertial>, so a mass scale
-    // is a patch of that <inertial> (no little model), bit for bit.
+    // is a patch of that <inertial> (no body model), bit for bit.
     let scene = Scene::load(root().join("corpora/scenes/patch/inertials.toml")).unwrap();
     let superset = scene.superset().unwrap();
     let mut cache = ModelCache::new(&scene, 2, None).with_superset().unwrap();

@@ -19,9 +19,9 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ._errors import _error
+from ._errors import error
 from ._mjcf_forge import MjcfError, Scene
-from ._plan import _Plan, _in_order_sum
+from ._plan import Plan, in_order_sum
 from ._progress import progress_of
 from ._trees import TreeDerivation
 
@@ -58,13 +58,13 @@ def _signature(model: Any) -> tuple:
 
 # Model arrays no patch changes (meshes, textures, height fields, skins, flexes, bounding
 # volumes, names): left out of batch().
-_STATIC_PREFIXES = (
+STATIC_PREFIXES = (
     "mesh_", "tex_", "hfield_", "skin_", "flex", "bvh_", "oct_", "name", "text_", "paths",
     "tuple_", "numeric_", "plugin", "sensor_", "key_",
 )
 
 
-def _evict(
+def evict(
     entries: "collections.OrderedDict[str, Any]",
     max_models: int,
     max_bytes: int | None,
@@ -81,7 +81,7 @@ def _evict(
         dropped(key, gone)
 
 
-def _copy(value: Any) -> Any:
+def copy_value(value: Any) -> Any:
     return value.copy() if hasattr(value, "copy") else value
 
 
@@ -156,7 +156,7 @@ class ModelCache:
         self._entries: collections.OrderedDict[str, Any] = collections.OrderedDict()
         # How to patch each model seen (cached ones and the caller's), by id; holding the
         # model keeps the id its own. Bounded: the least recently patched go first.
-        self._plans: collections.OrderedDict[int, _Plan] = collections.OrderedDict()
+        self._plans: collections.OrderedDict[int, Plan] = collections.OrderedDict()
         # Signatures of structures seen, kept after their models are evicted, and the
         # <statistic> values each fixes.
         self._signatures: dict[str, tuple] = {}
@@ -173,8 +173,8 @@ class ModelCache:
         """Bytes held: every cached model, and every model's scratch ``MjData``."""
         return sum(p.nbytes for p in self._plans.values())
 
-    def _plan(self, model: Any, key: str) -> _Plan:
-        plan = _Plan(self._mujoco, model, key, self._fixed_values[key], self.superset is not None)
+    def _plan(self, model: Any, key: str) -> Plan:
+        plan = Plan(self._mujoco, model, key, self._fixed_values[key], self.superset is not None)
         self._plans[id(model)] = plan
         self._trim()
         return plan
@@ -186,13 +186,13 @@ class ModelCache:
             self._plans.pop(id(gone), None)
             cached.discard(id(gone))
 
-        _evict(self._entries, self._max_models, self._max_bytes, lambda: self.nbytes, dropped)
+        evict(self._entries, self._max_models, self._max_bytes, lambda: self.nbytes, dropped)
         # Plans of the caller's models: as many as cached models are allowed.
         extra = [k for k in self._plans if k not in cached]
         for k in extra[: max(0, len(extra) - self._max_models)]:
             del self._plans[k]
 
-    def _variant_inertia(self, model: Any, plan: "_Plan", variant: Any, parked: Any = None) -> None:
+    def _variant_inertia(self, model: Any, plan: "Plan", variant: Any, parked: Any = None) -> None:
         """Superset: ``stat.meaninertia`` (which scales the constraint solver's tolerance)
         as the variant's own model has it: the mean of the mass matrix's diagonal over the
         dofs of what the variant places (in the superset's dof order, which is the
@@ -212,7 +212,7 @@ class ModelCache:
             mask[np.concatenate([of[root] for root in roots])] = False
         keep = np.flatnonzero(mask)
         if len(keep):
-            model.stat.meaninertia = _in_order_sum(plan.M[plan.M_diagonal[keep]]) / len(keep)
+            model.stat.meaninertia = in_order_sum(plan.M[plan.M_diagonal[keep]]) / len(keep)
 
     def _key_and_patch(self, variant: Any) -> tuple[str, Any]:
         if self.superset is not None:
@@ -227,7 +227,7 @@ class ModelCache:
         self.compiles += 1
         key = self.superset.structure_key if self.superset is not None else variant.structure_key
         self._signatures[key] = _signature(model)
-        self._fixed_values[key] = [(s, _copy(getattr(model.stat, s))) for s in self._fixed]
+        self._fixed_values[key] = [(s, copy_value(getattr(model.stat, s))) for s in self._fixed]
         self._entries[key] = model
         self._entries.move_to_end(key)
         plan = self._plan(model, key)
@@ -265,8 +265,8 @@ class ModelCache:
     # where a patch allows. False: always the whole mj_setConst (the tests compare both).
     _by_tree = True
 
-    def _tree_derive(self, plan: _Plan, parked: Any) -> Any:
-        """Superset: ``derive(model, data, layout)`` for :meth:`_Plan.apply`, deriving
+    def _tree_derive(self, plan: Plan, parked: Any) -> Any:
+        """Superset: ``derive(model, data, layout)`` for :meth:`Plan.apply`, deriving
         tree by tree (:class:`TreeDerivation`, per plan and patch layout) what
         ``mj_setConst`` would, or None (``mj_setConst``): no superset, or turned off."""
         if self.superset is None or not self._by_tree or parked is None:
@@ -315,13 +315,13 @@ class ModelCache:
                 # The structure's first sight: its compile (kept) says what it is.
                 self._compile(variant)
             if _signature(model) != self._signatures[key]:
-                raise _error(
+                raise error(
                     f"the model does not have the structure of variant {variant.index} "
                     f"(key {key}): its sizes, names or element types differ"
                 )
             plan = self._plan(model, key)
         elif plan.key != key:
-            raise _error(
+            raise error(
                 f"the model has structure {plan.key}, variant {variant.index} has {key}: "
                 "a patch cannot change a structure (cache.model(variant) compiles it)"
             )
@@ -387,7 +387,7 @@ class ModelCache:
             for n in dir(model)
             if not n.startswith("_")
             and isinstance(getattr(model, n, None), np.ndarray)
-            and not n.startswith(_STATIC_PREFIXES)
+            and not n.startswith(STATIC_PREFIXES)
         ]
         rows: dict[str, list[np.ndarray]] = {n: [] for n in names}
         stats = {f"stat.{s}": [] for s in ("meaninertia", "meanmass", "meansize", "extent", "center")}

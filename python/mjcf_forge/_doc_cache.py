@@ -20,10 +20,10 @@ from typing import Any
 
 import numpy as np
 
-from ._cache import _copy, _evict
-from ._errors import _error
+from ._cache import copy_value, evict
+from ._errors import error
 from ._mjcf_forge import Document, MjcfError
-from ._plan import _Plan
+from ._plan import Plan
 
 # The sizes that count rows of mesh, texture, height field, skin and bounding-volume data:
 # no patch writes them and they are most of a model's bytes (70 MB of lift5's 70.5), so
@@ -42,7 +42,7 @@ _BULK_PREFIXES = (
     "skin_bonevert",
 )
 # The parts of mjVisual, each a struct of numbers.
-_VISUAL = ("global_", "quality", "headlight", "map", "scale", "rgba")
+VISUAL = ("global_", "quality", "headlight", "map", "scale", "rgba")
 
 
 def _restored_arrays(mujoco: Any, model: Any) -> list[str]:
@@ -81,10 +81,10 @@ class _Snapshot:
     def __init__(self, mujoco: Any, model: Any) -> None:
         self.arrays = {n: getattr(model, n).copy() for n in _restored_arrays(mujoco, model)}
         self.structs: dict[tuple[str, ...], dict[str, Any]] = {}
-        for path in [("opt",)] + [("vis", v) for v in _VISUAL]:
+        for path in [("opt",)] + [("vis", v) for v in VISUAL]:
             obj = _walk(model, path)
             if obj is not None:
-                self.structs[path] = {n: _copy(getattr(obj, n)) for n in _struct_fields(obj)}
+                self.structs[path] = {n: copy_value(getattr(obj, n)) for n in _struct_fields(obj)}
         self.nbytes = sum(a.nbytes for a in self.arrays.values())
 
 
@@ -113,7 +113,7 @@ class _Working:
                     self.structs.append((obj, name, saved))
         # The plan reads the model as compiled (a copy of another model may hold its patch).
         self.restore()
-        self.plan = _Plan(mujoco, model, structure.key, structure.fixed, superset=False)
+        self.plan = Plan(mujoco, model, structure.key, structure.fixed, superset=False)
         self.plan.resolve(list(structure.layout))
         # The references the cache itself holds (this object's views and plan), counted
         # by calibrate() once the model's maker has let go of it.
@@ -154,7 +154,7 @@ class _Structure:
     def __init__(self, mujoco: Any, key: str, model: Any, doc: Any, fixed: list) -> None:
         self.key = key
         self.layout = doc.patch
-        self.fixed = [(s, _copy(getattr(model.stat, s))) for s in fixed]
+        self.fixed = [(s, copy_value(getattr(model.stat, s))) for s in fixed]
         self.snapshot = _Snapshot(mujoco, model)
         self.models: dict[int, list[_Working]] = {}
 
@@ -318,7 +318,7 @@ class DocumentCache:
         the snapshot restores is written back before its first patch; the bulk data is
         never written)."""
         if other is None:
-            raise _error(f"structure {structure.key} has no model to copy")
+            raise error(f"structure {structure.key} has no model to copy")
         # No local name holds the copy, so that calibrate() counts the cache's own.
         working = _Working(self._mujoco, copy.copy(other.model), structure)
         working.calibrate()
@@ -335,7 +335,7 @@ class DocumentCache:
             try:
                 model = self._mujoco.MjModel.from_xml_string(xml)
             except ValueError as e:
-                raise _error(doc._mujoco_error(xml, str(e))) from None
+                raise error(doc._mujoco_error(xml, str(e))) from None
             structure = _Structure(self._mujoco, key, model, doc, fixed)
             working = _Working(self._mujoco, model, structure)
             del model  # calibrate() counts the cache's own references
@@ -353,7 +353,7 @@ class DocumentCache:
                     self._compiling.pop(key).set()
 
     def _trim(self) -> None:
-        _evict(self._entries, self._max_models, self._max_bytes, self._nbytes, lambda k, s: None)
+        evict(self._entries, self._max_models, self._max_bytes, self._nbytes, lambda k, s: None)
 
 
 def _document(source: Any, base_dir: Any) -> Any:

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from ._errors import _error
+from ._errors import error
 
 # Bounds a simulator reads only to cull collision candidates (the narrow phase reads the
 # geoms' own margins): where a simulator holds one for all worlds, the largest of the
@@ -79,7 +79,7 @@ class MjxWorlds:
             if not isinstance(leaf, jax.Array):
                 if (rows == rows[0]).all() or name in _BOUNDS or name in _FLAGS:
                     continue
-                raise _error(
+                raise error(
                     f"MJX cannot vary {name} per world (put_model keeps it as a static NumPy "
                     "array), and the batch's worlds differ in it"
                 )

@@ -1,9 +1,9 @@
-"""How one compiled model is patched in place: :class:`_Plan`, made once per model (the
+"""How one compiled model is patched in place: :class:`Plan`, made once per model (the
 model caches, ``_cache.py`` and ``_doc_cache.py``, hold one per model they patch).
 
 A plan resolves where each entry of a patch lands (per target array, the flat indices and
 where the numbers come from, once per layout), writes a patch's numbers, material ids and
-the bodies' little models, then what follows from the values: ``mj_setConst`` (or a
+the body models, then what follows from the values: ``mj_setConst`` (or a
 caller's derivation that writes the same, see ``_trees.py``), the model statistics the
 compiler derives at ``qpos0`` (which ``mj_setConst`` of 3.17 and 4.0 leaves), computed with
 the compiler's operations in its order, and the statistics the document fixes.
@@ -16,7 +16,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ._errors import _error
+from ._errors import error
 
 # The array prefix of each accessor's fields in MjModel, its object type and its count.
 _PREFIX = {
@@ -29,7 +29,7 @@ _PREFIX = {
     "material": "mat_",
     "actuator": "actuator_",
 }
-_OBJ = {
+OBJ = {
     "body": "mjOBJ_BODY",
     "joint": "mjOBJ_JOINT",
     "geom": "mjOBJ_GEOM",
@@ -56,7 +56,7 @@ _JOINT_QPOS = {0: 7, 1: 4, 2: 1, 3: 1}  # free, ball, slide, hinge
 _JOINT_DOFS = {0: 6, 1: 3, 2: 1, 3: 1}
 
 
-def _target_array(obj: str, field: str) -> str | None:
+def target_array(obj: str, field: str) -> str | None:
     """The MjModel array a patch entry of an ``obj``'s ``field`` writes (a joint's dof and
     qpos fields and its keyframe rows have arrays of their own); None for the options."""
     if obj == "joint" and field in _DOF_FIELDS:
@@ -90,13 +90,13 @@ def _dist(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] + d[:, 2] * d[:, 2])
 
 
-def _in_order_sum(values: np.ndarray) -> float:
+def in_order_sum(values: np.ndarray) -> float:
     """A left-to-right sum, as a C loop adds (``np.add.accumulate`` is sequential; ``sum``
     is pairwise and may differ in the last bits)."""
     return float(np.add.accumulate(values)[-1]) if len(values) else 0.0
 
 
-class _Plan:
+class Plan:
     """Everything patching one model object takes, made once per model: its structure key,
     a scratch ``MjData`` (``mj_setConst`` overwrites the qpos of the data it is given), the
     array views of the last patch's entries, and the views and constants of the statistics
@@ -116,7 +116,7 @@ class _Plan:
         self.derivations: dict[int, tuple[list, Any]] = {}
         self.derived_at = -1
         # The patch the layout was last resolved from (ModelCache._apply_world), and which
-        # of its string values are a body's little model (the others: material names).
+        # of its string values are a body model (the others: material names).
         self.source: Any = None
         self.string_geoms: list[bool] = []
         self.groups: list[tuple[Any, np.ndarray, np.ndarray]] = []
@@ -124,11 +124,11 @@ class _Plan:
         self.matids: list[tuple[Any, int, int]] = []
         # (field of model.opt, first of its numbers, how many) per option entry.
         self.options: list[tuple[str, int, int]] = []
-        # The bodies of the patch's "geoms" entries, in order, and the little models of
+        # The bodies of the patch's "geoms" entries, in order, and the body models of
         # their geoms compiled so far (MJCF text -> model), the newest last.
         self.bodies: list[int] = []
         self.body_models: dict[str, Any] = {}
-        # Per "geoms" entry: its little model as the structure compiled it (what the
+        # Per "geoms" entry: its body model as the structure compiled it (what the
         # snapshot's arrays hold), and the one last written into this model (None: not
         # known; the bounding volumes are not restored before a patch).
         self.body_xml0: list[str] = []
@@ -142,7 +142,7 @@ class _Plan:
         self.geom_xpos, self.xipos, self.xanchor = data.geom_xpos, data.xipos, data.xanchor
         self.body_mass = model.body_mass[1:]
         # A body its geoms give no mass has its inertial frame where MuJoCo puts a massless
-        # body's (not a function of its geoms alone: a little model at the origin has
+        # body's (not a function of its geoms alone: a body model at the origin has
         # another): the frames as compiled, kept while the body's own frame is (below).
         self.massless0 = {
             b: (model.body_pos[b].copy(), model.body_quat[b].copy(), model.body_ipos[b].copy(), model.body_iquat[b].copy(), int(model.body_sameframe[b]))
@@ -158,7 +158,7 @@ class _Plan:
         self.dof_length = getattr(model, "dof_length", None)  # not in MuJoCo 3.3
         # Geom radii for the bounding box: a plane or height field (rbound 0) counts a
         # tenth of its largest size. Sizes are patched only through "geoms" entries, which
-        # update these (compiled_body()).
+        # update these (body_model()).
         size, kind = model.geom_size, model.geom_type
         rbound = model.geom_rbound.copy()
         plane = (rbound <= 0) & (kind == mujoco.mjtGeom.mjGEOM_PLANE)
@@ -202,16 +202,16 @@ class _Plan:
         for obj, name, field, value in patch:
             if obj == "option":
                 if isinstance(value, str) or not hasattr(model.opt, field):
-                    raise _error(f"this MuJoCo's mjOption has no field {field}")
+                    raise error(f"this MuJoCo's mjOption has no field {field}")
                 options.append((field, numbers, len(value)))
                 numbers += len(value)
                 continue
             if isinstance(name, int):
                 i = name if name < getattr(model, _COUNT[obj]) else -1
             else:
-                i = mujoco.mj_name2id(model, getattr(mujoco.mjtObj, _OBJ[obj]), name)
+                i = mujoco.mj_name2id(model, getattr(mujoco.mjtObj, OBJ[obj]), name)
             if i < 0:
-                raise _error(
+                raise error(
                     f"the patch names {obj} '{name}', which the compiled model does not have"
                 )
             if field == "geoms":
@@ -244,7 +244,7 @@ class _Plan:
             whole = getattr(model, array)
             flat = whole.reshape(-1)
             if not np.shares_memory(flat, whole):
-                raise _error(f"mjModel.{array} is not one contiguous array here")
+                raise error(f"mjModel.{array} is not one contiguous array here")
             if isinstance(value, str):
                 matids.append((flat, rows[0], len(matids)))
                 continue
@@ -285,14 +285,14 @@ class _Plan:
 
     def write(self, values: np.ndarray, materials: list, bodies: list = ()) -> None:
         """Writes a patch of the resolved layout: its numbers end to end (``values``), the
-        names of its materials in order, and the little models of its bodies' geoms."""
+        names of its materials in order, and the body models of its bodies' geoms."""
         for flat, targets, sources in self.groups:
             # A float32 array takes the numbers rounded as MuJoCo rounds them (they are).
             flat[targets] = values[sources]
         for flat, index, k in self.matids:
             i = self.mujoco.mj_name2id(self.model, self.mujoco.mjtObj.mjOBJ_MATERIAL, materials[k])
             if i < 0:
-                raise _error(f"no material named '{materials[k]}'")
+                raise error(f"no material named '{materials[k]}'")
             flat[index] = i
         opt = self.model.opt
         for field, first, n in self.options:
@@ -309,21 +309,21 @@ class _Plan:
                 if xml == self.body_xml0[k] and self.body_written[k] == xml:
                     continue
                 self.body_written[k] = None
-                self.compiled_body(body, xml)
+                self.body_model(body, xml)
                 self.body_written[k] = xml
 
-    def compiled_body(self, body: int, xml: str) -> None:
+    def body_model(self, body: int, xml: str) -> None:
         """Writes what MuJoCo derives from ``body``'s geoms, read off its compile of their
-        little model ``xml`` (the same computation on the same numbers: each geom's size,
+        body model ``xml`` (the same computation on the same numbers: each geom's size,
         bounding radius and box, the body's mass, inertia and inertial frame, its bounding
-        volumes). Raises when the little model's layout is not the body's (the document is
+        volumes). Raises when the body model's layout is not the body's (the document is
         then compiled)."""
         mini = self.body_models.get(xml)
         if mini is None:
             try:
                 mini = self.mujoco.MjModel.from_xml_string(xml)
             except ValueError as e:
-                raise _error(f"body '{self.model.body(body).name}': its geoms alone: {e}") from None
+                raise error(f"body '{self.model.body(body).name}': its geoms alone: {e}") from None
             if len(self.body_models) >= 64:
                 del self.body_models[next(iter(self.body_models))]
             self.body_models[xml] = mini
@@ -338,7 +338,7 @@ class _Plan:
         if kept is not None and not (
             np.array_equal(model.body_pos[body], kept[0]) and np.array_equal(model.body_quat[body], kept[1])
         ):
-            raise _error(f"body '{model.body(body).name}' has no mass and another frame: not a patch of it")
+            raise error(f"body '{model.body(body).name}' has no mass and another frame: not a patch of it")
         if (
             mini.nbody != 2
             or int(mini.body_geomnum[1]) != n
@@ -350,7 +350,7 @@ class _Plan:
             or not np.array_equal(mini.bvh_depth[mbvh : mbvh + nbvh], model.bvh_depth[bvh : bvh + nbvh])
             or not np.array_equal(mini.bvh_nodeid[mbvh : mbvh + nbvh] + (first - mfirst) * (mini.bvh_nodeid[mbvh : mbvh + nbvh] >= 0), model.bvh_nodeid[bvh : bvh + nbvh])
         ):
-            raise _error(
+            raise error(
                 f"body '{model.body(body).name}': its geoms compile to another layout than "
                 "this structure's (sizes, frames or densities that move or turn its inertial "
                 "frame off its own, or another bounding-volume tree): not a patch of it"
@@ -427,11 +427,11 @@ class _Plan:
             self.by_geom_body.maximum(body, far)
         if self.nbody > 1:
             body[1:] = np.maximum(body[1:], 1e-5)
-            stat.meansize = _in_order_sum(body[1:] / (self.nbody - 1))
-            stat.meanmass = _in_order_sum(self.body_mass) / (self.nbody - 1)
+            stat.meansize = in_order_sum(body[1:] / (self.nbody - 1))
+            stat.meanmass = in_order_sum(self.body_mass) / (self.nbody - 1)
         # Rotational dofs take their body's size.
         if self.nv:
             if self.dof_length is not None:
                 self.dof_length[:] = np.where(self.rotational, body[self.dof_body], 1.0)
-            stat.meaninertia = _in_order_sum(self.M[self.M_diagonal]) / self.nv
+            stat.meaninertia = in_order_sum(self.M[self.M_diagonal]) / self.nv
         stat.extent = max(extent, 2 * stat.meansize)

@@ -39,8 +39,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from . import base as _base
-from ._doc_cache import _VISUAL
+from . import _settings
+from ._doc_cache import VISUAL
 
 _KEPT = threading.local()
 # Simulations a forked child inherited kept: never used (their OpenGL contexts belong to
@@ -73,7 +73,7 @@ def _render_inputs(mujoco: Any, model: Any) -> bytes:
     """What a new render context takes from ``model`` besides the bulk data, as bytes:
     equal bytes, equal context."""
     parts = [np.float64(model.stat.extent).tobytes()]
-    for group in _VISUAL:
+    for group in VISUAL:
         obj = getattr(model.vis, group)
         for name in sorted(dir(obj)):
             if not name.startswith("_"):
@@ -117,7 +117,7 @@ def keep_simulations(sim_class: Any) -> None:
             free_sim(sim)
 
     def free(self: Any) -> None:
-        if _base.model_cache() is None:
+        if _settings.model_cache() is None:
             return free_sim(self)
         previous, _KEPT.sim = getattr(_KEPT, "sim", None), (self, True)
         if previous is not None and previous[0] is not self:
@@ -125,7 +125,7 @@ def keep_simulations(sim_class: Any) -> None:
 
     def from_xml_string(cls: Any, xml: str) -> Any:
         offered, _KEPT.sim = getattr(_KEPT, "sim", None), None
-        cache = _base.model_cache()
+        cache = _settings.model_cache()
         if cache is None or offered is None or type(offered[0]) is not cls:
             if offered is not None:
                 release(*offered)
@@ -163,7 +163,7 @@ def keep_environment(env_class: Any) -> None:
         # A hard reset that does not free the simulation (robosuite 1.5's, unless its
         # renderer is "mujoco") lets go of it as the new one is made: offered too.
         sim = getattr(self, "sim", None)
-        if sim is not None and getattr(_KEPT, "sim", None) is None and _base.model_cache() is not None:
+        if sim is not None and getattr(_KEPT, "sim", None) is None and _settings.model_cache() is not None:
             _KEPT.sim = (sim, False)
         return initialize_sim(self, xml_string)
 

@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from ._plan import _OBJ, _target_array
+from ._plan import OBJ, target_array
 
 # Patch targets (MjModel arrays) that mj_setConst reads: a tree written into through
 # them is derived again per world.
@@ -234,7 +234,7 @@ class TreeDerivation:
         for obj, name, field in layout:
             if obj == "option":
                 continue
-            target = _target_array(obj, field)
+            target = target_array(obj, field)
             if field == "geoms":
                 target = "body_mass"
             if target in ("geom_pos", "geom_quat", "site_pos", "site_quat"):
@@ -250,7 +250,7 @@ class TreeDerivation:
             if body is None:
                 return None
             roots.add(int(model.body_rootid[body]))
-            if field == "geoms":  # a little model writes the geoms' frames too
+            if field == "geoms":  # a body model writes the geoms' frames too
                 framed_bodies.add(body)
                 framed.update(("geom", int(g)) for g in np.flatnonzero(model.geom_bodyid == body))
             elif target in ("body_ipos", "body_iquat"):
@@ -346,7 +346,7 @@ class TreeDerivation:
 
 
 def _id_of(mujoco: Any, model: Any, obj: str, name: Any) -> int | None:
-    kind = _OBJ.get(obj)
+    kind = OBJ.get(obj)
     if kind is None:
         return None
     i = name if isinstance(name, int) else mujoco.mj_name2id(model, getattr(mujoco.mjtObj, kind), name)

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from ._errors import _error
+from ._errors import error
 
 # Fields MuJoCo Warp holds for all worlds but reads only when sleeping is enabled (a
 # rotational dof's length is its body's size, which for a massless root body depends on
@@ -87,7 +87,7 @@ class WarpWorlds:
                     continue
                 rows = self.arrays.get(name)
                 if rows is not None and not (rows == rows[0]).all():
-                    raise _error(
+                    raise error(
                         f"MuJoCo Warp cannot vary {name} per world (its Model field is shared "
                         "by all worlds), and the batch's worlds differ in it"
                     )

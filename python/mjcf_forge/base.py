@@ -20,6 +20,11 @@ approximations; docs/model-hierarchy.md lists every such difference with MuJoCo'
 Errors are :class:`XMLError`: an :class:`~mjcf_forge.MjcfError` (so a ``ValueError``), and,
 once robosuite is imported, robosuite's own ``robosuite.utils.errors.XMLError`` too, so
 ``except`` clauses of code written for either catch it.
+
+This module holds robosuite's classes; what they stand on lives in rooms of its own and
+is re-exported here under robosuite's names: the error type (``_errors.py``), robosuite's
+``mjcf_utils`` helpers (``_mjcf_utils.py``), the process's rules and model cache
+(``_settings.py``), and the MuJoCo compile a merge calls back (``_upcalls.py``).
 """
 
 from __future__ import annotations
@@ -28,27 +33,45 @@ import difflib
 import os
 import sys
 import xml.dom.minidom
-from typing import Any, Callable, Optional
+from typing import Any, Optional
 
-import numpy as np
-
-from ._mjcf_forge import Document, Element, LoadCache, MjcfError
+from ._mjcf_forge import Document, LoadCache, MjcfError
 from . import _stock
 from . import etree as ET
+from ._errors import XMLError, reraised as _reraised, xml_error
 from ._files import write_atomic
+from ._mjcf_utils import (
+    array_to_string,
+    asset_name as _asset_name,
+    element_filter as _element_filter,
+    group as _group,
+    named as _named,
+    same_subtree as _same_subtree,
+    sort_elements,
+    string_to_array,
+    tree_parent as _tree_parent,
+)
+from . import _settings
+from ._settings import MODEL_CACHE_ENV, RULES, model_cache, rules, set_model_cache, set_rules
+from ._upcalls import compile_inertia as _compile_inertia
 
 __all__ = [
     "MujocoModel",
     "MujocoXML",
     "MujocoXMLModel",
     "FILE_CACHE",
+    "MODEL_CACHE_ENV",
+    "RULES",
     "USING_INSTANCE_RANDOMIZATION",
     "XMLError",
+    "array_to_string",
     "model_cache",
     "rules",
     "set_model_cache",
     "set_rules",
     "sort_elements",
+    "string_to_array",
+    "xml_error",
 ]
 
 #: robosuite's ``macros.USING_INSTANCE_RANDOMIZATION``: give every visual geom without a
@@ -62,259 +85,6 @@ USING_INSTANCE_RANDOMIZATION = False
 #: ``None``: every file is read anew. Either way the document is the file as it is now.
 FILE_CACHE: Optional[LoadCache] = LoadCache(256)
 
-# The rules MujocoXML reads and merges by (see set_rules).
-RULES = ("mujoco", "robosuite")
-_rules = "mujoco"
-
-
-def rules() -> str:
-    """The rules :class:`MujocoXML` reads default classes and merges models by:
-    ``"mujoco"`` (the default) or ``"robosuite"`` (see :func:`set_rules`)."""
-    return _rules
-
-
-def set_rules(rules: str) -> str:
-    """Sets the rules :class:`MujocoXML` reads and merges by, for the models made from then
-    on, and returns the rules it replaces.
-
-    - ``"mujoco"``: MuJoCo's. Default classes inlined exactly; a merge converts a part's
-      compiler settings (angles, Euler sequences, mass settings with the installed
-      ``mujoco``) so that every part compiles to what it compiles to alone, shares
-      identical assets and refuses a name clash, and carries every section. A merged
-      model can differ from stock robosuite's: the table's mass, joint ranges of parts
-      written in degrees, a clashing asset refused (docs/model-hierarchy.md).
-    - ``"robosuite"``: stock robosuite's (1.4.0 and 1.5.2 alike), so that a model compiles
-      to the one stock robosuite builds: only the top-level default classes inlined, a
-      part's ``<compiler>`` dropped (its values read under the base's), the base's asset
-      kept where a part repeats a name, seven sections carried (module
-      ``mjcf_forge._stock``). What :func:`mjcf_forge.robosuite.use` sets by default.
-
-    >>> from mjcf_forge import base
-    >>> previous = base.set_rules("robosuite")
-    >>> base.rules()
-    'robosuite'
-    >>> _ = base.set_rules(previous)
-
-    Raises:
-        ValueError: rules other than ``"mujoco"`` and ``"robosuite"``
-    """
-    global _rules
-    if rules not in RULES:
-        raise ValueError(f"rules are 'mujoco' or 'robosuite', not {rules!r}")
-    previous, _rules = _rules, rules
-    return previous
-
-
-# --------------------------------------------------------------------------------------
-# The error type
-# --------------------------------------------------------------------------------------
-
-
-class XMLError(MjcfError):
-    """A model or merge that :mod:`mjcf_forge.base` refuses (robosuite's ``XMLError``).
-
-    An :class:`~mjcf_forge.MjcfError`, hence a ``ValueError``; ``errors`` holds the
-    message's lines. Raised errors are also instances of robosuite's
-    ``robosuite.utils.errors.XMLError`` whenever that module is imported: the class raised
-    is then a subclass of both (made once, also named ``XMLError``), so ``except
-    XMLError`` works with either import.
-    """
-
-
-_FLAVOURS: dict = {}
-
-
-def _robosuite_xml_error() -> Optional[type]:
-    """robosuite's XMLError if robosuite is imported and ours is not already one."""
-    module = sys.modules.get("robosuite.utils.errors")
-    theirs = getattr(module, "XMLError", None)
-    if (
-        isinstance(theirs, type)
-        and issubclass(theirs, BaseException)
-        and not issubclass(XMLError, theirs)
-    ):
-        return theirs
-    return None
-
-
-def xml_error(message: str, errors: Optional[list] = None) -> XMLError:
-    """An :class:`XMLError` carrying ``message`` (and ``errors``, default: its lines),
-    also robosuite's ``XMLError`` when robosuite is imported."""
-    cls: type = XMLError
-    theirs = _robosuite_xml_error()
-    if theirs is not None:
-        cls = _FLAVOURS.get(theirs)
-        if cls is None:
-            cls = type(
-                "XMLError",
-                (XMLError, theirs),
-                {"__module__": __name__, "__doc__": XMLError.__doc__},
-            )
-            _FLAVOURS[theirs] = cls
-    error = cls(message)
-    error.errors = list(errors) if errors else str(message).splitlines() or [str(message)]
-    return error
-
-
-def _reraised(error: MjcfError) -> XMLError:
-    return xml_error(str(error), getattr(error, "errors", None))
-
-
-# --------------------------------------------------------------------------------------
-# Helpers (robosuite's mjcf_utils, with MuJoCo's rules where robosuite's differ)
-# --------------------------------------------------------------------------------------
-
-
-def array_to_string(array: Any) -> str:
-    """``[0, 1, 2]`` as ``"0 1 2"`` (robosuite's ``array_to_string``)."""
-    return " ".join(["{}".format(x) for x in array])
-
-
-def string_to_array(string: str) -> np.ndarray:
-    """``"0 1 2"`` as ``array([0., 1., 2.])`` (any white space between numbers)."""
-    return np.array([float(x) for x in string.split()])
-
-
-# Where MuJoCo takes a <body>, <geom>, <site> or <joint> as part of the kinematic tree.
-_TREE = {"worldbody", "body", "frame", "replicate"}
-
-
-def _group(element: Any) -> Optional[int]:
-    """A geom's group as MuJoCo reads it (0 when absent), or None if it is no integer."""
-    value = element.get("group")
-    if value is None:
-        return 0
-    try:
-        return int(value.strip())
-    except ValueError:
-        return None
-
-
-def _tree_parent(element: Any, parent: Any) -> bool:
-    return parent is not None and parent.tag in _TREE
-
-
-def _element_filter(element: Any, parent: Any) -> Optional[str]:
-    """robosuite's ``_element_filter`` with MuJoCo's scopes: the key ``element`` is sorted
-    under (``"root_body"``, ``"bodies"``, ``"joints"``, ``"actuators"``, ``"sites"``,
-    ``"sensors"``, ``"contact_geoms"``, ``"visual_geoms"``), or None.
-
-    Bodies, joints, sites and geoms count only in the kinematic tree (not a tendon's
-    ``<site>``/``<geom>`` wrap references, an equality's ``<joint>``, or ``<default>``);
-    a body is the root body when no body encloses it (frames do not count); every child
-    of ``<sensor>`` is a sensor. As robosuite: ``<freejoint>`` is not listed, geoms of
-    groups other than 0 and 1 are not.
-    """
-    tag = element.tag
-    if parent is not None and parent.tag == "actuator":
-        return "actuators"
-    if parent is not None and parent.tag == "sensor":
-        return "sensors"
-    if not _tree_parent(element, parent):
-        return None
-    if tag == "joint":
-        return "joints"
-    if tag == "body":
-        above = parent
-        while above is not None and above.tag in ("frame", "replicate"):
-            above = above.parent
-        return "bodies" if above is not None and above.tag == "body" else "root_body"
-    if tag == "site":
-        return "sites"
-    if tag == "geom":
-        group = _group(element)
-        if group == 0:
-            return "contact_geoms"
-        if group == 1:
-            return "visual_geoms"
-    return None
-
-
-def sort_elements(
-    root: Any,
-    parent: Any = None,
-    element_filter: Optional[Callable[[Any, Any], Optional[str]]] = None,
-    _elements_dict: Optional[dict] = None,
-) -> dict:
-    """robosuite's ``sort_elements``: every element under ``root`` (itself included, in
-    document order) grouped in lists under the key ``element_filter(element, parent)``
-    returns (None: left out). The default filter is :func:`_element_filter`."""
-    if _elements_dict is None:
-        _elements_dict = {}
-    if element_filter is None:
-        element_filter = _element_filter
-    # Depth first in document order, without recursion (models nest deep).
-    stack = [(root, parent)]
-    while stack:
-        element, above = stack.pop()
-        key = element_filter(element, above)
-        if key is not None:
-            _elements_dict.setdefault(key, []).append(element)
-        children = list(element)
-        stack.extend((child, element) for child in reversed(children))
-    return _elements_dict
-
-
-# The module's own sorting functions: while they are the ones in use (not replaced on the
-# module), MujocoXMLModel sorts its elements natively (Document._sort_elements), with the
-# same result; a replaced one is honoured through the Python path.
-_SORTING = None
-
-
-def _native_sorting() -> bool:
-    g = globals()
-    for name, fn in _SORTING:
-        if g[name] is not fn:
-            return False
-    return True
-
-
-def _find_elements(root: Any, tags: Any, attribs: Optional[dict] = None) -> Optional[Any]:
-    """The first element under ``root`` (itself included) with one of ``tags`` and the
-    given attribute values (robosuite's ``find_elements(..., return_first=True)``)."""
-    tags = [tags] if isinstance(tags, str) else tags
-    for element in root.iter():
-        if element.tag in tags and all(element.get(k) == v for k, v in (attribs or {}).items()):
-            return element
-    return None
-
-
-def _without_materials(xml: str) -> str:
-    """``xml`` without its materials and textures, and without every reference to a
-    material: what no mass or inertia depends on. A part may refer to materials that the
-    model it goes into gets only later (robosuite's TwoArmPegInHole puts a peg with its
-    material into each robot and merges the material into the task afterwards), so the
-    part alone is compiled without them (and without decoding textures)."""
-    import xml.etree.ElementTree as XET
-
-    root = XET.fromstring(xml)
-    for asset in root.iter("asset"):
-        for child in [c for c in asset if c.tag in ("material", "texture")]:
-            asset.remove(child)
-    for element in root.iter():
-        element.attrib.pop("material", None)
-    return XET.tostring(root, encoding="unicode")
-
-
-def _compile_inertia(xml: str, model_dir: Any) -> tuple:
-    """The bodies' names, masses and inertias as the installed ``mujoco`` compiles ``xml``
-    alone: what a merge writes out when a part's compiler mass settings differ from the
-    base's (``Document.merge(compile_inertia=...)``). Through the process's model cache
-    when it is on: robosuite merges the same arena at every hard reset."""
-    import mujoco
-
-    xml = _without_materials(xml)
-    cache = model_cache()
-    model = cache.model(xml) if cache is not None else mujoco.MjModel.from_xml_string(xml)
-    names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, i) or "" for i in range(model.nbody)]
-    return (
-        names,
-        model.body_mass.ravel().tolist(),
-        model.body_ipos.ravel().tolist(),
-        model.body_iquat.ravel().tolist(),
-        model.body_inertia.ravel().tolist(),
-    )
-
 
 def _instance_randomization() -> bool:
     macros = sys.modules.get("robosuite.macros")
@@ -323,99 +93,22 @@ def _instance_randomization() -> bool:
     return bool(USING_INSTANCE_RANDOMIZATION)
 
 
-def _named(names: list) -> list:
-    """The names of a raw list (robosuite's ``_joints`` and friends) without the ``None``
-    of unnamed elements, which no name can refer to."""
-    return [n for n in names if n is not None]
+# The sorting functions robosuite's classes call, by their names here: while they are the
+# ones in use (not replaced on this module), MujocoXMLModel sorts its elements natively
+# (Document._sort_elements), with the same result; a replaced one is honoured through the
+# Python path.
+_SORTING = (
+    ("sort_elements", sort_elements),
+    ("_element_filter", _element_filter),
+    ("_group", _group),
+    ("_tree_parent", _tree_parent),
+)
 
 
-def _same_subtree(a: Any, b: Any) -> bool:
-    """Same tag, attributes (any order), text and children, recursively."""
-    if a.tag != b.tag or dict(a.items()) != dict(b.items()):
-        return False
-    if (a.text or "").strip() != (b.text or "").strip():
-        return False
-    kids_a, kids_b = list(a), list(b)
-    return len(kids_a) == len(kids_b) and all(_same_subtree(x, y) for x, y in zip(kids_a, kids_b))
+def _native_sorting() -> bool:
+    g = globals()
+    return all(g[name] is fn for name, fn in _SORTING)
 
-
-# Assets MuJoCo names after their file when they have no name of their own.
-_NAMED_AFTER_FILE = {"mesh", "texture", "hfield", "skin"}
-
-
-def _asset_name(asset: Any) -> Optional[str]:
-    name = asset.get("name")
-    if name:
-        return name
-    if asset.tag in _NAMED_AFTER_FILE and asset.get("file"):
-        stem = os.path.splitext(os.path.basename(asset.get("file").replace("\\", "/")))[0]
-        return stem or None
-    return None
-
-
-# --------------------------------------------------------------------------------------
-# The process's model cache
-# --------------------------------------------------------------------------------------
-
-#: The environment variable that turns the process's model cache off before it is made:
-#: ``MJCF_FORGE_MODEL_CACHE=0`` (or ``off``, ``false``, ``no``).
-MODEL_CACHE_ENV = "MJCF_FORGE_MODEL_CACHE"
-
-_UNSET: Any = object()
-_model_cache: Any = _UNSET
-
-
-def model_cache() -> Optional[Any]:
-    """The process's :class:`~mjcf_forge.DocumentCache`, through which
-    :meth:`MujocoXML.get_model` (and, with :func:`mjcf_forge.robosuite.use`, robosuite's
-    simulations) compiles, or ``None`` when it is off.
-
-    On by default: made on first use (at most 8 structures, least recently used out), unless
-    the environment variable ``MJCF_FORGE_MODEL_CACHE`` is ``0``, ``off``, ``false`` or
-    ``no``. :func:`set_model_cache` replaces it or turns it off.
-    """
-    global _model_cache
-    if _model_cache is _UNSET:
-        if os.environ.get(MODEL_CACHE_ENV, "").strip().lower() in ("0", "off", "false", "no"):
-            _model_cache = None
-        else:
-            from ._doc_cache import DocumentCache
-
-            _model_cache = DocumentCache(max_models=8)
-    return _model_cache
-
-
-def set_model_cache(cache: Any) -> Optional[Any]:
-    """Sets the process's model cache (see :func:`model_cache`) and returns the one it
-    replaces (``None`` if it was off), so a caller can put it back.
-
-    Args:
-        cache: a :class:`~mjcf_forge.DocumentCache` (yours, with your bounds), ``True`` (a
-            new default one), or ``None`` / ``False`` (off: every ``get_model`` compiles)
-
-    >>> from mjcf_forge import base
-    >>> previous = base.set_model_cache(None)      # off: MuJoCo compiles every model
-    >>> base.model_cache() is None
-    True
-    >>> _ = base.set_model_cache(previous)         # as it was
-    """
-    global _model_cache
-    from ._doc_cache import DocumentCache
-
-    if cache is True:
-        cache = DocumentCache(max_models=8)
-    elif cache is False:
-        cache = None
-    elif cache is not None and not isinstance(cache, DocumentCache):
-        raise TypeError(f"set_model_cache takes a DocumentCache, True, False or None, not {type(cache).__name__}")
-    previous = model_cache()
-    _model_cache = cache
-    return previous
-
-
-# --------------------------------------------------------------------------------------
-# MujocoXML
-# --------------------------------------------------------------------------------------
 
 def _load_exact(fname: str) -> Any:
     files = FILE_CACHE
@@ -424,7 +117,6 @@ def _load_exact(fname: str) -> Any:
 
 # The sections MujocoXML holds, in robosuite's order (created in that order when missing).
 _SECTIONS = ["worldbody", "actuator", "sensor", "asset", "tendon", "equality", "contact"]
-
 
 
 class MujocoXML(object):
@@ -452,7 +144,7 @@ class MujocoXML(object):
         self.file = fname
         self.folder = os.path.dirname(fname)
         try:
-            if _rules == "robosuite":
+            if _settings.rules() == "robosuite":
                 self.document = _stock.load(fname, _load_exact, xml_error)
             else:
                 self.document = _load_exact(fname)
@@ -541,7 +233,7 @@ class MujocoXML(object):
                 raise xml_error(
                     "merge_body {!r} is not a body of {}{}".format(body, self._label(), hint)
                 )
-        if _rules == "robosuite":
+        if _settings.rules() == "robosuite":
             into = None if body is None and not worldbody else (
                 self.worldbody if body is None else self.worldbody.find_named("body", body))
             for other in others:
@@ -617,7 +309,7 @@ class MujocoXML(object):
         With ``rules="robosuite"`` (:func:`set_rules`), robosuite's rule instead: an asset
         whose tag and ``name`` are here already is left out, whatever its content.
         """
-        if _rules == "robosuite":
+        if _settings.rules() == "robosuite":
             _stock.merge_assets(self, other)
             return
         names = {}
@@ -941,7 +633,7 @@ class MujocoXMLModel(MujocoXML, MujocoModel):
             def keep(name):
                 return name in kept or bool(exclude(name))
 
-        if _rules == "robosuite":
+        if _settings.rules() == "robosuite":
             # robosuite's add_prefix leaves a value that already begins with the prefix.
             excluded = keep
 
@@ -1082,7 +774,3 @@ class MujocoXMLModel(MujocoXML, MujocoModel):
         """Defined by subclasses."""
         raise NotImplementedError
 
-
-_SORTING = tuple(
-    (fn.__name__, fn) for fn in (sort_elements, _element_filter, _group, _tree_parent)
-)

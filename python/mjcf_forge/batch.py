@@ -33,10 +33,10 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ._cache import _STATIC_PREFIXES, ModelCache
-from ._errors import _error
+from ._cache import STATIC_PREFIXES, ModelCache
+from ._errors import error
 from ._mjx import MjxWorlds
-from ._plan import _target_array
+from ._plan import target_array
 from ._progress import progress_of
 from ._warp import WarpWorlds
 
@@ -59,8 +59,8 @@ _DERIVED = (
     "light_dir0",
     "dof_length",
 )
-# What a world's patch writes besides its own arrays: a body's little model
-# (_plan._Plan.compiled_body) and the same-frame flags (_trees).
+# What a world's patch writes besides its own arrays: a body model
+# (_plan.Plan.body_model) and the same-frame flags (_trees).
 _WRITTEN = (
     "geom_size", "geom_rbound", "geom_aabb", "geom_pos", "geom_quat",
     "body_mass", "body_inertia", "body_ipos", "body_iquat",
@@ -78,7 +78,7 @@ class _Index(NamedTuple):
 
 def _patched_arrays(patch: Sequence) -> set[str]:
     """The MjModel arrays a superset patch writes (``matid`` included)."""
-    targets = (_target_array(obj, field) for obj, _name, field, _value in patch)
+    targets = (target_array(obj, field) for obj, _name, field, _value in patch)
     return {t for t in targets if t is not None}
 
 
@@ -116,7 +116,7 @@ class WorldBatch(WarpWorlds, MjxWorlds):
             raise ValueError("WorldBatch needs ModelCache(scene, superset=True) or a Scene")
         indices = [int(getattr(v, "index", v)) for v in variants]
         if not indices:
-            raise _error("a batch needs at least one world: no variant was given (0 worlds)")
+            raise error("a batch needs at least one world: no variant was given (0 worlds)")
         self.cache = cache
         self.superset = cache.superset
         # A variant the superset cannot express fails (in its patch), with its index. The
@@ -134,7 +134,7 @@ class WorldBatch(WarpWorlds, MjxWorlds):
             for n in dir(model)
             if not n.startswith("_")
             and isinstance(getattr(model, n, None), np.ndarray)
-            and not n.startswith(_STATIC_PREFIXES)
+            and not n.startswith(STATIC_PREFIXES)
         ]
         self._candidates = sorted((self._patched | set(_DERIVED)) & set(self._fields))
         # Every other field as the batch's first world holds it: a world's row of one is
@@ -201,11 +201,11 @@ class WorldBatch(WarpWorlds, MjxWorlds):
             i = self.cache._mujoco.mj_name2id(model, self.cache._mujoco.mjtObj.mjOBJ_KEY, key)
             if i < 0:
                 names = [model.key(k).name for k in range(model.nkey)]
-                raise _error(f"the scene has no keyframe '{key}' (its keyframes: {names})")
+                raise error(f"the scene has no keyframe '{key}' (its keyframes: {names})")
             return int(i)
         i = int(key)
         if not 0 <= i < model.nkey:
-            raise _error(f"keyframe {i} is out of range: the scene has {model.nkey}")
+            raise error(f"keyframe {i} is out of range: the scene has {model.nkey}")
         return i
 
     def initial(self) -> dict[str, np.ndarray]:
@@ -274,7 +274,7 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         self.derived_by_tree += by_tree
         out = {n: getattr(model, n).copy() for n in self._candidates}
         # mj_setConst may write any field (none differs for a superset patch); derived
-        # tree by tree, only the patch and its bodies' little models write.
+        # tree by tree, only the patch and its body models write.
         if not by_tree:
             others = self._others
         elif self._plan_of_scratch().bodies:
@@ -309,7 +309,7 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         if parked[pairs].any():
             g1, g2 = (int(g) for g in pairs[np.flatnonzero(parked[pairs].any(axis=1))[0]])
             a, b = (g1, g2) if parked[g1] else (g2, g1)
-            raise _error(
+            raise error(
                 f"variant {index}: parked geom '{model.geom(a).name or a}' (object "
                 f"'{model.body(int(self._root_of_geom[a])).name}') touches geom "
                 f"'{model.geom(b).name or b}': its parking cell is within reach"
@@ -333,12 +333,12 @@ class WorldBatch(WarpWorlds, MjxWorlds):
             raise ValueError("assign() needs one variant per world")
         for w in worlds:
             if not 0 <= w < self.nworld:
-                raise _error(f"world {w} is not in the batch (0 to {self.nworld - 1})")
+                raise error(f"world {w} is not in the batch (0 to {self.nworld - 1})")
         rows = [self._rows(world) for world in self._worlds(indices)]
         for i, r in zip(indices, rows):
             for n in r:
                 if n not in self.arrays and n != "parked_geoms" and n not in self.keys:
-                    raise _error(
+                    raise error(
                         f"variant {i}: field {n} differs from the batch's, where all worlds "
                         "share one value (build a new WorldBatch)"
                     )

@@ -14,8 +14,7 @@ use mjcf_forge::ErrorKind;
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::sync::PyOnceLock;
-use pyo3::types::{PyList, PyType};
+use pyo3::types::PyList;
 
 create_exception!(
     mjcf_forge,
@@ -27,10 +26,6 @@ create_exception!(
      as the ``mjcf-forge`` command line prints them. ``error.errors`` holds the same lines as\n\
      a list of ``str``, one per problem, all problems of the pass at once."
 );
-
-/// `mjcf_forge.MjcfFileNotFoundError(MjcfError, FileNotFoundError)`, a Python class
-/// (`mjcf_forge/_errors.py`: `create_exception!` makes classes of one base only).
-static FILE_NOT_FOUND: PyOnceLock<Py<PyType>> = PyOnceLock::new();
 
 /// What went wrong on the Rust side, as the lines the exception will carry.
 #[derive(Debug)]
@@ -127,7 +122,9 @@ pub(crate) fn mjcf_error(lines: Vec<String>) -> PyErr {
 /// An `MjcfFileNotFoundError` told by `lines`, about `path` (an error making it is
 /// returned as the error to raise).
 fn file_not_found(py: Python<'_>, lines: Vec<String>, path: &Path) -> Result<PyErr, PyErr> {
-    let class = FILE_NOT_FOUND.import(py, "mjcf_forge._errors", "MjcfFileNotFoundError")?;
+    // A Python class (`mjcf_forge/_errors.py`): `create_exception!` makes classes of one
+    // base only.
+    let class = crate::upcalls::get(py, "MjcfFileNotFoundError")?;
     let value = class.call1((lines.join("\n"),))?;
     value.setattr("errors", PyList::new(py, &lines)?)?;
     value.setattr("errno", py.import("errno")?.getattr("ENOENT")?)?;

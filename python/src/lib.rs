@@ -7,15 +7,16 @@
 //! The files mirror the library's tiers: `document/` (the document tier, with elements that
 //! behave as `xml.etree` elements), `model.rs`
 //! (instances), `scene/` (the batch tier: scenes, variants, the stream, the superset);
-//! `errors.rs` is the edge where Rust errors and panics become `MjcfError`. The compiled
-//! tier's face, `ModelCache`, is Python (`mjcf_forge/_cache.py`), over the user's own
-//! `mujoco` package.
+//! `errors.rs` is the edge where Rust errors and panics become `MjcfError`; `upcalls.rs`
+//! the one way up into the package's Python code. The compiled tier's face, `ModelCache`,
+//! is Python (`mjcf_forge/_cache.py`), over the user's own `mujoco` package.
 #![forbid(unsafe_code)]
 
 mod document;
 mod errors;
 mod model;
 mod scene;
+mod upcalls;
 
 use pyo3::prelude::*;
 

@@ -74,7 +74,7 @@ OWN = {
 def own_values(part_xml):
     """``{array: {name: values}}`` of the part compiled alone (without its materials, as a
     merge compiles it), or the compiler's error."""
-    from mjcf_forge.base import _without_materials
+    from mjcf_forge._mjcf_utils import without_materials as _without_materials
 
     try:
         model = mujoco.MjModel.from_xml_string(_without_materials(part_xml))

@@ -302,7 +302,7 @@ def test_mujoco_warp_libero_worlds_agree_with_each_variant():
 
 
 # The built-in demo (a robot arm, blocks whose slab turns per variant: geom frames carried
-# by little models, per-world geom_quat): superset worlds follow their variant alone in
+# by body models, per-world geom_quat): superset worlds follow their variant alone in
 # Warp within 1.7e-5 m after 500 steps, and the variant alone in Warp parts from CPU MuJoCo
 # by up to 1.1e-4 m (world 2, float32 against float64; measured).
 DEMO_VS_WARP = 5e-5

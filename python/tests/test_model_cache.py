@@ -103,7 +103,7 @@ def test_structural_values_are_compiled_never_patched():
     assert len(cache) == 2
 
 
-def test_geom_sizes_frames_and_densities_are_carried_by_little_models():
+def test_geom_sizes_frames_and_densities_are_carried_by_body_models():
     # What MuJoCo derives from a geom's size, frame and density (bounding radius and box,
     # the body's mass, inertia, inertial frame and bounding volumes) comes from compiling
     # the body's geoms alone: one structure, every variant exact.
@@ -130,7 +130,7 @@ def test_geom_sizes_frames_and_densities_are_carried_by_little_models():
 def test_mass_of_bodies_without_inertial_is_a_patch():
     # A body without <inertial> (a box of two geoms, one with a frame and a written mass,
     # a mesh): its mass scale scales every geom's density or mass by one factor, carried by
-    # the body's little model (frames and meshes included), so its variants are patches
+    # the body model (frames and meshes included), so its variants are patches
     # and the superset holds them.
     scene = mjcf_forge.Scene.load(PATCH / "mass.toml")
     variants = [scene.variant(i) for i in range(24)]
@@ -149,7 +149,7 @@ def test_mass_of_bodies_without_inertial_is_a_patch():
 def test_written_inertials_make_masses_patches_without_compiles(monkeypatch):
     # write_inertials = true: each object body whose mass MuJoCo infers from its geoms gets
     # MuJoCo's own <inertial> when the scene loads (the file compiled alone), so a mass
-    # randomizer scales that <inertial>: no geom density changes, no little model to
+    # randomizer scales that <inertial>: no geom density changes, no body model to
     # compile, every variant a patch, exact.
     text = (PATCH / "inertials.toml").read_text()
     scene = mjcf_forge.Scene.load(PATCH / "inertials.toml")
@@ -166,7 +166,7 @@ def test_written_inertials_make_masses_patches_without_compiles(monkeypatch):
         ref, ours = mujoco.MjModel.from_xml_string(a.xml), mujoco.MjModel.from_xml_string(b.xml)
         assert judge.compare_models(ref, ours) == [] and not_bit_identical(ref, ours) == [], i
     compiled = []
-    monkeypatch.setattr(mjcf_forge._plan._Plan, "compiled_body", lambda *a: compiled.append(a))
+    monkeypatch.setattr(mjcf_forge._plan.Plan, "body_model", lambda *a: compiled.append(a))
     cache = mjcf_forge.ModelCache(scene)
     for v in variants:
         check_exact(v, cache.model(v))
@@ -527,7 +527,7 @@ def test_superset_names_unnamed_geoms_itself():
 
 
 def test_superset_carries_the_demo_scene():
-    # The demo turns a block's slab (a geom's orientation): carried by the block's little
+    # The demo turns a block's slab (a geom's orientation): carried by the block's body
     # model, placed or parked.
     cache = _superset_check(mjcf_forge.Scene.demo(), range(4), trajectory_tolerance=1e-4)
     assert cache.compiles == 1
@@ -590,7 +590,7 @@ def test_batch_calls_report_progress(capsys, monkeypatch):
 @pytest.mark.parametrize(
     "path, worlds, by_tree",
     [
-        (PATCH / "mass.toml", 24, True),  # masses through little models (frames, meshes)
+        (PATCH / "mass.toml", 24, True),  # masses through body models (frames, meshes)
         (PATCH / "fixed.toml", 24, True),  # fixed bases (no dofs) beside free objects
         (PATCH / "boxes.toml", 24, True),
         (PATCH / "patch.toml", 8, False),  # the robot's armature: a tree with actuators

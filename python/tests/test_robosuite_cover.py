@@ -50,7 +50,7 @@ import pytest
 import judge
 import mjcf_forge
 from conftest import ROOT
-from mjcf_forge.base import _without_materials
+from mjcf_forge._mjcf_utils import without_materials as _without_materials
 
 RS_ENV = ROOT / ".cache" / "venv-robosuite-env" / "bin" / "python"
 SCRIPT = Path(__file__).with_name("robosuite_cover.py")

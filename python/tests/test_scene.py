@@ -181,7 +181,7 @@ def test_scenes_and_variants_pickle(tmp_path, monkeypatch):
     v = scenes[1].variant(4)
     w = pickle.loads(pickle.dumps(v))
     assert (w.index, w.xml, w.params, repr(w)) == (v.index, v.xml, v.params, repr(v))
-    # Its patch too, a body's little model (the demo turns a slab) included.
+    # Its patch too, a body model (the demo turns a slab) included.
     assert w.patch == v.patch and any(f == "geoms" for _, _, f, _ in w.patch)
     assert w.structure_key == v.structure_key
     # The copy's document is read back from the XML: the same model, the same text.

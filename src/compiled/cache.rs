@@ -10,12 +10,14 @@
 use std::collections::HashMap;
 use std::ffi::{CString, c_int};
 
-use super::store::{
-    Signature, State, Store, mjf_patch_array, mjf_patch_array_name, mjf_patch_get_stat,
-    mjf_patch_meaninertia, mjf_patch_name2id,
+use super::store::{Signature, State, Store};
+use super::sys::{
+    mjf_patch_array, mjf_patch_array_name, mjf_patch_get_stat, mjf_patch_meaninertia,
+    mjf_patch_name2id,
 };
 use crate::mujoco::{CompileError, CompiledModel, compile_str};
-use crate::scene::{PatchEntry, Scene, Superset, VariantPatch};
+use crate::scene::{Scene, Superset, VariantPatch};
+use crate::split::PatchEntry;
 
 impl CompiledModel {
     /// Where `other` differs from this model: every array of `mjModel` compared bit for

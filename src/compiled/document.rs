@@ -1,6 +1,6 @@
 //! Compiled models of any documents at patch cost: a [`DocumentCache`] splits each document
 //! it is given into a structure key and a patch
-//! ([`split_document`](crate::scene::split_document)), compiles a structure the first time
+//! ([`split_document`](crate::split::split_document)), compiles a structure the first time
 //! it sees it, and from then on writes the patch into that model (then `mj_setConst` and
 //! the compiler's statistics, as [`super::ModelCache`] does): the model MuJoCo compiles
 //! from the document, every array bit for bit (`tests/document_cache.rs`).
@@ -11,7 +11,7 @@ use super::store::Store;
 use crate::document::Document;
 use crate::error::{Error, ErrorKind, Errors};
 use crate::mujoco::{CompiledModel, compile_document};
-use crate::scene::{SplitOptions, split_document_with};
+use crate::split::{SplitOptions, split_document_with};
 
 /// Compiled models of documents, one per structure, patched per document; bounded in
 /// count and bytes (models and their scratch data), least recently used out.
@@ -64,12 +64,7 @@ impl DocumentCache {
     /// document, is at the element it names in the document's sources
     /// ([`Document::mujoco_error`]); the cache is then as it was.
     pub fn model(&mut self, doc: &Document) -> Result<&CompiledModel, Errors> {
-        let split = split_document_with(
-            doc,
-            SplitOptions {
-                compiled_bodies: true,
-            },
-        );
+        let split = split_document_with(doc, SplitOptions { body_models: true });
         let key = split.structure_key.as_str();
         // When a value does not fit the cached model (a material that does not exist),
         // MuJoCo's own verdict follows. The cached model is whole again after its next

@@ -5,7 +5,7 @@
 //! turns that model into any variant of the structure by writing the variant's patch into
 //! its arrays; [`DocumentCache`] does the same for any [`Document`](crate::Document),
 //! finding its structure and patch by reading it
-//! ([`split_document`](crate::scene::split_document)). Both keep their models in one
+//! ([`split_document`](crate::split::split_document)). Both keep their models in one
 //! mechanism (`store.rs`: models by structure key, least recently used out, and how a
 //! model is patched). This tier is where whatever hands compiled models to simulators
 //! belongs: model caches, and the per-world arrays batched simulators take.
@@ -27,10 +27,11 @@
 // compiles against the linked MuJoCo's headers), as the FFI tier does.
 #![allow(unsafe_code)]
 
+mod body_models;
 mod cache;
 mod document;
-mod little;
 mod store;
+mod sys;
 mod worlds;
 
 pub use cache::ModelCache;

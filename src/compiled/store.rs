@@ -13,53 +13,13 @@ use std::collections::HashMap;
 use std::ffi::{CString, c_char, c_int, c_void};
 use std::ptr::NonNull;
 
-use super::little::Little;
+use super::body_models::BodyModels;
+use super::sys::{
+    RawData, mjf_patch_array, mjf_patch_delete_data, mjf_patch_finish, mjf_patch_get_stat,
+    mjf_patch_make_data, mjf_patch_nbytes, mjf_patch_option,
+};
 use crate::mujoco::{CompiledModel, MjModel, ObjType, Sizes};
-use crate::scene::{PatchEntry, PatchValue};
-
-/// mjData, opaque here: only the C side reads it.
-#[repr(C)]
-pub(super) struct RawData {
-    _private: [u8; 0],
-}
-
-unsafe extern "C" {
-    pub(super) fn mjf_patch_array(
-        m: *mut MjModel,
-        name: *const c_char,
-        elem: *mut usize,
-        count: *mut usize,
-    ) -> *mut c_void;
-    pub(super) fn mjf_patch_name2id(
-        m: *const MjModel,
-        kind: *const c_char,
-        name: *const c_char,
-    ) -> c_int;
-    pub(super) fn mjf_patch_make_data(m: *const MjModel) -> *mut RawData;
-    pub(super) fn mjf_patch_delete_data(d: *mut RawData);
-    pub(super) fn mjf_patch_nbytes(m: *const MjModel, d: *const RawData) -> i64;
-    pub(super) fn mjf_patch_get_stat(m: *const MjModel, out: *mut f64);
-    pub(super) fn mjf_patch_finish(
-        m: *mut MjModel,
-        d: *mut RawData,
-        fixed: c_int,
-        values: *const f64,
-    );
-    pub(super) fn mjf_patch_array_name(i: c_int) -> *const c_char;
-    pub(super) fn mjf_patch_array_type(i: c_int) -> *const c_char;
-    fn mjf_patch_option(
-        m: *mut MjModel,
-        name: *const c_char,
-        elem: *mut usize,
-        count: *mut usize,
-    ) -> *mut c_void;
-    pub(super) fn mjf_patch_meaninertia(
-        m: *mut MjModel,
-        d: *const RawData,
-        keep: *const c_int,
-        n: c_int,
-    );
-}
+use crate::split::{PatchEntry, PatchValue};
 
 /// Scratch mjData for `mj_setConst` (which overwrites the qpos of the data it is given).
 pub(super) struct Scratch(pub(super) NonNull<RawData>);
@@ -97,7 +57,7 @@ pub(super) struct Target {
     /// of every keyframe (`key_qpos`, one row of `nq` per key). One run elsewhere.
     runs: usize,
     stride: usize,
-    /// A body whose little model the entry is (`PatchValue::Compiled`): nothing at `ptr`.
+    /// A body whose body model the entry is (`PatchValue::BodyModel`): nothing at `ptr`.
     body: Option<usize>,
 }
 
@@ -108,8 +68,8 @@ pub(super) struct Plan {
     pub(super) scratch: Scratch,
     fields: Vec<(&'static str, String, Option<usize>, &'static str)>,
     targets: Vec<Target>,
-    /// The little models of its bodies compiled so far.
-    little: Little,
+    /// The body models of its bodies compiled so far.
+    body_models: BodyModels,
     nbytes: usize,
 }
 
@@ -289,7 +249,7 @@ impl State {
             scratch,
             fields: Vec::new(),
             targets: Vec::new(),
-            little: Little::default(),
+            body_models: BodyModels::default(),
             nbytes: usize::try_from(nbytes).unwrap_or(0),
         });
         Ok(self.plans.len() - 1)
@@ -318,7 +278,9 @@ impl State {
         let ptr = model.as_mut_ptr();
         for (t, e) in plan.targets.iter().zip(entries) {
             match (t.body, &e.value) {
-                (Some(body), PatchValue::Compiled(xml)) => plan.little.write(ptr, body, xml)?,
+                (Some(body), PatchValue::BodyModel(xml)) => {
+                    plan.body_models.write(ptr, body, xml)?
+                }
                 _ => write(ptr, t, &e.value)?,
             }
         }
@@ -346,8 +308,8 @@ fn write(model: *mut MjModel, t: &Target, value: &PatchValue) -> Result<(), Stri
             // SAFETY: `ptr` points at `n` >= 1 ints of the live model (see `resolve`).
             unsafe { t.ptr.cast::<c_int>().write_unaligned(id) };
         }
-        PatchValue::Compiled(_) => {
-            return Err("a body's little model is written by its plan".to_string());
+        PatchValue::BodyModel(_) => {
+            return Err("a body model is written by its plan".to_string());
         }
         PatchValue::Numbers(v) => {
             for run in 0..t.runs {
@@ -417,7 +379,7 @@ fn resolve(model: &mut CompiledModel, entries: &[PatchEntry]) -> Result<Vec<Targ
         let width = match &e.value {
             PatchValue::Numbers(v) => v.len(),
             PatchValue::Id { .. } => 1,
-            PatchValue::Compiled(_) => {
+            PatchValue::BodyModel(_) => {
                 out.push(Target {
                     ptr: std::ptr::null_mut(),
                     elem: 0,
@@ -499,7 +461,7 @@ fn option_target(model: *mut MjModel, e: &PatchEntry) -> Result<Target, String> 
     let p = unsafe { mjf_patch_option(model, c.as_ptr(), &mut elem, &mut count) };
     let width = match &e.value {
         PatchValue::Numbers(v) => v.len(),
-        PatchValue::Id { .. } | PatchValue::Compiled(_) => 0,
+        PatchValue::Id { .. } | PatchValue::BodyModel(_) => 0,
     };
     if p.is_null() || elem != std::mem::size_of::<f64>() || count != width {
         return Err(format!(

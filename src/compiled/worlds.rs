@@ -8,9 +8,7 @@
 use std::ffi::CStr;
 
 use super::cache::ModelCache;
-use super::store::{
-    mjf_patch_array, mjf_patch_array_name, mjf_patch_array_type, mjf_patch_get_stat,
-};
+use super::sys::{mjf_patch_array, mjf_patch_array_name, mjf_patch_array_type, mjf_patch_get_stat};
 use crate::mujoco::CompiledModel;
 
 /// Arrays no superset patch changes (meshes, textures, height fields, skins, flexes,

@@ -223,6 +223,24 @@ impl Document {
     }
 }
 
+impl Document {
+    /// Sets `discardvisual="true"` on the document's last `<compiler>` (the one whose setting
+    /// MuJoCo keeps), adding one when it has none.
+    pub(crate) fn set_discard_visual(&mut self) {
+        let root = self.root();
+        let last = self
+            .elements(root)
+            .filter(|&n| self.tag(n) == "compiler")
+            .last();
+        match last {
+            Some(c) => self.set_attr(c, "discardvisual", "true"),
+            None => {
+                self.append_element(root, "compiler", &[("discardvisual", "true")]);
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use crate::{Document, Section};

@@ -26,8 +26,10 @@
 
 pub(crate) mod defaults;
 pub(crate) mod edit;
+pub mod fuzzing;
 pub(crate) mod import;
 pub(crate) mod inertia;
+mod kinematic;
 pub(crate) mod limits;
 pub(crate) mod load;
 pub(crate) mod load_cache;

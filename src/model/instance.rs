@@ -518,48 +518,6 @@ impl XmlModel {
     }
 }
 
-impl Document {
-    /// The bodies whose parent is the world body (directly or through frames).
-    pub(crate) fn top_level_bodies(&self, world: Node) -> Vec<Node> {
-        self.children_through_frames(world, "body")
-    }
-
-    /// The `tag` elements whose parent is `node`, directly or through `<frame>`s, in
-    /// document order (a body's geoms, the world's bodies).
-    pub(crate) fn children_through_frames(&self, node: Node, tag: &str) -> Vec<Node> {
-        let mut out = Vec::new();
-        // Document order through nested frames, from a stack (frames nest without bound).
-        let mut stack: Vec<Node> = self.elements(node).collect();
-        stack.reverse();
-        while let Some(k) = stack.pop() {
-            match self.tag(k) {
-                t if t == tag => out.push(k),
-                "frame" => {
-                    let at = stack.len();
-                    stack.extend(self.elements(k));
-                    stack[at..].reverse();
-                }
-                _ => {}
-            }
-        }
-        out
-    }
-
-    /// Whether an element sits in the kinematic tree as a body's own child (through frames),
-    /// not inside a tendon, composite or default.
-    pub(crate) fn is_body_child(&self, node: Node) -> bool {
-        let mut p = self.parent(node);
-        while let Some(n) = p {
-            match self.tag(n) {
-                "body" | "worldbody" => return true,
-                "frame" => p = self.parent(n),
-                _ => return false,
-            }
-        }
-        false
-    }
-}
-
 impl MujocoModel for XmlModel {
     fn name(&self) -> &str {
         &self.name
@@ -625,47 +583,73 @@ impl MujocoModel for XmlModel {
     }
 }
 
-/// A JSON string literal.
-fn json_str(s: &str) -> String {
-    let mut out = String::with_capacity(s.len() + 2);
-    out.push('"');
-    for c in s.chars() {
-        match c {
-            '"' => out.push_str("\\\""),
-            '\\' => out.push_str("\\\\"),
-            '\n' => out.push_str("\\n"),
-            '\t' => out.push_str("\\t"),
-            '\r' => out.push_str("\\r"),
-            c if (c as u32) < 0x20 => out.push_str(&format!("\\u{:04x}", c as u32)),
-            c => out.push(c),
+/// [`XmlModel::info_json`]'s object, its keys in this order.
+#[derive(serde::Serialize)]
+struct Info<'a> {
+    name: &'a str,
+    naming_prefix: &'a str,
+    root_body: &'a str,
+    bodies: &'a [String],
+    joints: &'a [String],
+    actuators: &'a [String],
+    sites: &'a [String],
+    sensors: &'a [String],
+    contact_geoms: &'a [String],
+    visual_geoms: &'a [String],
+    important_geoms: &'a BTreeMap<String, Vec<String>>,
+    important_sites: &'a BTreeMap<String, String>,
+    important_sensors: &'a BTreeMap<String, String>,
+    base_offset: [f64; 3],
+    bottom_offset: [f64; 3],
+    top_offset: [f64; 3],
+    horizontal_radius: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    geometry_error: Option<&'a str>,
+}
+
+/// JSON on one line with Python's `json.dumps` separators (`", "`, `": "`), and numbers
+/// as Rust prints them (`0`, `0.1`; a number that is not finite is `null`).
+struct OneLine;
+
+impl serde_json::ser::Formatter for OneLine {
+    fn begin_array_value<W: ?Sized + std::io::Write>(
+        &mut self,
+        writer: &mut W,
+        first: bool,
+    ) -> std::io::Result<()> {
+        if first {
+            Ok(())
+        } else {
+            writer.write_all(b", ")
         }
     }
-    out.push('"');
-    out
-}
 
-fn json_list(v: &[String]) -> String {
-    format!(
-        "[{}]",
-        v.iter().map(|s| json_str(s)).collect::<Vec<_>>().join(", ")
-    )
-}
-
-fn json_num(x: f64) -> String {
-    if x.is_finite() {
-        format!("{x}")
-    } else {
-        "null".to_string()
+    fn begin_object_key<W: ?Sized + std::io::Write>(
+        &mut self,
+        writer: &mut W,
+        first: bool,
+    ) -> std::io::Result<()> {
+        if first {
+            Ok(())
+        } else {
+            writer.write_all(b", ")
+        }
     }
-}
 
-fn json_vec3(v: [f64; 3]) -> String {
-    format!(
-        "[{}, {}, {}]",
-        json_num(v[0]),
-        json_num(v[1]),
-        json_num(v[2])
-    )
+    fn begin_object_value<W: ?Sized + std::io::Write>(
+        &mut self,
+        writer: &mut W,
+    ) -> std::io::Result<()> {
+        writer.write_all(b": ")
+    }
+
+    fn write_f64<W: ?Sized + std::io::Write>(
+        &mut self,
+        writer: &mut W,
+        value: f64,
+    ) -> std::io::Result<()> {
+        write!(writer, "{value}")
+    }
 }
 
 impl XmlModel {
@@ -679,46 +663,30 @@ impl XmlModel {
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn info_json(&self) -> String {
-        let maps = |m: &BTreeMap<String, String>| {
-            format!(
-                "{{{}}}",
-                m.iter()
-                    .map(|(k, v)| format!("{}: {}", json_str(k), json_str(v)))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )
-        };
-        let geoms = format!(
-            "{{{}}}",
-            self.important_geoms
-                .iter()
-                .map(|(k, v)| format!("{}: {}", json_str(k), json_list(v)))
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
         let offsets = self.try_offsets();
-        let error = match &offsets {
-            Ok(_) => String::new(),
-            Err(e) => format!(", \"geometry_error\": {}", json_str(e)),
+        let info = Info {
+            name: &self.name,
+            naming_prefix: &self.prefix,
+            root_body: &self.root_body,
+            bodies: self.bodies(),
+            joints: self.joints(),
+            actuators: self.actuators(),
+            sites: self.sites(),
+            sensors: self.sensors(),
+            contact_geoms: self.contact_geoms(),
+            visual_geoms: self.visual_geoms(),
+            important_geoms: &self.important_geoms,
+            important_sites: &self.important_sites,
+            important_sensors: &self.important_sensors,
+            base_offset: self.base_offset(),
+            bottom_offset: self.bottom_offset(),
+            top_offset: self.top_offset(),
+            horizontal_radius: self.horizontal_radius(),
+            geometry_error: offsets.as_ref().err().map(|e| e.as_str()),
         };
-        format!(
-            "{{\"name\": {}, \"naming_prefix\": {}, \"root_body\": {}, \"bodies\": {}, \"joints\": {}, \"actuators\": {}, \"sites\": {}, \"sensors\": {}, \"contact_geoms\": {}, \"visual_geoms\": {}, \"important_geoms\": {geoms}, \"important_sites\": {}, \"important_sensors\": {}, \"base_offset\": {}, \"bottom_offset\": {}, \"top_offset\": {}, \"horizontal_radius\": {}{error}}}",
-            json_str(&self.name),
-            json_str(&self.prefix),
-            json_str(&self.root_body),
-            json_list(self.bodies()),
-            json_list(self.joints()),
-            json_list(self.actuators()),
-            json_list(self.sites()),
-            json_list(self.sensors()),
-            json_list(self.contact_geoms()),
-            json_list(self.visual_geoms()),
-            maps(&self.important_sites),
-            maps(&self.important_sensors),
-            json_vec3(self.base_offset()),
-            json_vec3(self.bottom_offset()),
-            json_vec3(self.top_offset()),
-            json_num(self.horizontal_radius()),
-        )
+        let mut out = Vec::new();
+        let mut writer = serde_json::Serializer::with_formatter(&mut out, OneLine);
+        serde::Serialize::serialize(&info, &mut writer).expect("writing to memory cannot fail");
+        String::from_utf8(out).expect("serde_json writes UTF-8")
     }
 }

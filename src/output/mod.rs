@@ -9,11 +9,13 @@
 //! [`AssetStore`]; the batch tier and the command line drive the rest).
 
 mod assets;
-mod files;
+mod atomic;
+mod folder;
 mod ordered;
 mod tar;
 
 pub use assets::AssetStore;
-pub use files::{AtomicFile, OutputDir, write_atomic};
+pub use atomic::{AtomicFile, write_atomic};
+pub use folder::OutputDir;
 pub use ordered::for_each_ordered;
 pub use tar::{PendingHeader, TarWriter, frame_text_member};

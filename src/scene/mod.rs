@@ -26,19 +26,17 @@
 //!
 //! Files: `spec.rs` (the scene file), `load/` (checks, template, instances), `place.rs`,
 //! `randomize.rs`, `rng.rs`, `splice.rs` (variants as text), `params.rs` (the manifest),
-//! `patch.rs` (structure keys and patches), `document_patch.rs` (the same for any
-//! document), `superset.rs` (one model for every variant),
+//! `patch.rs` (a variant's structure key and patch, by the split tier's rules),
+//! `superset.rs` (one model for every variant),
 //! `check.rs` (MuJoCo validation), `demo.rs` (the built-in scene).
 //!
-//! May use: the model and document tiers, `crate::output` (asset store, ordered pipeline),
-//! `crate::error`, and the MuJoCo FFI (`check.rs`, in builds with MuJoCo). Knows nothing of
-//! the compiled-model cache or the faces above.
+//! May use: the split, model and document tiers, `crate::output` (asset store, ordered
+//! pipeline), `crate::error`, and the MuJoCo FFI (`check.rs`, in builds with MuJoCo).
+//! Knows nothing of the compiled-model cache or the faces above.
 
-mod body_model;
 #[cfg(mjcf_mujoco)]
 mod check;
 mod demo;
-mod document_patch;
 mod load;
 mod params;
 mod patch;
@@ -55,18 +53,15 @@ use std::sync::{Arc, OnceLock};
 
 use rayon::prelude::*;
 
+use crate::document::Document;
 use crate::document::tree::Node;
-use crate::document::{Document, Section};
 use crate::error::{Error, ErrorKind, Errors, Location};
 use crate::model::merge::MergePart;
 
 #[cfg(mjcf_mujoco)]
 pub use check::{PENETRATION_TOLERANCE, check_model, check_variant};
-pub use document_patch::{
-    DocumentPatch, PATCHABLE_OPTIONS, SplitOptions, split_document, split_document_with,
-};
 pub use params::{Params, PlacedObject, RandomizedValue};
-pub use patch::{PATCHABLE, PatchEntry, PatchValue, VariantPatch};
+pub use patch::VariantPatch;
 pub use randomize::MUJOCO_DEFAULTS;
 pub use superset::Superset;
 
@@ -108,7 +103,7 @@ pub struct Scene {
     splice: Option<splice::Template>,
     /// What the scene's settings let a patch carry, and what its structure keys start
     /// from (a hash of the template and every pool model), made on first use.
-    structure: OnceLock<(patch::Rules, [u8; 32])>,
+    structure: OnceLock<(crate::split::Rules, [u8; 32])>,
     /// Variants are written with `<compiler discardvisual="true">`.
     discard_visual: bool,
 }
@@ -288,7 +283,7 @@ impl Scene {
             doc.merge_unchecked(&merge, false)?;
         }
         if self.discard_visual {
-            set_discard_visual(&mut doc);
+            doc.set_discard_visual();
         }
         Ok(Variant {
             index,
@@ -540,7 +535,7 @@ impl Scene {
 
     /// What the scene's settings let a patch carry, and the hash structure keys start
     /// from; made on first use.
-    fn structure(&self) -> &(patch::Rules, [u8; 32]) {
+    fn structure(&self) -> &(crate::split::Rules, [u8; 32]) {
         self.structure.get_or_init(|| {
             let parts: Vec<&Document> = self
                 .groups
@@ -554,7 +549,7 @@ impl Scene {
                 h.update(text.as_bytes());
             }
             (
-                patch::Rules::new(&self.template, &parts, self.discard_visual),
+                crate::split::Rules::new(&self.template, &parts, self.discard_visual),
                 *h.finalize().as_bytes(),
             )
         })
@@ -571,7 +566,7 @@ impl Scene {
     pub fn fixed_statistics(&self) -> Vec<&'static str> {
         ["meaninertia", "meanmass", "meansize", "extent", "center"]
             .into_iter()
-            .filter(|a| patch::setting(&self.template, "statistic", a).is_some())
+            .filter(|a| crate::split::setting(&self.template, "statistic", a).is_some())
             .collect()
     }
 
@@ -599,28 +594,5 @@ impl Scene {
             .get_or_init(|| load::make_instance(self, group, slot, m))
             .as_ref()
             .map_err(Clone::clone)
-    }
-}
-
-/// Sets `discardvisual="true"` on the document's last `<compiler>` (the one whose setting
-/// MuJoCo keeps), adding one when it has none.
-pub(crate) fn set_discard_visual(doc: &mut Document) {
-    let root = doc.root();
-    let last = doc
-        .elements(root)
-        .filter(|&n| doc.tag(n) == "compiler")
-        .last();
-    match last {
-        Some(c) => doc.set_attr(c, "discardvisual", "true"),
-        None => {
-            doc.append_element(root, "compiler", &[("discardvisual", "true")]);
-        }
-    }
-}
-
-impl Document {
-    /// The world body, if the document has one (no section is created).
-    pub(crate) fn worldbody(&self) -> Option<Node> {
-        self.find_section(Section::Worldbody)
     }
 }

@@ -25,9 +25,10 @@ use crate::document::tree::Node;
 use crate::error::{Error, ErrorKind, Errors};
 use crate::model::merge::MergePart;
 
-use super::patch::{self, PatchEntry, PatchValue, VariantPatch};
+use super::patch::{self, VariantPatch};
 use super::randomize::AttrTarget as _;
-use super::{Scene, body_model, place};
+use super::{Scene, place};
+use crate::split::{self, PatchEntry, PatchValue};
 
 /// Where parked objects wait: a horizontal grid of square cells `PARK_STEP` wide, centred
 /// `PARK_HEIGHT` straight above the world's origin: above any floor (a plane through the
@@ -181,7 +182,7 @@ impl Scene {
             .collect();
         doc.merge_unchecked(&merge, false)?;
         if self.discard_visual {
-            super::set_discard_visual(&mut doc);
+            doc.set_discard_visual();
         }
         let (_, fingerprint) = self.structure();
         let mut key = blake3::Hasher::new();
@@ -221,7 +222,7 @@ impl Scene {
                 };
                 let named = &superset.members[*k].named;
                 overlay.get(*node, attr).is_none_or(|value| {
-                    patch::entry(named, *node, attr, value, rules, None, *node == inst.root)
+                    split::entry(named, *node, attr, value, rules, None, *node == inst.root)
                         .is_none()
                 })
             })
@@ -256,17 +257,17 @@ impl Scene {
             let mut rgba: Vec<(String, Vec<f64>)> = Vec::new();
             // The instance with its unnamed elements named (the same nodes as inst.doc).
             let doc = &m.named;
-            // Bodies whose little models carry randomized values of their geoms (sizes,
+            // Bodies whose body models carry randomized values of their geoms (sizes,
             // frames, densities): one entry each, placed or parked.
-            let mut little: Vec<Node> = Vec::new();
+            let mut modelled: Vec<Node> = Vec::new();
             for (r, targets) in &inst.targets {
                 for t in targets {
                     for attr in self.randomizers[*r].attributes_set(doc, t.node) {
-                        if rules.little
-                            && let Some(body) = body_model::carried_by(doc, t.node, attr)
+                        if rules.body_models
+                            && let Some(body) = split::carried_by(doc, t.node, attr)
                         {
-                            if !little.contains(&body) {
-                                little.push(body);
+                            if !modelled.contains(&body) {
+                                modelled.push(body);
                             }
                             continue;
                         }
@@ -278,11 +279,11 @@ impl Scene {
                                 .or_else(|| super::randomize::mujoco_default(tag, attr)),
                         };
                         let Some(value) = value else { continue };
-                        if rules.discard && patch::dropped(doc, t.node, attr) != Some(false) {
+                        if rules.discard && split::dropped(doc, t.node, attr) != Some(false) {
                             continue;
                         }
                         let root = t.node == inst.root;
-                        let Some(mut e) = patch::entry(doc, t.node, attr, value, rules, None, root)
+                        let Some(mut e) = split::entry(doc, t.node, attr, value, rules, None, root)
                         else {
                             continue;
                         };
@@ -296,7 +297,7 @@ impl Scene {
                     }
                 }
             }
-            if !little.is_empty() {
+            if !modelled.is_empty() {
                 // Placed: the variant's values; parked: as authored.
                 let applied;
                 let source = match overlay {
@@ -308,11 +309,10 @@ impl Scene {
                     }
                     None => doc,
                 };
-                for body in little {
-                    let (Some(model), Some(name)) = (
-                        body_model::body_model(source, body),
-                        source.attr(body, "name"),
-                    ) else {
+                for body in modelled {
+                    let (Some(model), Some(name)) =
+                        (split::body_model(source, body), source.attr(body, "name"))
+                    else {
                         return Err(Errors(vec![Error::bare(ErrorKind::Invalid(format!(
                             "variant {index}: a geom of '{}' changes what its body derives, \
                              and the body cannot be compiled alone",
@@ -324,7 +324,7 @@ impl Scene {
                         name: format!("{}{name}", m.tag),
                         id: None,
                         field: "geoms",
-                        value: PatchValue::Compiled(model),
+                        value: PatchValue::BodyModel(model),
                     });
                 }
             }
@@ -352,10 +352,10 @@ impl Scene {
                 Some(o) => {
                     let read = |a: &str, n| {
                         o.get(inst.root, a)
-                            .and_then(|v| patch::numbers(v, n, false))
+                            .and_then(|v| split::numbers(v, n, false))
                     };
                     match (read("pos", 3), read("quat", 4)) {
-                        (Some(p), Some(q)) => (p, patch::normalized(q)),
+                        (Some(p), Some(q)) => (p, split::normalized(q)),
                         _ => {
                             return Err(Errors(vec![Error::bare(ErrorKind::Invalid(format!(
                                 "variant {index}: the pose of '{}' cannot be read",
@@ -455,8 +455,8 @@ fn member(
         .attr(root, "name")
         .ok_or_else(|| unnamed(part, "root body"))?
         .to_string();
-    let joint = patch::free_joint(part, root).map(str::to_string);
-    let root_massless = patch::massless(part, root);
+    let joint = split::free_joint(part, root).map(str::to_string);
+    let root_massless = split::massless(part, root);
     part.set_attr(root, "pos", &place::join(&parked));
     part.set_attr(root, "quat", "1 0 0 0");
     let nodes: Vec<Node> = std::iter::once(root)
@@ -479,7 +479,7 @@ fn member(
                 part.set_attr(n, "gravcomp", "1");
             }
             "geom" => {
-                if discard && patch::discarded(part, n) != Some(false) {
+                if discard && split::discarded(part, n) != Some(false) {
                     // Not in the compiled model (or kept by a reference: left alone).
                     continue;
                 }

@@ -538,7 +538,7 @@ impl PyElement {
     /// children, and, as a copy, no tail (the text after an element lives in its parent).
     fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
         let xml = self.read(py, |d, n| d.element_document(n).0.to_xml_string());
-        let rebuild = py.import("mjcf_forge.etree")?.getattr("fromstring")?;
+        let rebuild = crate::upcalls::get(py, "fromstring")?;
         let args = PyTuple::new(py, [xml])?;
         PyTuple::new(py, [rebuild, args.into_any()])
     }

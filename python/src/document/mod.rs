@@ -27,7 +27,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use ahash::AHashSet;
-use mjcf_forge::scene::{PatchValue, SplitOptions, split_document_with};
+use mjcf_forge::split::{PatchValue, SplitOptions, split_document_with};
 use mjcf_forge::{CompiledInertia, Document, MergePart, Node, Section};
 use pyo3::exceptions::{PyFutureWarning, PyTypeError};
 use pyo3::prelude::*;
@@ -43,14 +43,9 @@ pub(crate) use load_cache::PyLoadCache;
 pub(crate) use values::check_xml_text;
 
 /// The document's split as Python's `DocumentCache` takes it: sizes of primitive geoms
-/// patched through their bodies' little models, which it compiles.
-fn split(doc: &Document) -> mjcf_forge::scene::DocumentPatch {
-    split_document_with(
-        doc,
-        SplitOptions {
-            compiled_bodies: true,
-        },
-    )
+/// patched through their body models, which it compiles.
+fn split(doc: &Document) -> mjcf_forge::split::DocumentPatch {
+    split_document_with(doc, SplitOptions { body_models: true })
 }
 
 /// A shared, lockable document.
@@ -371,7 +366,7 @@ impl PyDocument {
     /// The split as the model cache takes it: ``(structure_key, numbers, materials,
     /// fixed_statistics, bodies)``: every number of :attr:`patch` end to end as float64
     /// bytes, the material names of its ``matid`` entries in order, the statistics the
-    /// document's ``<statistic>`` sets, and the little models of its ``geoms`` entries.
+    /// document's ``<statistic>`` sets, and the body models of its ``geoms`` entries.
     #[allow(clippy::type_complexity)]
     fn _split<'py>(
         &self,
@@ -394,7 +389,7 @@ impl PyDocument {
                         numbers.extend(v.iter().flat_map(|x| x.to_le_bytes()));
                     }
                     PatchValue::Id { name, .. } => materials.push(name),
-                    PatchValue::Compiled(model) => bodies.push(model),
+                    PatchValue::BodyModel(model) => bodies.push(model),
                 }
             }
             Ok((

@@ -1,7 +1,7 @@
 //! Patches as Python holds them: `(object, name or id, field, value)` tuples, for a
 //! document's patch (`Document.patch`) and a variant's (`Variant.patch`, `Superset.patch`).
 
-use mjcf_forge::scene::{PatchEntry, PatchValue};
+use mjcf_forge::split::{PatchEntry, PatchValue};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyList, PyTuple};
@@ -19,7 +19,7 @@ pub(crate) fn patch_list<'py>(
         .map(|e| {
             let value = match &e.value {
                 PatchValue::Numbers(v) => PyTuple::new(py, v)?.into_any(),
-                PatchValue::Id { name, .. } | PatchValue::Compiled(name) => {
+                PatchValue::Id { name, .. } | PatchValue::BodyModel(name) => {
                     name.as_str().into_pyobject(py)?.into_any()
                 }
             };
@@ -56,7 +56,7 @@ pub(crate) fn patch_entry(
     } else if field == "geoms" {
         "geoms"
     } else {
-        mjcf_forge::scene::PATCHABLE
+        mjcf_forge::split::PATCHABLE
             .iter()
             .map(|p| p.2)
             .chain([
@@ -73,8 +73,8 @@ pub(crate) fn patch_entry(
             .ok_or_else(unknown)?
     };
     let value = match value.extract::<String>() {
-        // A body's little model: its geoms as MJCF text.
-        Ok(model) if field == "geoms" => PatchValue::Compiled(model),
+        // A body model: its geoms as MJCF text.
+        Ok(model) if field == "geoms" => PatchValue::BodyModel(model),
         Ok(target) => PatchValue::Id {
             object: "material",
             name: target,

@@ -17,6 +17,7 @@ pub(crate) use variant::PyVariant;
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use crate::upcalls;
 use mjcf_forge::Document;
 use mjcf_forge::scene::Scene;
 use pyo3::exceptions::{PyIndexError, PyOverflowError, PyTypeError, PyValueError};
@@ -75,10 +76,7 @@ impl PyScene {
 /// The installed ``mujoco``, as the package calls it, for the inertials an object group
 /// writes out (``write_inertials = true``): called only when a group asks.
 fn python_mujoco(py: Python<'_>) -> PyResult<Py<PyAny>> {
-    Ok(py
-        .import("mjcf_forge.base")?
-        .getattr("_compile_inertia")?
-        .unbind())
+    Ok(upcalls::get(py, "compile_inertia")?.unbind())
 }
 
 #[pymethods]
@@ -230,10 +228,7 @@ impl PyScene {
     ) -> PyResult<Bound<'py, PyAny>> {
         // Drawn with the user's mujoco, in Python (mjcf_forge/_preview.py): this module
         // links no MuJoCo.
-        slf.py()
-            .import("mjcf_forge._preview")?
-            .getattr("preview")?
-            .call((slf, indices, path), options)
+        upcalls::get(slf.py(), "preview")?.call((slf, indices, path), options)
     }
 
     /// Variant ``index`` (made with the GIL released): an ``int`` from 0 to 2**64 - 1
@@ -280,10 +275,8 @@ impl PyScene {
         }
         let progress = match progress {
             Some(p) if !p.is_none() => {
-                let made = py
-                    .import("mjcf_forge._progress")?
-                    .getattr("progress_of")?
-                    .call1((p, indices.len(), "variants"))?;
+                let made =
+                    upcalls::get(py, "progress_of")?.call1((p, indices.len(), "variants"))?;
                 (!made.is_none()).then(|| made.unbind())
             }
             _ => None,

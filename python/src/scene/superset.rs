@@ -2,7 +2,8 @@
 
 use std::sync::Arc;
 
-use mjcf_forge::scene::{PatchEntry, PatchValue, Scene, Superset};
+use mjcf_forge::scene::{Scene, Superset};
+use mjcf_forge::split::{PatchEntry, PatchValue};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyTuple};
 use rayon::prelude::*;
@@ -119,7 +120,7 @@ impl PySuperset {
                     PatchValue::Numbers(v) => {
                         numbers.extend(v.iter().flat_map(|x| x.to_ne_bytes()));
                     }
-                    PatchValue::Id { name, .. } | PatchValue::Compiled(name) => {
+                    PatchValue::Id { name, .. } | PatchValue::BodyModel(name) => {
                         strings.push(name.clone());
                     }
                 }

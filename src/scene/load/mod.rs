@@ -325,7 +325,7 @@ fn build(
     // (set on the written text only: merging compares parts' settings with the template's).
     let splice = if spec.discard_visual {
         let mut written = template.clone();
-        super::set_discard_visual(&mut written);
+        written.set_discard_visual();
         splice::Template::build(&written, &template_targets, &randomizers)
     } else {
         splice::Template::build(&template, &template_targets, &randomizers)

@@ -1,17 +1,17 @@
 //! A body's geoms as a model of their own: what a document patch carries for a body whose
-//! primitive geoms change size, so that a model cache can read off that little model's
+//! primitive geoms change size, so that a model cache can read off that body model's
 //! compile what MuJoCo derives from the sizes (each geom's size, bounding radius and box,
 //! the body's mass, inertia and inertial frame, its bounding-volume tree) and write it
 //! into the compiled model of the whole structure.
 //!
 //! All of those are computed by the compiler from the body's own geoms in the body's own
 //! frame, under the `<compiler>` settings, and from nothing else of the model, so the
-//! little model (the `<compiler>`, one body at the world's origin holding the body's
+//! body model (the `<compiler>`, one body at the world's origin holding the body's
 //! `<inertial>` and geoms as written, without names, materials or user data) gives the
 //! same numbers, bit for bit (`tests` of `compiled` and the Python cache judge it against
 //! MuJoCo's compile of the whole document).
 //!
-//! A body qualifies only when its little model is complete: every child is a geom that
+//! A body qualifies only when its body model is complete: every child is a geom that
 //! needs no asset (no mesh, height field or signed distance field), a joint, a site, a
 //! camera, a light, an `<inertial>` or a body; no free joint of it makes MuJoCo align the
 //! body with its inertial frame (which moves the body). Whether the whole document allows
@@ -24,7 +24,7 @@ use crate::document::write::escape_attr;
 /// Geom types whose `size` alone sets their shape (with the type's defaults).
 const PRIMITIVES: [&str; 5] = ["sphere", "capsule", "ellipsoid", "cylinder", "box"];
 
-/// Children a body may have for its little model to be complete.
+/// Children a body may have for its body model to be complete.
 const KNOWN_CHILDREN: [&str; 8] = [
     "geom",
     "joint",
@@ -36,9 +36,9 @@ const KNOWN_CHILDREN: [&str; 8] = [
     "body",
 ];
 
-/// Geom attributes the little model leaves out: they name or reference what it does not
+/// Geom attributes the body model leaves out: they name or reference what it does not
 /// have, or set contact and looks, and the compiler derives nothing of the geom's shape,
-/// bounds or mass from them (so a variant that randomizes them finds its little model
+/// bounds or mass from them (so a variant that randomizes them finds its body model
 /// compiled already).
 const LEFT_OUT: [&str; 12] = [
     "name",
@@ -55,7 +55,7 @@ const LEFT_OUT: [&str; 12] = [
     "fluidcoef",
 ];
 
-/// Whether `geom`'s `size` can be patched through its body's little model: a primitive
+/// Whether `geom`'s `size` can be patched through its body model: a primitive
 /// type, sized by `size` (not `fromto`).
 pub(crate) fn sized_primitive(doc: &Document, geom: Node) -> bool {
     doc.tag(geom) == "geom"
@@ -64,8 +64,8 @@ pub(crate) fn sized_primitive(doc: &Document, geom: Node) -> bool {
         && PRIMITIVES.contains(&doc.attr(geom, "type").map_or("sphere", str::trim))
 }
 
-/// Geom attributes a body's little model carries into the compiled model: sizes, frames,
-/// densities and masses (what MuJoCo derives from them is what the little model compiles
+/// Geom attributes a body model carries into the compiled model: sizes, frames,
+/// densities and masses (what MuJoCo derives from them is what the body model compiles
 /// to).
 const CARRIED: [&str; 9] = [
     "size",
@@ -79,9 +79,9 @@ const CARRIED: [&str; 9] = [
     "mass",
 ];
 
-/// The body whose little model carries `attr` of `node`: a geom's size (a sized
+/// The body whose body model carries `attr` of `node`: a geom's size (a sized
 /// primitive) or frame, in a body that [`qualifies`]; its density or mass, in a body whose
-/// little model is [`complete`] (frames and meshes included).
+/// body model is [`complete`] (frames and meshes included).
 pub(crate) fn carried_by(doc: &Document, node: Node, attr: &str) -> Option<Node> {
     if doc.tag(node) != "geom" || !CARRIED.contains(&attr) {
         return None;
@@ -119,7 +119,7 @@ fn needs_asset(doc: &Document, geom: Node) -> bool {
         )
 }
 
-/// A mesh geom whose little model can hold its mesh: the `<mesh>` asset it names, with no
+/// A mesh geom whose body model can hold its mesh: the `<mesh>` asset it names, with no
 /// plugin (a height field or signed distance field is not carried).
 fn mesh_asset(doc: &Document, geom: Node) -> Option<Node> {
     if doc.attr(geom, "hfield").is_some()
@@ -143,7 +143,7 @@ fn mesh_asset(doc: &Document, geom: Node) -> Option<Node> {
         .filter(|&m| doc.elements(m).next().is_none())
 }
 
-/// The little model of `body` (see the module), if the body's little model is
+/// The body model of `body` (see the module), if the body model is
 /// [`complete`].
 pub(crate) fn body_model(doc: &Document, body: Node) -> Option<String> {
     if !complete(doc, body) {
@@ -183,7 +183,7 @@ pub(crate) fn body_model(doc: &Document, body: Node) -> Option<String> {
     Some(xml)
 }
 
-/// Writes the `<inertial>`, geoms and `<frame>`s (with their geoms) of `node` as the little
+/// Writes the `<inertial>`, geoms and `<frame>`s (with their geoms) of `node` as the body
 /// model has them, collecting the meshes its geoms use.
 fn push_children(doc: &Document, node: Node, xml: &mut String, meshes: &mut Vec<Node>) {
     for child in doc.elements(node) {
@@ -214,7 +214,7 @@ fn push_children(doc: &Document, node: Node, xml: &mut String, meshes: &mut Vec<
     }
 }
 
-/// Whether `body`'s geoms can be compiled alone for its sizes and frames: its little model
+/// Whether `body`'s geoms can be compiled alone for its sizes and frames: its body model
 /// is complete without meshes or frames, and it has a geom of [`sized_primitive`] (the
 /// document cache makes an entry for every such body).
 pub(crate) fn qualifies(doc: &Document, body: Node) -> bool {
@@ -226,7 +226,7 @@ pub(crate) fn qualifies(doc: &Document, body: Node) -> bool {
         && doc.elements(body).any(|c| sized_primitive(doc, c))
 }
 
-/// Whether `body` has a complete little model: a named body whose children are all of
+/// Whether `body` has a complete body model: a named body whose children are all of
 /// [`KNOWN_CHILDREN`] or `<frame>`s of geoms, whose geoms need no asset but a `<mesh>` (see
 /// [`mesh_asset`]), and no free joint of which aligns the body with its inertial frame.
 pub(crate) fn complete(doc: &Document, body: Node) -> bool {
@@ -292,7 +292,7 @@ mod tests {
             )
             .unwrap()
         };
-        // (complete: a little model exists; qualifies: its sizes are patched through it)
+        // (complete: a body model exists; qualifies: its sizes are patched through it)
         let facts = |inner: &str| {
             let d = doc(inner);
             let b = d
@@ -328,7 +328,7 @@ mod tests {
     }
 
     #[test]
-    fn a_little_model_holds_its_frames_and_meshes() {
+    fn a_body_model_holds_its_frames_and_meshes() {
         let xml = r#"<mujoco><asset><mesh name="m" vertex="0 0 0 1 0 0 0 1 0 0 0 1"/><mesh name="n" vertex="0 0 0 1 0 0 0 1 0 0 0 2"/></asset>
             <worldbody><body name="b"><geom name="g" type="mesh" mesh="m" density="5"/>
             <frame name="f" pos="1 0 0"><geom size="0.1" mass="2"/></frame></body></worldbody></mujoco>"#;

@@ -1,5 +1,5 @@
 //! Any document as a *structure key* and a *patch*, found by reading the document alone:
-//! what [`patch`](super::patch) does for a scene's variants, for documents built any other
+//! what `scene::patch` does for a scene's variants, for documents built any other
 //! way (robosuite's classes, a user's own code, an XML string).
 //!
 //! Every attribute whose value a rule of [`PATCHABLE`](super::PATCHABLE) (or of the two
@@ -19,8 +19,9 @@
 use std::path::Path;
 
 use super::body_model::{body_model, qualifies, sized_primitive};
-use super::patch::{
-    self, PatchEntry, PatchValue, Rules, derives_damping, entry, numbers, owner, setting,
+use super::rules::{
+    PatchEntry, PatchValue, Rules, derives_damping, dropped, entry, massless, normalized, numbers,
+    owner, setting,
 };
 use crate::document::tree::Node;
 use crate::document::{Document, Section};
@@ -29,11 +30,11 @@ use crate::document::{Document, Section};
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SplitOptions {
     /// Sizes of primitive geoms (sphere, capsule, ellipsoid, cylinder, box, sized by
-    /// `size`): their body's entry is a [`PatchValue::Compiled`] model of its geoms, whose
+    /// `size`): their body's entry is a [`PatchValue::BodyModel`] model of its geoms, whose
     /// compile gives what MuJoCo derives from them (sizes, bounds, mass and inertia,
     /// bounding volumes). For a model cache that compiles those (`DocumentCache`, in Rust
     /// and Python).
-    pub compiled_bodies: bool,
+    pub body_models: bool,
 }
 
 /// A document as a structure key and a patch (see [`split_document`]).
@@ -81,7 +82,7 @@ struct DocRules {
     /// The compiled id of each actuator (MuJoCo numbers them in order), when the ids of
     /// unnamed elements are known at all.
     actuator_ids: Option<ahash::AHashMap<Node, usize>>,
-    /// Sizes of primitive geoms are patched through their bodies' little models
+    /// Sizes of primitive geoms are patched through their body models
     /// ([`body_model`]): asked for, masses land unchanged and feed nothing the compiler
     /// keeps (no length-range simulation), every geom of the compiled model is one of the
     /// document (no `discardvisual`), and no spatial tendon, flex, composite or skin hangs
@@ -119,7 +120,7 @@ impl DocRules {
             .map(|_| actuators.iter().enumerate().map(|(i, &n)| (n, i)).collect());
         let dynamics = !actuators.iter().any(|&n| muscle(n)) && !lengthrange_all;
         DocRules {
-            sizes: options.compiled_bodies && base.mass && dynamics && !discard && !hanging,
+            sizes: options.body_models && base.mass && dynamics && !discard && !hanging,
             dynamics,
             options: doc
                 .elements(doc.root())
@@ -139,7 +140,7 @@ impl DocRules {
 ///
 /// ```
 /// use mjcf_forge::Document;
-/// use mjcf_forge::scene::split_document;
+/// use mjcf_forge::split::split_document;
 ///
 /// let xml = |rgba: &str, size: &str| {
 ///     format!(
@@ -159,22 +160,22 @@ pub fn split_document(doc: &Document) -> DocumentPatch {
     split_document_with(doc, SplitOptions::default())
 }
 
-/// [`split_document`] with [`SplitOptions`]: with `compiled_bodies`, documents that differ
+/// [`split_document`] with [`SplitOptions`]: with `body_models`, documents that differ
 /// in the sizes of primitive geoms share a structure.
 ///
 /// ```
 /// use mjcf_forge::Document;
-/// use mjcf_forge::scene::{PatchValue, SplitOptions, split_document_with};
+/// use mjcf_forge::split::{PatchValue, SplitOptions, split_document_with};
 ///
 /// let xml = |size: &str| {
 ///     format!("<mujoco><worldbody><body name='b'><freejoint/><geom size='{size}'/></body></worldbody></mujoco>")
 /// };
-/// let sizes = SplitOptions { compiled_bodies: true };
+/// let sizes = SplitOptions { body_models: true };
 /// let a = split_document_with(&Document::from_str(&xml("0.1"), ".")?, sizes);
 /// let b = split_document_with(&Document::from_str(&xml("0.2"), ".")?, sizes);
 /// assert_eq!(a.structure_key, b.structure_key);
 /// assert_eq!((b.entries[0].object, b.entries[0].field), ("body", "geoms"));
-/// let PatchValue::Compiled(body) = &b.entries[0].value else { unreachable!() };
+/// let PatchValue::BodyModel(body) = &b.entries[0].value else { unreachable!() };
 /// assert_eq!(body, r#"<mujoco><worldbody><body><geom size="0.2"/></body></worldbody></mujoco>"#);
 /// # Ok::<(), mjcf_forge::Errors>(())
 /// ```
@@ -348,7 +349,7 @@ fn element_entries<'d>(doc: &'d Document, node: Node, rules: &DocRules) -> Patch
         _ => {
             let ids = rules.base.ids.as_ref();
             for (attr, value) in doc.attrs(node) {
-                if rules.base.discard && patch::dropped(doc, node, attr) != Some(false) {
+                if rules.base.discard && dropped(doc, node, attr) != Some(false) {
                     continue;
                 }
                 let Some(e) = entry(doc, node, attr, value, &rules.base, ids, false) else {
@@ -386,7 +387,7 @@ fn body_entries<'d>(doc: &'d Document, body: Node, rules: &DocRules, out: &mut P
     // A quaternion of (nearly) zero norm is the compiler's to refuse.
     let quat = numbers(quat_text.unwrap_or("1 0 0 0"), 4, false)
         .filter(|q| q.iter().map(|x| x * x).sum::<f64>() > 1e-10)
-        .map(patch::normalized);
+        .map(normalized);
     let (Some(pos), Some(quat), Some(name)) = (pos, quat, doc.attr(body, "name")) else {
         return;
     };
@@ -400,7 +401,7 @@ fn body_entries<'d>(doc: &'d Document, body: Node, rules: &DocRules, out: &mut P
     }
     let attr = if pos_text.is_some() { "pos" } else { "quat" };
     let numbers = |v: &[f64]| PatchValue::Numbers(v.to_vec());
-    if patch::massless(doc, body) {
+    if massless(doc, body) {
         for (field, v) in [("ipos", &pos), ("iquat", &quat)] {
             let e = PatchEntry {
                 object: "body",
@@ -427,7 +428,7 @@ fn body_entries<'d>(doc: &'d Document, body: Node, rules: &DocRules, out: &mut P
     }
 }
 
-/// A body's entry of its little model ([`body_model`]), and a sized geom's `size`, which
+/// A body's entry of its body model ([`body_model`]), and a sized geom's `size`, which
 /// that entry carries.
 fn compiled_body_entries<'d>(doc: &'d Document, node: Node, out: &mut Patched<'d>) {
     match doc.tag(node) {
@@ -441,7 +442,7 @@ fn compiled_body_entries<'d>(doc: &'d Document, node: Node, out: &mut Patched<'d
                     name,
                     id: None,
                     field: "geoms",
-                    value: PatchValue::Compiled(model),
+                    value: PatchValue::BodyModel(model),
                 });
             }
         }

@@ -1,23 +1,23 @@
-//! A body's little model (`PatchValue::Compiled`, see `scene::SplitOptions`): the body's
+//! A body model (`PatchValue::BodyModel`, see `split::SplitOptions`): the body's
 //! geoms compiled alone, whose compile gives what MuJoCo derives from them (each geom's
 //! size, frame, bounding radius and box, the body's mass, inertia and inertial frame, its
-//! bounding volumes), copied into the body of a model of the whole structure. A little
+//! bounding volumes), copied into the body of a model of the whole structure. A body
 //! model whose layout is not the body's (another `body_sameframe` or `geom_sameframe`,
 //! bounding-volume tree or geom types) is refused: the document is then compiled.
 
 use std::ffi::{CString, c_int};
 use std::path::Path;
 
-use super::store::mjf_patch_array;
+use super::sys::mjf_patch_array;
 use crate::mujoco::{CompiledModel, MjModel, compile_str};
 
-/// Little models compiled so far, by their MJCF text, the newest last.
+/// Body models compiled so far, by their MJCF text, the newest last.
 #[derive(Default)]
-pub(super) struct Little {
+pub(super) struct BodyModels {
     models: Vec<(String, CompiledModel)>,
 }
 
-/// How many little models a plan keeps.
+/// How many body models a plan keeps.
 const KEPT: usize = 64;
 
 /// One array of a live model: its pointer, element size and element count.
@@ -105,9 +105,9 @@ fn copy(
     Ok(())
 }
 
-impl Little {
+impl BodyModels {
     /// Writes into body `body` of `model` what MuJoCo derives from its geoms, read off the
-    /// compile of their little model `xml` (compiled once, kept).
+    /// compile of their body model `xml` (compiled once, kept).
     pub(super) fn write(
         &mut self,
         model: *mut MjModel,
@@ -117,15 +117,15 @@ impl Little {
         let at = match self.models.iter().position(|(x, _)| x == xml) {
             Some(at) => at,
             None => {
-                let little = compile_str(xml, Path::new(".")).map_err(|e| e.to_string())?;
+                let part = compile_str(xml, Path::new(".")).map_err(|e| e.to_string())?;
                 if self.models.len() >= KEPT {
                     self.models.remove(0);
                 }
-                self.models.push((xml.to_string(), little));
+                self.models.push((xml.to_string(), part));
                 self.models.len() - 1
             }
         };
-        let little = self.models[at].1.as_mut_ptr();
+        let part = self.models[at].1.as_mut_ptr();
         let geoms = |m, b| -> Result<(usize, usize), String> {
             Ok((
                 int(m, "body_geomadr", b)? as usize,
@@ -139,12 +139,12 @@ impl Little {
             ))
         };
         let (g, n) = geoms(model, body)?;
-        let (lg, ln) = geoms(little, 1)?;
+        let (lg, ln) = geoms(part, 1)?;
         let (v, nv) = bvh(model, body)?;
-        let (lv, lnv) = bvh(little, 1)?;
+        let (lv, lnv) = bvh(part, 1)?;
         let same = |name: &str, width: usize, a: (usize, usize), b: (usize, usize)| {
             Ok::<bool, String>(
-                read(model, name, a.0, a.1, width)? == read(little, name, b.0, b.1, width)?,
+                read(model, name, a.0, a.1, width)? == read(part, name, b.0, b.1, width)?,
             )
         };
         let nodes = |m, first: usize, count| -> Result<Vec<i64>, String> {
@@ -152,8 +152,8 @@ impl Little {
                 .map(|k| int(m, "bvh_nodeid", k))
                 .collect()
         };
-        // Leaves name geoms by id: the little model's start at its first geom.
-        let shifted: Vec<i64> = nodes(little, lv, lnv)?
+        // Leaves name geoms by id: the body model's start at its first geom.
+        let shifted: Vec<i64> = nodes(part, lv, lnv)?
             .into_iter()
             .map(|id| {
                 if id >= 0 {
@@ -165,7 +165,7 @@ impl Little {
             .collect();
         if ln != n
             || lnv != nv
-            || int(little, "body_sameframe", 1)? != int(model, "body_sameframe", body)?
+            || int(part, "body_sameframe", 1)? != int(model, "body_sameframe", body)?
             || !same("geom_type", 1, (g, n), (lg, ln))?
             || !same("geom_sameframe", 1, (g, n), (lg, ln))?
             || !same("bvh_child", 2, (v, nv), (lv, lnv))?
@@ -185,7 +185,7 @@ impl Little {
             ("geom_pos", 3),
             ("geom_quat", 4),
         ] {
-            copy(name, width, n, (little, lg), (model, g))?;
+            copy(name, width, n, (part, lg), (model, g))?;
         }
         for (name, width) in [
             ("body_mass", 1),
@@ -193,9 +193,9 @@ impl Little {
             ("body_ipos", 3),
             ("body_iquat", 4),
         ] {
-            copy(name, width, 1, (little, 1), (model, body))?;
+            copy(name, width, 1, (part, 1), (model, body))?;
         }
-        copy("bvh_aabb", 6, nv, (little, lv), (model, v))?;
+        copy("bvh_aabb", 6, nv, (part, lv), (model, v))?;
         Ok(())
     }
 }

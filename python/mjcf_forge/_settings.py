@@ -1,0 +1,107 @@
+"""The process-wide settings of :mod:`mjcf_forge.base` (which re-exports them): the
+rules :class:`~mjcf_forge.base.MujocoXML` reads and merges by, and the process's model
+cache, through which ``get_model`` and the robosuite switch compile."""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Optional
+
+# The rules MujocoXML reads and merges by (see set_rules).
+RULES = ("mujoco", "robosuite")
+_rules = "mujoco"
+
+
+def rules() -> str:
+    """The rules :class:`~mjcf_forge.base.MujocoXML` reads default classes and merges
+    models by: ``"mujoco"`` (the default) or ``"robosuite"`` (see :func:`set_rules`)."""
+    return _rules
+
+
+def set_rules(rules: str) -> str:
+    """Sets the rules :class:`~mjcf_forge.base.MujocoXML` reads and merges by, for the
+    models made from then on, and returns the rules it replaces.
+
+    - ``"mujoco"``: MuJoCo's. Default classes inlined exactly; a merge converts a part's
+      compiler settings (angles, Euler sequences, mass settings with the installed
+      ``mujoco``) so that every part compiles to what it compiles to alone, shares
+      identical assets and refuses a name clash, and carries every section. A merged
+      model can differ from stock robosuite's: the table's mass, joint ranges of parts
+      written in degrees, a clashing asset refused (docs/model-hierarchy.md).
+    - ``"robosuite"``: stock robosuite's (1.4.0 and 1.5.2 alike), so that a model compiles
+      to the one stock robosuite builds: only the top-level default classes inlined, a
+      part's ``<compiler>`` dropped (its values read under the base's), the base's asset
+      kept where a part repeats a name, seven sections carried (module
+      ``mjcf_forge._stock``). What :func:`mjcf_forge.robosuite.use` sets by default.
+
+    >>> from mjcf_forge import base
+    >>> previous = base.set_rules("robosuite")
+    >>> base.rules()
+    'robosuite'
+    >>> _ = base.set_rules(previous)
+
+    Raises:
+        ValueError: rules other than ``"mujoco"`` and ``"robosuite"``
+    """
+    global _rules
+    if rules not in RULES:
+        raise ValueError(f"rules are 'mujoco' or 'robosuite', not {rules!r}")
+    previous, _rules = _rules, rules
+    return previous
+
+
+#: The environment variable that turns the process's model cache off before it is made:
+#: ``MJCF_FORGE_MODEL_CACHE=0`` (or ``off``, ``false``, ``no``).
+MODEL_CACHE_ENV = "MJCF_FORGE_MODEL_CACHE"
+
+_UNSET: Any = object()
+_model_cache: Any = _UNSET
+
+
+def model_cache() -> Optional[Any]:
+    """The process's :class:`~mjcf_forge.DocumentCache`, through which
+    :meth:`~mjcf_forge.base.MujocoXML.get_model` (and, with
+    :func:`mjcf_forge.robosuite.use`, robosuite's simulations) compiles, or ``None`` when
+    it is off.
+
+    On by default: made on first use (at most 8 structures, least recently used out), unless
+    the environment variable ``MJCF_FORGE_MODEL_CACHE`` is ``0``, ``off``, ``false`` or
+    ``no``. :func:`set_model_cache` replaces it or turns it off.
+    """
+    global _model_cache
+    if _model_cache is _UNSET:
+        if os.environ.get(MODEL_CACHE_ENV, "").strip().lower() in ("0", "off", "false", "no"):
+            _model_cache = None
+        else:
+            from ._doc_cache import DocumentCache
+
+            _model_cache = DocumentCache(max_models=8)
+    return _model_cache
+
+
+def set_model_cache(cache: Any) -> Optional[Any]:
+    """Sets the process's model cache (see :func:`model_cache`) and returns the one it
+    replaces (``None`` if it was off), so a caller can put it back.
+
+    Args:
+        cache: a :class:`~mjcf_forge.DocumentCache` (yours, with your bounds), ``True`` (a
+            new default one), or ``None`` / ``False`` (off: every ``get_model`` compiles)
+
+    >>> from mjcf_forge import base
+    >>> previous = base.set_model_cache(None)      # off: MuJoCo compiles every model
+    >>> base.model_cache() is None
+    True
+    >>> _ = base.set_model_cache(previous)         # as it was
+    """
+    global _model_cache
+    from ._doc_cache import DocumentCache
+
+    if cache is True:
+        cache = DocumentCache(max_models=8)
+    elif cache is False:
+        cache = None
+    elif cache is not None and not isinstance(cache, DocumentCache):
+        raise TypeError(f"set_model_cache takes a DocumentCache, True, False or None, not {type(cache).__name__}")
+    previous = model_cache()
+    _model_cache = cache
+    return previous

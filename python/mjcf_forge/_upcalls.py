@@ -1,0 +1,43 @@
+"""Everything the compiled module calls in Python, in one place: ``python/src/upcalls.rs``
+looks each up here by name, and nowhere else.
+
+- :func:`compile_inertia`: the installed ``mujoco`` compiling a part alone
+  (``Document.merge(compile_inertia=...)``, a scene group's ``write_inertials``);
+- ``preview``: a contact sheet drawn with the installed ``mujoco`` (``Scene.preview``);
+- ``progress_of``: a progress reporter (``Scene.variants(progress=...)``);
+- ``fromstring``: an element rebuilt from its XML (pickling an ``Element``);
+- ``MjcfFileNotFoundError``: the error raised when every problem is a missing file.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ._errors import MjcfFileNotFoundError
+from ._mjcf_utils import without_materials
+from ._preview import preview
+from ._progress import progress_of
+from ._settings import model_cache
+from .etree import fromstring
+
+__all__ = ["MjcfFileNotFoundError", "compile_inertia", "fromstring", "preview", "progress_of"]
+
+
+def compile_inertia(xml: str, model_dir: Any) -> tuple:
+    """The bodies' names, masses and inertias as the installed ``mujoco`` compiles ``xml``
+    alone: what a merge writes out when a part's compiler mass settings differ from the
+    base's (``Document.merge(compile_inertia=...)``). Through the process's model cache
+    when it is on: robosuite merges the same arena at every hard reset."""
+    import mujoco
+
+    xml = without_materials(xml)
+    cache = model_cache()
+    model = cache.model(xml) if cache is not None else mujoco.MjModel.from_xml_string(xml)
+    names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, i) or "" for i in range(model.nbody)]
+    return (
+        names,
+        model.body_mass.ravel().tolist(),
+        model.body_ipos.ravel().tolist(),
+        model.body_iquat.ravel().tolist(),
+        model.body_inertia.ravel().tolist(),
+    )

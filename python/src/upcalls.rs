@@ -1,0 +1,33 @@
+//! Every call this module makes up into the package's Python code, in one place: each
+//! target is a name in `mjcf_forge._upcalls`, looked up once per process.
+//!
+//! ```text
+//! compile_inertia(xml, model_dir)   the user's mujoco compiling a part alone
+//! preview(scene, indices, path, **options)
+//! progress_of(progress, total, unit)
+//! fromstring(xml)                   an Element rebuilt (pickling)
+//! MjcfFileNotFoundError             the error of missing files
+//! ```
+//!
+//! The package's modules never import the compiled module's internals the other way
+//! round: what Python needs of Rust is the public `_mjcf_forge` types.
+
+use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::PyModule;
+
+/// The Python side of every upcall.
+const MODULE: &str = "mjcf_forge._upcalls";
+
+/// `mjcf_forge._upcalls`, imported on first use.
+fn module(py: Python<'_>) -> PyResult<&Bound<'_, PyModule>> {
+    static UPCALLS: PyOnceLock<Py<PyModule>> = PyOnceLock::new();
+    UPCALLS
+        .get_or_try_init(py, || py.import(MODULE).map(Bound::unbind))
+        .map(|m| m.bind(py))
+}
+
+/// The upcall `name` (a function or class of `mjcf_forge._upcalls`).
+pub fn get<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+    module(py)?.getattr(name)
+}

@@ -1,0 +1,52 @@
+//! The C functions of `patch.c` (compiled by `build.rs` against the linked MuJoCo's
+//! headers, as the FFI's shim is): arrays found by name through MuJoCo's X-macro table,
+//! scratch data, the derived values after a patch. The only `extern` block of this tier;
+//! `store.rs` (plans, scratch data), `body_models.rs` and `worlds.rs` call it.
+
+use std::ffi::{c_char, c_int, c_void};
+
+use crate::mujoco::MjModel;
+
+/// mjData, opaque here: only the C side reads it.
+#[repr(C)]
+pub(super) struct RawData {
+    _private: [u8; 0],
+}
+
+unsafe extern "C" {
+    pub(super) fn mjf_patch_array(
+        m: *mut MjModel,
+        name: *const c_char,
+        elem: *mut usize,
+        count: *mut usize,
+    ) -> *mut c_void;
+    pub(super) fn mjf_patch_name2id(
+        m: *const MjModel,
+        kind: *const c_char,
+        name: *const c_char,
+    ) -> c_int;
+    pub(super) fn mjf_patch_make_data(m: *const MjModel) -> *mut RawData;
+    pub(super) fn mjf_patch_delete_data(d: *mut RawData);
+    pub(super) fn mjf_patch_nbytes(m: *const MjModel, d: *const RawData) -> i64;
+    pub(super) fn mjf_patch_get_stat(m: *const MjModel, out: *mut f64);
+    pub(super) fn mjf_patch_finish(
+        m: *mut MjModel,
+        d: *mut RawData,
+        fixed: c_int,
+        values: *const f64,
+    );
+    pub(super) fn mjf_patch_array_name(i: c_int) -> *const c_char;
+    pub(super) fn mjf_patch_array_type(i: c_int) -> *const c_char;
+    pub(super) fn mjf_patch_option(
+        m: *mut MjModel,
+        name: *const c_char,
+        elem: *mut usize,
+        count: *mut usize,
+    ) -> *mut c_void;
+    pub(super) fn mjf_patch_meaninertia(
+        m: *mut MjModel,
+        d: *const RawData,
+        keep: *const c_int,
+        n: c_int,
+    );
+}

@@ -1,0 +1,47 @@
+//! The split tier: a model as a *structure key* and a *patch*.
+//!
+//! Two documents (or two variants of a scene) with the same structure key compile to
+//! models that differ only in the patched values and what MuJoCo's `mj_setConst` derives
+//! from them, so a model cache compiles one model per key and patches it into each
+//! ([`crate::compiled`]). The rules say which attribute lands in which compiled field,
+//! exactly; whatever no rule can write exactly goes into the key.
+//!
+//! ```
+//! use mjcf_forge::Document;
+//! use mjcf_forge::split::split_document;
+//!
+//! let red = Document::from_str(
+//!     r#"<mujoco><worldbody><geom name="g" size="0.1" rgba="1 0 0 1"/></worldbody></mujoco>"#,
+//!     ".",
+//! )?;
+//! let blue = Document::from_str(
+//!     r#"<mujoco><worldbody><geom name="g" size="0.1" rgba="0 0 1 1"/></worldbody></mujoco>"#,
+//!     ".",
+//! )?;
+//! let (a, b) = (split_document(&red), split_document(&blue));
+//! assert_eq!(a.structure_key, b.structure_key);
+//! assert_ne!(a.entries, b.entries);
+//! # Ok::<(), mjcf_forge::Errors>(())
+//! ```
+//!
+//! Files: `rules.rs` (the attribute-to-field rules, [`PATCHABLE`], the patch entry types),
+//! `document.rs` (any document split by reading it), `body_model.rs` (a body's geoms as a
+//! model of their own, for what MuJoCo derives from their sizes). The scene tier reads its
+//! drawn variants through the same rules (`scene/patch.rs`).
+//!
+//! May use: the document tier and `crate::error`. Knows nothing of scenes, MuJoCo or the
+//! caches that use it.
+
+mod body_model;
+mod document;
+mod rules;
+
+pub use document::{
+    DocumentPatch, PATCHABLE_OPTIONS, SplitOptions, split_document, split_document_with,
+};
+pub use rules::{PATCHABLE, PatchEntry, PatchValue};
+
+pub(crate) use body_model::{body_model, carried_by};
+pub(crate) use rules::{
+    Rules, discarded, dropped, entry, free_joint, massless, normalized, numbers, setting,
+};
