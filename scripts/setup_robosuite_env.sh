@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Optional: a real, pip-installed robosuite==1.5.2 that can create its Lift env
-# headless, for scripts/bench_robosuite_dr.py (the same-run baseline for ModelCache:
+# headless, for benches/compare/bench_robosuite_dr.py (the same-run baseline for ModelCache:
 # robosuite's DomainRandomizationWrapper on a compiled model). Idempotent; fast when
 # already done. Needs only python3 and PyPI.
 #
@@ -43,4 +43,4 @@ else
   fi
   echo "$req_sha" > "$stamp"
 fi
-echo "setup_robosuite_env: run  $PY scripts/bench_robosuite_dr.py"
+echo "setup_robosuite_env: run  $PY benches/compare/bench_robosuite_dr.py"

@@ -23,7 +23,7 @@ enum Value {
 }
 
 /// Parses one flat JSON object of string and integer values (all that `compile --json`
-/// and scripts/sizes.py print), so the test needs no JSON crate.
+/// and tests/judge/sizes.py print), so the test needs no JSON crate.
 fn parse_flat_json(line: &str) -> Result<BTreeMap<String, Value>, String> {
     let mut chars = line.trim().chars().peekable();
     let mut map = BTreeMap::new();
@@ -104,28 +104,28 @@ const REQUIRED_KEYS: [&str; 9] = [
     "nbody", "njnt", "ngeom", "nsite", "nu", "nsensor", "nq", "nv", "nmesh",
 ];
 
-/// Python MuJoCo's sizes of each path, from one run of scripts/sizes.py.
+/// Python MuJoCo's sizes of each path, from one run of tests/judge/sizes.py.
 fn python_sizes(paths: &[PathBuf], dir: &Path) -> Vec<BTreeMap<String, Value>> {
     let list = dir.join("models.txt");
     let body: String = paths.iter().map(|p| format!("{}\n", p.display())).collect();
     std::fs::write(&list, body).unwrap();
     let out = Command::new(python_linked())
-        .arg(root().join("scripts/sizes.py"))
+        .arg(root().join("tests/judge/sizes.py"))
         .arg("--list")
         .arg(&list)
         .current_dir(dir)
         .output()
-        .expect("run scripts/sizes.py");
+        .expect("run tests/judge/sizes.py");
     assert!(
         out.status.success(),
-        "scripts/sizes.py failed: {}",
+        "tests/judge/sizes.py failed: {}",
         stderr(&out)
     );
     let text = stdout(&out);
     let rows: Vec<BTreeMap<String, Value>> = text
         .lines()
         .map(|l| {
-            parse_flat_json(l).unwrap_or_else(|e| panic!("scripts/sizes.py printed {l:?}: {e}"))
+            parse_flat_json(l).unwrap_or_else(|e| panic!("tests/judge/sizes.py printed {l:?}: {e}"))
         })
         .collect();
     assert_eq!(rows.len(), paths.len(), "one JSON line per model");

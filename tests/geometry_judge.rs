@@ -1,5 +1,5 @@
 //! Geometry judged by MuJoCo: `subtree_bounds` against the compiled model posed at `qpos0`
-//! (scripts/bounds.py, one Python process for every model), and `element_pose` /
+//! (tests/judge/bounds.py, one Python process for every model), and `element_pose` /
 //! `body_relative_pose` against the compiled `body_quat`/`geom_quat`/`site_quat` (and
 //! their positions).
 //!
@@ -320,7 +320,7 @@ fn judged() -> &'static Judged {
             .collect();
         std::fs::write(&batch, lines).unwrap();
         let mut child = Command::new(python())
-            .arg(root().join("scripts/bounds.py"))
+            .arg(root().join("tests/judge/bounds.py"))
             .arg("--batch")
             .arg(&batch)
             .arg("--frames")
@@ -328,7 +328,7 @@ fn judged() -> &'static Judged {
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
             .spawn()
-            .expect("run scripts/bounds.py");
+            .expect("run tests/judge/bounds.py");
         // Read MuJoCo's answers on another thread (so the pipe never fills) while measuring.
         let mut stdout = child.stdout.take().unwrap();
         let reader = std::thread::spawn(move || {

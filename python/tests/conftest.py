@@ -24,9 +24,8 @@ CORPUS = ROOT / ".cache" / "corpus"
 MODELS_TXT = CORPUS / "models.txt"
 RS_ASSETS = CORPUS / "robosuite-1.5.2" / "robosuite" / "models" / "assets"
 
-# The MuJoCo judges (tests/judge) and MuJoCo's bounds (scripts/bounds.py).
+# The MuJoCo judges and MuJoCo's bounds (tests/judge).
 sys.path.insert(0, str(ROOT / "tests" / "judge"))
-sys.path.insert(0, str(ROOT / "scripts"))
 # The examples are imported as modules by their tests.
 sys.path.insert(0, str(ROOT / "python" / "examples"))
 
@@ -58,7 +57,7 @@ ROBOSUITE_PKG = ROOT / ".cache" / "corpus" / "robosuite-1.5.2" / "robosuite"
 def stub_robosuite() -> None:
     """Makes robosuite 1.5.2's unpacked wheel importable as the package `robosuite` without
     running its __init__.py (which imports every environment), as
-    scripts/bench_robosuite.py does; stand-ins for PIL and termcolor when they are not
+    benches/compare/bench_robosuite.py does; stand-ins for PIL and termcolor when they are not
     installed (the model classes never call them)."""
     if not ROBOSUITE_PKG.is_dir():
         pytest.fail(f"{ROBOSUITE_PKG} missing: run scripts/setup.sh")

@@ -1,6 +1,6 @@
 """Runs LIBERO's own tasks with LIBERO's own code, stock or on the switch
 (``mjcf_forge.robosuite.use()``), and records what a comparison needs: run by
-test_libero.py and scripts/bench_libero.py in the LIBERO venv (.cache/venv-libero:
+test_libero.py and benches/compare/bench_libero.py in the LIBERO venv (.cache/venv-libero:
 LIBERO 0.1.1, robosuite 1.4.0, MuJoCo 3.3.1; scripts/setup_libero_env.sh).
 
     python libero_run.py {stock|switch} OUT_DIR SUITE:INDEX [SUITE:INDEX ...]

@@ -2,7 +2,7 @@
 
 Every attribute and hook robosuite's classes have, subclassing in each form robosuite uses,
 errors, and the comparison with robosuite 1.5.2's own classes (imported from the unpacked
-wheel, as scripts/bench_robosuite.py does): compiled models equal, except where robosuite
+wheel, as benches/compare/bench_robosuite.py does): compiled models equal, except where robosuite
 breaks a MuJoCo rule, each such case a test here (corpora/base/) and a line of
 docs/model-hierarchy.md ("Where MuJoCo's rules differ from robosuite's").
 """

@@ -1,5 +1,5 @@
 """Model (our XmlModel, robosuite's MujocoXMLModel vocabulary): names against what MuJoCo
-compiles, offsets against MuJoCo's own geometry (scripts/bounds.py), merging, errors."""
+compiles, offsets against MuJoCo's own geometry (tests/judge/bounds.py), merging, errors."""
 from __future__ import annotations
 
 import json

@@ -11,7 +11,7 @@
 //!
 //! Everything here is judged against MuJoCo's compiled model (`body_quat`, `geom_quat`,
 //! `site_quat`, and `geom_xpos`/`geom_xmat`/`mesh_vert` after `mj_kinematics`) by
-//! `tests/geometry_judge.rs` with `scripts/bounds.py`.
+//! `tests/geometry_judge.rs` with `tests/judge/bounds.py`.
 //!
 //! ```
 //! use mjcf_forge::Document;

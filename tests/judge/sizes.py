@@ -14,7 +14,7 @@ The size keys and their order are those of `mjcf_forge::mujoco::Sizes::to_json`;
 this MuJoCo's MjModel lacks is left out. Exits 0 even when models fail (the caller
 compares); 2 on bad usage.
 
-Run it with the setup's venv: .cache/venv/bin/python scripts/sizes.py ...
+Run it with the setup's venv: .cache/venv/bin/python tests/judge/sizes.py ...
 """
 from __future__ import annotations
 

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Same-run speed comparison of assembling robosuite's Lift scene (table arena, Panda
 # with Rethink mount and Panda gripper, 5 XML objects, merged and written to a string):
-# robosuite 1.5.2 (scripts/bench_robosuite_scene.py) vs mjcf-forge
-# (examples/assemble_scene.rs), back to back on this machine.
+# robosuite 1.5.2 (benches/compare/bench_robosuite_scene.py) vs mjcf-forge
+# (benches/tools/assemble_scene.rs), back to back on this machine.
 #
 # Prints the mjcf-forge line, the robosuite JSON for its own classes (--mode classes,
 # as Lift builds the scene) and for its bare MujocoXML merge path (--mode merge,
@@ -16,7 +16,7 @@
 # Env: RUNS (default 20), FORGE_SCENES (default 1000), FORGE_REPEATS (default 3).
 # Needs scripts/setup_robosuite.sh (run here; fast when done).
 set -euo pipefail
-cd "$(dirname "${BASH_SOURCE[0]}")/.."
+cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 RUNS="${RUNS:-20}"
 FORGE_SCENES="${FORGE_SCENES:-1000}"
 FORGE_REPEATS="${FORGE_REPEATS:-3}"
@@ -35,8 +35,8 @@ for _ in $(seq "$FORGE_REPEATS"); do
   fi
 done
 
-rs_classes="$("$PY" scripts/bench_robosuite_scene.py --runs "$RUNS" --mode auto 2>/dev/null)"
-rs_merge="$("$PY" scripts/bench_robosuite_scene.py --runs "$RUNS" --mode merge 2>/dev/null)"
+rs_classes="$("$PY" benches/compare/bench_robosuite_scene.py --runs "$RUNS" --mode auto 2>/dev/null)"
+rs_merge="$("$PY" benches/compare/bench_robosuite_scene.py --runs "$RUNS" --mode merge 2>/dev/null)"
 
 echo "mjcf-forge:          $forge_line (best of $FORGE_REPEATS processes)"
 echo "robosuite (classes): $rs_classes"

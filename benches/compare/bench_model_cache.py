@@ -23,14 +23,13 @@ its compile, a variant patched into it (`cache.model(variant)`), and the simulat
 of the superset model against the variant's own (mj_step, STEPS steps from the initial
 pose, best of 3).
 
-Usage: python scripts/bench_model_cache.py [--scene S] [--runs N] [--compiles K] [--superset]
+Usage: python benches/compare/bench_model_cache.py [--scene S] [--runs N] [--compiles K] [--superset]
 (run with .cache/venv's Python for MuJoCo 3.17.0, .cache/venv-mj4's for 4.0.0).
 """
 from __future__ import annotations
 
 import argparse
 import json
-import statistics
 import sys
 import time
 from pathlib import Path
@@ -39,22 +38,13 @@ import mujoco
 import numpy as np
 
 import mjcf_forge
+from timing import each_ms, summary  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[1]
-
-
-def timed(fn, runs: int) -> list[float]:
-    fn(0)
-    out = []
-    for i in range(1, runs + 1):
-        t = time.perf_counter()
-        fn(i)
-        out.append((time.perf_counter() - t) * 1e3)
-    return out
+ROOT = Path(__file__).resolve().parents[2]
 
 
-def summary(ms: list[float]) -> dict:
-    return {"best_ms": min(ms), "median_ms": statistics.median(ms), "runs": len(ms)}
+
+
 
 
 def steps_per_second(model, steps: int) -> float:
@@ -77,7 +67,7 @@ def superset(args) -> int:
     compile_ms = (time.perf_counter() - t) * 1e3
     own = mujoco.MjModel.from_xml_string(first.xml)
     variants = [scene.variant(i) for i in range(args.runs + 1)]
-    patch_ms = summary(timed(lambda i: cache.model(variants[i]), args.runs))
+    patch_ms = summary(each_ms(lambda i: cache.model(variants[i]), args.runs))
     cache.model(first)
     result = {
         "scene": args.scene,
@@ -157,10 +147,10 @@ def main() -> int:
         "mujoco": mujoco.__version__,
         "python": sys.version.split()[0],
         "patch_entries": len(first.patch),
-        "compile": summary(timed(compile_one, args.compiles)),
-        "variant": summary(timed(variant_one, args.runs)),
-        "apply": summary(timed(apply_one, args.runs)),
-        "ready": summary(timed(ready_one, args.runs)),
+        "compile": summary(each_ms(compile_one, args.compiles)),
+        "variant": summary(each_ms(variant_one, args.runs)),
+        "apply": summary(each_ms(apply_one, args.runs)),
+        "ready": summary(each_ms(ready_one, args.runs)),
     }
     print(json.dumps(result))
     c, r = result["compile"], result["ready"]

@@ -2,7 +2,7 @@
 //! same-run comparison with robosuite): `cargo run --release --example assemble_scene -- 100`.
 //! With `NO_WRITE` set, the scenes are not written out.
 
-#[path = "../benches/lift_scene.rs"]
+#[path = "../lift_scene.rs"]
 mod lift_scene;
 use lift_scene::{assemble, parts};
 

@@ -3,7 +3,7 @@
 robosuite's classes, run on `robosuite.models.base` (robosuite 1.5.2) and on
 `mjcf_forge.base`, in one process, rounds alternating between the two.
 
-What one scene is (robosuite's Lift parts, as `scripts/bench_robosuite_scene.py --mode
+What one scene is (robosuite's Lift parts, as `benches/compare/bench_robosuite_scene.py --mode
 merge` builds them): Panda, its gripper and its mount loaded as `MujocoXMLModel`s (load,
 inline default classes, absolute paths, prefix, recolour), the gripper merged into
 `robot0_right_hand` and the mount into `robot0_base`, five robosuite objects loaded the
@@ -16,7 +16,7 @@ Also: `findall` over a Panda's root with ElementPath queries, robosuite's tree
 (`xml.etree`) against ours, on the same model.
 
 Run (needs scripts/setup.sh and scripts/setup_robosuite_env.sh):
-  bash scripts/bench_base.sh [ROUNDS]
+  bash benches/compare/bench_base.sh [ROUNDS]
 which runs this file in .cache/venv-robosuite-env (robosuite 1.5.2, MuJoCo 3.9.0) with the
 checkout's installed `mjcf_forge` on the path. Prints one JSON object per measurement and
 the ratios (robosuite's time over ours: above 1 means we are faster).
@@ -28,10 +28,10 @@ import argparse
 import json
 import statistics
 import sys
-import time
 from pathlib import Path
+from timing import mean_seconds  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 ASSETS = ROOT / ".cache/corpus/robosuite-1.5.2/robosuite/models/assets"
 OBJECT_FILES = ["can", "milk", "bread", "cereal", "lemon"]
 QUERIES = [".//geom", ".//body[@name='link7']", "./worldbody/body", ".//joint[@type]", ".//*[@pos]"]
@@ -76,11 +76,6 @@ def make_builder(base, colors):
     return build
 
 
-def timed(fn, n):
-    t0 = time.perf_counter()
-    for _ in range(n):
-        fn()
-    return (time.perf_counter() - t0) / n
 
 
 def main() -> int:
@@ -126,7 +121,7 @@ def main() -> int:
     scene_times = {name: [] for name in sides}
     for _ in range(args.rounds):
         for name, build in sides.items():
-            scene_times[name].append(timed(build, args.scenes))
+            scene_times[name].append(mean_seconds(build, args.scenes))
 
     # ElementPath over the same Panda: robosuite's tree against ours.
     panda = str(ASSETS / "robots/panda/robot.xml")
@@ -140,7 +135,7 @@ def main() -> int:
         assert counts["robosuite"] == counts["mjcf_forge"], (q, counts)
         for _ in range(args.rounds):
             for name, root in trees.items():
-                find_times[q][name].append(timed(lambda: root.findall(q), 2000))
+                find_times[q][name].append(mean_seconds(lambda: root.findall(q), 2000))
 
     result = {
         "python": sys.version.split()[0],

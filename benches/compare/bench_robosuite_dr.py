@@ -58,7 +58,7 @@ robosuite's INFO log (one line per controller load, on every hard reset) is turn
 down to WARNING: a quiet run, and console printing is not what is being measured.
 
 Setup: bash scripts/setup_robosuite_env.sh, then
-  .cache/venv-robosuite-env/bin/python scripts/bench_robosuite_dr.py [--runs N]
+  .cache/venv-robosuite-env/bin/python benches/compare/bench_robosuite_dr.py [--runs N]
   [--warmup N] [--seed S]
 MuJoCo there is 3.9.0, the newest release robosuite 1.5.2's Lift runs on (see
 scripts/requirements-robosuite-env.txt).
@@ -71,10 +71,9 @@ import copy
 import json
 import logging
 import platform
-import statistics
 import sys
-import time
 from pathlib import Path
+from timing import wall_and_cpu  # noqa: E402
 
 # Fields mj_setConst recomputes from the ones the dynamics modder changes.
 SETCONST_FIELDS = (
@@ -87,21 +86,6 @@ SETCONST_FIELDS = (
 )
 
 
-def timed(fn, runs: int, warmup: int) -> dict:
-    for _ in range(warmup):
-        fn()
-    wall, cpu = [], []
-    for _ in range(runs):
-        c0, t0 = time.process_time(), time.perf_counter()
-        fn()
-        wall.append(time.perf_counter() - t0)
-        cpu.append(time.process_time() - c0)
-    return {
-        "best": round(min(wall) * 1e3, 3),
-        "median": round(statistics.median(wall) * 1e3, 3),
-        "cpu_best": round(min(cpu) * 1e3, 3),
-        "cpu_median": round(statistics.median(cpu) * 1e3, 3),
-    }
 
 
 def field(model, name: str):
@@ -211,31 +195,31 @@ def main() -> int:
     }
 
     # Randomize calls alone (soft-reset sim; each call redraws around the saved defaults).
-    ms = {"randomize_domain": timed(wrapped.randomize_domain, args.runs, args.warmup)}
+    ms = {"randomize_domain": wall_and_cpu(wrapped.randomize_domain, args.runs, args.warmup)}
     for key, modder in (
         ("randomize_camera", wrapped.camera_modder),
         ("randomize_lighting", wrapped.light_modder),
         ("randomize_dynamics", wrapped.dynamics_modder),
     ):
-        ms[key] = timed(modder.randomize, args.runs, args.warmup)
+        ms[key] = wall_and_cpu(modder.randomize, args.runs, args.warmup)
 
     # One randomized variant, exactly as the wrapper leaves it, against mj_setConst.
     wrapped.reset()
     setconst = setconst_staleness(env.sim.model._model)
 
     env.hard_reset = False
-    ms["reset_soft"] = timed(wrapped.reset, args.runs, args.warmup)
-    ms["reset_soft_no_dr"] = timed(env.reset, args.runs, args.warmup)
+    ms["reset_soft"] = wall_and_cpu(wrapped.reset, args.runs, args.warmup)
+    ms["reset_soft_no_dr"] = wall_and_cpu(env.reset, args.runs, args.warmup)
 
     # The XML a hard reset compiles, as _initialize_sim builds it.
     xml = env.model.get_xml()
     for processor in env._xml_processors:
         xml = processor(xml)
-    ms["compile"] = timed(lambda: mujoco.MjModel.from_xml_string(xml), args.runs, args.warmup)
+    ms["compile"] = wall_and_cpu(lambda: mujoco.MjModel.from_xml_string(xml), args.runs, args.warmup)
 
     env.hard_reset = True
     with contextlib.redirect_stdout(sys.stderr):
-        ms["reset_hard"] = timed(wrapped.reset, args.runs, args.warmup)
+        ms["reset_hard"] = wall_and_cpu(wrapped.reset, args.runs, args.warmup)
     # A hard reset must have replaced the sim, and the modders must follow it.
     if env.sim is sim or wrapped.dynamics_modder.sim is not env.sim:
         raise SystemExit("bench_robosuite_dr: hard reset did not rebuild the sim")

@@ -22,7 +22,7 @@ Best and median of RUNS per item (compile: COMPILES), after one warm-up; every m
 the sample is checked against compiling its XML (the judge, then bit for bit) before
 timing. Prints one JSON line, then the ratio.
 
-Usage: python scripts/bench_doc_cache.py [--scene S] [--runs N] [--compiles K]
+Usage: python benches/compare/bench_doc_cache.py [--scene S] [--runs N] [--compiles K]
 (run with .cache/venv's Python for MuJoCo 3.17.0, .cache/venv-mj4's for 4.0.0).
 """
 from __future__ import annotations
@@ -39,22 +39,13 @@ import mujoco
 import numpy as np
 
 import mjcf_forge
+from timing import each_ms, summary  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[1]
-
-
-def timed(fn, runs: int) -> list[float]:
-    fn(0)
-    out = []
-    for i in range(1, runs + 1):
-        t = time.perf_counter()
-        fn(i)
-        out.append((time.perf_counter() - t) * 1e3)
-    return out
+ROOT = Path(__file__).resolve().parents[2]
 
 
-def summary(ms: list[float]) -> dict:
-    return {"best_ms": round(min(ms), 4), "median_ms": round(statistics.median(ms), 4), "runs": len(ms)}
+
+
 
 
 def main() -> int:
@@ -91,12 +82,12 @@ def main() -> int:
             print(f"document {i} differs: {diffs[:3]} {floats[:3]}", file=sys.stderr)
             return 1
 
-    compile_ms = timed(lambda i: mujoco.MjModel.from_xml_string(xmls[i]), args.compiles)
-    split_ms = timed(lambda i: docs[i]._split(), args.runs)
-    hit_ms = timed(lambda i: cache.model(docs[i]), args.runs)
-    text_ms = timed(lambda i: cache.model(xmls[i]), args.runs)
+    compile_ms = each_ms(lambda i: mujoco.MjModel.from_xml_string(xmls[i]), args.compiles)
+    split_ms = each_ms(lambda i: docs[i]._split(), args.runs)
+    hit_ms = each_ms(lambda i: cache.model(docs[i]), args.runs)
+    text_ms = each_ms(lambda i: cache.model(xmls[i]), args.runs)
     model = cache.model(docs[0])
-    copy_ms = timed(lambda i: copy.copy(model), min(args.runs, 20))
+    copy_ms = each_ms(lambda i: copy.copy(model), min(args.runs, 20))
     out = {
         "scene": str(Path(args.scene).relative_to(ROOT)) if args.scene.startswith(str(ROOT)) else args.scene,
         "mujoco": mujoco.__version__,
@@ -106,11 +97,11 @@ def main() -> int:
         "model_mb": round(model.nbuffer / 1e6, 1),
         "patch_entries": len(docs[0].patch),
         "first_compile_ms": round(first_ms, 1),
-        "compile": summary(compile_ms),
-        "split": summary(split_ms),
-        "hit": summary(hit_ms),
-        "text_hit": summary(text_ms),
-        "copy": summary(copy_ms),
+        "compile": summary(compile_ms, 4),
+        "split": summary(split_ms, 4),
+        "hit": summary(hit_ms, 4),
+        "text_hit": summary(text_ms, 4),
+        "copy": summary(copy_ms, 4),
         "compiles": cache.compiles,
         "patches": cache.patches,
     }

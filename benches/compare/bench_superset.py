@@ -17,7 +17,7 @@ For SCENE (default benches/scenes/lift5.toml), in one process:
 Ratios: compile median / ready median (the issue asks >= 50x), and extrapolated compiles
 of WORLDS variants / arrays (>= 100x for 4,096 lift5 worlds). Prints one JSON line.
 
-Usage: python scripts/bench_superset.py [--scene S] [--worlds 4096] [--sample 8] [--runs 200]
+Usage: python benches/compare/bench_superset.py [--scene S] [--worlds 4096] [--sample 8] [--runs 200]
 (any venv with mujoco and mjcf_forge: .cache/venv-sim for MuJoCo 4.0.0).
 """
 from __future__ import annotations
@@ -35,7 +35,7 @@ import mjcf_forge
 from mjcf_forge import ModelCache
 from mjcf_forge.batch import WorldBatch
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def main() -> int:

@@ -13,7 +13,7 @@ Prints one JSON object on stdout:
   placements_checked, stubs, robosuite, python, numpy.
 
 Setup: scripts/setup_robosuite.sh, then
-  .cache/venv-robosuite/bin/python scripts/bench_robosuite_variants.py [--runs N]
+  .cache/venv-robosuite/bin/python benches/compare/bench_robosuite_variants.py [--runs N]
   [--seed S] [--dump DIR]
 
 What is timed, per variant i (one variant per run, --runs distinct variants,
@@ -65,7 +65,7 @@ Not included (not XML assembly, or not done at XML level by robosuite):
   - Writing the XML anywhere: get_xml() returns a string, nothing is written.
   - No manifest of sampled values (mjcf-forge's stream carries a JSON per variant).
 
-Imports: as in scripts/bench_robosuite_scene.py (whose helpers this uses): robosuite's
+Imports: as in benches/compare/bench_robosuite_scene.py (whose helpers this uses): robosuite's
 code from the unpacked wheel .cache/corpus/robosuite-1.5.2 without running
 robosuite/__init__.py, and stand-ins in sys.modules for numba, mujoco and cv2 only
 when they are not installed (listed under "stubs"). None of them runs in the timed

@@ -3,7 +3,7 @@
 figure is the median over its runs. Results: docs/speed.md.
 
     bash scripts/setup_libero_env.sh
-    .cache/venv/bin/python scripts/bench_libero.py [--tasks SUITE:INDEX ...] [--resets N]
+    .cache/venv/bin/python benches/compare/bench_libero.py [--tasks SUITE:INDEX ...] [--resets N]
         [--rounds N] [--cameras]
 
 Each process makes one task's environment (LIBERO's ``OffScreenRenderEnv``, which always
@@ -22,7 +22,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 LIBERO_PY = ROOT / ".cache" / "venv-libero" / "bin" / "python"
 
 CHILD = r"""

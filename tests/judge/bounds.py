@@ -21,10 +21,10 @@ is the maximum of ``|P + cos(t) U + sin(t) V|`` over ``t``: found here by
 sampling and golden-section refinement, deliberately not by the closed-form
 method the Rust side uses, so the two check each other.
 
-CLI:    python scripts/bounds.py MODEL BODY [BODY...] [--frames]
+CLI:    python tests/judge/bounds.py MODEL BODY [BODY...] [--frames]
         BODY is a body name or ``#ID`` (a body id: ``#0`` is the world, ``#1``
         the first top-level body). Prints one JSON object.
-Batch:  python scripts/bounds.py --batch FILE [--frames] [--jobs N]
+Batch:  python tests/judge/bounds.py --batch FILE [--frames] [--jobs N]
         each non-blank line is MODEL<TAB>BODY[<TAB>BODY...]; prints one JSON
         object per line, ``{"model": ..., "error": "..."}`` when MuJoCo fails
         (then exits 1 after the rest). ``--jobs N`` compiles N models at a time;

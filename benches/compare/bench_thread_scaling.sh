@@ -11,11 +11,11 @@
 # longer). Run it on an otherwise idle machine: with another process on
 # one of the two cores, the two-thread runs share it.
 #
-# Usage: bash scripts/bench_thread_scaling.sh [SCENE]   (default benches/scenes/lift5.toml)
+# Usage: bash benches/compare/bench_thread_scaling.sh [SCENE]   (default benches/scenes/lift5.toml)
 # Env: N (variants per run, default 200000), ROUNDS (default 5), BIN (default
 #      target/release/mjcf-forge, built here when it is the default).
 set -euo pipefail
-cd "$(dirname "${BASH_SOURCE[0]}")/.."
+cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 SCENE="${1:-benches/scenes/lift5.toml}"
 N="${N:-200000}"
 ROUNDS="${ROUNDS:-5}"

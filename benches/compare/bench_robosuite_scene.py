@@ -1,13 +1,13 @@
 #!/usr/bin/env python3
 """Same-run speed baseline: robosuite assembling its Lift scene (the scene of
-examples/assemble_scene.rs and benches/model.rs) with its own model classes.
+benches/tools/assemble_scene.rs and benches/model.rs) with its own model classes.
 
 Prints one JSON object on stdout:
   scenes_per_s, ms_per_scene (best run), runs, what, mode, median_ms_per_scene,
   mean_ms_per_scene, parse_ms_per_scene, output_chars, stubs, robosuite, python.
 
 Setup: scripts/setup_robosuite.sh, then
-  .cache/venv-robosuite/bin/python scripts/bench_robosuite_scene.py [--runs N]
+  .cache/venv-robosuite/bin/python benches/compare/bench_robosuite_scene.py [--runs N]
   [--mode auto|classes|merge] [--minimal]
 
 What is timed (one scene per run, best of --runs, default 20):
@@ -57,7 +57,7 @@ What is timed (one scene per run, best of --runs, default 20):
 
 Imports: robosuite's code comes from the unpacked wheel .cache/corpus/robosuite-1.5.2
 (robosuite/__init__.py, which imports every environment, is skipped, as in
-scripts/bench_robosuite.py). Importing the model classes also imports modules that
+benches/compare/bench_robosuite.py). Importing the model classes also imports modules that
 need numba, mujoco and cv2, which the light venv lacks; for those this script puts
 minimal stand-ins in sys.modules, only when the real package is not installed, and
 lists them under "stubs". None of them runs during assembly:
@@ -86,7 +86,7 @@ import types
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 RS_DIR = ROOT / ".cache" / "corpus" / "robosuite-1.5.2"
 ASSETS = RS_DIR / "robosuite" / "models" / "assets"
 

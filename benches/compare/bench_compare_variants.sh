@@ -14,7 +14,7 @@
 #     creating N files of the variants' mean XML size in an empty folder on the same
 #     filesystem, then one syncfs (also reported before the sync);
 #  4. robosuite 1.5.2 building the same randomized scene with its own classes,
-#     scripts/bench_robosuite_variants.py (read its docstring: best and median of RUNS
+#     benches/compare/bench_robosuite_variants.py (read its docstring: best and median of RUNS
 #     variants, one build each).
 # Measurements 1-3 run in REPEATS interleaved rounds; the best of each is kept (mjcf-forge:
 # processes of N variants each). Each mjcf-forge process also reports its CPU time
@@ -29,7 +29,7 @@
 #    per file (files - streamed) / the filesystem's cost per file: the "within 1.5x of
 #    the filesystem's own cost per file" figure (1.0 = no more than the filesystem).
 #
-# Usage: bash scripts/bench_compare_variants.sh [--rss] [--rss-only]
+# Usage: bash benches/compare/bench_compare_variants.sh [--rss] [--rss-only]
 #   --rss       also: peak memory of RSS_N (default 100000) variants streamed,
 #               `/usr/bin/time -v mjcf-forge generate lift5.toml -n RSS_N -o - > /dev/null`
 #               ("Maximum resident set size"); takes minutes.
@@ -38,7 +38,7 @@
 #      RSS_N (default 100000), SCRATCH (default target/bench-variants, removed after).
 # Needs scripts/setup_robosuite.sh (run here; fast when done).
 set -euo pipefail
-cd "$(dirname "${BASH_SOURCE[0]}")/.."
+cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 N="${N:-5000}"
 REPEATS="${REPEATS:-3}"
 RUNS="${RUNS:-50}"
@@ -171,7 +171,7 @@ done
 
 # robosuite logs macro warnings on stderr: shown only when the script fails.
 rs_err="$(mktemp)"
-rs="$("$PY" scripts/bench_robosuite_variants.py --runs "$RUNS" 2>"$rs_err")" \
+rs="$("$PY" benches/compare/bench_robosuite_variants.py --runs "$RUNS" 2>"$rs_err")" \
   || { cat "$rs_err" >&2; rm -f "$rs_err"; echo "bench_compare_variants: bench_robosuite_variants.py failed" >&2; exit 1; }
 rm -f "$rs_err"
 

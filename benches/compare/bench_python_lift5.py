@@ -4,7 +4,7 @@ mjcf_forge (``scene.variant(i).xml``, one at a time) against robosuite 1.5.2 bui
 same randomized scene with its own classes; and the cost of crossing into Python per
 variant.
 
-Run: bash scripts/bench_python_lift5.sh [--rounds R] [--forge N] [--robosuite M]
+Run: bash benches/compare/bench_python_lift5.sh [--rounds R] [--forge N] [--robosuite M]
 (which installs the package into .cache/venv-robosuite and runs this there).
 
 The scene (benches/scenes/lift5.toml): robosuite's table arena, the Panda with its mount
@@ -51,8 +51,8 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "scripts"))
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import bench_robosuite_scene as rs  # noqa: E402  (robosuite import helpers, stubs)
 

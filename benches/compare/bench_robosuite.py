@@ -10,7 +10,7 @@ default classes, resolve asset paths, serialize) over every robosuite model in
   rejects; they are left out of files/bytes/seconds), versions.
 
 Setup: scripts/setup_robosuite.sh, then
-  .cache/venv-robosuite/bin/python scripts/bench_robosuite.py [--runs N]
+  .cache/venv-robosuite/bin/python benches/compare/bench_robosuite.py [--runs N]
 
 --import-mode stub (default): robosuite's code comes from the unpacked wheel
   .cache/corpus/robosuite-1.5.2; only robosuite/__init__.py is skipped (it
@@ -32,7 +32,7 @@ import sys
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 CORPUS = ROOT / ".cache" / "corpus"
 RS_DIR = CORPUS / "robosuite-1.5.2"
 MODELS_TXT = CORPUS / "models.txt"

@@ -5,7 +5,7 @@ thread, and the Rust work alone (``Scene._rust_seconds``: the same variants made
 loop, no Python object). Every variant's ``.xml`` is read, as a caller writing or
 compiling it would.
 
-Run: .cache/venv/bin/python scripts/bench_python_stream.py [--n N] [--rounds R]
+Run: .cache/venv/bin/python benches/compare/bench_python_stream.py [--n N] [--rounds R]
 (after scripts/setup.sh, which installs the package into .cache/venv and unpacks the
 robosuite models benches/scenes/lift5.toml uses). Rounds alternate the ways; the best
 and median of each are printed, in variants per second.
@@ -18,7 +18,7 @@ from pathlib import Path
 
 import mjcf_forge
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def rate(n, run):

@@ -4,11 +4,11 @@
 # back to back on this machine; prints both JSON lines and the ratio.
 # Needs scripts/setup_robosuite.sh (run here if missing).
 set -euo pipefail
-cd "$(dirname "${BASH_SOURCE[0]}")/.."
+cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 RUNS="${RUNS:-50}"
 bash scripts/setup_robosuite.sh >/dev/null
 cargo build --release --quiet --example load_throughput
-rs_json="$(.cache/venv-robosuite/bin/python scripts/bench_robosuite.py --runs "$RUNS")"
+rs_json="$(.cache/venv-robosuite/bin/python benches/compare/bench_robosuite.py --runs "$RUNS")"
 # Exactly the files robosuite handled.
 mapfile -t files < <(.cache/venv-robosuite/bin/python - "$rs_json" <<'PY'
 import json, sys

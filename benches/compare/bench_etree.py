@@ -4,7 +4,7 @@ Not a timed test: it prints the time per call of each query, ours and xml.etree'
 accelerator over the tree xml.etree reads from our Document.to_xml()), and their ratio;
 the goal is within 2x of xml.etree.
 
-Run: python scripts/bench_etree.py [model.xml]   (default: robosuite's panda robot)
+Run: python benches/compare/bench_etree.py [model.xml]   (default: robosuite's panda robot)
 
 "cold": the elements found have no Python object yet, so every call makes them (the usual
 case of a loop that drops its results); "warm": every element's object is alive (code
@@ -13,24 +13,16 @@ keeping handles), so a call finds them.
 from __future__ import annotations
 
 import sys
-import timeit
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 from mjcf_forge import Document
+from timing import per_call  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 PANDA = ROOT / ".cache/corpus/robosuite-1.5.2/robosuite/models/assets/robots/panda/robot.xml"
 
 
-def per_call(fn, budget=0.3) -> float:
-    """Seconds per call: the best of five runs of about `budget` seconds each."""
-    n, took = 1, 0.0
-    while took < budget / 10:
-        n *= 2
-        took = timeit.timeit(fn, number=n)
-    n = max(1, int(n * budget / 5 / took))
-    return min(timeit.repeat(fn, number=n, repeat=5)) / n
 
 
 def main() -> None:

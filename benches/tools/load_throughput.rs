@@ -1,5 +1,5 @@
 //! Load + write throughput over a list of MJCF files, best of N runs, as one JSON line.
-//! Used by `scripts/bench_compare.sh` for the same-run comparison with robosuite.
+//! Used by `benches/compare/bench_compare.sh` for the same-run comparison with robosuite.
 //!
 //! `cargo run --release --example load_throughput -- --runs 20 FILE...`
 

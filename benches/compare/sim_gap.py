@@ -15,7 +15,7 @@ before building them (e.g. iterations=100 tolerance=1e-12 ls_iterations=50 cone=
 impratio=10), to see whether a solver setting brings Warp to CPU.
 
 Usage (in .cache/venv-sim):
-  python scripts/sim_gap.py [--scene benches/scenes/lift5.toml] [--worlds 8] [--steps 500]
+  python benches/compare/sim_gap.py [--scene benches/scenes/lift5.toml] [--worlds 8] [--steps 500]
                             [--option iterations=100 ...]
 Prints one JSON line.
 """

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """robosuite's hard reset, stock against mjcf_forge.robosuite.use(), in one run.
 
-    .cache/venv-robosuite-env/bin/python scripts/bench_robosuite_reset.py \
+    .cache/venv-robosuite-env/bin/python benches/compare/bench_robosuite_reset.py \
         [--envs Lift,PickPlace,NutAssembly] [--rounds 8] [--per-round 3] [--profile ENV]
 
 Two worker processes of the robosuite venv (robosuite 1.5.2, MuJoCo 3.9.0) stay alive for
@@ -32,7 +32,7 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def worker(mode: str) -> None:

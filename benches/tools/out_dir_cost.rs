@@ -11,7 +11,7 @@
 //! - `fs_write`: the bare cost of creating that many small files: a loop of plain
 //!   `std::fs::write` of the same bytes into an empty folder.
 //!
-//! Prints one JSON line: microseconds per file of each, and their ratios to `fs_write`. Run by `scripts/bench_out_dir.sh`.
+//! Prints one JSON line: microseconds per file of each, and their ratios to `fs_write`. Run by `benches/compare/bench_out_dir.sh`.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
