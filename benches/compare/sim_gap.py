@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 os.environ.setdefault("WARP_CACHE_PATH", str(ROOT / ".cache" / "warp-kernels"))
 
 import mujoco  # noqa: E402
