@@ -6,7 +6,7 @@
 #
 # Without tasks: every task of libero_spatial, libero_object, libero_goal, libero_10 and
 # libero_90. Each way runs in its own process (two at once); each task's record is
-# .cache/libero-check/{stock,switch}/<suite>-<index>.npz (python/tests/libero_run.py), and
+# .cache/libero-check/{stock,switch}/<suite>-<index>.npz (python/tests/drivers/libero_run.py), and
 # the last line says how many tasks were built, how many have equal models, and how many
 # equal observations (50 steps with cameras, then a hard reset and 5 steps, unless
 # --model-only). Model arrays are recorded as digests (--digest).
@@ -27,21 +27,13 @@ if [[ "${1:-}" == "--model-only" ]]; then
 fi
 tasks=("$@")
 if [[ ${#tasks[@]} -eq 0 ]]; then
-  read -r -a tasks <<<"$(LIBERO_CONFIG_PATH="$ROOT/.cache/libero-config" "$PY" - <<'PY'
-import importlib.util, os
-from libero.libero import get_libero_path
-path = os.path.join(os.path.dirname(get_libero_path("bddl_files")), "benchmark", "libero_suite_task_map.py")
-spec = importlib.util.spec_from_file_location("m", path)
-m = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(m)
-print(" ".join(f"{s}:{i}" for s, tasks in m.libero_task_map.items() for i in range(len(tasks))))
-PY
-)"
+  read -r -a tasks <<<"$(PYTHONPATH="$ROOT/python/tests/drivers" LIBERO_CONFIG_PATH="$ROOT/.cache/libero-config" "$PY" -c \
+    'from libero_tasks import task_map; print(" ".join(f"{s}:{i}" for s, t in task_map().items() for i in range(len(t))))')"
 fi
 rm -rf "$OUT/stock" "$OUT/switch"
 for mode in stock switch; do
   PYTHONPATH="$only" PYTHONHASHSEED=0 LIBERO_CONFIG_PATH="$ROOT/.cache/libero-config" MUJOCO_GL="${MUJOCO_GL:-egl}" \
-    "$PY" python/tests/libero_run.py "$mode" "$OUT/$mode" "${tasks[@]}" "${flags[@]}" >"$OUT/$mode.log" 2>&1 &
+    "$PY" python/tests/drivers/libero_run.py "$mode" "$OUT/$mode" "${tasks[@]}" "${flags[@]}" >"$OUT/$mode.log" 2>&1 &
 done
 wait
 "$ROOT/.cache/venv/bin/python" - "$OUT" <<'PY'

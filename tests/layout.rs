@@ -192,3 +192,143 @@ fn the_crate_root_holds_at_most_four_files() {
         "src/ holds {files:?}: move one into its tier"
     );
 }
+
+/// Where a source or page may name a file of ours: the top-level folders, the library's
+/// and the bindings' tier folders.
+const OUR_FOLDERS: [&str; 20] = [
+    "src", "python", "tests", "benches", "scripts", "docs", "corpora", "examples", "fuzz",
+    "document", "output", "mujoco", "model", "split", "scene", "compiled", "preview", "cli",
+    "judge", "drivers",
+];
+
+/// The extensions of files a comment or page points to.
+const POINTED: [&str; 8] = [".rs", ".py", ".sh", ".c", ".toml", ".md", ".xml", ".json"];
+
+/// Every file of the checkout (outside `.git`, build outputs and caches), relative.
+fn checkout_files(root: &Path, dir: &Path, out: &mut Vec<String>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        if path.is_dir() {
+            if !name.starts_with('.') && !matches!(name.as_str(), "target" | "__pycache__" | "out")
+            {
+                checkout_files(root, &path, out);
+            }
+        } else {
+            out.push(
+                path.strip_prefix(root)
+                    .unwrap()
+                    .to_string_lossy()
+                    .replace('\\', "/"),
+            );
+        }
+    }
+}
+
+/// The names of our files in `text`: a path whose first folder is one of ours
+/// (`scene/patch.rs`, `python/tests/helpers.py`), or a private module or test file of the
+/// Python package named alone (`_trees.py`, `test_world_batch.py`).
+fn pointers(text: &str) -> Vec<(usize, String)> {
+    let part = |c: char| c.is_ascii_alphanumeric() || matches!(c, '_' | '.' | '/' | '-');
+    let mut out = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let chars: Vec<(usize, char)> = line.char_indices().collect();
+        let mut k = 0;
+        while k < chars.len() {
+            let (at, c) = chars[k];
+            let starts = part(c) && (k == 0 || !part(chars[k - 1].1));
+            if !starts {
+                k += 1;
+                continue;
+            }
+            let mut end = k;
+            while end < chars.len() && part(chars[end].1) {
+                end += 1;
+            }
+            let stop = chars.get(end).map_or(line.len(), |x| x.0);
+            // A glob or placeholder (`bench_*.py`, `<suite>.npz`) names no one file.
+            let open = chars
+                .get(end)
+                .is_some_and(|x| matches!(x.1, '*' | '<' | '{'));
+            let token = line[at..stop].trim_end_matches('.');
+            k = end;
+            if open || !POINTED.iter().any(|e| token.ends_with(e)) {
+                continue;
+            }
+            let ours = match token.split_once('/') {
+                Some((first, _)) => OUR_FOLDERS.contains(&first),
+                None => {
+                    token.starts_with("_") && token.ends_with(".py")
+                        || token.starts_with("test_") && token.ends_with(".py")
+                }
+            };
+            if ours {
+                out.push((n + 1, token.to_string()));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn every_file_a_comment_or_page_names_exists() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    checkout_files(root, root, &mut files);
+    let exists = |token: &str| {
+        files
+            .iter()
+            .any(|f| f == token || f.ends_with(&format!("/{token}")))
+    };
+    // A folder of ours that holds the pointed file: another project's path that merely
+    // starts like ours (MuJoCo's `src/render/...`) is no pointer of ours.
+    let folder_exists = |token: &str| {
+        let Some((dir, _)) = token.rsplit_once('/') else {
+            return true;
+        };
+        files
+            .iter()
+            .any(|f| f.starts_with(&format!("{dir}/")) || f.contains(&format!("/{dir}/")))
+    };
+    // Error cases name files that must not exist (`missing_hand.xml`, `no_such_robot.xml`).
+    let meant_missing = |token: &str| {
+        let name = token.rsplit('/').next().unwrap_or(token);
+        token.contains("..") || name.starts_with("missing_") || name.starts_with("no_such_")
+    };
+    let mut missing = Vec::new();
+    let texts: Vec<&String> = files
+        .iter()
+        .filter(|f| {
+            [".rs", ".py", ".sh", ".c", ".md", ".toml"]
+                .iter()
+                .any(|e| f.ends_with(e))
+                && !f.starts_with("corpora/")
+                && !f.ends_with("vocab.rs")
+        })
+        .collect();
+    assert!(texts.len() > 100, "only {} files read", texts.len());
+    for file in texts {
+        let text = std::fs::read_to_string(root.join(file)).unwrap_or_default();
+        for (line, token) in pointers(&text) {
+            if folder_exists(&token) && !meant_missing(&token) && !exists(&token) {
+                missing.push(format!("{file}:{line}: {token}"));
+            }
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "names of files that do not exist:\n{}",
+        missing.join("\n")
+    );
+}
+
+#[test]
+fn pointers_are_found_in_prose_and_code() {
+    let text = "see `scene/patch.rs` and python/tests/helpers.py.\nbench_*.py, _trees.py, \
+                robosuite's binding_utils.py, x/scene/y.rs";
+    let found: Vec<String> = pointers(text).into_iter().map(|(_, t)| t).collect();
+    assert_eq!(
+        found,
+        ["scene/patch.rs", "python/tests/helpers.py", "_trees.py"]
+    );
+}

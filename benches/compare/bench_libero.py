@@ -31,16 +31,10 @@ mode, task, resets, cameras = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.ar
 if mode == "switch":
     import mjcf_forge.robosuite
     mjcf_forge.robosuite.use()
-import importlib.util
-from libero.libero import get_libero_path
 from libero.libero.envs import OffScreenRenderEnv
+from libero_tasks import bddl_file, task_name
 suite, _, index = task.partition(":")
-path = os.path.join(os.path.dirname(get_libero_path("bddl_files")), "benchmark", "libero_suite_task_map.py")
-spec = importlib.util.spec_from_file_location("m", path)
-m = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(m)
-name = m.libero_task_map[suite][int(index)]
-bddl = os.path.join(get_libero_path("bddl_files"), suite, name + ".bddl")
+bddl = bddl_file(suite, task_name(suite, int(index)))
 t = time.perf_counter()
 env = OffScreenRenderEnv(bddl_file_name=bddl, camera_heights=128, camera_widths=128,
                          has_offscreen_renderer=cameras, use_camera_obs=cameras)
@@ -72,7 +66,7 @@ def main() -> None:
     if link.is_symlink() or link.exists():
         link.unlink()
     link.symlink_to(Path(mjcf_forge.__file__).resolve().parent)
-    env = dict(os.environ, PYTHONPATH=str(only), PYTHONHASHSEED="0",
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(only), str(ROOT / "python" / "tests" / "drivers")]), PYTHONHASHSEED="0",
                LIBERO_CONFIG_PATH=str(ROOT / ".cache" / "libero-config"))
     env.setdefault("MUJOCO_GL", "egl")
     print(f"LIBERO hard reset, {'with' if args.cameras else 'without'} cameras; "

@@ -16,7 +16,7 @@ and per world the tree's values are copied into its skeleton, MuJoCo's own
 values of their first computation. What spans trees is computed on the superset itself:
 ``body_subtreemass`` (the same sums in the same order) and the cameras' and lights'
 reference frames (MuJoCo's kinematics at ``qpos0``, then the same differences). The
-result is bit for bit what ``mj_setConst`` gives (``python/tests/test_batch.py`` compares
+result is bit for bit what ``mj_setConst`` gives (``python/tests/test_world_batch.py`` compares
 every per-world array of both ways); a patch that writes anything else ``mj_setConst``
 reads (a robot's armature, an actuated tree, a tendon) gets ``None`` from
 :meth:`TreeDerivation.build`, and the caller keeps ``mj_setConst``.

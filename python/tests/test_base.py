@@ -20,7 +20,7 @@ import pytest
 
 import judge
 import merge_judge
-from conftest import ROOT, RS_ASSETS, stub_robosuite
+from helpers import ROOT, RS_ASSETS, stub_robosuite
 import mjcf_forge
 from mjcf_forge import Element, MjcfError
 from mjcf_forge import base

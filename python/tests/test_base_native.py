@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import pytest
 
-from conftest import ROOT, RS_ASSETS
+from helpers import ROOT, RS_ASSETS
 from mjcf_forge import base
 from mjcf_forge.base import MujocoXML, MujocoXMLModel
 

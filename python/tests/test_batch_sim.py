@@ -21,7 +21,7 @@ import os
 import numpy as np
 import pytest
 
-from conftest import ROOT, RS_ASSETS
+from helpers import ROOT, RS_ASSETS
 
 os.environ.setdefault("WARP_CACHE_PATH", str(ROOT / ".cache" / "warp-kernels"))
 
@@ -191,7 +191,7 @@ def deviations(batch, scene, worlds, xpos, steps, keyframe=None) -> tuple[float,
     return alone, cpu
 
 
-# lift5 in MuJoCo Warp (docs/compiled.md, measured with scripts/sim_gap.py): its objects
+# lift5 in MuJoCo Warp (docs/compiled.md, measured with benches/compare/sim_gap.py): its objects
 # roll and rock on the table, and Warp amplifies any float32 rounding by about 10x per 50
 # steps there: a superset world and its variant's own model, both in Warp, agree within 1.0e-5 m
 # at 100 steps and part by up to 1.1e-3 m at 500; Warp and CPU MuJoCo, each on the variant's

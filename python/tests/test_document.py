@@ -18,7 +18,7 @@ import pytest
 
 import judge
 import mjcf_forge
-from conftest import ROOT, RS_ASSETS, corpus_models
+from helpers import ROOT, RS_ASSETS, corpus_models
 from mjcf_forge import Document, MjcfError
 
 PANDA = RS_ASSETS / "robots" / "panda" / "robot.xml"

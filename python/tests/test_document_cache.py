@@ -19,8 +19,8 @@ import pytest
 
 import judge
 import mjcf_forge
-from conftest import CORPUS, MODELS_TXT, ROOT, RS_ASSETS
-from test_model_cache import not_bit_identical
+from helpers import CORPUS, MODELS_TXT, ROOT, RS_ASSETS
+from helpers import not_bit_identical
 
 SCENES = [
     ROOT / "corpora" / "scenes" / "patch" / "patch.toml",

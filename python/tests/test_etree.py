@@ -14,7 +14,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from conftest import RS_ASSETS
+from helpers import RS_ASSETS
 from mjcf_forge import Document, Element, MjcfError, Model
 from mjcf_forge import etree
 

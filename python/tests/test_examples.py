@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import bounds
-from conftest import ROOT
+from helpers import ROOT
 from mjcf_forge import Scene
 
 DEMO = ROOT / "corpora" / "scenes" / "demo" / "demo.toml"

@@ -24,11 +24,11 @@ import mjcf_forge
 import numpy as np
 import pytest
 
-from conftest import ROOT
+from helpers import ROOT
 
 LIBERO_PY = ROOT / ".cache" / "venv-libero" / "bin" / "python"
 CONFIG = ROOT / ".cache" / "libero-config"
-SCRIPT = Path(__file__).with_name("libero_run.py")
+SCRIPT = Path(__file__).parent / "drivers" / "libero_run.py"
 # One task of each suite; three with LIBERO's flat stove, whose part repeats an asset name
 # of the scene with other content (stock keeps the scene's: robosuite's asset rule).
 TASKS = ["libero_spatial:0", "libero_object:0", "libero_goal:1", "libero_10:2", "libero_90:20"]
@@ -99,7 +99,7 @@ def test_a_libero_hard_reset_on_the_switch_keeps_the_simulation(records, task):
     assert int(records["switch"][task]["kept"]) == 1
 
 
-EVAL = Path(__file__).with_name("libero_eval.py")
+EVAL = Path(__file__).parent / "drivers" / "libero_eval.py"
 EVAL_TASK = "libero_object:0"
 
 

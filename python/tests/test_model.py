@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import bounds
-from conftest import RS_ASSETS
+from helpers import RS_ASSETS
 from mjcf_forge import Document, MjcfError, Model
 
 PANDA = RS_ASSETS / "robots" / "panda" / "robot.xml"

@@ -13,7 +13,7 @@ import pytest
 import judge
 import mjcf_forge
 import mjcf_forge.robosuite as forge_robosuite
-from conftest import RS_ASSETS
+from helpers import RS_ASSETS
 from mjcf_forge import base
 
 PANDA = RS_ASSETS / "robots" / "panda" / "robot.xml"

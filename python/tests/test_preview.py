@@ -15,7 +15,7 @@ import zlib
 import numpy as np
 import pytest
 
-from conftest import ROOT, RS_ASSETS
+from helpers import ROOT, RS_ASSETS
 
 import mjcf_forge
 from mjcf_forge import MjcfError, Scene

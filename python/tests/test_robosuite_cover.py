@@ -49,11 +49,11 @@ import pytest
 
 import judge
 import mjcf_forge
-from conftest import ROOT
+from helpers import ROOT
 from mjcf_forge._mjcf_utils import without_materials as _without_materials
 
 RS_ENV = ROOT / ".cache" / "venv-robosuite-env" / "bin" / "python"
-SCRIPT = Path(__file__).with_name("robosuite_cover.py")
+SCRIPT = Path(__file__).parent / "drivers" / "robosuite_cover.py"
 
 # How many cases of each kind robosuite 1.5.2 has (robosuite_cover.py finds them).
 COUNTS = {"robot": 18, "gripper": 16, "base": 10, "object": 29, "arena": 7, "env": 19, "lift": 17}

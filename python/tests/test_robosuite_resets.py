@@ -21,11 +21,11 @@ import pytest
 
 import judge
 import mjcf_forge
-from conftest import ROOT
-from test_model_cache import not_bit_identical
+from helpers import ROOT
+from helpers import not_bit_identical
 
 RS_ENV = ROOT / ".cache" / "venv-robosuite-env" / "bin" / "python"
-SCRIPT = Path(__file__).with_name("robosuite_resets.py")
+SCRIPT = Path(__file__).parent / "drivers" / "robosuite_resets.py"
 RESETS = 2
 
 

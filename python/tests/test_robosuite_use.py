@@ -24,7 +24,7 @@ import pytest
 import judge
 import mjcf_forge
 import mjcf_forge.robosuite as forge_robosuite
-from conftest import ROOT, stub_robosuite
+from helpers import ROOT, stub_robosuite
 from mjcf_forge import base, etree
 
 RS_ENV = ROOT / ".cache" / "venv-robosuite-env" / "bin" / "python"
@@ -108,7 +108,7 @@ def built(tmp_path_factory):
     for mode in ("robosuite", "forge", "forge-mujoco"):
         path = tmp / f"{mode}.json"
         run = subprocess.run(
-            [str(RS_ENV), str(Path(__file__).with_name("robosuite_build.py")), mode, str(path), "--env"],
+            [str(RS_ENV), str(Path(__file__).parent / "drivers" / "robosuite_build.py"), mode, str(path), "--env"],
             cwd=tmp, env=env, capture_output=True, text=True, timeout=900,
         )
         assert run.returncode == 0, run.stderr[-3000:]

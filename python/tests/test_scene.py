@@ -11,7 +11,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from conftest import ROOT
+from helpers import ROOT
 from mjcf_forge import Document, MjcfError, Scene, Variant
 
 if sys.version_info >= (3, 11):

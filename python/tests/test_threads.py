@@ -6,7 +6,7 @@ import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 
-from conftest import RS_ASSETS
+from helpers import RS_ASSETS
 from mjcf_forge import Document, Scene
 
 PANDA = RS_ASSETS / "robots" / "panda" / "robot.xml"

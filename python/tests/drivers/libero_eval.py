@@ -22,11 +22,6 @@ step, the success predicate and the simulator's state.
 from __future__ import annotations
 
 import argparse
-import importlib.util
-import os
-import pickle
-import zipfile
-
 import sys
 
 if "--stock" not in sys.argv:
@@ -35,8 +30,8 @@ if "--stock" not in sys.argv:
     mjcf_forge.robosuite.use()
 
 import numpy as np  # noqa: E402
-from libero.libero import get_libero_path  # noqa: E402
 from libero.libero.envs import OffScreenRenderEnv, SubprocVectorEnv  # noqa: E402
+from libero_tasks import bddl_file, init_states, task_name  # noqa: E402
 
 ap = argparse.ArgumentParser()
 ap.add_argument("out")
@@ -48,14 +43,9 @@ ap.add_argument("--no-vector", action="store_true")
 args = ap.parse_args()
 
 suite, _, index = args.task.partition(":")
-path = os.path.join(os.path.dirname(get_libero_path("bddl_files")), "benchmark", "libero_suite_task_map.py")
-spec = importlib.util.spec_from_file_location("libero_suite_task_map", path)
-task_map = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(task_map)
-name = task_map.libero_task_map[suite][int(index)]
-BDDL = os.path.join(get_libero_path("bddl_files"), suite, name + ".bddl")
-with zipfile.ZipFile(os.path.join(get_libero_path("init_states"), suite, name + ".pruned_init")) as z:
-    INIT = pickle.loads(z.read(next(n for n in z.namelist() if n.endswith("/data.pkl"))))
+name = task_name(suite, int(index))
+BDDL = bddl_file(suite, name)
+INIT = init_states(suite, name)
 
 
 def make_env():

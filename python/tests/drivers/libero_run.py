@@ -31,12 +31,9 @@ from __future__ import annotations
 
 import argparse
 import hashlib
-import importlib.util
 import os
-import pickle
 import sys
 import traceback
-import zipfile
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 
@@ -58,26 +55,8 @@ if args.mode == "switch":
 
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
-from libero.libero import get_libero_path  # noqa: E402
 from libero.libero.envs import OffScreenRenderEnv  # noqa: E402
-
-
-def task_map() -> dict:
-    """LIBERO's suites and their tasks in order (libero.libero.benchmark's own map; its
-    package imports torch, so the module is loaded alone)."""
-    path = os.path.join(os.path.dirname(get_libero_path("bddl_files")), "benchmark", "libero_suite_task_map.py")
-    spec = importlib.util.spec_from_file_location("libero_suite_task_map", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module.libero_task_map
-
-
-def init_states(suite: str, task: str) -> np.ndarray:
-    """The task's init states: a torch.save zip whose pickle holds one numpy array."""
-    path = os.path.join(get_libero_path("init_states"), suite, task + ".pruned_init")
-    with zipfile.ZipFile(path) as z:
-        name = next(n for n in z.namelist() if n.endswith("/data.pkl"))
-        return pickle.loads(z.read(name))
+from libero_tasks import bddl_file, init_states, task_name  # noqa: E402
 
 
 def _digest(value: np.ndarray) -> np.ndarray:
@@ -113,8 +92,8 @@ def model_arrays(model) -> dict:
 
 
 def run(suite: str, index: int) -> dict:
-    task = task_map()[suite][index]
-    bddl = os.path.join(get_libero_path("bddl_files"), suite, task + ".bddl")
+    task = task_name(suite, index)
+    bddl = bddl_file(suite, task)
     size = 128
     env = OffScreenRenderEnv(
         bddl_file_name=bddl, camera_heights=size, camera_widths=size,
