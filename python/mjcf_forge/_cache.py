@@ -20,22 +20,10 @@ from typing import Any, Callable
 import numpy as np
 
 from ._errors import error
-from ._mjcf_forge import MjcfError, Scene
+from ._mjcf_forge import SIGNATURE_ARRAYS, STATIC_PREFIXES, MjcfError, Scene
 from ._plan import Plan, in_order_sum
 from ._progress import progress_of
 from ._trees import TreeDerivation
-
-# Integer arrays that, with the sizes and the names, tell one structure from another.
-_SIGNATURE_ARRAYS = (
-    "body_parentid",
-    "jnt_type",
-    "geom_type",
-    "geom_bodyid",
-    "geom_dataid",
-    "mesh_vertnum",
-    "tex_width",
-)
-
 
 # Sizes mj_setConst recomputes from patched values (bodies with gravity compensation).
 _SET_BY_PATCHING = frozenset({"ngravcomp"})
@@ -51,17 +39,9 @@ def _signature(model: Any) -> tuple:
         and isinstance(getattr(model, a, None), int)
     )
     arrays = tuple(
-        getattr(model, a).tobytes() for a in _SIGNATURE_ARRAYS if hasattr(model, a)
+        getattr(model, a).tobytes() for a in SIGNATURE_ARRAYS if hasattr(model, a)
     )
     return sizes, bytes(model.names), arrays
-
-
-# Model arrays no patch changes (meshes, textures, height fields, skins, flexes, bounding
-# volumes, names): left out of batch().
-STATIC_PREFIXES = (
-    "mesh_", "tex_", "hfield_", "skin_", "flex", "bvh_", "oct_", "name", "text_", "paths",
-    "tuple_", "numeric_", "plugin", "sensor_", "key_",
-)
 
 
 def evict(

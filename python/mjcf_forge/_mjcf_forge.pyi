@@ -1,5 +1,5 @@
 """Type stubs of the compiled module ``mjcf_forge._mjcf_forge`` (kept by hand, checked
-against the module's own signatures by python/tests/test_stubs.py)."""
+against the module's own signatures by python/tests/test_package.py)."""
 
 import os
 from pathlib import Path
@@ -10,6 +10,16 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
+
+#: The split tier's tables the package's caches read (``mjcf_forge::split::targets``).
+PATCH_OBJECTS: dict[str, tuple[str, str, str]]
+DOF_FIELDS: tuple[str, ...]
+QPOS_FIELDS: tuple[str, ...]
+STATIC_PREFIXES: tuple[str, ...]
+SIGNATURE_ARRAYS: tuple[str, ...]
+
+def target_array(object: str, field: str) -> Optional[str]: ...
+def joint_widths(jnt_type: int) -> tuple[int, int]: ...
 
 _Path = Union[str, os.PathLike[str]]
 #: What Element.set and Element.append take as an attribute value.

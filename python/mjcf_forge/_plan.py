@@ -17,54 +17,11 @@ from typing import Any, Callable
 import numpy as np
 
 from ._errors import error
+from ._mjcf_forge import DOF_FIELDS, PATCH_OBJECTS, QPOS_FIELDS, joint_widths, target_array
 
-# The array prefix of each accessor's fields in MjModel, its object type and its count.
-_PREFIX = {
-    "body": "body_",
-    "joint": "jnt_",
-    "geom": "geom_",
-    "site": "site_",
-    "camera": "cam_",
-    "light": "light_",
-    "material": "mat_",
-    "actuator": "actuator_",
-}
-OBJ = {
-    "body": "mjOBJ_BODY",
-    "joint": "mjOBJ_JOINT",
-    "geom": "mjOBJ_GEOM",
-    "site": "mjOBJ_SITE",
-    "camera": "mjOBJ_CAMERA",
-    "light": "mjOBJ_LIGHT",
-    "material": "mjOBJ_MATERIAL",
-    "actuator": "mjOBJ_ACTUATOR",
-}
-_COUNT = {
-    "body": "nbody",
-    "joint": "njnt",
-    "geom": "ngeom",
-    "site": "nsite",
-    "camera": "ncam",
-    "light": "nlight",
-    "material": "nmat",
-    "actuator": "nu",
-}
-# Joint fields that are per degree of freedom or per qpos coordinate.
-_DOF_FIELDS = ("damping", "armature", "frictionloss")
-_QPOS_FIELDS = ("qpos0", "qpos_spring")
-_JOINT_QPOS = {0: 7, 1: 4, 2: 1, 3: 1}  # free, ball, slide, hinge
-_JOINT_DOFS = {0: 6, 1: 3, 2: 1, 3: 1}
-
-
-def target_array(obj: str, field: str) -> str | None:
-    """The MjModel array a patch entry of an ``obj``'s ``field`` writes (a joint's dof and
-    qpos fields and its keyframe rows have arrays of their own); None for the options."""
-    if obj == "joint" and field in _DOF_FIELDS:
-        return "dof_" + field
-    if obj == "joint" and (field in _QPOS_FIELDS or field == "key_qpos"):
-        return field
-    prefix = _PREFIX.get(obj)
-    return None if prefix is None else prefix + field
+# The split tier's tables (``mjcf_forge::split::targets``, through the extension): each
+# patched object's array prefix, mjtObj name and count; the joints' dof and qpos fields.
+OBJ = {obj: kind for obj, (_prefix, kind, _count) in PATCH_OBJECTS.items()}
 
 
 class _Groups:
@@ -207,7 +164,7 @@ class Plan:
                 numbers += len(value)
                 continue
             if isinstance(name, int):
-                i = name if name < getattr(model, _COUNT[obj]) else -1
+                i = name if name < getattr(model, PATCH_OBJECTS[obj][2]) else -1
             else:
                 i = mujoco.mj_name2id(model, getattr(mujoco.mjtObj, OBJ[obj]), name)
             if i < 0:
@@ -218,27 +175,24 @@ class Plan:
                 bodies.append(int(i))
                 body_xml.append(value)
                 continue
-            if obj == "joint" and field in _DOF_FIELDS:
-                array = f"dof_{field}"
+            array = target_array(obj, field)
+            if obj == "joint" and field in DOF_FIELDS:
                 first = int(model.jnt_dofadr[i])
-                rows = range(first, first + _JOINT_DOFS[int(model.jnt_type[i])])
-            elif obj == "joint" and field in _QPOS_FIELDS:
-                array = field
-                first = int(model.jnt_qposadr[i])
-                rows = range(first, first + _JOINT_QPOS[int(model.jnt_type[i])])
+                rows = range(first, first + joint_widths(int(model.jnt_type[i]))[0])
             elif obj == "joint" and field == "key_qpos":
                 # The joint's rows of every keyframe (one row of nq per key).
-                array = field
                 first = int(model.jnt_qposadr[i])
-                width = _JOINT_QPOS[int(model.jnt_type[i])]
+                width = joint_widths(int(model.jnt_type[i]))[1]
                 _, targets, sources = groups.setdefault(array, (model.key_qpos.reshape(-1), [], []))
                 for k in range(model.nkey):
                     targets.extend(range(k * model.nq + first, k * model.nq + first + width))
                     sources.extend(range(numbers, numbers + len(value)))
                 numbers += len(value)
                 continue
+            elif obj == "joint" and field in QPOS_FIELDS:
+                first = int(model.jnt_qposadr[i])
+                rows = range(first, first + joint_widths(int(model.jnt_type[i]))[1])
             else:
-                array = _PREFIX[obj] + field
                 width = 1 if isinstance(value, str) else len(value)
                 rows = range(i * width, (i + 1) * width)
             whole = getattr(model, array)

@@ -29,7 +29,8 @@ from typing import Any
 
 import numpy as np
 
-from ._plan import OBJ, target_array
+from ._mjcf_forge import target_array
+from ._plan import OBJ
 
 # Patch targets (MjModel arrays) that mj_setConst reads: a tree written into through
 # them is derived again per world.

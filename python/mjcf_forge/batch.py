@@ -33,10 +33,10 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ._cache import STATIC_PREFIXES, ModelCache
+from ._cache import ModelCache
 from ._errors import error
+from ._mjcf_forge import STATIC_PREFIXES, target_array
 from ._mjx import MjxWorlds
-from ._plan import target_array
 from ._progress import progress_of
 from ._warp import WarpWorlds
 

@@ -10,16 +10,18 @@
 //! over the raw model, its serial number and the writable pointer through `pub(crate)` items.
 
 use std::collections::HashMap;
-use std::ffi::{CString, c_char, c_int, c_void};
+use std::ffi::{CString, c_int};
 use std::ptr::NonNull;
 
 use super::body_models::BodyModels;
 use super::sys::{
     RawData, mjf_patch_array, mjf_patch_delete_data, mjf_patch_finish, mjf_patch_get_stat,
-    mjf_patch_make_data, mjf_patch_nbytes, mjf_patch_option,
+    mjf_patch_make_data, mjf_patch_name2id, mjf_patch_nbytes, mjf_patch_option,
 };
 use crate::mujoco::{CompiledModel, MjModel, ObjType, Sizes};
-use crate::split::{PatchEntry, PatchValue};
+use crate::split::{
+    DOF_FIELDS, PatchEntry, PatchValue, QPOS_FIELDS, SIGNATURE_ARRAYS, joint_widths, target_array,
+};
 
 /// Scratch mjData for `mj_setConst` (which overwrites the qpos of the data it is given).
 pub(super) struct Scratch(pub(super) NonNull<RawData>);
@@ -77,21 +79,40 @@ pub(super) struct Plan {
 // written through `&mut` of that model.
 unsafe impl Send for Plan {}
 
-/// What a structure is: the sizes and names of its model, to refuse a model of another.
+/// What a structure is: the sizes, names and integer arrays
+/// ([`SIGNATURE_ARRAYS`](crate::split::SIGNATURE_ARRAYS)) of its model, to refuse a model
+/// of another.
 #[derive(PartialEq)]
 pub(super) struct Signature {
     sizes: Sizes,
     names: Vec<Vec<String>>,
+    arrays: Vec<Vec<u8>>,
 }
 
 impl Signature {
     pub(super) fn of(m: &CompiledModel) -> Signature {
+        let arrays = SIGNATURE_ARRAYS
+            .iter()
+            .map(|name| {
+                let c = CString::new(*name).expect("array names hold no NUL");
+                let (mut elem, mut count) = (0usize, 0usize);
+                let raw = std::ptr::from_ref(m.raw()).cast_mut();
+                // SAFETY: the model is live and only read; `c` is NUL-terminated.
+                let p = unsafe { mjf_patch_array(raw, c.as_ptr(), &mut elem, &mut count) };
+                if p.is_null() {
+                    return Vec::new();
+                }
+                // SAFETY: MuJoCo's array holds `count` elements of `elem` bytes.
+                unsafe { std::slice::from_raw_parts(p.cast::<u8>(), elem * count) }.to_vec()
+            })
+            .collect();
         Signature {
             sizes: m.sizes(),
             names: [ObjType::Body, ObjType::Joint, ObjType::Geom, ObjType::Site]
                 .into_iter()
                 .map(|o| m.names(o))
                 .collect(),
+            arrays,
         }
     }
 }
@@ -393,21 +414,15 @@ fn resolve(model: &mut CompiledModel, entries: &[PatchEntry]) -> Result<Vec<Targ
             }
         };
         let (mut runs, mut stride) = (1, 0);
+        let target = target_array(e.object, e.field)
+            .ok_or_else(|| format!("a patch names no array for {}.{}", e.object, e.field))?;
         let (name, offset, n) = match (e.object, e.field) {
-            ("joint", f @ ("damping" | "armature" | "frictionloss")) => {
-                let dofs = match int_at("jnt_type", id)? {
-                    0 => 6,
-                    1 => 3,
-                    _ => 1,
-                };
-                (format!("dof_{f}"), int_at("jnt_dofadr", id)?, dofs)
+            ("joint", f) if DOF_FIELDS.contains(&f) => {
+                let (dofs, _) = joint_widths(int_at("jnt_type", id)? as i64);
+                (target, int_at("jnt_dofadr", id)?, dofs)
             }
-            ("joint", f @ ("qpos0" | "qpos_spring" | "key_qpos")) => {
-                let n = match int_at("jnt_type", id)? {
-                    0 => 7,
-                    1 => 4,
-                    _ => 1,
-                };
+            ("joint", f) if QPOS_FIELDS.contains(&f) => {
+                let (_, n) = joint_widths(int_at("jnt_type", id)? as i64);
                 if f == "key_qpos" {
                     // The joint's rows of every keyframe: one row of nq per key.
                     let (_, _, nq) = array("qpos0")?;
@@ -415,21 +430,9 @@ fn resolve(model: &mut CompiledModel, entries: &[PatchEntry]) -> Result<Vec<Targ
                     runs = all.checked_div(nq).unwrap_or(0);
                     stride = nq;
                 }
-                (f.to_string(), int_at("jnt_qposadr", id)?, n)
+                (target, int_at("jnt_qposadr", id)?, n)
             }
-            (object, field) => {
-                let prefix = match object {
-                    "body" => "body_",
-                    "joint" => "jnt_",
-                    "geom" => "geom_",
-                    "site" => "site_",
-                    "camera" => "cam_",
-                    "light" => "light_",
-                    "actuator" => "actuator_",
-                    _ => "mat_",
-                };
-                (format!("{prefix}{field}"), id * width, width)
-            }
+            _ => (target, id * width, width),
         };
         let (p, elem, count) = array(&name)?;
         let end = offset + n + runs.saturating_sub(1) * stride;

@@ -10,13 +10,7 @@ use std::ffi::CStr;
 use super::cache::ModelCache;
 use super::sys::{mjf_patch_array, mjf_patch_array_name, mjf_patch_array_type, mjf_patch_get_stat};
 use crate::mujoco::CompiledModel;
-
-/// Arrays no superset patch changes (meshes, textures, height fields, skins, flexes,
-/// bounding-volume trees, names, sensors, keyframes): never compared, never per world.
-const STATIC_PREFIXES: [&str; 15] = [
-    "mesh_", "tex_", "hfield_", "skin_", "flex", "bvh_", "oct_", "name", "text_", "paths",
-    "tuple_", "numeric_", "plugin", "sensor_", "key_",
-];
+use crate::split::STATIC_PREFIXES;
 
 /// The element type of an `mjModel` array, as MuJoCo declares it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -25,6 +25,8 @@
 //! ```
 //!
 //! Files: `rules.rs` (the attribute-to-field rules, [`PATCHABLE`], the patch entry types),
+//! `targets.rs` (the `mjModel` array each entry writes, the arrays no patch changes, the
+//! arrays that tell structures apart: the one copy the model caches of both faces read),
 //! `document.rs` (any document split by reading it), `body_model.rs` (a body's geoms as a
 //! model of their own, for what MuJoCo derives from their sizes). The scene tier reads its
 //! drawn variants through the same rules (`scene/patch.rs`).
@@ -35,11 +37,16 @@
 mod body_model;
 mod document;
 mod rules;
+mod targets;
 
 pub use document::{
     DocumentPatch, PATCHABLE_OPTIONS, SplitOptions, split_document, split_document_with,
 };
 pub use rules::{PATCHABLE, PatchEntry, PatchValue};
+pub use targets::{
+    DOF_FIELDS, PATCH_OBJECTS, PatchObject, QPOS_FIELDS, SIGNATURE_ARRAYS, STATIC_PREFIXES,
+    joint_widths, target_array,
+};
 
 pub(crate) use body_model::{body_model, carried_by};
 pub(crate) use rules::{

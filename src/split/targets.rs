@@ -1,0 +1,136 @@
+//! Where a patch lands in MuJoCo's compiled model: the `mjModel` array of each patch
+//! entry, the arrays no patch changes, and the integer arrays that tell one structure from
+//! another. The one copy of these tables: the model caches (`crate::compiled`) and the
+//! Python package's caches (`_plan.py`, `_cache.py`, `batch.py`, through the extension)
+//! read them here.
+//!
+//! ```
+//! use mjcf_forge::split::target_array;
+//! assert_eq!(target_array("geom", "rgba").as_deref(), Some("geom_rgba"));
+//! assert_eq!(target_array("joint", "damping").as_deref(), Some("dof_damping"));
+//! assert_eq!(target_array("joint", "qpos0").as_deref(), Some("qpos0"));
+//! assert_eq!(target_array("option", "timestep"), None);
+//! ```
+
+/// An element type a patch entry names: its `mjModel` array prefix, its `mjtObj` name
+/// and the size that counts it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PatchObject {
+    /// The type as MuJoCo's named accessors call it (`PatchEntry::object`).
+    pub object: &'static str,
+    /// The prefix of its arrays in `mjModel` (`jnt_` for a joint).
+    pub prefix: &'static str,
+    /// Its `mjtObj` value's name (`mjOBJ_JOINT`).
+    pub obj_type: &'static str,
+    /// The size that counts it (`njnt`).
+    pub count: &'static str,
+}
+
+/// Every element type a patch entry can name besides `option`.
+pub const PATCH_OBJECTS: [PatchObject; 8] = [
+    PatchObject {
+        object: "body",
+        prefix: "body_",
+        obj_type: "mjOBJ_BODY",
+        count: "nbody",
+    },
+    PatchObject {
+        object: "joint",
+        prefix: "jnt_",
+        obj_type: "mjOBJ_JOINT",
+        count: "njnt",
+    },
+    PatchObject {
+        object: "geom",
+        prefix: "geom_",
+        obj_type: "mjOBJ_GEOM",
+        count: "ngeom",
+    },
+    PatchObject {
+        object: "site",
+        prefix: "site_",
+        obj_type: "mjOBJ_SITE",
+        count: "nsite",
+    },
+    PatchObject {
+        object: "camera",
+        prefix: "cam_",
+        obj_type: "mjOBJ_CAMERA",
+        count: "ncam",
+    },
+    PatchObject {
+        object: "light",
+        prefix: "light_",
+        obj_type: "mjOBJ_LIGHT",
+        count: "nlight",
+    },
+    PatchObject {
+        object: "material",
+        prefix: "mat_",
+        obj_type: "mjOBJ_MATERIAL",
+        count: "nmat",
+    },
+    PatchObject {
+        object: "actuator",
+        prefix: "actuator_",
+        obj_type: "mjOBJ_ACTUATOR",
+        count: "nu",
+    },
+];
+
+/// A joint's fields that are per degree of freedom (`dof_<field>`).
+pub const DOF_FIELDS: [&str; 3] = ["damping", "armature", "frictionloss"];
+
+/// A joint's fields that are per `qpos` coordinate, arrays of their own (`key_qpos`: its
+/// rows of every keyframe).
+pub const QPOS_FIELDS: [&str; 3] = ["qpos0", "qpos_spring", "key_qpos"];
+
+/// How many degrees of freedom and `qpos` coordinates a joint of MuJoCo type `jnt_type`
+/// has (free, ball, slide, hinge).
+///
+/// ```
+/// assert_eq!(mjcf_forge::split::joint_widths(0), (6, 7));
+/// assert_eq!(mjcf_forge::split::joint_widths(3), (1, 1));
+/// ```
+pub fn joint_widths(jnt_type: i64) -> (usize, usize) {
+    match jnt_type {
+        0 => (6, 7),
+        1 => (3, 4),
+        _ => (1, 1),
+    }
+}
+
+/// The `mjModel` array a patch entry of an `object`'s `field` writes (a joint's dof and
+/// qpos fields have arrays of their own), or `None` for the options and body models.
+pub fn target_array(object: &str, field: &str) -> Option<String> {
+    if object == "joint" && DOF_FIELDS.contains(&field) {
+        return Some(format!("dof_{field}"));
+    }
+    if object == "joint" && QPOS_FIELDS.contains(&field) {
+        return Some(field.to_string());
+    }
+    PATCH_OBJECTS
+        .iter()
+        .find(|o| o.object == object)
+        .map(|o| format!("{}{field}", o.prefix))
+}
+
+/// The prefixes of `mjModel` arrays no patch changes (meshes, textures, height fields,
+/// skins, flexes, bounding-volume trees, names, sensors, keyframes): never compared
+/// across a batch's worlds, never per world.
+pub const STATIC_PREFIXES: [&str; 15] = [
+    "mesh_", "tex_", "hfield_", "skin_", "flex", "bvh_", "oct_", "name", "text_", "paths",
+    "tuple_", "numeric_", "plugin", "sensor_", "key_",
+];
+
+/// Integer arrays that, with the sizes and the names, tell one structure's compiled model
+/// from another's (a model cache refuses to patch a model of another structure).
+pub const SIGNATURE_ARRAYS: [&str; 7] = [
+    "body_parentid",
+    "jnt_type",
+    "geom_type",
+    "geom_bodyid",
+    "geom_dataid",
+    "mesh_vertnum",
+    "tex_width",
+];
