@@ -338,8 +338,6 @@ fn is_plain_path(link: &Path) -> bool {
     !(text.ends_with(b"]") && text.contains(&b':') && !text.contains(&b'/'))
 }
 
-/// A folder that receives many output files, from many threads at once.
-
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;

@@ -19,6 +19,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use super::atomic::{AtomicFile, Sink, TEMP_PREFIX, TempFile, folder_of, write_error};
 use crate::error::{Error, ErrorKind};
 
+/// A folder that receives many output files, from many threads at once.
 ///
 /// [`OutputDir::write`] takes `&self` and holds no lock: each file is its own temporary
 /// file and rename, so threads only meet in the kernel. Files get the permissions of a
