@@ -46,7 +46,7 @@ echo "== judge self-tests (MuJoCo 3.17.0 and 4.0.0) [${SECONDS}s in]"
 echo "== python package (pytest: API, errors, threads, MuJoCo judge, Gymnasium, Ray) [${SECONDS}s in]"
 # (test_batch_sim.py needs MuJoCo Warp and JAX: it runs in .cache/venv-sim below.)
 # (test_libero.py runs LIBERO in .cache/venv-libero, MuJoCo 3.3.1, stock and on the switch.)
-.cache/venv/bin/python -m pytest python/tests -q -p no:cacheprovider --ignore=python/tests/test_batch_sim.py
+.cache/venv/bin/python -m pytest python/tests -q -p no:cacheprovider --ignore=python/tests/test_batch_sim.py --durations=15
 echo "== ModelCache and DocumentCache under MuJoCo 4.0.0 (patched models judged against 4.0.0's compile) [${SECONDS}s in]"
 .cache/venv-mj4/bin/python -m pytest python/tests/test_model_cache.py python/tests/test_world_batch.py python/tests/test_document_cache.py -q -p no:cacheprovider
 # robosuite's task XMLs (written by the robosuite venv) through a DocumentCache, judged by 4.0.0.
