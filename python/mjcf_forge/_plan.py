@@ -17,6 +17,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ._errors import error
+from . import _mujoco
 from ._mjcf_forge import DOF_FIELDS, PATCH_OBJECTS, QPOS_FIELDS, joint_widths, target_array
 
 # The split tier's tables (``mjcf_forge::split::targets``, through the extension): each
@@ -105,14 +106,10 @@ class Plan:
             b: (model.body_pos[b].copy(), model.body_quat[b].copy(), model.body_ipos[b].copy(), model.body_iquat[b].copy(), int(model.body_sameframe[b]))
             for b in np.flatnonzero((model.body_mass == 0) & ~model.body_inertia.any(axis=1))
         }
-        # The mass matrix's diagonal: the last of each row of data.M where MuJoCo has
-        # it (3.9 does), else data.qM at dof_Madr (3.3: the same numbers).
-        if hasattr(data, "M"):
-            self.M, self.M_diagonal = data.M, model.M_rowadr + model.M_rownnz - 1
-        else:
-            self.M, self.M_diagonal = data.qM, model.dof_Madr.copy()
+        # The mass matrix's diagonal, where this MuJoCo keeps it (_mujoco.py).
+        self.M, self.M_diagonal = _mujoco.inertia_diagonal(model, data)
         self.nbody, self.nv = model.nbody, model.nv
-        self.dof_length = getattr(model, "dof_length", None)  # not in MuJoCo 3.3
+        self.dof_length = _mujoco.field(model, "dof_length")
         # Geom radii for the bounding box: a plane or height field (rbound 0) counts a
         # tenth of its largest size. Sizes are patched only through "geoms" entries, which
         # update these (body_model()).
@@ -351,9 +348,8 @@ class Plan:
             self.qpos[:] = self.qpos0
             mujoco.mj_kinematics(model, data)
             mujoco.mj_comPos(model, data)
-        # The joint-space inertia: mj_makeM where this MuJoCo has it, else mj_crb (3.3.1),
-        # which fills qM the same way.
-        (getattr(mujoco, "mj_makeM", None) or mujoco.mj_crb)(model, data)
+        # The joint-space inertia (_mujoco.py: mj_makeM or, in 3.3, mj_crb).
+        _mujoco.make_inertia(mujoco, model, data)
         lo = np.full(3, 1e10)
         hi = np.full(3, -1e10)
         points = np.concatenate(

@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from ._mjcf_forge import target_array
+from . import _mujoco
 from ._plan import OBJ
 
 # Patch targets (MjModel arrays) that mj_setConst reads: a tree written into through
@@ -106,7 +107,7 @@ class _Tree:
         md = slice(before, before + count)
         # The mass matrix's sparsity, as the superset's (the dofs' own rows).
         rows = slice(start, start + count)
-        if not hasattr(sk, "M_rownnz"):
+        if _mujoco.field(sk, "M_rownnz") is None:
             # MuJoCo 3.3 has no M_rownnz to compare (mj_setConst on the whole model then).
             raise ValueError("this MuJoCo has no M_rownnz")
         if not (
@@ -120,7 +121,7 @@ class _Tree:
             )
             and all(
                 np.array_equal(getattr(sk, n)[mb], getattr(model, n)[self.bodies])
-                for n in ("body_simple",) if hasattr(sk, n)
+                for n in ("body_simple",) if _mujoco.field(sk, n) is not None
             )
         ):
             raise ValueError("the skeleton's mass matrix is not laid out as the tree's")
@@ -151,7 +152,7 @@ class _Tree:
         # The compiler makes a body whose inertial frame is its own "simple" (a sparser
         # mass matrix): the skeleton's bodies are simple exactly where the superset's are.
         offset = '<inertial pos=".01 .02 .03" quat=".9 .1 .2 .3" mass="1" diaginertia="1 1 1"/>'
-        simple = getattr(model, "body_simple", None)
+        simple = _mujoco.field(model, "body_simple")
 
         def body(b: int) -> str:
             children = [int(c) for c in bodies if model.body_parentid[c] == b and c != b]
