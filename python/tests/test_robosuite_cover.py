@@ -142,6 +142,14 @@ def compiled(xml: str):
         return re.sub(r",? ?line \d+", "", str(e)).strip()
 
 
+@pytest.fixture(scope="module", autouse=True)
+def _free_compiled():
+    """The compiled models are shared by this module's tests and freed after them (every
+    robosuite case's model held to the end of the run is gigabytes)."""
+    yield
+    compiled.cache_clear()
+
+
 def bit_equal(a, b) -> list:
     """The arrays, sizes and option, statistic and visual fields in which two compiled
     models differ, compared byte for byte (names included)."""

@@ -144,5 +144,8 @@ for spec in args.tasks:
     except Exception as e:  # noqa: BLE001 - the record says what LIBERO's code raised
         traceback.print_exc()
         record = {"error": np.array(f"{type(e).__name__}: {e}")}
-    np.savez(os.path.join(args.out, f"{suite}-{index}.npz"), **record)
+    # Written whole or not at all: a killed run leaves no half record (libero_check --resume).
+    path = os.path.join(args.out, f"{suite}-{index}.npz")
+    np.savez(path + ".part.npz", **record)
+    os.replace(path + ".part.npz", path)
     print(spec, "error" if "error" in record else "ok", flush=True)
