@@ -131,11 +131,11 @@ def covered(tmp_path_factory):
     return run_all(tmp_path_factory.mktemp("robosuite_cover"))
 
 
-@functools.lru_cache(maxsize=None)
+@functools.lru_cache(maxsize=64)
 def compiled(xml: str):
     """The model MuJoCo compiles, or its error message without line numbers (ours is one
-    line of text, robosuite's indented); each text compiled once per run (the cases share
-    their parts)."""
+    line of text, robosuite's indented). The most recent 64 kept (the cases share their
+    parts): all of robosuite's would be gigabytes, enough to bring a CI machine down."""
     try:
         return mujoco.MjModel.from_xml_string(xml)
     except ValueError as e:
