@@ -23,8 +23,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import importlib.machinery
-import importlib.util
 import json
 import os
 import platform
@@ -32,9 +30,10 @@ import sys
 import time
 from pathlib import Path
 
+from bench_robosuite_scene import import_robosuite_package
+
 ROOT = Path(__file__).resolve().parents[2]
 CORPUS = ROOT / ".cache" / "corpus"
-RS_DIR = CORPUS / "robosuite-1.5.2"
 MODELS_TXT = CORPUS / "models.txt"
 
 
@@ -42,17 +41,7 @@ def import_mujoco_xml(mode: str):
     """robosuite.models.base.MujocoXML; robosuite's import-time log lines go to stderr."""
     with contextlib.redirect_stdout(sys.stderr):
         if mode == "stub":
-            pkg_dir = RS_DIR / "robosuite"
-            if not pkg_dir.is_dir():
-                raise SystemExit(f"bench_robosuite: {pkg_dir} missing: run scripts/setup_robosuite.sh")
-            # A package object for `robosuite` whose submodules load from the
-            # unpacked wheel, without running robosuite/__init__.py.
-            spec = importlib.machinery.ModuleSpec("robosuite", None, is_package=True)
-            spec.submodule_search_locations = [str(pkg_dir)]
-            pkg = importlib.util.module_from_spec(spec)
-            pkg.__file__ = str(pkg_dir / "__init__.py")
-            pkg.__version__ = "1.5.2"
-            sys.modules["robosuite"] = pkg
+            import_robosuite_package()
         import robosuite  # noqa: F401
         import robosuite.models.base as base
     return base.MujocoXML, getattr(robosuite, "__version__", "?"), base.__file__

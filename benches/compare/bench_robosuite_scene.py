@@ -131,9 +131,11 @@ def install_stubs() -> list[str]:
 
 
 def import_robosuite_package():
+    """robosuite 1.5.2's unpacked wheel importable as the package ``robosuite`` (its
+    modules load from there) without running its ``__init__.py``."""
     pkg_dir = RS_DIR / "robosuite"
     if not pkg_dir.is_dir():
-        raise SystemExit(f"bench_robosuite_scene: {pkg_dir} missing: run scripts/setup_robosuite.sh")
+        raise SystemExit(f"{pkg_dir} missing: run scripts/setup_robosuite.sh")
     # A package object for `robosuite` whose submodules load from the unpacked
     # wheel, without running robosuite/__init__.py.
     spec = importlib.machinery.ModuleSpec("robosuite", None, is_package=True)
