@@ -20,22 +20,26 @@ from typing import Any, Callable
 import numpy as np
 
 from ._errors import error
-from ._mjcf_forge import SIGNATURE_ARRAYS, STATIC_PREFIXES, MjcfError, Scene
+from ._mjcf_forge import (
+    SIGNATURE_ARRAYS,
+    SIGNATURE_SKIPPED_SIZES,
+    STATIC_PREFIXES,
+    MjcfError,
+    Scene,
+)
 from ._plan import Plan, in_order_sum
 from ._progress import progress_of
 from ._trees import TreeDerivation
 
-# Sizes mj_setConst recomputes from patched values (bodies with gravity compensation).
-_SET_BY_PATCHING = frozenset({"ngravcomp"})
-
 
 def _signature(model: Any) -> tuple:
-    """Sizes, names and the integer arrays that decide a model's structure."""
+    """What decides a model's structure (``mjcf_forge::split``'s signature, from this
+    MuJoCo): every size but those a patch changes, the names, the integer arrays."""
     sizes = tuple(
         getattr(model, a)
         for a in sorted(dir(model))
         if a.startswith("n")
-        and a not in _SET_BY_PATCHING
+        and a not in SIGNATURE_SKIPPED_SIZES
         and isinstance(getattr(model, a, None), int)
     )
     arrays = tuple(

@@ -17,6 +17,7 @@ DOF_FIELDS: tuple[str, ...]
 QPOS_FIELDS: tuple[str, ...]
 STATIC_PREFIXES: tuple[str, ...]
 SIGNATURE_ARRAYS: tuple[str, ...]
+SIGNATURE_SKIPPED_SIZES: tuple[str, ...]
 
 def target_array(object: str, field: str) -> Optional[str]: ...
 def joint_widths(jnt_type: int) -> tuple[int, int]: ...

@@ -232,3 +232,32 @@ void mjf_patch_meaninertia(mjModel* m, const mjData* d, const int* keep, int n) 
   }
   m->stat.meaninertia = inertia / n;
 }
+
+// mjModel's sizes in MJMODEL_SIZES order: each one's name, and its value in a model
+// (whatever integer type this MuJoCo gives sizes).
+static const char* kSizes[] = {
+#define X(name) #name,
+    MJMODEL_SIZES
+#undef X
+};
+static const int kNumSizes = (int)(sizeof(kSizes) / sizeof(kSizes[0]));
+
+// The name of mjModel's size number `i`; NULL past the last.
+const char* mjf_patch_size_name(int i) {
+  return i >= 0 && i < kNumSizes ? kSizes[i] : NULL;
+}
+
+// The value of mjModel's size number `i` in `m`; -1 past the last.
+long long mjf_patch_size(const mjModel* m, int i) {
+  int k = 0;
+#define X(name) if (k++ == i) return (long long)m->name;
+  MJMODEL_SIZES
+#undef X
+  return -1;
+}
+
+// The names buffer of `m` (every name, NUL-separated) and its length in bytes.
+const char* mjf_patch_names(const mjModel* m, long long* len) {
+  *len = (long long)m->nnames;
+  return m->names;
+}

@@ -16,11 +16,13 @@ use std::ptr::NonNull;
 use super::body_models::BodyModels;
 use super::sys::{
     RawData, mjf_patch_array, mjf_patch_delete_data, mjf_patch_finish, mjf_patch_get_stat,
-    mjf_patch_make_data, mjf_patch_name2id, mjf_patch_nbytes, mjf_patch_option,
+    mjf_patch_make_data, mjf_patch_name2id, mjf_patch_names, mjf_patch_nbytes, mjf_patch_option,
+    mjf_patch_size, mjf_patch_size_name,
 };
-use crate::mujoco::{CompiledModel, MjModel, ObjType, Sizes};
+use crate::mujoco::{CompiledModel, MjModel};
 use crate::split::{
-    DOF_FIELDS, PatchEntry, PatchValue, QPOS_FIELDS, SIGNATURE_ARRAYS, joint_widths, target_array,
+    DOF_FIELDS, PatchEntry, PatchValue, QPOS_FIELDS, SIGNATURE_ARRAYS, SIGNATURE_SKIPPED_SIZES,
+    joint_widths, target_array,
 };
 
 /// Scratch mjData for `mj_setConst` (which overwrites the qpos of the data it is given).
@@ -79,24 +81,25 @@ pub(super) struct Plan {
 // written through `&mut` of that model.
 unsafe impl Send for Plan {}
 
-/// What a structure is: the sizes, names and integer arrays
-/// ([`SIGNATURE_ARRAYS`](crate::split::SIGNATURE_ARRAYS)) of its model, to refuse a model
-/// of another.
+/// What a structure is, to refuse a model of another: every size of its model but
+/// [`SIGNATURE_SKIPPED_SIZES`](crate::split::SIGNATURE_SKIPPED_SIZES), its names buffer and
+/// the integer arrays [`SIGNATURE_ARRAYS`](crate::split::SIGNATURE_ARRAYS) (the Python
+/// caches take the same, from their own MuJoCo).
 #[derive(PartialEq)]
 pub(super) struct Signature {
-    sizes: Sizes,
-    names: Vec<Vec<String>>,
+    sizes: Vec<i64>,
+    names: Vec<u8>,
     arrays: Vec<Vec<u8>>,
 }
 
 impl Signature {
     pub(super) fn of(m: &CompiledModel) -> Signature {
+        let raw = std::ptr::from_ref(m.raw()).cast_mut();
         let arrays = SIGNATURE_ARRAYS
             .iter()
             .map(|name| {
                 let c = CString::new(*name).expect("array names hold no NUL");
                 let (mut elem, mut count) = (0usize, 0usize);
-                let raw = std::ptr::from_ref(m.raw()).cast_mut();
                 // SAFETY: the model is live and only read; `c` is NUL-terminated.
                 let p = unsafe { mjf_patch_array(raw, c.as_ptr(), &mut elem, &mut count) };
                 if p.is_null() {
@@ -106,12 +109,32 @@ impl Signature {
                 unsafe { std::slice::from_raw_parts(p.cast::<u8>(), elem * count) }.to_vec()
             })
             .collect();
+        let mut sizes = Vec::new();
+        for i in 0.. {
+            // SAFETY: a static NUL-terminated name, or null past the last size.
+            let name = unsafe { mjf_patch_size_name(i) };
+            if name.is_null() {
+                break;
+            }
+            // SAFETY: as above.
+            let name = unsafe { std::ffi::CStr::from_ptr(name) }.to_string_lossy();
+            if !SIGNATURE_SKIPPED_SIZES.contains(&name.as_ref()) {
+                // SAFETY: the model is live; `i` names one of its sizes.
+                sizes.push(unsafe { mjf_patch_size(raw, i) });
+            }
+        }
+        let mut len = 0i64;
+        // SAFETY: the model is live; its names buffer holds `len` bytes.
+        let p = unsafe { mjf_patch_names(raw, &mut len) };
+        let names = if p.is_null() || len <= 0 {
+            Vec::new()
+        } else {
+            // SAFETY: as above.
+            unsafe { std::slice::from_raw_parts(p.cast::<u8>(), len as usize) }.to_vec()
+        };
         Signature {
-            sizes: m.sizes(),
-            names: [ObjType::Body, ObjType::Joint, ObjType::Geom, ObjType::Site]
-                .into_iter()
-                .map(|o| m.names(o))
-                .collect(),
+            sizes,
+            names,
             arrays,
         }
     }

@@ -36,6 +36,9 @@ unsafe extern "C" {
         values: *const f64,
     );
     pub(super) fn mjf_patch_array_name(i: c_int) -> *const c_char;
+    pub(super) fn mjf_patch_size_name(i: c_int) -> *const c_char;
+    pub(super) fn mjf_patch_size(m: *const MjModel, i: c_int) -> i64;
+    pub(super) fn mjf_patch_names(m: *const MjModel, len: *mut i64) -> *const c_char;
     pub(super) fn mjf_patch_array_type(i: c_int) -> *const c_char;
     pub(super) fn mjf_patch_option(
         m: *mut MjModel,

@@ -44,8 +44,8 @@ pub use document::{
 };
 pub use rules::{PATCHABLE, PatchEntry, PatchValue};
 pub use targets::{
-    DOF_FIELDS, PATCH_OBJECTS, PatchObject, QPOS_FIELDS, SIGNATURE_ARRAYS, STATIC_PREFIXES,
-    joint_widths, target_array,
+    DOF_FIELDS, PATCH_OBJECTS, PatchObject, QPOS_FIELDS, SIGNATURE_ARRAYS, SIGNATURE_SKIPPED_SIZES,
+    STATIC_PREFIXES, joint_widths, target_array,
 };
 
 pub(crate) use body_model::{body_model, carried_by};

@@ -123,6 +123,11 @@ pub const STATIC_PREFIXES: [&str; 15] = [
     "tuple_", "numeric_", "plugin", "sensor_", "key_",
 ];
 
+/// Sizes of `mjModel` that a patch can change (`mj_setConst` counts the bodies with
+/// gravity compensation): left out of the structure signature, which is every other
+/// size, the names buffer and [`SIGNATURE_ARRAYS`].
+pub const SIGNATURE_SKIPPED_SIZES: [&str; 1] = ["ngravcomp"];
+
 /// Integer arrays that, with the sizes and the names, tell one structure's compiled model
 /// from another's (a model cache refuses to patch a model of another structure).
 pub const SIGNATURE_ARRAYS: [&str; 7] = [

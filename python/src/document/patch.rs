@@ -108,6 +108,10 @@ pub(crate) fn add_tables(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "SIGNATURE_ARRAYS",
         PyTuple::new(py, split::SIGNATURE_ARRAYS)?,
     )?;
+    m.add(
+        "SIGNATURE_SKIPPED_SIZES",
+        PyTuple::new(py, split::SIGNATURE_SKIPPED_SIZES)?,
+    )?;
     m.add_function(wrap_pyfunction!(target_array, m)?)?;
     m.add_function(wrap_pyfunction!(joint_widths, m)?)?;
     Ok(())
