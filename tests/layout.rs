@@ -10,7 +10,7 @@ const TIERS: [&str; 9] = [
 
 /// The Python bindings' modules (`python/src/`), which mirror the tiers, from the bottom up.
 /// `upcalls` (the one way into the package's Python code) sits below them all.
-const PY_TIERS: [&str; 5] = ["upcalls", "errors", "document", "model", "scene"];
+const PY_TIERS: [&str; 6] = ["upcalls", "errors", "document", "model", "split", "scene"];
 
 /// The crate root's re-exports (`crate::Document`) and the tier each belongs to.
 const ROOT_ITEMS: [(&str, &str); 20] = [

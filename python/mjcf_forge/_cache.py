@@ -27,7 +27,7 @@ from ._mjcf_forge import (
     MjcfError,
     Scene,
 )
-from ._plan import Plan, in_order_sum
+from ._plan import Plan
 from ._progress import progress_of
 from ._trees import TreeDerivation
 
@@ -196,7 +196,7 @@ class ModelCache:
             mask[np.concatenate([of[root] for root in roots])] = False
         keep = np.flatnonzero(mask)
         if len(keep):
-            model.stat.meaninertia = in_order_sum(plan.M[plan.M_diagonal[keep]]) / len(keep)
+            model.stat.meaninertia = plan.mean_inertia(keep)
 
     def _key_and_patch(self, variant: Any) -> tuple[str, Any]:
         if self.superset is not None:

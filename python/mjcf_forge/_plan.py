@@ -5,8 +5,10 @@ A plan resolves where each entry of a patch lands (per target array, the flat in
 where the numbers come from, once per layout), writes a patch's numbers, material ids and
 the body models, then what follows from the values: ``mj_setConst`` (or a
 caller's derivation that writes the same, see ``_trees.py``), the model statistics the
-compiler derives at ``qpos0`` (which ``mj_setConst`` of 3.17 and 4.0 leaves), computed with
-the compiler's operations in its order, and the statistics the document fixes.
+compiler derives at ``qpos0`` (which ``mj_setConst`` of 3.17 and 4.0 leaves: this module
+runs the kinematics, the extension's ``Statistics`` computes them in place, the one
+implementation both faces use, ``mjcf_forge::split::statistics``), and the statistics the
+document fixes.
 """
 
 from __future__ import annotations
@@ -18,40 +20,11 @@ import numpy as np
 
 from ._errors import error
 from . import _mujoco
-from ._mjcf_forge import DOF_FIELDS, PATCH_OBJECTS, QPOS_FIELDS, joint_widths, target_array
+from ._mjcf_forge import DOF_FIELDS, PATCH_OBJECTS, QPOS_FIELDS, Statistics, joint_widths, target_array
 
 # The split tier's tables (``mjcf_forge::split::targets``, through the extension): each
 # patched object's array prefix, mjtObj name and count; the joints' dof and qpos fields.
 OBJ = {obj: kind for obj, (_prefix, kind, _count) in PATCH_OBJECTS.items()}
-
-
-class _Groups:
-    """Rows grouped by an index (``np.maximum.at`` without its slow per-row loop)."""
-
-    def __init__(self, index: np.ndarray) -> None:
-        self.order = np.argsort(index, kind="stable")
-        ordered = index[self.order]
-        self.starts = np.flatnonzero(np.r_[True, ordered[1:] != ordered[:-1]]) if len(index) else index
-        self.targets = ordered[self.starts] if len(index) else index
-
-    def maximum(self, out: np.ndarray, values: np.ndarray) -> None:
-        """``out[i] = max(out[i], values of rows indexed i)`` (a maximum: any order)."""
-        if len(self.order):
-            best = np.maximum.reduceat(values[self.order], self.starts)
-            out[self.targets] = np.maximum(out[self.targets], best)
-
-
-def _dist(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise distances, each computed as mju_dist3 computes it (same operations, same
-    order, so the same bits)."""
-    d = a - b
-    return np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] + d[:, 2] * d[:, 2])
-
-
-def in_order_sum(values: np.ndarray) -> float:
-    """A left-to-right sum, as a C loop adds (``np.add.accumulate`` is sequential; ``sum``
-    is pairwise and may differ in the last bits)."""
-    return float(np.add.accumulate(values)[-1]) if len(values) else 0.0
 
 
 class Plan:
@@ -96,9 +69,6 @@ class Plan:
         # Views (fetching one from the bindings costs microseconds) and constants.
         self.stat = model.stat
         self.qpos0, self.qpos = model.qpos0, data.qpos
-        self.points = (data.xpos[1:], data.xipos[1:], data.xanchor, data.site_xpos)
-        self.geom_xpos, self.xipos, self.xanchor = data.geom_xpos, data.xipos, data.xanchor
-        self.body_mass = model.body_mass[1:]
         # A body its geoms give no mass has its inertial frame where MuJoCo puts a massless
         # body's (not a function of its geoms alone: a body model at the origin has
         # another): the frames as compiled, kept while the body's own frame is (below).
@@ -106,40 +76,10 @@ class Plan:
             b: (model.body_pos[b].copy(), model.body_quat[b].copy(), model.body_ipos[b].copy(), model.body_iquat[b].copy(), int(model.body_sameframe[b]))
             for b in np.flatnonzero((model.body_mass == 0) & ~model.body_inertia.any(axis=1))
         }
-        # The mass matrix's diagonal, where this MuJoCo keeps it (_mujoco.py).
-        self.M, self.M_diagonal = _mujoco.inertia_diagonal(model, data)
-        self.nbody, self.nv = model.nbody, model.nv
-        self.dof_length = _mujoco.field(model, "dof_length")
-        # Geom radii for the bounding box: a plane or height field (rbound 0) counts a
-        # tenth of its largest size. Sizes are patched only through "geoms" entries, which
-        # update these (body_model()).
-        size, kind = model.geom_size, model.geom_type
-        rbound = model.geom_rbound.copy()
-        plane = (rbound <= 0) & (kind == mujoco.mjtGeom.mjGEOM_PLANE)
-        finite = (size[:, 0] != 0) | (size[:, 1] != 0)
-        rbound[plane & finite] = np.maximum(size[:, 0], size[:, 1])[plane & finite] * 0.1
-        rbound[plane & ~finite] = 0.01
-        for g in np.flatnonzero((rbound <= 0) & (kind == mujoco.mjtGeom.mjGEOM_HFIELD)):
-            h = model.hfield_size[model.geom_dataid[g]]
-            rbound[g] = max(h[0], max(h[1], max(h[2], h[3]))) * 0.1
-        rbound[rbound < 0] = 0.0
-        self.box_radius = rbound[:, None]
-        self.box_radius0 = self.box_radius.copy()
-        self.joint_body = model.jnt_bodyid.copy()
-        self.joint_parent = model.body_parentid[self.joint_body]
-        self.by_joint_body = _Groups(self.joint_body)
-        self.by_joint_parent = _Groups(self.joint_parent)
-        geoms = np.flatnonzero((model.geom_rbound > 0) & (model.geom_bodyid > 0))
-        self.sized_geoms = geoms
-        self.sized_geom_body = model.geom_bodyid[geoms]
-        self.by_geom_body = _Groups(self.sized_geom_body)
-        self.sized_geom_rbound = model.geom_rbound[geoms].copy()
-        self.sized_geom_rbound0 = self.sized_geom_rbound.copy()
-        jnt = model.dof_jntid
-        jtype = model.jnt_type[jnt]
-        offset = np.arange(model.nv) - model.jnt_dofadr[jnt]
-        self.rotational = (jtype == 1) | (jtype == 3) | ((jtype == 0) & (offset >= 3))
-        self.dof_body = model.dof_bodyid.copy()
+        # The mass matrix's diagonal, where this MuJoCo keeps it (_mujoco.py), and the
+        # arrays the statistics read, found once.
+        inertia, diagonal = _mujoco.inertia_diagonal(model, data)
+        self.statistics_arrays = Statistics(model, data, inertia, diagonal)
 
     def resolve(self, patch: list) -> None:
         """Where every entry of ``patch`` lands: per target array, the flat indices its
@@ -252,9 +192,6 @@ class Plan:
             else:
                 getattr(opt, field)[:] = values[first : first + n]
         if self.bodies:
-            # The statistics' radii as compiled, then each body's as written below.
-            self.box_radius[:] = self.box_radius0
-            self.sized_geom_rbound[:] = self.sized_geom_rbound0
             for k, (body, xml) in enumerate(zip(self.bodies, bodies)):
                 # As compiled and as last written: the arrays already hold it.
                 if xml == self.body_xml0[k] and self.body_written[k] == xml:
@@ -315,12 +252,6 @@ class Plan:
             model.body_ipos[body], model.body_iquat[body] = kept[2], kept[3]
             model.body_sameframe[body] = kept[4]
         model.bvh_aabb[bvh : bvh + nbvh] = mini.bvh_aabb[mbvh : mbvh + nbvh]
-        # The bounding radii the statistics take (primitives: rbound > 0).
-        rbound = mini.geom_rbound[mgeoms]
-        self.box_radius[geoms, 0] = rbound
-        at = np.searchsorted(self.sized_geoms, np.arange(first, first + n))
-        hit = (at < len(self.sized_geoms)) & (self.sized_geoms[np.minimum(at, len(self.sized_geoms) - 1)] == np.arange(first, first + n))
-        self.sized_geom_rbound[at[hit]] = rbound[hit]
 
     def finish(self, derive: Callable[[Any, Any, list], None] | None = None) -> None:
         """What follows the values: ``mj_setConst`` (or ``derive(model, data, layout)``,
@@ -340,48 +271,19 @@ class Plan:
 
     def statistics(self, fresh: bool = False) -> None:
         """The model statistics and dof lengths, computed from the model at qpos0 as the
-        compiler computes them: the same operations, sums in the same order, so the same
-        bits (minima and maxima do not depend on order, so those run vectorized).
-        ``fresh``: the scratch data holds the kinematics and centres of mass at qpos0."""
-        mujoco, model, data, stat = self.mujoco, self.model, self.data, self.stat
+        compiler computes them (``mjcf_forge::split::statistics``: the same operations in
+        the same order, so the same bits). ``fresh``: the scratch data holds the kinematics
+        and centres of mass at qpos0."""
         if not fresh:
             self.qpos[:] = self.qpos0
-            mujoco.mj_kinematics(model, data)
-            mujoco.mj_comPos(model, data)
+            self.mujoco.mj_kinematics(self.model, self.data)
+            self.mujoco.mj_comPos(self.model, self.data)
         # The joint-space inertia (_mujoco.py: mj_makeM or, in 3.3, mj_crb).
-        _mujoco.make_inertia(mujoco, model, data)
-        lo = np.full(3, 1e10)
-        hi = np.full(3, -1e10)
-        points = np.concatenate(
-            self.points + (self.geom_xpos - self.box_radius, self.geom_xpos + self.box_radius)
-        )
-        if len(points):
-            lo = np.minimum(lo, points.min(axis=0))
-            hi = np.maximum(hi, points.max(axis=0))
-        stat.center[:] = (lo + hi) * 0.5
-        extent = stat.extent
-        if hi[0] > lo[0]:
-            d = hi - lo
-            extent = max(1e-5, max(d[0], max(d[1], d[2])))
-        # Body sizes: the largest com-joint distance (the joint's body and its parent),
-        # then geom bounds around the com.
-        body = np.zeros(self.nbody)
-        if len(self.joint_body):
-            xipos, xanchor = self.xipos, self.xanchor
-            self.by_joint_body.maximum(body, _dist(xipos[self.joint_body], xanchor))
-            self.by_joint_parent.maximum(body, _dist(xipos[self.joint_parent], xanchor))
-        body[0] = 0.0
-        if len(self.sized_geoms):
-            gb = self.sized_geom_body
-            far = self.sized_geom_rbound + _dist(self.xipos[gb], self.geom_xpos[self.sized_geoms])
-            self.by_geom_body.maximum(body, far)
-        if self.nbody > 1:
-            body[1:] = np.maximum(body[1:], 1e-5)
-            stat.meansize = in_order_sum(body[1:] / (self.nbody - 1))
-            stat.meanmass = in_order_sum(self.body_mass) / (self.nbody - 1)
-        # Rotational dofs take their body's size.
-        if self.nv:
-            if self.dof_length is not None:
-                self.dof_length[:] = np.where(self.rotational, body[self.dof_body], 1.0)
-            stat.meaninertia = in_order_sum(self.M[self.M_diagonal]) / self.nv
-        stat.extent = max(extent, 2 * stat.meansize)
+        _mujoco.make_inertia(self.mujoco, self.model, self.data)
+        self.statistics_arrays.compute()
+
+    def mean_inertia(self, dofs: np.ndarray) -> float:
+        """The mean of the joint-space inertia's diagonal over ``dofs`` (in order, not
+        empty), from the scratch data as :meth:`finish` left it: a superset world's
+        ``stat.meaninertia``, the dofs of what its variant places."""
+        return self.statistics_arrays.mean_inertia(dofs.tolist())

@@ -6,16 +6,21 @@
 //!
 //! The files mirror the library's tiers: `document/` (the document tier, with elements that
 //! behave as `xml.etree` elements), `model.rs`
-//! (instances), `scene/` (the batch tier: scenes, variants, the stream, the superset);
-//! `errors.rs` is the edge where Rust errors and panics become `MjcfError`; `upcalls.rs`
-//! the one way up into the package's Python code. The compiled tier's face, `ModelCache`,
-//! is Python (`mjcf_forge/_cache.py`), over the user's own `mujoco` package.
-#![forbid(unsafe_code)]
+//! (instances), `split/` (the split tier's tables, and its rules run over the user's
+//! `MjModel` arrays in place), `scene/` (the batch tier: scenes, variants, the stream, the
+//! superset); `errors.rs` is the edge where Rust errors and panics become `MjcfError`;
+//! `upcalls.rs` the one way up into the package's Python code. The compiled tier's face,
+//! `ModelCache`, is Python (`mjcf_forge/_cache.py`), over the user's own `mujoco` package.
+//!
+//! No `unsafe` but in `split/`, which reads and writes NumPy arrays of the user's MuJoCo
+//! in place (`split/arrays.rs`).
+#![deny(unsafe_code)]
 
 mod document;
 mod errors;
 mod model;
 mod scene;
+mod split;
 mod upcalls;
 
 use pyo3::prelude::*;
@@ -63,7 +68,7 @@ fn _mjcf_forge(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::PyVariantIter>()?;
     m.add_class::<scene::PySuperset>()?;
     m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
-    document::patch::add_tables(m)?;
+    split::add(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -99,3 +99,23 @@ def test_a_rust_panic_reaches_python_as_mjcf_error():
         ]
     # The module still works afterwards.
     assert mjcf_forge.Document.from_string("<mujoco/>").to_xml() == "<mujoco/>"
+
+
+def test_the_compiled_modules_examples_run():
+    """Every ``>>>`` example in a docstring of the compiled module (its functions and
+    classes, with their methods) runs and prints what it says."""
+    import doctest
+
+    from mjcf_forge import _mjcf_forge
+
+    finder, runner = doctest.DocTestFinder(exclude_empty=True), doctest.DocTestRunner()
+    examples = 0
+    for name in dir(_mjcf_forge):
+        obj = getattr(_mjcf_forge, name)
+        if name.startswith("__") or not (inspect.isclass(obj) or callable(obj)):
+            continue
+        for test in finder.find(obj, name, globs={}):
+            examples += len(test.examples)
+            runner.run(test)
+    assert runner.failures == 0, f"{runner.failures} of {examples} examples failed"
+    assert examples >= 14, examples

@@ -10,14 +10,12 @@
 use std::collections::HashMap;
 use std::ffi::{CString, c_int};
 
+use super::statistics::variant_inertia;
 use super::store::{Signature, State, Store};
-use super::sys::{
-    mjf_patch_array, mjf_patch_array_name, mjf_patch_get_stat, mjf_patch_meaninertia,
-    mjf_patch_name2id,
-};
+use super::sys::{mjf_patch_array, mjf_patch_array_name, mjf_patch_get_stat, mjf_patch_name2id};
 use crate::mujoco::{CompileError, CompiledModel, compile_str};
 use crate::scene::{Scene, Superset, VariantPatch};
-use crate::split::PatchEntry;
+use crate::split::{PatchEntry, fixed_statistics_mask};
 
 impl CompiledModel {
     /// Where `other` differs from this model: every array of `mjModel` compared bit for
@@ -111,7 +109,7 @@ pub struct ModelCache<'s> {
     /// With [`ModelCache::with_superset`]: the scene's superset.
     superset: Option<SupersetState>,
     /// The statistics the scene's `<statistic>` fixes, as bits (see `Store::insert`).
-    fixed: c_int,
+    fixed: u32,
     store: Store,
 }
 
@@ -123,7 +121,7 @@ impl<'s> ModelCache<'s> {
             scene,
             dir: None,
             superset: None,
-            fixed: super::fixed_bits(&scene.fixed_statistics()),
+            fixed: fixed_statistics_mask(scene.fixed_statistics()),
             store: Store::new(max_models, max_bytes),
         }
     }
@@ -299,7 +297,7 @@ impl<'s> ModelCache<'s> {
 struct SupersetState {
     superset: Superset,
     xml: String,
-    kept_dofs: HashMap<Vec<String>, Vec<c_int>>,
+    kept_dofs: HashMap<Vec<String>, Vec<usize>>,
 }
 
 /// Writes variant `index`'s patch (`key`, `entries`) into `model`, and for a superset
@@ -330,19 +328,12 @@ fn patch_variant(
     };
     // SAFETY: live model and its scratch data (left at qpos0 by the statistics); `keep`
     // holds valid dof indices of this structure.
-    unsafe {
-        mjf_patch_meaninertia(
-            model.as_mut_ptr(),
-            plan.scratch.0.as_ptr(),
-            keep.as_ptr(),
-            keep.len() as c_int,
-        );
-    }
+    unsafe { variant_inertia(model.as_mut_ptr(), plan.scratch.0.as_ptr(), keep) };
     Ok(())
 }
 
 /// The dofs of `model` outside the subtrees of the bodies named in `parked`, in order.
-fn kept_dofs(model: &mut CompiledModel, parked: &[String]) -> Result<Vec<c_int>, String> {
+fn kept_dofs(model: &mut CompiledModel, parked: &[String]) -> Result<Vec<usize>, String> {
     let nbody = model.sizes().nbody;
     let nv = model.sizes().nv;
     let parent = model.body_parentid().to_vec();
@@ -380,7 +371,5 @@ fn kept_dofs(model: &mut CompiledModel, parked: &[String]) -> Result<Vec<c_int>,
         let n = usize::try_from(dofnum[b]).unwrap_or(0);
         parked_dof[first..first + n].fill(true);
     }
-    Ok((0..nv as c_int)
-        .filter(|&d| !parked_dof[d as usize])
-        .collect())
+    Ok((0..nv).filter(|&d| !parked_dof[d]).collect())
 }

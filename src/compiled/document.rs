@@ -11,7 +11,7 @@ use super::store::Store;
 use crate::document::Document;
 use crate::error::{Error, ErrorKind, Errors};
 use crate::mujoco::{CompiledModel, compile_document};
-use crate::split::{SplitOptions, split_document_with};
+use crate::split::{SplitOptions, fixed_statistics_mask, split_document_with};
 
 /// Compiled models of documents, one per structure, patched per document; bounded in
 /// count and bytes (models and their scratch data), least recently used out.
@@ -75,7 +75,7 @@ impl DocumentCache {
         }
         let model = compile_document(doc).map_err(|e| Errors(vec![e]))?;
         self.store.remove(key);
-        let fixed = super::fixed_bits(&split.fixed_statistics);
+        let fixed = fixed_statistics_mask(split.fixed_statistics.iter().copied());
         self.store.insert(key, model, fixed).map_err(internal)?;
         self.last()
     }

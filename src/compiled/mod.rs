@@ -30,6 +30,7 @@
 mod body_models;
 mod cache;
 mod document;
+mod statistics;
 mod store;
 mod sys;
 mod worlds;
@@ -37,17 +38,3 @@ mod worlds;
 pub use cache::ModelCache;
 pub use document::DocumentCache;
 pub use worlds::{Dtype, WorldArrays, WorldField, WorldStatistics};
-
-/// The statistics a `<statistic>` fixes as the bits `patch.c`'s `mjf_patch_finish` takes.
-fn fixed_bits(names: &[&str]) -> std::ffi::c_int {
-    names
-        .iter()
-        .map(|s| match *s {
-            "meaninertia" => 1,
-            "meanmass" => 2,
-            "meansize" => 4,
-            "extent" => 8,
-            _ => 16,
-        })
-        .fold(0, |a, b| a | b)
-}

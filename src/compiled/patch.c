@@ -2,7 +2,6 @@
 // against the linked MuJoCo's own headers, as the FFI's shim is, so mjModel's and mjData's
 // layouts are never copied into Rust: arrays are found by name through MuJoCo's X-macro
 // table.
-#include <math.h>
 #include <stddef.h>
 #include <string.h>
 
@@ -84,116 +83,72 @@ void mjf_patch_get_stat(const mjModel* m, double out[7]) {
   out[6] = m->stat.center[2];
 }
 
-static double dist3(const double* a, const double* b) {
-  double d0 = a[0] - b[0], d1 = a[1] - b[1], d2 = a[2] - b[2];
-  return sqrt(d0 * d0 + d1 * d1 + d2 * d2);
-}
+// The arrays mjcf_forge::split::statistics reads (src/split/statistics.rs), as
+// compiled/statistics.rs declares them: positions of n rows have 3n numbers, the
+// inertia's diagonal is at M_rowadr + M_rownnz - 1.
+struct mjf_stat_arrays {
+  const double *xpos, *xipos, *xanchor, *site_xpos, *geom_xpos, *geom_rbound, *geom_size,
+      *hfield_size, *body_mass, *inertia;
+  const int *geom_type, *geom_dataid, *body_parentid, *body_geomadr, *body_geomnum,
+      *jnt_bodyid, *jnt_type, *jnt_dofadr, *dof_jntid, *dof_bodyid, *M_rowadr, *M_rownnz;
+  double* dof_length;
+  long long nbody, njnt, nsite, ngeom, nhfield, nv, ninertia;
+};
 
-static double maxd(double a, double b) { return a > b ? a : b; }
-
-static void update_box(double* lo, double* hi, const double* p, double r) {
-  for (int k = 0; k < 3; k++) {
-    lo[k] = lo[k] < p[k] - r ? lo[k] : p[k] - r;
-    hi[k] = hi[k] > p[k] + r ? hi[k] : p[k] + r;
-  }
-}
-
-// The statistics and dof lengths the compiler derives from the model at qpos0, which
-// mj_setConst of MuJoCo 3.17 and 4.0 leaves as they were: computed as the compiler does,
-// the same operations in the same order. `d` is scratch (its state is overwritten).
-static void statistics(mjModel* m, mjData* d) {
+// After a patch's values are written: mj_setConst on scratch data `d`, then the
+// kinematics, centres of mass and joint-space inertia at qpos0 (what the compiler's
+// statistics read; mj_setConst of 3.17 and 4.0 leaves those statistics as they were).
+void mjf_patch_set_const(mjModel* m, mjData* d) {
+  mj_setConst(m, d);
   mju_copy(d->qpos, m->qpos0, m->nq);
   mj_kinematics(m, d);
   mj_comPos(m, d);
   mj_makeM(m, d);
-  double lo[3] = {1e10, 1e10, 1e10}, hi[3] = {-1e10, -1e10, -1e10};
-  for (int i = 1; i < m->nbody; i++) {
-    update_box(lo, hi, d->xpos + 3 * i, 0);
-    update_box(lo, hi, d->xipos + 3 * i, 0);
-  }
-  for (int i = 0; i < m->njnt; i++) update_box(lo, hi, d->xanchor + 3 * i, 0);
-  for (int i = 0; i < m->nsite; i++) update_box(lo, hi, d->site_xpos + 3 * i, 0);
-  for (int i = 0; i < m->ngeom; i++) {
-    double r = 0;
-    if (m->geom_rbound[i] > 0) {
-      r = m->geom_rbound[i];
-    } else if (m->geom_type[i] == mjGEOM_PLANE) {
-      const double* s = m->geom_size + 3 * i;
-      r = (s[0] || s[1]) ? maxd(s[0], s[1]) * 0.1 : 0.01;
-    } else if (m->geom_type[i] == mjGEOM_HFIELD) {
-      const double* h = m->hfield_size + 4 * m->geom_dataid[i];
-      r = maxd(h[0], maxd(h[1], maxd(h[2], h[3]))) * 0.1;
-    }
-    update_box(lo, hi, d->geom_xpos + 3 * i, r);
-  }
-  for (int k = 0; k < 3; k++) m->stat.center[k] = (lo[k] + hi[k]) * 0.5;
-  if (hi[0] > lo[0]) {
-    m->stat.extent = maxd(1e-5, maxd(hi[0] - lo[0], maxd(hi[1] - lo[1], hi[2] - lo[2])));
-  }
-
-  // Body sizes: the largest com-joint distance (the joint's body and its parent), then
-  // geom bounds around the com.
-  mj_markStack(d);
-  double* body = mj_stackAllocNum(d, m->nbody);
-  for (int i = 0; i < m->nbody; i++) body[i] = 0;
-  for (int j = 0; j < m->njnt; j++) {
-    int id = m->jnt_bodyid[j];
-    body[id] = maxd(body[id], dist3(d->xipos + 3 * id, d->xanchor + 3 * j));
-    id = m->body_parentid[id];
-    body[id] = maxd(body[id], dist3(d->xipos + 3 * id, d->xanchor + 3 * j));
-  }
-  body[0] = 0;
-  for (int i = 1; i < m->nbody; i++) {
-    for (int g = m->body_geomadr[i]; g < m->body_geomadr[i] + m->body_geomnum[i]; g++) {
-      if (m->geom_rbound[g] > 0) {
-        body[i] = maxd(body[i], m->geom_rbound[g] + dist3(d->xipos + 3 * i, d->geom_xpos + 3 * g));
-      }
-    }
-  }
-  if (m->nbody > 1) {
-    m->stat.meansize = 0;
-    for (int i = 1; i < m->nbody; i++) {
-      body[i] = maxd(body[i], 1e-5);
-      m->stat.meansize += body[i] / (m->nbody - 1);
-    }
-  }
-  // Rotational dofs take their body's size.
-  for (int i = 0; i < m->nv; i++) {
-    int jnt = m->dof_jntid[i];
-    int type = m->jnt_type[jnt];
-    int offset = i - m->jnt_dofadr[jnt];
-    int rotational = type == mjJNT_BALL || type == mjJNT_HINGE || (type == mjJNT_FREE && offset >= 3);
-    m->dof_length[i] = rotational ? body[m->dof_bodyid[i]] : 1;
-  }
-  mj_freeStack(d);
-  m->stat.extent = maxd(m->stat.extent, 2 * m->stat.meansize);
-  if (m->nbody > 1) {
-    double mass = 0;
-    for (int i = 1; i < m->nbody; i++) mass += m->body_mass[i];
-    m->stat.meanmass = mass / (m->nbody - 1);
-  }
-  if (m->nv) {
-    double inertia = 0;
-    for (int i = 0; i < m->nv; i++) inertia += d->M[m->M_rowadr[i] + m->M_rownnz[i] - 1];
-    m->stat.meaninertia = inertia / m->nv;
-  }
 }
 
-// After a patch's values are written: mj_setConst on scratch data `d`, the compiler's
-// statistics, then the statistics the scene's <statistic> fixes (bit k of `fixed` for
-// value k of `values`, as mjf_patch_get_stat lays them out; center is bit 4).
-void mjf_patch_finish(mjModel* m, mjData* d, int fixed, const double values[7]) {
-  mj_setConst(m, d);
-  statistics(m, d);
-  if (fixed & 1) m->stat.meaninertia = values[0];
-  if (fixed & 2) m->stat.meanmass = values[1];
-  if (fixed & 4) m->stat.meansize = values[2];
-  if (fixed & 8) m->stat.extent = values[3];
-  if (fixed & 16) {
-    m->stat.center[0] = values[4];
-    m->stat.center[1] = values[5];
-    m->stat.center[2] = values[6];
-  }
+// The arrays of `m` and of `d` (as mjf_patch_set_const left it) the statistics read.
+void mjf_patch_stat_arrays(mjModel* m, const mjData* d, struct mjf_stat_arrays* out) {
+  out->xpos = d->xpos;
+  out->xipos = d->xipos;
+  out->xanchor = d->xanchor;
+  out->site_xpos = d->site_xpos;
+  out->geom_xpos = d->geom_xpos;
+  out->geom_rbound = m->geom_rbound;
+  out->geom_size = m->geom_size;
+  out->hfield_size = m->hfield_size;
+  out->body_mass = m->body_mass;
+  out->inertia = d->M;
+  out->geom_type = m->geom_type;
+  out->geom_dataid = m->geom_dataid;
+  out->body_parentid = m->body_parentid;
+  out->body_geomadr = m->body_geomadr;
+  out->body_geomnum = m->body_geomnum;
+  out->jnt_bodyid = m->jnt_bodyid;
+  out->jnt_type = m->jnt_type;
+  out->jnt_dofadr = m->jnt_dofadr;
+  out->dof_jntid = m->dof_jntid;
+  out->dof_bodyid = m->dof_bodyid;
+  out->M_rowadr = m->M_rowadr;
+  out->M_rownnz = m->M_rownnz;
+  out->dof_length = m->dof_length;
+  out->nbody = m->nbody;
+  out->njnt = m->njnt;
+  out->nsite = m->nsite;
+  out->ngeom = m->ngeom;
+  out->nhfield = m->nhfield;
+  out->nv = m->nv;
+  out->ninertia = m->nv ? (long long)m->M_rowadr[m->nv - 1] + m->M_rownnz[m->nv - 1] : 0;
+}
+
+// Sets the model's statistics, laid out as mjf_patch_get_stat gives them.
+void mjf_patch_set_stat(mjModel* m, const double in[7]) {
+  m->stat.meaninertia = in[0];
+  m->stat.meanmass = in[1];
+  m->stat.meansize = in[2];
+  m->stat.extent = in[3];
+  m->stat.center[0] = in[4];
+  m->stat.center[1] = in[5];
+  m->stat.center[2] = in[6];
 }
 
 // mjModel's arrays in MJMODEL_POINTERS order: each one's name and C type as MuJoCo
@@ -218,19 +173,6 @@ const char* mjf_patch_array_name(int i) {
 // The C type of mjModel's array number `i`; NULL past the last.
 const char* mjf_patch_array_type(int i) {
   return i >= 0 && i < kNumArrays ? kArrays[i].type : NULL;
-}
-
-// Superset: stat.meaninertia as the variant's own model has it, the mean of the mass
-// matrix's diagonal (at qpos0, as the statistics left it in `d`) over the `n` dofs in
-// `keep` (the variant's, in order).
-void mjf_patch_meaninertia(mjModel* m, const mjData* d, const int* keep, int n) {
-  if (n <= 0) return;
-  double inertia = 0;
-  for (int k = 0; k < n; k++) {
-    int i = keep[k];
-    inertia += d->M[m->M_rowadr[i] + m->M_rownnz[i] - 1];
-  }
-  m->stat.meaninertia = inertia / n;
 }
 
 // mjModel's sizes in MJMODEL_SIZES order: each one's name, and its value in a model

@@ -15,9 +15,9 @@ use std::ptr::NonNull;
 
 use super::body_models::BodyModels;
 use super::sys::{
-    RawData, mjf_patch_array, mjf_patch_delete_data, mjf_patch_finish, mjf_patch_get_stat,
-    mjf_patch_make_data, mjf_patch_name2id, mjf_patch_names, mjf_patch_nbytes, mjf_patch_option,
-    mjf_patch_size, mjf_patch_size_name,
+    RawData, mjf_patch_array, mjf_patch_delete_data, mjf_patch_get_stat, mjf_patch_make_data,
+    mjf_patch_name2id, mjf_patch_names, mjf_patch_nbytes, mjf_patch_option, mjf_patch_size,
+    mjf_patch_size_name,
 };
 use crate::mujoco::{CompiledModel, MjModel};
 use crate::split::{
@@ -184,7 +184,7 @@ impl Store {
         &mut self,
         key: &str,
         model: CompiledModel,
-        fixed: c_int,
+        fixed: u32,
     ) -> Result<(), String> {
         let state = &mut self.state;
         state.compiles += 1;
@@ -243,7 +243,7 @@ pub(super) struct State {
     pub(super) signatures: HashMap<String, Signature>,
     /// Per structure, the statistics its `<statistic>` fixes (bits as `mjf_patch_finish`
     /// takes them) and the values MuJoCo compiled.
-    stats: HashMap<String, (c_int, [f64; 7])>,
+    stats: HashMap<String, (u32, [f64; 7])>,
     pub(super) compiles: u64,
     pub(super) patches: u64,
 }
@@ -330,7 +330,7 @@ impl State {
         }
         let (fixed, stat) = self.stats.get(key).copied().unwrap_or_default();
         // SAFETY: the model and its scratch data are live and of one structure.
-        unsafe { mjf_patch_finish(ptr, plan.scratch.0.as_ptr(), fixed, stat.as_ptr()) };
+        unsafe { super::statistics::finish(ptr, plan.scratch.0.as_ptr(), fixed, &stat) };
         let plan = self.plans.remove(at);
         self.plans.push(plan);
         self.patches += 1;

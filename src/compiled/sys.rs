@@ -29,12 +29,13 @@ unsafe extern "C" {
     pub(super) fn mjf_patch_delete_data(d: *mut RawData);
     pub(super) fn mjf_patch_nbytes(m: *const MjModel, d: *const RawData) -> i64;
     pub(super) fn mjf_patch_get_stat(m: *const MjModel, out: *mut f64);
-    pub(super) fn mjf_patch_finish(
+    pub(super) fn mjf_patch_set_const(m: *mut MjModel, d: *mut RawData);
+    pub(super) fn mjf_patch_stat_arrays(
         m: *mut MjModel,
-        d: *mut RawData,
-        fixed: c_int,
-        values: *const f64,
+        d: *const RawData,
+        out: *mut super::statistics::RawStatArrays,
     );
+    pub(super) fn mjf_patch_set_stat(m: *mut MjModel, values: *const f64);
     pub(super) fn mjf_patch_array_name(i: c_int) -> *const c_char;
     pub(super) fn mjf_patch_size_name(i: c_int) -> *const c_char;
     pub(super) fn mjf_patch_size(m: *const MjModel, i: c_int) -> i64;
@@ -46,10 +47,4 @@ unsafe extern "C" {
         elem: *mut usize,
         count: *mut usize,
     ) -> *mut c_void;
-    pub(super) fn mjf_patch_meaninertia(
-        m: *mut MjModel,
-        d: *const RawData,
-        keep: *const c_int,
-        n: c_int,
-    );
 }

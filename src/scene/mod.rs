@@ -564,10 +564,7 @@ impl Scene {
     /// # Ok::<(), mjcf_forge::Errors>(())
     /// ```
     pub fn fixed_statistics(&self) -> Vec<&'static str> {
-        ["meaninertia", "meanmass", "meansize", "extent", "center"]
-            .into_iter()
-            .filter(|a| crate::split::setting(&self.template, "statistic", a).is_some())
-            .collect()
+        crate::split::fixed_statistics(&self.template)
     }
 
     /// Variants `range`, made in parallel (rayon), in index order.

@@ -296,10 +296,7 @@ fn split_resolved(doc: &Document, options: SplitOptions) -> DocumentPatch {
         }
         entries.extend(patched.entries);
     }
-    let fixed_statistics = ["meaninertia", "meanmass", "meansize", "extent", "center"]
-        .into_iter()
-        .filter(|a| setting(doc, "statistic", a).is_some())
-        .collect();
+    let fixed_statistics = super::fixed_statistics(doc);
     DocumentPatch {
         structure_key: key.finish(&entries),
         entries,

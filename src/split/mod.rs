@@ -28,7 +28,8 @@
 //! `targets.rs` (the `mjModel` array each entry writes, the arrays no patch changes, the
 //! arrays that tell structures apart: the one copy the model caches of both faces read),
 //! `document.rs` (any document split by reading it), `body_model.rs` (a body's geoms as a
-//! model of their own, for what MuJoCo derives from their sizes). The scene tier reads its
+//! model of their own, for what MuJoCo derives from their sizes), `statistics.rs` (the
+//! compiler's statistics at `qpos0`, computed over a model's arrays for both faces). The scene tier reads its
 //! drawn variants through the same rules (`scene/patch.rs`).
 //!
 //! May use: the document tier and `crate::error`. Knows nothing of scenes, MuJoCo or the
@@ -37,12 +38,17 @@
 mod body_model;
 mod document;
 mod rules;
+mod statistics;
 mod targets;
 
 pub use document::{
     DocumentPatch, PATCHABLE_OPTIONS, SplitOptions, split_document, split_document_with,
 };
 pub use rules::{PATCHABLE, PatchEntry, PatchValue};
+pub use statistics::{
+    STATISTIC_NAMES, StatArrays, Statistics, fixed_statistics, fixed_statistics_mask, keep_fixed,
+    mean_inertia, statistics,
+};
 pub use targets::{
     DOF_FIELDS, PATCH_OBJECTS, PatchObject, QPOS_FIELDS, SIGNATURE_ARRAYS, SIGNATURE_SKIPPED_SIZES,
     STATIC_PREFIXES, joint_widths, target_array,

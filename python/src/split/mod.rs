@@ -1,0 +1,19 @@
+//! The split tier's face in Python: its tables (`tables.rs`, the one copy of each the
+//! package's caches read) and the rules the caches run over the user's `MjModel` in place
+//! (`statistics.rs`, through `arrays.rs`).
+
+// NumPy's memory read in place: the bindings' only unsafe code.
+#[allow(unsafe_code)]
+mod arrays;
+#[allow(unsafe_code)]
+mod statistics;
+mod tables;
+
+use pyo3::prelude::*;
+
+/// Adds the tier's tables, functions and classes to the module.
+pub(crate) fn add(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    tables::add(m)?;
+    m.add_class::<statistics::PyStatistics>()?;
+    Ok(())
+}

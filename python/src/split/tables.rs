@@ -1,0 +1,53 @@
+//! The split tier's tables the package's caches read (`mjcf_forge._plan`, `_cache`,
+//! `batch`): the one copy of each, `mjcf_forge::split::targets`.
+
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+
+/// The split tier's tables the package's caches read (`mjcf_forge._plan`, `_cache`,
+/// `batch`), added to the module: the one copy of each (`mjcf_forge::split::targets`).
+pub(super) fn add(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    use mjcf_forge::split;
+    let py = m.py();
+    let objects = pyo3::types::PyDict::new(py);
+    for o in split::PATCH_OBJECTS {
+        objects.set_item(o.object, (o.prefix, o.obj_type, o.count))?;
+    }
+    m.add("PATCH_OBJECTS", objects)?;
+    m.add("DOF_FIELDS", PyTuple::new(py, split::DOF_FIELDS)?)?;
+    m.add("QPOS_FIELDS", PyTuple::new(py, split::QPOS_FIELDS)?)?;
+    m.add("STATIC_PREFIXES", PyTuple::new(py, split::STATIC_PREFIXES)?)?;
+    m.add(
+        "SIGNATURE_ARRAYS",
+        PyTuple::new(py, split::SIGNATURE_ARRAYS)?,
+    )?;
+    m.add(
+        "SIGNATURE_SKIPPED_SIZES",
+        PyTuple::new(py, split::SIGNATURE_SKIPPED_SIZES)?,
+    )?;
+    m.add_function(wrap_pyfunction!(target_array, m)?)?;
+    m.add_function(wrap_pyfunction!(joint_widths, m)?)?;
+    Ok(())
+}
+
+/// The ``MjModel`` array a patch entry of an ``object``'s ``field`` writes (a joint's dof
+/// and qpos fields have arrays of their own), or ``None`` (the options).
+///
+/// >>> from mjcf_forge._mjcf_forge import target_array
+/// >>> target_array("joint", "damping")
+/// 'dof_damping'
+#[pyfunction]
+fn target_array(object: &str, field: &str) -> Option<String> {
+    mjcf_forge::split::target_array(object, field)
+}
+
+/// How many degrees of freedom and ``qpos`` coordinates a joint of MuJoCo type
+/// ``jnt_type`` has (free, ball, slide, hinge).
+///
+/// >>> from mjcf_forge._mjcf_forge import joint_widths
+/// >>> joint_widths(0)
+/// (6, 7)
+#[pyfunction]
+fn joint_widths(jnt_type: i64) -> (usize, usize) {
+    mjcf_forge::split::joint_widths(jnt_type)
+}
