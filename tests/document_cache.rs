@@ -509,3 +509,24 @@ fn sizes_of_primitive_geoms_are_patched_through_their_bodies_body_models() {
     exact(&mut cache, &turned, "turned");
     assert_eq!(cache.compiles(), 2);
 }
+
+#[test]
+fn files_meant_for_inclusion_are_answered_as_mujoco_compiles_them() {
+    // Bodies and frames directly under <mujoco> (a file meant to be included into a
+    // <worldbody>): MuJoCo reads them and compiles the file to the world alone. The cache
+    // answers the same, for the first document of a structure and for its patches (the
+    // timestep), and for other values in what MuJoCo leaves out (in the key: compiled).
+    let mut cache = DocumentCache::new(4, None);
+    for (k, mass) in ["1", "1", "1", "2.5"].iter().enumerate() {
+        let text = format!(
+            r#"<mujoco model="part"><option timestep="0.00{}"/>
+                 <body name="b" pos="0 0 1"><geom name="g" size="0.1" mass="{mass}" rgba="1 0 0 1"/></body>
+                 <frame pos="1 0 0"><body name="c"><joint name="j" damping="{mass}"/><geom size="0.2"/></body></frame>
+               </mujoco>"#,
+            k + 1
+        );
+        let doc = Document::from_str(&text, ".").unwrap();
+        exact(&mut cache, &doc, &format!("fragment {k}"));
+    }
+    assert_eq!((cache.compiles(), cache.patches()), (2, 2));
+}

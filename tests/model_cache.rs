@@ -442,6 +442,57 @@ fn written_inertials_make_masses_patches_of_the_superset() {
 }
 
 #[test]
+fn masses_of_geom_bodies_are_patches_by_default() {
+    use mjcf_forge::mujoco::ObjType;
+    // mass_auto.toml: mass.toml with `write_inertials` unset. The build's MuJoCo writes each
+    // object body's own <inertial> when the scene loads, so a mass scale is a patch of it
+    // (no body model) and the superset compiles once; against mass.toml's variants (the
+    // same draws on the geoms' densities), masses and inertias within 1e-12 relative,
+    // inertial frames within 1e-12.
+    let dir = root().join("corpora/scenes/patch");
+    let auto = Scene::load(dir.join("mass_auto.toml")).unwrap();
+    let densities = Scene::load(dir.join("mass.toml")).unwrap();
+    for i in 0..8 {
+        let (xml, _) = auto.variant_xml(i).unwrap();
+        assert!(xml.contains("<inertial"), "variant {i}");
+        let (got, want) = (compiled(&auto, i), compiled(&densities, i));
+        assert_eq!(got.names(ObjType::Body), want.names(ObjType::Body));
+        let close = |a: &[f64], b: &[f64], relative: bool| {
+            a.iter().zip(b).all(|(x, y)| {
+                let d = (x - y).abs();
+                if relative && *y != 0.0 {
+                    d / y.abs() < 1e-12
+                } else {
+                    d < 1e-12
+                }
+            })
+        };
+        assert!(
+            close(got.body_mass(), want.body_mass(), true),
+            "variant {i}"
+        );
+        assert!(
+            close(got.body_inertia(), want.body_inertia(), true),
+            "variant {i}"
+        );
+        assert!(
+            close(got.body_ipos(), want.body_ipos(), false),
+            "variant {i}"
+        );
+        assert!(
+            close(got.body_iquat(), want.body_iquat(), false),
+            "variant {i}"
+        );
+    }
+    let superset = auto.superset().unwrap();
+    let mut cache = ModelCache::new(&auto, 2, None).with_superset().unwrap();
+    for i in 0..6 {
+        superset_masses_are_the_variants(&auto, &superset, &mut cache, i, false);
+    }
+    assert_eq!(cache.compiles(), 1);
+}
+
+#[test]
 fn per_world_arrays_hold_each_worlds_superset_model() {
     use mjcf_forge::compiled::Dtype;
     let scene = Scene::load(root().join("corpora/scenes/patch/boxes.toml")).unwrap();

@@ -226,6 +226,24 @@ def test_sizes_of_primitive_geoms_are_patched_through_their_bodys_compile():
     assert sizes == [("body", "geoms")] * 4
 
 
+def test_files_meant_for_inclusion_are_answered_as_mujoco_compiles_them():
+    # Bodies and frames directly under <mujoco> (a file meant to be included into a
+    # <worldbody>): MuJoCo reads them and compiles the file to the world alone; the cache
+    # answers the same, never refuses it: patches of the timestep, and other values in
+    # what MuJoCo leaves out (in the structure key: compiled).
+    cache = mjcf_forge.DocumentCache()
+    for k, mass in enumerate(["1", "1", "1", "2.5"]):
+        text = (
+            f'<mujoco model="part"><option timestep="0.00{k + 1}"/>'
+            f'<body name="b" pos="0 0 1"><geom name="g" size="0.1" mass="{mass}"/></body>'
+            f'<frame pos="1 0 0"><body name="c"><joint name="j" damping="{mass}"/><geom size="0.2"/></body></frame>'
+            "</mujoco>"
+        )
+        doc = mjcf_forge.Document.from_string(text)
+        check_exact(doc, cache.model(doc), f"fragment {k}")
+    assert (cache.compiles, cache.patches) == (2, 2)
+
+
 def test_structural_edits_are_compiled_and_exact():
     cache = mjcf_forge.DocumentCache(max_models=64)
     for path, doc in sample_docs():

@@ -129,6 +129,57 @@ def test_mass_of_bodies_without_inertial_is_a_patch():
     _superset_check(scene, range(4), trajectory_tolerance=0.0)
 
 
+def test_masses_of_geom_bodies_are_patches_by_default(monkeypatch):
+    # mass_auto.toml: mass.toml's scene with `write_inertials` unset. A body mass
+    # randomizer applies to the group, so MuJoCo's own <inertial>s are written when the
+    # scene loads and every variant is a patch of them: no body model compiled, the
+    # superset holds them, and each variant is within a few ulps of mass.toml's (the same
+    # draws on the geoms' densities): relative 1e-12 on masses and inertias, inertial
+    # frames within 1e-12, the same trajectories within 1e-9 m over 500 steps.
+    auto = mjcf_forge.Scene.load(PATCH / "mass_auto.toml")
+    densities = mjcf_forge.Scene.load(PATCH / "mass.toml")
+    worst = {"mass": 0.0, "inertia": 0.0, "frame": 0.0, "path": 0.0}
+    for i in range(8):
+        va, vd = auto.variant(i), densities.variant(i)
+        assert "<inertial" in va.xml and "<inertial" not in vd.xml, i
+        assert {r["attribute"] for r in va.params["randomized"]} == {"mass"}
+        ma, md = mujoco.MjModel.from_xml_string(va.xml), mujoco.MjModel.from_xml_string(vd.xml)
+        assert ma.nbody == md.nbody and ma.ngeom == md.ngeom, i
+        heavy = md.body_mass > 0
+        assert np.array_equal(ma.body_mass == 0, ~heavy), i
+        worst["mass"] = max(worst["mass"], np.max(np.abs(ma.body_mass - md.body_mass)[heavy] / md.body_mass[heavy]))
+        inertia = np.abs(md.body_inertia) > 0
+        worst["inertia"] = max(worst["inertia"], np.max(np.abs(ma.body_inertia - md.body_inertia)[inertia] / np.abs(md.body_inertia[inertia])))
+        worst["frame"] = max(worst["frame"], np.max(np.abs(ma.body_ipos - md.body_ipos)), np.max(np.abs(ma.body_iquat - md.body_iquat)))
+        da, dd = mujoco.MjData(ma), mujoco.MjData(md)
+        for _ in range(500):
+            mujoco.mj_step(ma, da)
+            mujoco.mj_step(md, dd)
+            worst["path"] = max(worst["path"], np.max(np.abs(da.xpos - dd.xpos)))
+    assert worst["mass"] < 1e-12 and worst["inertia"] < 1e-12, worst
+    assert worst["frame"] < 1e-12 and worst["path"] < 1e-9, worst
+    # The draws reach the masses: each recorded mass is its body's compiled mass.
+    drawn = set()
+    for i in range(4):
+        v = auto.variant(i)
+        m = mujoco.MjModel.from_xml_string(v.xml)
+        for r in v.params["randomized"]:
+            assert m.body(r["name"]).mass[0] == r["value"], (i, r)
+            drawn.add(r["value"])
+    assert len(drawn) >= 6, drawn
+    compiled = []
+    monkeypatch.setattr(mjcf_forge._plan.Plan, "body_model", lambda *a: compiled.append(a))
+    cache = mjcf_forge.ModelCache(auto)
+    for i in range(24):
+        v = auto.variant(i)
+        check_exact(v, cache.model(v))
+    assert cache.patches >= 12, cache.patches
+    _superset_check(auto, range(4), trajectory_tolerance=0.0)
+    assert compiled == []
+    # Set to false, the geoms' densities are scaled (mass.toml), through body models.
+    assert all("<inertial" not in densities.variant(i).xml for i in range(4))
+
+
 def test_written_inertials_make_masses_patches_without_compiles(monkeypatch):
     # write_inertials = true: each object body whose mass MuJoCo infers from its geoms gets
     # MuJoCo's own <inertial> when the scene loads (the file compiled alone), so a mass
@@ -163,7 +214,10 @@ def test_written_inertials_make_masses_patches_without_compiles(monkeypatch):
     assert all(0.05 <= r["value"] <= 0.5 for r in v.params["randomized"])
     check_exact(v, mjcf_forge.ModelCache(masses).model(v))
     with pytest.raises(mjcf_forge.MjcfError, match="has no <inertial>: its mass comes from its geoms"):
-        mjcf_forge.Scene.from_toml(absolute.replace("write_inertials = true\n", ""), base_dir=PATCH)
+        mjcf_forge.Scene.from_toml(absolute.replace("write_inertials = true\n", "write_inertials = false\n"), base_dir=PATCH)
+    # Unset, the absolute masses apply to the <inertial>s MuJoCo writes.
+    unset = mjcf_forge.Scene.from_toml(absolute.replace("write_inertials = true\n", ""), base_dir=PATCH)
+    check_exact(unset.variant(3), mjcf_forge.ModelCache(unset).model(unset.variant(3)))
 
 
 def test_superset_varies_fixed_base_objects_per_world():

@@ -258,6 +258,11 @@ impl Randomizer {
     ) -> Result<Vec<Target>, Errors> {
         let mut out = Vec::new();
         let mut errors = Vec::new();
+        // Bodies selected for their mass that have none (neither geoms nor <inertial>).
+        let mut massless = Vec::new();
+        // A geom's density does nothing where it has a mass, its own or its class's: the
+        // document with its classes inlined (same nodes) tells, made once when needed.
+        let mut inlined: Option<Option<Document>> = None;
         for node in nodes {
             if doc.tag(node) != self.kind {
                 continue;
@@ -277,7 +282,7 @@ impl Randomizer {
                     errors.push(doc.error_at(
                         node,
                         ErrorKind::Invalid(format!(
-                            "randomizer at {}: body {} has no <inertial>: its mass comes from its geoms, so it can only be scaled (add `scale = true`, without `components`), or give the body an <inertial> (`write_inertials = true` on its group writes MuJoCo's own)",
+                            "randomizer at {}: body {} has no <inertial>: its mass comes from its geoms, so it can only be scaled (add `scale = true`, without `components`), or give the body an <inertial> (on an object group, leave `write_inertials` unset or set it true, and MuJoCo's own is written)",
                             self.location,
                             quoted(name)
                         )),
@@ -285,8 +290,13 @@ impl Randomizer {
                     continue;
                 }
                 // A body with neither <inertial> nor geoms weighs nothing: nothing to scale
-                // (robosuite's and LIBERO's objects hold their geoms in an inner body).
+                // (robosuite's and LIBERO's objects hold their geoms in an inner body,
+                // which a pattern selects with it); an error below when nothing selected
+                // has a mass.
                 let geoms = doc.children_through_frames(node, "geom");
+                if geoms.is_empty() {
+                    massless.push(node);
+                }
                 for g in geoms {
                     out.push(Target {
                         node: g,
@@ -297,6 +307,29 @@ impl Randomizer {
                     });
                 }
                 continue;
+            }
+            if self.kind == "geom" && self.attribute == "density" {
+                let resolved = inlined.get_or_insert_with(|| {
+                    let mut copy = doc.clone();
+                    crate::document::defaults::inline_defaults(&mut copy)
+                        .ok()
+                        .map(|()| copy)
+                });
+                let has_mass = match resolved {
+                    Some(r) => r.attr(node, "mass").is_some(),
+                    None => doc.attr(node, "mass").is_some(),
+                };
+                if has_mass {
+                    errors.push(doc.error_at(
+                        node,
+                        ErrorKind::Invalid(format!(
+                            "randomizer at {}: {} has a mass, which MuJoCo takes over its density: randomize its `mass` instead",
+                            self.location,
+                            element_label(doc, node)
+                        )),
+                    ));
+                    continue;
+                }
             }
             let target = if self.kind == "body" && self.attribute == "mass" {
                 match doc.elements(node).find(|&k| doc.tag(k) == "inertial") {
@@ -327,6 +360,19 @@ impl Randomizer {
                 prefix: Arc::from(prefix),
                 mass_of: None,
             });
+        }
+        if let Some(&body) = massless.first()
+            && out.is_empty()
+            && errors.is_empty()
+        {
+            errors.push(doc.error_at(
+                body,
+                ErrorKind::Invalid(format!(
+                    "randomizer at {}: body {} has neither geoms nor an <inertial>: it has no mass to randomize",
+                    self.location,
+                    quoted(doc.attr(body, "name"))
+                )),
+            ));
         }
         if errors.is_empty() {
             Ok(out)

@@ -74,9 +74,11 @@ pub(crate) struct GroupSpec {
     pub(crate) name_unnamed_geoms: bool,
     /// Give every body of the pool's models whose mass MuJoCo infers from its geoms an
     /// explicit `<inertial>`, as MuJoCo compiles the model file alone (needs MuJoCo when
-    /// the scene loads): its mass randomization then scales that `<inertial>`.
+    /// the scene loads): its mass randomization then scales that `<inertial>`. Unset: done
+    /// when a body mass randomizer applies to the group, no randomizer changes its geoms'
+    /// densities or masses, and MuJoCo is at hand (see [`super::load`]).
     #[serde(default)]
-    pub(crate) write_inertials: bool,
+    pub(crate) write_inertials: Option<bool>,
 }
 
 fn yes() -> bool {

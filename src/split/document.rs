@@ -257,6 +257,17 @@ fn split_resolved(doc: &Document, options: SplitOptions) -> DocumentPatch {
     // The open elements, to mark where each one closes (the key holds the tree's shape).
     let mut open: Vec<Node> = Vec::new();
     let mut replicated = 0usize;
+    // A <body> or <frame> directly under <mujoco> (a file meant to be included into a
+    // <worldbody>) is read and left out by MuJoCo, which compiles such a file to the world
+    // alone: what it holds is in the key, and in no patch.
+    let root = doc.root();
+    let ignored = |node: Node| {
+        let mut top = node;
+        while let Some(p) = doc.parent(top).filter(|&p| p != root) {
+            top = p;
+        }
+        matches!(doc.tag(top), "body" | "frame") && doc.parent(top) == Some(root)
+    };
     for node in doc.descendants(doc.root()) {
         let parent = doc.parent(node);
         while open.last().is_some_and(|&o| Some(o) != parent) {
@@ -272,7 +283,7 @@ fn split_resolved(doc: &Document, options: SplitOptions) -> DocumentPatch {
         key.mark(b'<');
         key.str(tag);
         // Elements a `replicate` repeats are renamed and numbered by the compiler.
-        let patched = if replicated == 0 {
+        let patched = if replicated == 0 && !ignored(node) {
             element_entries(doc, node, &rules)
         } else {
             Patched::default()

@@ -18,8 +18,20 @@ use crate::scene::{Group, PoolModel};
 
 use super::{MAX_COUNT, ModelSource, Source, model_options, root_body};
 
+/// Whether a group's models get MuJoCo's own `<inertial>`s written out when they load.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum WriteInertials {
+    /// No (`write_inertials = false`, or nothing asks for it).
+    No,
+    /// Yes (`write_inertials = true`): a model whose inertials cannot be written is an error.
+    Yes,
+    /// Where they can be written (a body mass randomizer applies to the group): a model
+    /// whose inertials cannot be written keeps its geoms' densities, the slower patch.
+    Where,
+}
+
 /// Checks and loads group `g` (its models read once, their files recorded in `files`,
-/// their inertials written out with `inertias` when the group asks), against the template
+/// their inertials written out with `inertias` as `write` says), against the template
 /// and the groups before it; every problem at its key.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn load(
@@ -31,6 +43,7 @@ pub(super) fn load(
     angles: &Angles,
     models: &dyn ModelSource,
     mut inertias: Option<&mut InertiaCompiler<'_>>,
+    write: WriteInertials,
     files: &mut Vec<PathBuf>,
 ) -> Result<Group, Errors> {
     let mut errors = Vec::new();
@@ -103,21 +116,29 @@ pub(super) fn load(
             }
         };
         files.extend(path);
-        if g.write_inertials {
+        if write != WriteInertials::No {
             // MuJoCo's own masses and inertias of the file alone, written out: a mass
             // randomizer then scales an <inertial> (a patch) instead of the geoms' densities
-            // (which only MuJoCo can turn into masses).
+            // (which only MuJoCo can turn into masses). Written into a copy, so a model
+            // whose inertials cannot be written stays as it was.
+            let mut written_doc = doc.clone();
             let written = match inertias.as_deref_mut() {
-                Some(compile) => doc.write_compiled_inertials(false, true, compile),
+                Some(compile) => written_doc.write_compiled_inertials(false, true, compile),
                 None => Err(
                     "write_inertials needs MuJoCo: load the scene from Python, or \
                      build mjcf-forge with the `mujoco` feature"
                         .to_string(),
                 ),
             };
-            if let Err(e) = written {
-                errors.push(src.error(&at, format!("cannot write the inertials of '{file}': {e}")));
-                continue;
+            match written {
+                Ok(_) => doc = written_doc,
+                Err(_) if write == WriteInertials::Where => {}
+                Err(e) => {
+                    errors.push(
+                        src.error(&at, format!("cannot write the inertials of '{file}': {e}")),
+                    );
+                    continue;
+                }
             }
         }
         let Some(root) = root_body(&doc) else {

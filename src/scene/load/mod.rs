@@ -18,7 +18,7 @@ use crate::model::{XmlModel, XmlModelOptions};
 
 use super::place::{self};
 use super::randomize::{self};
-use super::spec::SceneSpec;
+use super::spec::{self, SceneSpec};
 use super::{Group, Instance, Scene, splice};
 
 mod group;
@@ -160,6 +160,32 @@ fn from_text(
     })
 }
 
+/// Whether group `g`'s models get MuJoCo's own `<inertial>`s written out: as the group
+/// says, else where they can be (`mujoco` at hand) when a body mass randomizer applies to
+/// the group and none changes its geoms' densities or masses (an `<inertial>` would make
+/// those do nothing). A written `<inertial>` makes a mass scale a patch of four numbers;
+/// the geoms' densities need a body model compiled per variant (docs/compiled.md).
+fn write_inertials(
+    g: &spec::GroupSpec,
+    randomizers: &[randomize::Randomizer],
+    mujoco: bool,
+) -> group::WriteInertials {
+    let name = g.name.as_ref().as_str();
+    let applies = |kind: &str, attrs: &[&str]| {
+        randomizers.iter().any(|r| {
+            r.kind == kind && attrs.contains(&r.attribute.as_str()) && r.applies_to_part(name)
+        })
+    };
+    match g.write_inertials {
+        Some(true) => group::WriteInertials::Yes,
+        Some(false) => group::WriteInertials::No,
+        None if mujoco && applies("body", &["mass"]) && !applies("geom", &["density", "mass"]) => {
+            group::WriteInertials::Where
+        }
+        None => group::WriteInertials::No,
+    }
+}
+
 fn build(
     src: &Source<'_>,
     dir: PathBuf,
@@ -288,9 +314,10 @@ fn build(
         .map_err(|e| Error::at(src.location(spec.base.span()), ErrorKind::Invalid(e)))?;
     let mut groups: Vec<Group> = Vec::new();
     for g in &spec.objects {
+        let write = write_inertials(g, &randomizers, inertias.is_some());
         let compile = inertias.as_deref_mut();
         match group::load(
-            src, &dir, g, &groups, &template, &angles, models, compile, &mut files,
+            src, &dir, g, &groups, &template, &angles, models, compile, write, &mut files,
         ) {
             Ok(x) => groups.push(x),
             Err(e) => errors.extend(e.0),

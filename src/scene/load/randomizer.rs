@@ -169,6 +169,23 @@ pub(super) fn load(
         }
     };
     let numeric = !matches!(dist, Dist::Choice { .. });
+    // A mass or density (or a factor of one) drawn at zero or below is no body MuJoCo
+    // simulates: refused when the scene loads, not at the variant that draws it.
+    let lowest = match &dist {
+        Dist::Uniform { lo, .. } | Dist::LogUniform { lo, .. } => lo.clone(),
+        Dist::Normal { min, .. } => min.clone(),
+        Dist::Choice { .. } => Vec::new(),
+    };
+    if matches!(attribute, "mass" | "density") && lowest.iter().any(|&x| x <= 0.0) {
+        let what = if r.scale { "factor of a" } else { "" };
+        return Err(src.error(
+            &r.attribute,
+            format!(
+                "a {what}{}{attribute} must be drawn above 0: give bounds > 0 (a normal needs min > 0)",
+                if r.scale { " " } else { "" }
+            ),
+        ));
+    }
     if r.scale && !numeric {
         return Err(src.error(&r.attribute, "scale needs numbers, not a choice"));
     }
