@@ -30,6 +30,13 @@ class Statistics:
     def compute(self) -> None: ...
     def mean_inertia(self, dofs: list[int]) -> float: ...
 
+class ModelArrays:
+    """A compiled model's arrays a body model is copied from or into
+    (``mjcf_forge::split::copy_body_model``)."""
+
+    def __init__(self, model: Any) -> None: ...
+    def copy_body_model(self, body: int, name: str, part: ModelArrays) -> None: ...
+
 _Path = Union[str, os.PathLike[str]]
 #: What Element.set and Element.append take as an attribute value.
 _AttrValue = Union[str, bool, int, float, Sequence[Union[int, float]], npt.NDArray[Any]]

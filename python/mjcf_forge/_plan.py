@@ -20,7 +20,7 @@ import numpy as np
 
 from ._errors import error
 from . import _mujoco
-from ._mjcf_forge import DOF_FIELDS, PATCH_OBJECTS, QPOS_FIELDS, Statistics, joint_widths, target_array
+from ._mjcf_forge import DOF_FIELDS, PATCH_OBJECTS, QPOS_FIELDS, ModelArrays, Statistics, joint_widths, target_array
 
 # The split tier's tables (``mjcf_forge::split::targets``, through the extension): each
 # patched object's array prefix, mjtObj name and count; the joints' dof and qpos fields.
@@ -58,7 +58,7 @@ class Plan:
         # The bodies of the patch's "geoms" entries, in order, and the body models of
         # their geoms compiled so far (MJCF text -> model), the newest last.
         self.bodies: list[int] = []
-        self.body_models: dict[str, Any] = {}
+        self.body_models: dict[str, tuple[Any, Any]] = {}
         # Per "geoms" entry: its body model as the structure compiled it (what the
         # snapshot's arrays hold), and the one last written into this model (None: not
         # known; the bounding volumes are not restored before a patch).
@@ -69,13 +69,10 @@ class Plan:
         # Views (fetching one from the bindings costs microseconds) and constants.
         self.stat = model.stat
         self.qpos0, self.qpos = model.qpos0, data.qpos
-        # A body its geoms give no mass has its inertial frame where MuJoCo puts a massless
-        # body's (not a function of its geoms alone: a body model at the origin has
-        # another): the frames as compiled, kept while the body's own frame is (below).
-        self.massless0 = {
-            b: (model.body_pos[b].copy(), model.body_quat[b].copy(), model.body_ipos[b].copy(), model.body_iquat[b].copy(), int(model.body_sameframe[b]))
-            for b in np.flatnonzero((model.body_mass == 0) & ~model.body_inertia.any(axis=1))
-        }
+        # The arrays a body model is copied into (the copy: the extension's
+        # ModelArrays.copy_body_model, mjcf_forge::split::copy_body_model), with the
+        # inertial frames of the bodies the structure compiled without mass.
+        self.arrays = ModelArrays(model)
         # The mass matrix's diagonal, where this MuJoCo keeps it (_mujoco.py), and the
         # arrays the statistics read, found once.
         inertia, diagonal = _mujoco.inertia_diagonal(model, data)
@@ -206,52 +203,19 @@ class Plan:
         bounding radius and box, the body's mass, inertia and inertial frame, its bounding
         volumes). Raises when the body model's layout is not the body's (the document is
         then compiled)."""
-        mini = self.body_models.get(xml)
-        if mini is None:
+        entry = self.body_models.get(xml)
+        if entry is None:
             try:
                 mini = self.mujoco.MjModel.from_xml_string(xml)
             except ValueError as e:
                 raise error(f"body '{self.model.body(body).name}': its geoms alone: {e}") from None
             if len(self.body_models) >= 64:
                 del self.body_models[next(iter(self.body_models))]
-            self.body_models[xml] = mini
-        model = self.model
-        first, n = int(model.body_geomadr[body]), int(model.body_geomnum[body])
-        mfirst = int(mini.body_geomadr[1]) if mini.nbody == 2 else -1
-        bvh, nbvh = int(model.body_bvhadr[body]), int(model.body_bvhnum[body])
-        mbvh = int(mini.body_bvhadr[1]) if mini.nbody == 2 else -1
-        kept = self.massless0.get(body)
-        if kept is not None and mini.nbody == 2 and (mini.body_mass[1] != 0 or mini.body_inertia[1].any()):
-            kept = None  # it has a mass now: its geoms place its inertial frame
-        if kept is not None and not (
-            np.array_equal(model.body_pos[body], kept[0]) and np.array_equal(model.body_quat[body], kept[1])
-        ):
-            raise error(f"body '{model.body(body).name}' has no mass and another frame: not a patch of it")
-        if (
-            mini.nbody != 2
-            or int(mini.body_geomnum[1]) != n
-            or (kept is None and int(mini.body_sameframe[1]) != int(model.body_sameframe[body]))
-            or int(mini.body_bvhnum[1]) != nbvh
-            or not np.array_equal(mini.geom_type[mfirst : mfirst + n], model.geom_type[first : first + n])
-            or not np.array_equal(mini.geom_sameframe[mfirst : mfirst + n], model.geom_sameframe[first : first + n])
-            or not np.array_equal(mini.bvh_child[mbvh : mbvh + nbvh], model.bvh_child[bvh : bvh + nbvh])
-            or not np.array_equal(mini.bvh_depth[mbvh : mbvh + nbvh], model.bvh_depth[bvh : bvh + nbvh])
-            or not np.array_equal(mini.bvh_nodeid[mbvh : mbvh + nbvh] + (first - mfirst) * (mini.bvh_nodeid[mbvh : mbvh + nbvh] >= 0), model.bvh_nodeid[bvh : bvh + nbvh])
-        ):
-            raise error(
-                f"body '{model.body(body).name}': its geoms compile to another layout than "
-                "this structure's (sizes, frames or densities that move or turn its inertial "
-                "frame off its own, or another bounding-volume tree): not a patch of it"
-            )
-        geoms, mgeoms = slice(first, first + n), slice(mfirst, mfirst + n)
-        for field in ("geom_size", "geom_rbound", "geom_aabb", "geom_pos", "geom_quat"):
-            getattr(model, field)[geoms] = getattr(mini, field)[mgeoms]
-        for field in ("body_mass", "body_inertia", "body_ipos", "body_iquat"):
-            getattr(model, field)[body] = getattr(mini, field)[1]
-        if kept is not None:
-            model.body_ipos[body], model.body_iquat[body] = kept[2], kept[3]
-            model.body_sameframe[body] = kept[4]
-        model.bvh_aabb[bvh : bvh + nbvh] = mini.bvh_aabb[mbvh : mbvh + nbvh]
+            entry = self.body_models[xml] = (mini, ModelArrays(mini))
+        try:
+            self.arrays.copy_body_model(body, self.model.body(body).name, entry[1])
+        except ValueError as e:
+            raise error(str(e)) from None
 
     def finish(self, derive: Callable[[Any, Any, list], None] | None = None) -> None:
         """What follows the values: ``mj_setConst`` (or ``derive(model, data, layout)``,

@@ -1,111 +1,93 @@
 //! A body model (`PatchValue::BodyModel`, see `split::SplitOptions`): the body's
-//! geoms compiled alone, whose compile gives what MuJoCo derives from them (each geom's
-//! size, frame, bounding radius and box, the body's mass, inertia and inertial frame, its
-//! bounding volumes), copied into the body of a model of the whole structure. A body
-//! model whose layout is not the body's (another `body_sameframe` or `geom_sameframe`,
-//! bounding-volume tree or geom types) is refused: the document is then compiled.
+//! geoms compiled alone, whose compile gives what MuJoCo derives from them, copied into the
+//! body of a model of the whole structure by [`crate::split::copy_body_model`] (the rule
+//! both faces share; this is the C face's side: the linked MuJoCo's arrays by name, and the
+//! body models compiled so far).
 
-use std::ffi::{CString, c_int};
+use std::ffi::CString;
 use std::path::Path;
 
 use super::sys::mjf_patch_array;
 use crate::mujoco::{CompiledModel, MjModel, compile_str};
+use crate::split::{MasslessFrame, ModelArrays, ModelArraysMut, copy_body_model, massless_frames};
 
-/// Body models compiled so far, by their MJCF text, the newest last.
-#[derive(Default)]
+/// A live model's arrays by name, through `patch.c`.
+struct Arrays(*mut MjModel);
+
+impl Arrays {
+    /// `name`'s pointer and element count, checked to hold elements of `T`.
+    fn find<T>(&self, name: &str) -> Result<(*mut T, usize), String> {
+        let c = CString::new(name).map_err(|e| e.to_string())?;
+        let (mut elem, mut count) = (0usize, 0usize);
+        // SAFETY: the model is live; `c` is NUL-terminated.
+        let p = unsafe { mjf_patch_array(self.0, c.as_ptr(), &mut elem, &mut count) };
+        if elem != std::mem::size_of::<T>() || (p.is_null() && count > 0) {
+            return Err(format!(
+                "this MuJoCo's mjModel has no array {name} of that type"
+            ));
+        }
+        Ok((p.cast(), count))
+    }
+
+    fn get<T>(&self, name: &str) -> Result<&[T], String> {
+        let (p, n) = self.find::<T>(name)?;
+        // SAFETY: `n` elements of the live model at `p`, read while `self` is borrowed.
+        Ok(unsafe { crate::mujoco::slice_or_empty(p.cast_const(), n) })
+    }
+
+    fn get_mut<T>(&mut self, name: &str) -> Result<&mut [T], String> {
+        let (p, n) = self.find::<T>(name)?;
+        if n == 0 {
+            return Ok(&mut []);
+        }
+        // SAFETY: `n` elements of the live model at `p`, the only view while `self` is
+        // borrowed mutably.
+        Ok(unsafe { std::slice::from_raw_parts_mut(p, n) })
+    }
+}
+
+impl ModelArrays for Arrays {
+    fn floats(&self, name: &str) -> Result<&[f64], String> {
+        self.get(name)
+    }
+    fn ints(&self, name: &str) -> Result<&[i32], String> {
+        self.get(name)
+    }
+    fn bytes(&self, name: &str) -> Result<&[u8], String> {
+        self.get(name)
+    }
+}
+
+impl ModelArraysMut for Arrays {
+    fn floats_mut(&mut self, name: &str) -> Result<&mut [f64], String> {
+        self.get_mut(name)
+    }
+    fn bytes_mut(&mut self, name: &str) -> Result<&mut [u8], String> {
+        self.get_mut(name)
+    }
+}
+
+/// Body models compiled so far, by their MJCF text, the newest last; and the inertial
+/// frames of the structure's massless bodies.
 pub(super) struct BodyModels {
     models: Vec<(String, CompiledModel)>,
+    massless: Vec<(usize, MasslessFrame)>,
 }
 
 /// How many body models a plan keeps.
 const KEPT: usize = 64;
 
-/// One array of a live model: its pointer, element size and element count.
-struct Array {
-    ptr: *mut u8,
-    elem: usize,
-    count: usize,
-}
-
-fn array(m: *mut MjModel, name: &str) -> Result<Array, String> {
-    let c = CString::new(name).map_err(|e| e.to_string())?;
-    let (mut elem, mut count) = (0usize, 0usize);
-    // SAFETY: the model is live; `c` is NUL-terminated.
-    let p = unsafe { mjf_patch_array(m, c.as_ptr(), &mut elem, &mut count) };
-    if (p.is_null() && count > 0) || elem == 0 {
-        return Err(format!("this MuJoCo's mjModel has no array {name}"));
-    }
-    Ok(Array {
-        ptr: p.cast(),
-        elem,
-        count,
-    })
-}
-
-/// `name[at]`, an integer (or a byte) of the model.
-fn int(m: *mut MjModel, name: &str, at: usize) -> Result<i64, String> {
-    let a = array(m, name)?;
-    if at >= a.count {
-        return Err(format!("{name}[{at}] out of range"));
-    }
-    // SAFETY: `at` < count elements of `elem` bytes at `ptr`.
-    Ok(unsafe {
-        match a.elem {
-            1 => i64::from(a.ptr.add(at).read()),
-            4 => i64::from(a.ptr.cast::<c_int>().add(at).read_unaligned()),
-            _ => return Err(format!("{name} is not an integer array")),
-        }
-    })
-}
-
-/// Where rows `first..first + n` of `name` are, each `width` elements wide: their first
-/// byte and their length in bytes, checked against the array's length.
-fn span(
-    m: *mut MjModel,
-    name: &str,
-    first: usize,
-    n: usize,
-    width: usize,
-) -> Result<(*mut u8, usize), String> {
-    let a = array(m, name)?;
-    let (start, len) = (first * width, n * width);
-    if start + len > a.count {
-        return Err(format!("{name}[{start}..{}] out of range", start + len));
-    }
-    // SAFETY: in bounds of the live array (checked above).
-    Ok((unsafe { a.ptr.add(start * a.elem) }, len * a.elem))
-}
-
-/// A copy of the bytes of rows `first..first + n` of `name`.
-fn read(
-    m: *mut MjModel,
-    name: &str,
-    first: usize,
-    n: usize,
-    width: usize,
-) -> Result<Vec<u8>, String> {
-    let (p, len) = span(m, name, first, n, width)?;
-    // SAFETY: `len` bytes of the live model at `p` (see `span`).
-    Ok(unsafe { std::slice::from_raw_parts(p, len) }.to_vec())
-}
-
-/// Copies rows of `name` from `from` (starting at `from_first`) to `to` (at `to_first`).
-fn copy(
-    name: &str,
-    width: usize,
-    n: usize,
-    from: (*mut MjModel, usize),
-    to: (*mut MjModel, usize),
-) -> Result<(), String> {
-    let (src, len) = span(from.0, name, from.1, n, width)?;
-    let (dst, dst_len) = span(to.0, name, to.1, n, width)?;
-    debug_assert_eq!(len, dst_len);
-    // SAFETY: `len` bytes of two live models (see `span`), distinct allocations.
-    unsafe { std::ptr::copy_nonoverlapping(src, dst, len.min(dst_len)) };
-    Ok(())
-}
-
 impl BodyModels {
+    /// The body models of `model`'s plan, none compiled yet; its massless bodies' frames
+    /// as it holds them now (made when the model is first patched).
+    pub(super) fn of(model: &CompiledModel) -> Result<BodyModels, String> {
+        let arrays = Arrays(std::ptr::from_ref(model.raw()).cast_mut());
+        Ok(BodyModels {
+            models: Vec::new(),
+            massless: massless_frames(&arrays)?,
+        })
+    }
+
     /// Writes into body `body` of `model` what MuJoCo derives from its geoms, read off the
     /// compile of their body model `xml` (compiled once, kept).
     pub(super) fn write(
@@ -125,77 +107,12 @@ impl BodyModels {
                 self.models.len() - 1
             }
         };
-        let part = self.models[at].1.as_mut_ptr();
-        let geoms = |m, b| -> Result<(usize, usize), String> {
-            Ok((
-                int(m, "body_geomadr", b)? as usize,
-                int(m, "body_geomnum", b)? as usize,
-            ))
-        };
-        let bvh = |m, b| -> Result<(usize, usize), String> {
-            Ok((
-                int(m, "body_bvhadr", b)?.max(0) as usize,
-                int(m, "body_bvhnum", b)? as usize,
-            ))
-        };
-        let (g, n) = geoms(model, body)?;
-        let (lg, ln) = geoms(part, 1)?;
-        let (v, nv) = bvh(model, body)?;
-        let (lv, lnv) = bvh(part, 1)?;
-        let same = |name: &str, width: usize, a: (usize, usize), b: (usize, usize)| {
-            Ok::<bool, String>(
-                read(model, name, a.0, a.1, width)? == read(part, name, b.0, b.1, width)?,
-            )
-        };
-        let nodes = |m, first: usize, count| -> Result<Vec<i64>, String> {
-            (first..first + count)
-                .map(|k| int(m, "bvh_nodeid", k))
-                .collect()
-        };
-        // Leaves name geoms by id: the body model's start at its first geom.
-        let shifted: Vec<i64> = nodes(part, lv, lnv)?
-            .into_iter()
-            .map(|id| {
-                if id >= 0 {
-                    id - lg as i64 + g as i64
-                } else {
-                    id
-                }
-            })
-            .collect();
-        if ln != n
-            || lnv != nv
-            || int(part, "body_sameframe", 1)? != int(model, "body_sameframe", body)?
-            || !same("geom_type", 1, (g, n), (lg, ln))?
-            || !same("geom_sameframe", 1, (g, n), (lg, ln))?
-            || !same("bvh_child", 2, (v, nv), (lv, lnv))?
-            || !same("bvh_depth", 1, (v, nv), (lv, lnv))?
-            || shifted != nodes(model, v, nv)?
-        {
-            return Err(format!(
-                "body {body}: its geoms compile to another layout than this structure's \
-                 (sizes, frames or densities that move or turn its inertial frame off its own, \
-                 or another bounding-volume tree): not a patch of it"
-            ));
-        }
-        for (name, width) in [
-            ("geom_size", 3),
-            ("geom_rbound", 1),
-            ("geom_aabb", 6),
-            ("geom_pos", 3),
-            ("geom_quat", 4),
-        ] {
-            copy(name, width, n, (part, lg), (model, g))?;
-        }
-        for (name, width) in [
-            ("body_mass", 1),
-            ("body_inertia", 3),
-            ("body_ipos", 3),
-            ("body_iquat", 4),
-        ] {
-            copy(name, width, 1, (part, 1), (model, body))?;
-        }
-        copy("bvh_aabb", 6, nv, (part, lv), (model, v))?;
-        Ok(())
+        let part = Arrays(self.models[at].1.as_mut_ptr());
+        let kept = self
+            .massless
+            .iter()
+            .find(|(b, _)| *b == body)
+            .map(|(_, k)| k);
+        copy_body_model(&mut Arrays(model), body, &body.to_string(), kept, &part)
     }
 }

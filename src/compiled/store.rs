@@ -293,7 +293,7 @@ impl State {
             scratch,
             fields: Vec::new(),
             targets: Vec::new(),
-            body_models: BodyModels::default(),
+            body_models: BodyModels::of(model)?,
             nbytes: usize::try_from(nbytes).unwrap_or(0),
         });
         Ok(self.plans.len() - 1)

@@ -28,19 +28,22 @@
 //! `targets.rs` (the `mjModel` array each entry writes, the arrays no patch changes, the
 //! arrays that tell structures apart: the one copy the model caches of both faces read),
 //! `document.rs` (any document split by reading it), `body_model.rs` (a body's geoms as a
-//! model of their own, for what MuJoCo derives from their sizes), `statistics.rs` (the
+//! model of their own, for what MuJoCo derives from their sizes), `body_copy.rs` (that
+//! model's compile copied into a structure's model, for both faces), `statistics.rs` (the
 //! compiler's statistics at `qpos0`, computed over a model's arrays for both faces). The scene tier reads its
 //! drawn variants through the same rules (`scene/patch.rs`).
 //!
 //! May use: the document tier and `crate::error`. Knows nothing of scenes, MuJoCo or the
 //! caches that use it.
 
+mod body_copy;
 mod body_model;
 mod document;
 mod rules;
 mod statistics;
 mod targets;
 
+pub use body_copy::{MasslessFrame, ModelArrays, ModelArraysMut, copy_body_model, massless_frames};
 pub use document::{
     DocumentPatch, PATCHABLE_OPTIONS, SplitOptions, split_document, split_document_with,
 };

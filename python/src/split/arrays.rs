@@ -19,6 +19,10 @@ impl Element for i32 {
     const TYPESTR: &'static str = "<i4";
 }
 
+impl Element for u8 {
+    const TYPESTR: &'static str = "|u1";
+}
+
 /// A C-contiguous NumPy array of `T`, kept alive (and so the model or data whose memory it
 /// views) while this lives. MuJoCo's models and data never move their arrays, so the
 /// address read once stays right.
@@ -60,6 +64,11 @@ impl<T: Element> Array<T> {
     /// How many numbers the array holds.
     pub(crate) fn len(&self) -> usize {
         self.len
+    }
+
+    /// Where the numbers start (to tell two models' arrays apart).
+    pub(crate) fn address(&self) -> usize {
+        self.address
     }
 
     /// The numbers.

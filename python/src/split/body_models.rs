@@ -1,0 +1,183 @@
+//! `ModelArrays`: the arrays of a user's `MjModel` that a body model's compile is copied
+//! from and into, found once, and the copy itself: [`mjcf_forge::split::copy_body_model`],
+//! the rule both faces share (`mjcf_forge._plan.Plan` compiles the body models with the
+//! user's `mujoco`).
+
+use ahash::AHashMap;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use super::arrays::Array;
+use mjcf_forge::split::{self, MasslessFrame};
+
+/// The arrays the copy reads or writes, by type.
+const FLOATS: [&str; 12] = [
+    "body_mass",
+    "body_inertia",
+    "body_pos",
+    "body_quat",
+    "body_ipos",
+    "body_iquat",
+    "geom_size",
+    "geom_rbound",
+    "geom_aabb",
+    "geom_pos",
+    "geom_quat",
+    "bvh_aabb",
+];
+const INTS: [&str; 8] = [
+    "body_geomadr",
+    "body_geomnum",
+    "body_bvhadr",
+    "body_bvhnum",
+    "geom_type",
+    "bvh_child",
+    "bvh_depth",
+    "bvh_nodeid",
+];
+const BYTES: [&str; 2] = ["body_sameframe", "geom_sameframe"];
+
+/// A compiled model's arrays a body model is copied from or into, found once.
+///
+/// ``ModelArrays(model)``; :meth:`copy_body_model` writes into ``model`` what MuJoCo
+/// derives from a body's geoms, read off the compile of its body model.
+///
+/// >>> import mujoco
+/// >>> from mjcf_forge._mjcf_forge import ModelArrays
+/// >>> body = '<body name="b"><geom type="box" size="{}"/></body>'
+/// >>> whole = mujoco.MjModel.from_xml_string(
+/// ...     f'<mujoco><worldbody><body name="a"/>{body.format("0.1 0.1 0.1")}</worldbody></mujoco>')
+/// >>> part = mujoco.MjModel.from_xml_string(
+/// ...     f'<mujoco><worldbody>{body.format("0.2 0.1 0.1")}</worldbody></mujoco>')
+/// >>> ModelArrays(whole).copy_body_model(2, "b", ModelArrays(part))
+/// >>> bool(whole.body_mass[2] == part.body_mass[1])
+/// True
+#[pyclass(name = "ModelArrays", module = "mjcf_forge._mjcf_forge", frozen)]
+pub(crate) struct PyModelArrays {
+    floats: AHashMap<&'static str, Array<f64>>,
+    ints: AHashMap<&'static str, Array<i32>>,
+    bytes: AHashMap<&'static str, Array<u8>>,
+    /// The massless bodies' inertial frames as the model held them when this was made.
+    massless: Vec<(usize, MasslessFrame)>,
+}
+
+fn missing(name: &str) -> String {
+    format!("no array {name} here")
+}
+
+/// Write access to the model, for the length of one copy (the GIL held, no Python code
+/// running).
+struct Writer<'a>(&'a PyModelArrays);
+
+impl split::ModelArrays for PyModelArrays {
+    fn floats(&self, name: &str) -> Result<&[f64], String> {
+        // SAFETY: the GIL is held and no Python code runs while the slice lives; the
+        // part and the model are different models (checked by `copy_body_model`).
+        self.floats
+            .get(name)
+            .map(|a| unsafe { a.slice() })
+            .ok_or_else(|| missing(name))
+    }
+    fn ints(&self, name: &str) -> Result<&[i32], String> {
+        // SAFETY: as above.
+        self.ints
+            .get(name)
+            .map(|a| unsafe { a.slice() })
+            .ok_or_else(|| missing(name))
+    }
+    fn bytes(&self, name: &str) -> Result<&[u8], String> {
+        // SAFETY: as above.
+        self.bytes
+            .get(name)
+            .map(|a| unsafe { a.slice() })
+            .ok_or_else(|| missing(name))
+    }
+}
+
+impl split::ModelArrays for Writer<'_> {
+    fn floats(&self, name: &str) -> Result<&[f64], String> {
+        self.0.floats(name)
+    }
+    fn ints(&self, name: &str) -> Result<&[i32], String> {
+        self.0.ints(name)
+    }
+    fn bytes(&self, name: &str) -> Result<&[u8], String> {
+        self.0.bytes(name)
+    }
+}
+
+impl split::ModelArraysMut for Writer<'_> {
+    fn floats_mut(&mut self, name: &str) -> Result<&mut [f64], String> {
+        // SAFETY: the only view of this array while `self` is borrowed mutably (each array
+        // is one entry; the GIL is held and no Python code runs).
+        self.0
+            .floats
+            .get(name)
+            .map(|a| unsafe { a.slice_mut() })
+            .ok_or_else(|| missing(name))
+    }
+    fn bytes_mut(&mut self, name: &str) -> Result<&mut [u8], String> {
+        // SAFETY: as above.
+        self.0
+            .bytes
+            .get(name)
+            .map(|a| unsafe { a.slice_mut() })
+            .ok_or_else(|| missing(name))
+    }
+}
+
+#[pymethods]
+impl PyModelArrays {
+    #[new]
+    fn new(model: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let mut arrays = PyModelArrays {
+            floats: AHashMap::new(),
+            ints: AHashMap::new(),
+            bytes: AHashMap::new(),
+            massless: Vec::new(),
+        };
+        for name in FLOATS {
+            arrays
+                .floats
+                .insert(name, Array::of(&model.getattr(name)?, name, true)?);
+        }
+        for name in INTS {
+            arrays
+                .ints
+                .insert(name, Array::of(&model.getattr(name)?, name, false)?);
+        }
+        for name in BYTES {
+            arrays
+                .bytes
+                .insert(name, Array::of(&model.getattr(name)?, name, true)?);
+        }
+        arrays.massless = split::massless_frames(&arrays).map_err(PyValueError::new_err)?;
+        Ok(arrays)
+    }
+
+    /// Writes into body ``body`` (``name`` in errors) of this model what MuJoCo derives
+    /// from its geoms, read off ``part``, the compile of its body model; raises
+    /// ``ValueError``, with nothing written, when ``part`` has another layout than the
+    /// body (the document is then compiled).
+    fn copy_body_model(
+        &self,
+        body: usize,
+        name: &str,
+        part: &Bound<'_, PyModelArrays>,
+    ) -> PyResult<()> {
+        let part = part.get();
+        let address = |a: &PyModelArrays| a.floats.get("body_mass").map(Array::address);
+        if address(part) == address(self) {
+            return Err(PyValueError::new_err(
+                "a body model is copied from another model",
+            ));
+        }
+        let kept = self
+            .massless
+            .iter()
+            .find(|(b, _)| *b == body)
+            .map(|(_, k)| k);
+        split::copy_body_model(&mut Writer(self), body, name, kept, part)
+            .map_err(PyValueError::new_err)
+    }
+}
