@@ -30,6 +30,7 @@ import statistics
 import sys
 from pathlib import Path
 from timing import mean_seconds  # noqa: E402
+from robosuite_models import part_class  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 ASSETS = ROOT / ".cache/corpus/robosuite-1.5.2/robosuite/models/assets"
@@ -40,26 +41,7 @@ QUERIES = [".//geom", ".//body[@name='link7']", "./worldbody/body", ".//joint[@t
 def make_builder(base, colors):
     """The scene, written once against robosuite's API, over `base`'s classes."""
 
-    class Part(base.MujocoXMLModel):
-        def __init__(self, rel, idn, rgba):
-            self._rgba = rgba
-            super().__init__(str(ASSETS / rel), idn=idn)
-
-        @property
-        def contact_geom_rgba(self):
-            return self._rgba
-
-        @property
-        def _important_sites(self):
-            return {}
-
-        @property
-        def _important_geoms(self):
-            return {}
-
-        @property
-        def _important_sensors(self):
-            return {}
+    Part = part_class(base.MujocoXMLModel, ASSETS)
 
     def build() -> str:
         robot = Part("robots/panda/robot.xml", "robot0", colors["robot"])

@@ -60,65 +60,11 @@ LIFT5 = ROOT / "benches" / "scenes" / "lift5.toml"
 
 
 def make_robosuite_builder(seed: int):
-    from robosuite.models.arenas import TableArena
-    from robosuite.models.bases import robot_base_factory
-    from robosuite.models.grippers import gripper_factory
-    from robosuite.models.objects import (
-        BottleObject,
-        BreadObject,
-        CanObject,
-        CerealObject,
-        LemonObject,
-        MilkObject,
-    )
-    from robosuite.models.robots import create_robot
-    from robosuite.models.tasks import ManipulationTask
-    from robosuite.utils.mjcf_utils import array_to_string
-    from robosuite.utils.placement_samplers import UniformRandomSampler
+    """``build(index) -> xml``: lift5's variant ``index`` the robosuite way."""
+    from robosuite_models import lift5_builder
 
-    pool = [CanObject, MilkObject, BreadObject, CerealObject, LemonObject, BottleObject]
-    table_full_size = (0.8, 0.8, 0.05)
-
-    def build(index: int) -> str:
-        rng = np.random.default_rng([seed, index])
-        robot = create_robot("Panda", idn=0)
-        robot.add_base(base=robot_base_factory(robot.default_base, idn=0))
-        robot.update_joints()
-        robot.update_actuators()
-        gripper = gripper_factory(robot.default_gripper["right"], idn="0_right")
-        robot.add_gripper(gripper, robot.eef_name["right"])
-        robot.set_base_xpos(robot.base_xpos_offset["table"](table_full_size[0]))
-        arena = TableArena(
-            table_full_size=table_full_size,
-            table_friction=(1.0, 5e-3, 1e-4),
-            table_offset=(0, 0, 0.8),
-        )
-        arena.set_origin([0, 0, 0])
-        objects = [pool[int(k)](name=f"object{i}") for i, k in enumerate(rng.integers(0, len(pool), 5))]
-        sampler = UniformRandomSampler(
-            name="ObjectSampler",
-            mujoco_objects=objects,
-            x_range=[-0.3, 0.3],
-            y_range=[-0.3, 0.3],
-            rotation=None,
-            rotation_axis="z",
-            ensure_object_boundary_in_range=False,
-            ensure_valid_placement=True,
-            reference_pos=(0, 0, 0.8),
-            z_offset=0.01,
-            rng=rng,
-        )
-        for pos, quat, obj in sampler.sample().values():
-            root = obj.get_obj()
-            root.set("pos", array_to_string(pos))
-            root.set("quat", array_to_string(quat))
-        for obj in objects:
-            for geom in obj.get_obj().iter("geom"):
-                geom.set("rgba", array_to_string(np.r_[rng.uniform(0, 1, 3), 1.0]))
-        task = ManipulationTask(mujoco_arena=arena, mujoco_robots=[robot], mujoco_objects=objects)
-        return task.get_xml()
-
-    return build
+    build = lift5_builder()
+    return lambda index: build(seed, index)[0]
 
 
 def per_variant(fn, indices) -> float:

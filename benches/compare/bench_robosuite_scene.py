@@ -194,28 +194,9 @@ def make_merge_builder():
         ROBOT_COLLISION_COLOR,
     )
 
-    class Part(MujocoXMLModel):
-        """MujocoXMLModel with only the abstract properties it needs; prefix = idn + "_"."""
+    from robosuite_models import part_class
 
-        def __init__(self, rel, idn, rgba):
-            self._rgba = rgba
-            super().__init__(str(ASSETS / rel), idn=idn)
-
-        @property
-        def contact_geom_rgba(self):
-            return self._rgba
-
-        @property
-        def _important_sites(self):
-            return {}
-
-        @property
-        def _important_geoms(self):
-            return {}
-
-        @property
-        def _important_sensors(self):
-            return {}
+    Part = part_class(MujocoXMLModel, ASSETS)
 
     def build() -> str:
         robot = Part("robots/panda/robot.xml", "robot0", ROBOT_COLLISION_COLOR)

@@ -89,75 +89,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_robosuite_scene import import_robosuite_package, install_stubs  # noqa: E402
-
-N_OBJECTS = 5
-
-
-def make_builder():
-    import numpy as np
-    from robosuite.models.arenas import TableArena
-    from robosuite.models.bases import robot_base_factory
-    from robosuite.models.grippers import gripper_factory
-    from robosuite.models.objects import (
-        BottleObject,
-        BreadObject,
-        CanObject,
-        CerealObject,
-        LemonObject,
-        MilkObject,
-    )
-    from robosuite.models.robots import create_robot
-    from robosuite.models.tasks import ManipulationTask
-    from robosuite.utils.mjcf_utils import array_to_string
-    from robosuite.utils.placement_samplers import UniformRandomSampler
-
-    # lift5.toml's pool, in its order.
-    pool = [CanObject, MilkObject, BreadObject, CerealObject, LemonObject, BottleObject]
-    table_full_size = (0.8, 0.8, 0.05)
-    table_offset = (0, 0, 0.8)
-
-    def build(seed: int, index: int):
-        rng = np.random.default_rng([seed, index])
-        robot = create_robot("Panda", idn=0)
-        robot.add_base(base=robot_base_factory(robot.default_base, idn=0))
-        robot.update_joints()
-        robot.update_actuators()
-        gripper = gripper_factory(robot.default_gripper["right"], idn="0_right")
-        robot.add_gripper(gripper, robot.eef_name["right"])
-        robot.set_base_xpos(robot.base_xpos_offset["table"](table_full_size[0]))
-        arena = TableArena(
-            table_full_size=table_full_size,
-            table_friction=(1.0, 5e-3, 1e-4),
-            table_offset=table_offset,
-        )
-        arena.set_origin([0, 0, 0])
-        choice = rng.integers(len(pool), size=N_OBJECTS)
-        objects = [pool[c](name=f"object{i}") for i, c in enumerate(choice)]
-        for obj in objects:
-            for geom in obj.get_obj().iter("geom"):
-                geom.set("rgba", array_to_string(np.append(rng.uniform(0.0, 1.0, 3), 1.0)))
-        sampler = UniformRandomSampler(
-            name="ObjectSampler",
-            mujoco_objects=objects,
-            x_range=[-0.3, 0.3],
-            y_range=[-0.3, 0.3],
-            rotation=None,
-            rotation_axis="z",
-            ensure_object_boundary_in_range=False,
-            ensure_valid_placement=True,
-            reference_pos=table_offset,
-            z_offset=0.01,
-            rng=rng,
-        )
-        placements = sampler.sample()
-        for pos, quat, obj in placements.values():
-            obj.get_obj().set("pos", array_to_string(pos))
-            obj.get_obj().set("quat", array_to_string(quat))
-        task = ManipulationTask(mujoco_arena=arena, mujoco_robots=[robot], mujoco_objects=objects)
-        return task.get_xml(), placements
-
-    return build
-
+from robosuite_models import N_OBJECTS, lift5_builder  # noqa: E402
 
 def check_variant(xml: str, placements) -> None:
     """The output has the 5 objects at their sampled poses (fails loudly otherwise)."""
@@ -192,7 +124,7 @@ def main() -> int:
     with contextlib.redirect_stdout(sys.stderr):
         import_robosuite_package()
         stubs = install_stubs()
-        build = make_builder()
+        build = lift5_builder()
         # Untimed: one variant outside the timed indices (imports, caches).
         xml, placements = build(args.seed, args.runs)
     check_variant(xml, placements)
