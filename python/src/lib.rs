@@ -47,6 +47,18 @@ fn _panic_for_tests(py: Python<'_>, detached: bool) -> PyResult<()> {
     }
 }
 
+/// A random MJCF model, its structure drawn from ``seed`` and its values from ``(seed,
+/// variant)`` (``mjcf_forge::fuzzing::random_mjcf``): the differential tests' documents.
+/// Not part of the API.
+///
+/// >>> from mjcf_forge._mjcf_forge import _random_mjcf
+/// >>> _random_mjcf(3, 0) == _random_mjcf(3, 0) != _random_mjcf(3, 1)
+/// True
+#[pyfunction]
+fn _random_mjcf(seed: u64, variant: u64) -> String {
+    mjcf_forge::fuzzing::random_mjcf(seed, variant)
+}
+
 /// MuJoCo MJCF models loaded exactly as MuJoCo reads them, prefixed, merged into scenes,
 /// and written back; randomized scene variants generated in Rust threads.
 #[pymodule]
@@ -68,6 +80,7 @@ fn _mjcf_forge(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::PyVariantIter>()?;
     m.add_class::<scene::PySuperset>()?;
     m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
+    m.add_function(wrap_pyfunction!(_random_mjcf, m)?)?;
     split::add(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

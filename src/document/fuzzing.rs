@@ -1,6 +1,9 @@
-//! Entry points for the fuzz targets in `fuzz/`: internals they compare, not a supported API.
+//! Entry points for the fuzz targets in `fuzz/` and the differential tests: internals they
+//! compare and the random documents they draw, not a supported API.
 
 use std::path::Path;
+
+pub use super::random_mjcf::random_mjcf;
 
 /// The outcome of loading `bytes` through the fast reader (falling back as every load does)
 /// and through quick-xml's path alone, each as text (see `load::describe_load`): equal for

@@ -37,6 +37,7 @@ pub(crate) mod locate;
 pub(crate) mod names;
 pub(crate) mod paths;
 pub(crate) mod prefix;
+mod random_mjcf;
 pub(crate) mod read;
 mod relocate;
 pub(crate) mod schema;

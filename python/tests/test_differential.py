@@ -1,0 +1,121 @@
+"""The Python DocumentCache against MuJoCo on random documents (the extension's
+``_random_mjcf``, the same generator as tests/document_differential.rs): every answer equals
+MuJoCo compiling the same text, bit for bit, or both refuse it; and the caller's ways of
+holding what it gets: models kept while later ones are patched, models the caller changes,
+models given back with ``into``, threads sharing one cache. Fixed seeds (a short run in CI);
+the long campaigns are scripts/differential.py's, with their results in docs/limits.md."""
+from __future__ import annotations
+
+import os
+import threading
+
+import mujoco
+import numpy as np
+
+import judge
+import mjcf_forge
+from helpers import not_bit_identical
+from mjcf_forge._mjcf_forge import _random_mjcf
+
+# MJCF_FORGE_DIFFERENTIAL=SEEDS,VARIANTS for a longer run (scripts/differential.sh).
+SEEDS, VARIANTS = (int(x) for x in os.environ.get("MJCF_FORGE_DIFFERENTIAL", "40,6").split(","))
+
+
+def verdict(text: str, answer) -> str | None:
+    """``None`` when ``answer`` (a model, or the exception the cache raised) is MuJoCo's own
+    verdict on ``text``; else what differs."""
+    try:
+        ref = mujoco.MjModel.from_xml_string(text)
+    except ValueError as e:
+        return None if isinstance(answer, Exception) else f"MuJoCo refuses it ({e}), the cache answers"
+    if isinstance(answer, Exception):
+        return f"MuJoCo compiles it, the cache refuses: {answer}"
+    diffs = judge.compare_models(ref, answer) + not_bit_identical(ref, answer)
+    return f"{diffs[:4]}" if diffs else None
+
+
+def ask(cache, text: str, **kw):
+    try:
+        return cache.model(mjcf_forge.Document.from_string(text), **kw)
+    except (mjcf_forge.MjcfError, ValueError) as e:
+        return e
+
+
+def snapshot(model) -> bytes:
+    """Every float array of ``model``, to tell later whether anything changed it."""
+    return b"".join(
+        getattr(model, n).tobytes()
+        for n in dir(model)
+        if isinstance(getattr(model, n, None), np.ndarray) and getattr(model, n).dtype.kind == "f"
+    )
+
+
+def test_random_documents_are_answered_as_mujoco_compiles_them():
+    cache = mjcf_forge.DocumentCache()
+    findings, held = [], []
+    answered = refused = 0
+    for seed in range(SEEDS):
+        for variant in range(VARIANTS):
+            text = _random_mjcf(seed, variant)
+            answer = ask(cache, text)
+            problem = verdict(text, answer)
+            if problem:
+                findings.append(f"{seed}/{variant}: {problem}")
+            elif isinstance(answer, Exception):
+                refused += 1
+            else:
+                answered += 1
+                # Held by the caller: no later patch may change it.
+                if variant % 3 == 0:
+                    held.append((seed, variant, answer, snapshot(answer)))
+    assert findings == [], "\n".join(findings)
+    for seed, variant, model, before in held:
+        assert snapshot(model) == before, f"{seed}/{variant}: changed after it was returned"
+    assert answered >= SEEDS * VARIANTS // 2, (answered, refused)
+    assert cache.patches >= answered // 8, (cache.patches, answered)
+    print(f"python: {answered} answered ({cache.compiles} compiles, {cache.patches} patches), "
+          f"{refused} refused by both, {len(held)} held models unchanged")
+
+
+def test_models_changed_or_given_back_by_the_caller_leave_later_answers_exact():
+    cache = mjcf_forge.DocumentCache()
+    findings = []
+    for seed in range(100, 100 + SEEDS // 2):
+        model = None
+        for variant in range(VARIANTS):
+            text = _random_mjcf(seed, variant)
+            # Every other call gives the last model back to be patched in place.
+            answer = ask(cache, text, into=model) if model is not None and variant % 2 else ask(cache, text)
+            problem = verdict(text, answer)
+            if problem:
+                findings.append(f"{seed}/{variant}: {problem}")
+            if isinstance(answer, Exception):
+                model = None
+                continue
+            # The caller scribbles over what it got: the next answer is exact all the same.
+            answer.geom_rgba[:] = 0.5
+            answer.body_mass[:] *= 2
+            answer.opt.timestep = 0.123
+            model = answer
+    assert findings == [], "\n".join(findings)
+
+
+def test_threads_sharing_one_cache_each_get_exact_answers():
+    cache = mjcf_forge.DocumentCache()
+    findings: list[str] = []
+
+    def work(first: int) -> None:
+        for seed in range(first, first + 6):
+            for variant in range(VARIANTS):
+                text = _random_mjcf(seed, variant)
+                problem = verdict(text, ask(cache, text))
+                if problem:
+                    findings.append(f"{seed}/{variant}: {problem}")
+
+    # Two threads on the same seeds (the same structures at once), one on others.
+    threads = [threading.Thread(target=work, args=(s,)) for s in (200, 200, 300)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert findings == [], "\n".join(findings)

@@ -1,0 +1,355 @@
+//! Random MJCF documents for differential tests of the model caches against MuJoCo
+//! (`tests/document_differential.rs`, `python/tests/test_differential.py`,
+//! `scripts/differential.py`): [`random_mjcf`]`(seed, variant)` draws a model's structure
+//! from `seed` and its values from `(seed, variant)`, so the variants of one seed are
+//! mostly one structure with other values (what a cache patches), and now and then another
+//! structure (a geom more or less, another joint type: what it compiles).
+
+use std::fmt::Write;
+
+/// splitmix64: a small seeded generator (the same documents on every platform).
+struct Rng(u64);
+
+impl Rng {
+    fn new(a: u64, b: u64) -> Rng {
+        let mut r = Rng(a ^ b.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ 0x5851_f42d_4c95_7f2d);
+        r.next();
+        r
+    }
+
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in `[0, n)`.
+    fn below(&mut self, n: u64) -> u64 {
+        self.next() % n.max(1)
+    }
+
+    fn chance(&mut self, p: f64) -> bool {
+        self.unit() < p
+    }
+
+    fn unit(&mut self) -> f64 {
+        (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// A value in `[lo, hi)`, or now and then one of its limits exactly.
+    fn value(&mut self, lo: f64, hi: f64) -> f64 {
+        match self.below(12) {
+            0 => lo,
+            1 => hi,
+            _ => lo + (hi - lo) * self.unit(),
+        }
+    }
+
+    fn values(&mut self, n: usize, lo: f64, hi: f64) -> String {
+        (0..n)
+            .map(|_| format!("{}", self.value(lo, hi)))
+            .collect::<Vec<_>>()
+            .join(" ")
+    }
+}
+
+/// Both generators: `s` draws the structure and the values no patch carries (a joint's
+/// axis and range, actuators, keyframes...: the same for every variant of a seed but a rare
+/// structural change), `v` the values a patch may carry.
+struct Gen {
+    s: Rng,
+    v: Rng,
+    out: String,
+    /// qpos widths of the joints written, in order (for keyframes).
+    nq: usize,
+    joints: Vec<String>,
+    bodies: usize,
+    geoms: usize,
+    geometry: bool,
+}
+
+const GEOM_TYPES: [&str; 5] = ["sphere", "box", "capsule", "cylinder", "ellipsoid"];
+
+impl Gen {
+    /// The generator of geoms' sizes, frames, densities and masses: the values' for a seed
+    /// that varies them (what body models carry, where a body qualifies), else the
+    /// structure's (so the other values' patches are exercised too).
+    fn geo(&mut self) -> &mut Rng {
+        if self.geometry {
+            &mut self.v
+        } else {
+            &mut self.s
+        }
+    }
+
+    fn name(&mut self, prefix: &str, n: usize) -> String {
+        // Some elements unnamed: only named ones are patched on an object of a scene, and
+        // a document's unnamed ones by their index.
+        if self.s.chance(0.85) {
+            format!(r#" name="{prefix}{n}""#)
+        } else {
+            String::new()
+        }
+    }
+
+    fn geom(&mut self, indent: &str, classes: bool) {
+        self.geoms += 1;
+        let kind = GEOM_TYPES[self.s.below(5) as usize];
+        let name = self.name("g", self.geoms);
+        let size = match kind {
+            "sphere" => self.geo().values(1, 0.01, 0.2),
+            "capsule" | "cylinder" => self.geo().values(2, 0.01, 0.2),
+            _ => self.geo().values(3, 0.01, 0.2),
+        };
+        let mut attrs = format!(r#"{name} type="{kind}" size="{size}""#);
+        if self.s.chance(0.5) {
+            let _ = write!(attrs, r#" pos="{}""#, self.geo().values(3, -0.2, 0.2));
+        }
+        if self.s.chance(0.3) {
+            let _ = write!(attrs, r#" euler="{}""#, self.geo().values(3, -1.5, 1.5));
+        }
+        if self.s.chance(0.6) {
+            let _ = write!(attrs, r#" rgba="{} 1""#, self.v.values(3, 0.0, 1.0));
+        }
+        if self.s.chance(0.5) {
+            let _ = write!(
+                attrs,
+                r#" friction="{} {} {}""#,
+                self.v.value(0.1, 2.0),
+                self.v.value(0.0, 0.1),
+                self.v.value(0.0, 0.01)
+            );
+        }
+        match self.s.below(3) {
+            0 => {
+                let _ = write!(attrs, r#" density="{}""#, self.geo().value(100.0, 5000.0));
+            }
+            1 => {
+                let _ = write!(attrs, r#" mass="{}""#, self.geo().value(0.01, 5.0));
+            }
+            _ => {}
+        }
+        if self.s.chance(0.2) {
+            let _ = write!(
+                attrs,
+                r#" contype="0" conaffinity="0" group="{}""#,
+                1 + self.s.below(3)
+            );
+        }
+        if classes && self.s.chance(0.3) {
+            attrs.push_str(r#" class="soft""#);
+        }
+        let _ = writeln!(self.out, "{indent}<geom{attrs}/>");
+    }
+
+    /// A joint; `after_ball`: one of the body's joints before it is a ball, after which
+    /// MuJoCo refuses a rotation (drawn anyway now and then: both must refuse it).
+    fn joint(&mut self, indent: &str, free: bool, after_ball: bool) -> bool {
+        let n = self.joints.len();
+        let name = format!("j{n}");
+        if free {
+            let _ = writeln!(self.out, r#"{indent}<freejoint name="{name}"/>"#);
+            self.nq += 7;
+            self.joints.push(name);
+            return false;
+        }
+        let mut kind = ["hinge", "slide", "ball", "hinge"][self.s.below(4) as usize];
+        if after_ball && kind != "slide" && self.s.chance(0.9) {
+            kind = "slide";
+        }
+        let mut attrs = format!(r#" name="{name}" type="{kind}""#);
+        if kind != "ball" {
+            let _ = write!(attrs, r#" axis="{}""#, self.s.values(3, 0.1, 1.0));
+        }
+        if self.s.chance(0.5) {
+            let _ = write!(attrs, r#" damping="{}""#, self.v.value(0.0, 2.0));
+        }
+        if self.s.chance(0.4) {
+            let _ = write!(attrs, r#" armature="{}""#, self.v.value(0.0, 0.1));
+        }
+        if self.s.chance(0.3) {
+            let _ = write!(attrs, r#" stiffness="{}""#, self.v.value(0.0, 5.0));
+        }
+        if self.s.chance(0.3) {
+            let _ = write!(attrs, r#" frictionloss="{}""#, self.v.value(0.0, 0.5));
+        }
+        if kind != "ball" && self.s.chance(0.4) {
+            let lo = self.s.value(-1.0, 0.0);
+            let _ = write!(
+                attrs,
+                r#" range="{lo} {}""#,
+                lo + 0.1 + self.s.value(0.0, 1.0)
+            );
+        }
+        let _ = writeln!(self.out, "{indent}<joint{attrs}/>");
+        self.nq += if kind == "ball" { 4 } else { 1 };
+        self.joints.push(name);
+        kind == "ball"
+    }
+
+    fn body(&mut self, depth: usize, indent: &str, top: bool, classes: bool) {
+        self.bodies += 1;
+        let name = self.name("b", self.bodies);
+        let pos = self.v.values(3, -0.5, 0.5);
+        let mut attrs = format!(r#"{name} pos="{pos}""#);
+        if self.s.chance(0.4) {
+            let _ = write!(attrs, r#" quat="{}""#, self.v.values(4, 0.1, 1.0));
+        }
+        if classes && self.s.chance(0.2) {
+            attrs.push_str(r#" childclass="soft""#);
+        }
+        let _ = writeln!(self.out, "{indent}<body{attrs}>");
+        let inner = format!("{indent}  ");
+        if top && self.s.chance(0.3) {
+            self.joint(&inner, true, false);
+        } else {
+            let mut ball = false;
+            for _ in 0..self.s.below(3) {
+                ball |= self.joint(&inner, false, ball);
+            }
+        }
+        if self.s.chance(0.2) {
+            let _ = writeln!(
+                self.out,
+                r#"{inner}<inertial pos="{}" mass="{}" diaginertia="{}"/>"#,
+                self.s.values(3, -0.05, 0.05),
+                self.v.value(0.05, 3.0),
+                self.v.values(3, 0.002, 0.004)
+            );
+        }
+        for _ in 0..1 + self.s.below(3) {
+            self.geom(&inner, classes);
+        }
+        if self.s.chance(0.3) {
+            let _ = writeln!(
+                self.out,
+                r#"{inner}<site name="s{}" pos="{}" size="0.01"/>"#,
+                self.bodies,
+                self.s.values(3, -0.1, 0.1)
+            );
+        }
+        if self.s.chance(0.2) {
+            let _ = writeln!(
+                self.out,
+                r#"{inner}<frame pos="{}" euler="{}">"#,
+                self.s.values(3, -0.2, 0.2),
+                self.s.values(3, -1.0, 1.0)
+            );
+            self.geom(&format!("{inner}  "), classes);
+            let _ = writeln!(self.out, "{inner}</frame>");
+        }
+        if depth < 2 {
+            for _ in 0..self.s.below(3) {
+                self.body(depth + 1, &inner, false, classes);
+            }
+        }
+        let _ = writeln!(self.out, "{indent}</body>");
+    }
+}
+
+/// A random MJCF model: structure from `seed`, values from `(seed, variant)`; variants of a
+/// seed share their structure but for about one in eight, which changes one thing.
+///
+/// Drawn: an `<option>`, default classes with `class` and `childclass`, a tree of named and
+/// unnamed bodies (free, hinge, slide and ball joints with their values, primitives of
+/// every kind with sizes, frames, colours, frictions, densities or masses, visual geoms,
+/// some explicit `<inertial>`s, sites, `<frame>`s), motors and position actuators,
+/// keyframes, and now and then a `<body>` directly under `<mujoco>` (a file meant to be
+/// included, which MuJoCo compiles to the world alone). Values include their ranges'
+/// limits. Not every document is one MuJoCo accepts: a cache must then refuse it too.
+///
+/// ```
+/// use mjcf_forge::fuzzing::random_mjcf;
+/// let (a, b) = (random_mjcf(7, 0), random_mjcf(7, 1));
+/// assert!(a.starts_with("<mujoco") && a != b);
+/// assert_eq!(random_mjcf(7, 0), a);
+/// ```
+pub fn random_mjcf(seed: u64, variant: u64) -> String {
+    let mut s = Rng::new(seed, 0);
+    // One structural change in some variants: the structure generator takes another turn.
+    let changed = variant > 0 && Rng::new(seed, variant).below(8) == 0;
+    if changed {
+        s = Rng::new(seed, variant.wrapping_mul(31).wrapping_add(1));
+    }
+    let mut g = Gen {
+        s,
+        v: Rng::new(seed.wrapping_mul(0x2545_f491_4f6c_dd1d), variant),
+        out: String::new(),
+        nq: 0,
+        joints: Vec::new(),
+        bodies: 0,
+        geoms: 0,
+        geometry: false,
+    };
+    g.geometry = g.s.chance(0.3);
+    let classes = g.s.chance(0.4);
+    let _ = writeln!(g.out, r#"<mujoco model="random{seed}">"#);
+    if g.s.chance(0.3) {
+        g.out.push_str("  <compiler angle=\"radian\"/>\n");
+    }
+    let _ = writeln!(
+        g.out,
+        r#"  <option timestep="{}" gravity="0 0 {}"/>"#,
+        g.v.value(0.001, 0.01),
+        g.v.value(-12.0, -1.0)
+    );
+    if classes {
+        let _ = writeln!(
+            g.out,
+            r#"  <default><default class="soft"><geom rgba="{} 1" friction="{}"/><joint damping="{}"/></default></default>"#,
+            g.s.values(3, 0.0, 1.0),
+            g.s.value(0.2, 1.5),
+            g.s.value(0.0, 1.0)
+        );
+    }
+    g.out.push_str("  <worldbody>\n");
+    if g.s.chance(0.6) {
+        g.out
+            .push_str("    <geom name=\"floor\" type=\"plane\" size=\"2 2 0.1\"/>\n    <light name=\"sun\" pos=\"0 0 3\"/>\n");
+    }
+    for _ in 0..1 + g.s.below(3) {
+        g.body(0, "    ", true, classes);
+    }
+    g.out.push_str("  </worldbody>\n");
+    let hinges: Vec<String> = g.joints.clone();
+    if !hinges.is_empty() && g.s.chance(0.5) {
+        g.out.push_str("  <actuator>\n");
+        for _ in 0..1 + g.s.below(2) {
+            let j = &hinges[g.s.below(hinges.len() as u64) as usize];
+            if g.s.chance(0.5) {
+                let _ = writeln!(
+                    g.out,
+                    r#"    <motor joint="{j}" gear="{}" ctrlrange="-1 1"/>"#,
+                    g.s.value(0.5, 50.0)
+                );
+            } else {
+                let _ = writeln!(
+                    g.out,
+                    r#"    <position joint="{j}" kp="{}"/>"#,
+                    g.s.value(1.0, 100.0)
+                );
+            }
+        }
+        g.out.push_str("  </actuator>\n");
+    }
+    if g.nq > 0 && g.s.chance(0.3) {
+        let qpos = g.s.values(g.nq, -0.1, 0.1);
+        let _ = writeln!(
+            g.out,
+            r#"  <keyframe><key name="k" time="{}" qpos="{qpos}"/></keyframe>"#,
+            g.s.value(0.0, 1.0)
+        );
+    }
+    if g.s.chance(0.15) {
+        // A file meant to be included into a <worldbody>: MuJoCo leaves this out.
+        let _ = writeln!(
+            g.out,
+            r#"  <body name="loose" pos="{}"><geom size="0.05"/></body>"#,
+            g.s.values(3, -1.0, 1.0)
+        );
+    }
+    g.out.push_str("</mujoco>\n");
+    g.out
+}

@@ -1,0 +1,91 @@
+//! The document caches against MuJoCo on random documents (`fuzzing::random_mjcf`): every
+//! answer of `DocumentCache::model` equals MuJoCo compiling the same text, bit for bit in
+//! every array and statistic, or both refuse it. Fixed seeds here (a short run in CI); the
+//! long campaigns are `scripts/differential.py`'s, with their results in docs/limits.md.
+
+#![cfg(mjcf_mujoco)]
+
+use std::path::Path;
+
+use mjcf_forge::Document;
+use mjcf_forge::compiled::DocumentCache;
+use mjcf_forge::fuzzing::random_mjcf;
+use mjcf_forge::mujoco::compile_str;
+
+/// Seeds and variants of the run: `MJCF_FORGE_DIFFERENTIAL=SEEDS,VARIANTS` (e.g.
+/// `2000,8`) for a longer one.
+fn extent() -> (u64, u64) {
+    std::env::var("MJCF_FORGE_DIFFERENTIAL")
+        .ok()
+        .and_then(|v| {
+            let (a, b) = v.split_once(',')?;
+            Some((a.trim().parse().ok()?, b.trim().parse().ok()?))
+        })
+        .unwrap_or((60, 6))
+}
+
+#[test]
+fn random_documents_are_answered_as_mujoco_compiles_them() {
+    let (seeds, variants) = extent();
+    let mut cache = DocumentCache::new(8, None);
+    let mut findings = Vec::new();
+    let (mut answered, mut refused) = (0u64, 0u64);
+    for seed in 0..seeds {
+        for variant in 0..variants {
+            let text = random_mjcf(seed, variant);
+            let want = compile_str(&text, Path::new("."));
+            let doc = match Document::from_str(&text, ".") {
+                Ok(doc) => doc,
+                Err(e) => {
+                    if want.is_ok() {
+                        findings.push(format!(
+                            "{seed}/{variant}: MuJoCo compiles it, we cannot read it: {e}"
+                        ));
+                    }
+                    continue;
+                }
+            };
+            match (want, cache.model(&doc)) {
+                (Ok(want), Ok(got)) => {
+                    answered += 1;
+                    let diffs = got.differences(&want);
+                    if !diffs.is_empty() {
+                        findings.push(format!("{seed}/{variant}: {diffs:?}"));
+                    }
+                }
+                (Err(_), Err(_)) => refused += 1,
+                (Ok(_), Err(e)) => {
+                    findings.push(format!(
+                        "{seed}/{variant}: MuJoCo compiles it, the cache refuses: {e}"
+                    ));
+                }
+                (Err(e), Ok(_)) => {
+                    findings.push(format!(
+                        "{seed}/{variant}: MuJoCo refuses it ({e}), the cache answers"
+                    ));
+                }
+            }
+        }
+    }
+    assert!(
+        findings.is_empty(),
+        "{} findings:\n{}",
+        findings.len(),
+        findings.join("\n")
+    );
+    // The run exercised both ways of answering.
+    assert!(
+        answered >= seeds * variants / 2,
+        "{answered} answered, {refused} refused"
+    );
+    assert!(
+        cache.patches() >= answered / 6,
+        "{} patches of {answered}",
+        cache.patches()
+    );
+    eprintln!(
+        "{answered} answered ({} compiles, {} patches), {refused} refused by both",
+        cache.compiles(),
+        cache.patches()
+    );
+}
