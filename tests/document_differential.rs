@@ -1,7 +1,7 @@
 //! The document caches against MuJoCo on random documents (`fuzzing::random_mjcf`): every
 //! answer of `DocumentCache::model` equals MuJoCo compiling the same text, bit for bit in
 //! every array and statistic, or both refuse it. Fixed seeds here (a short run in CI); the
-//! long campaigns are `scripts/differential.py`'s, with their results in docs/limits.md.
+//! long campaigns are `scripts/differential.sh`'s, with their results in docs/limits.md.
 
 #![cfg(mjcf_mujoco)]
 

@@ -3,7 +3,7 @@
 MuJoCo compiling the same text, bit for bit, or both refuse it; and the caller's ways of
 holding what it gets: models kept while later ones are patched, models the caller changes,
 models given back with ``into``, threads sharing one cache. Fixed seeds (a short run in CI);
-the long campaigns are scripts/differential.py's, with their results in docs/limits.md."""
+the long campaigns are scripts/differential.sh's, with their results in docs/limits.md."""
 from __future__ import annotations
 
 import os

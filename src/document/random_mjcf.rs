@@ -1,6 +1,6 @@
 //! Random MJCF documents for differential tests of the model caches against MuJoCo
 //! (`tests/document_differential.rs`, `python/tests/test_differential.py`,
-//! `scripts/differential.py`): [`random_mjcf`]`(seed, variant)` draws a model's structure
+//! `scripts/differential.sh`): [`random_mjcf`]`(seed, variant)` draws a model's structure
 //! from `seed` and its values from `(seed, variant)`, so the variants of one seed are
 //! mostly one structure with other values (what a cache patches), and now and then another
 //! structure (a geom more or less, another joint type: what it compiles).
