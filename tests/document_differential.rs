@@ -89,3 +89,82 @@ fn random_documents_are_answered_as_mujoco_compiles_them() {
         cache.patches()
     );
 }
+
+/// `scene`'s files written into a fresh folder of the system's temporary one.
+fn written(seed: u64, scene: &mjcf_forge::fuzzing::RandomScene) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!(
+        "mjcf-forge-differential-{}-{seed}",
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, text) in &scene.files {
+        std::fs::write(dir.join(name), text).unwrap();
+    }
+    std::fs::write(dir.join("scene.toml"), &scene.toml).unwrap();
+    dir
+}
+
+#[test]
+fn random_scenes_variants_are_patched_as_mujoco_compiles_them() {
+    use mjcf_forge::compiled::ModelCache;
+    use mjcf_forge::fuzzing::random_scene;
+    use mjcf_forge::scene::Scene;
+    let (seeds, variants) = extent();
+    let (seeds, variants) = (seeds / 2, variants + 4);
+    let mut findings = Vec::new();
+    let (mut answered, mut patches, mut refused) = (0u64, 0u64, 0u64);
+    for seed in 0..seeds {
+        let random = random_scene(seed);
+        let dir = written(seed, &random);
+        let scene = match Scene::load(dir.join("scene.toml")) {
+            Ok(scene) => scene,
+            Err(_) => {
+                // A scene file the loader refuses (a randomizer that selects nothing...):
+                // no variant to judge.
+                refused += 1;
+                let _ = std::fs::remove_dir_all(&dir);
+                continue;
+            }
+        };
+        let mut cache = ModelCache::new(&scene, 4, None);
+        for i in 0..variants {
+            let (xml, _) = scene.variant_xml(i).unwrap();
+            match (compile_str(&xml, &dir), cache.model(i)) {
+                (Ok(want), Ok(got)) => {
+                    answered += 1;
+                    let diffs = got.differences(&want);
+                    if !diffs.is_empty() {
+                        findings.push(format!("scene {seed}, variant {i}: {diffs:?}"));
+                    }
+                }
+                (Err(_), Err(_)) => {}
+                (want, got) => findings.push(format!(
+                    "scene {seed}, variant {i}: MuJoCo {}, the cache {}",
+                    if want.is_ok() {
+                        "compiles it"
+                    } else {
+                        "refuses it"
+                    },
+                    if got.is_ok() { "answers" } else { "refuses" }
+                )),
+            }
+        }
+        patches += cache.patches();
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+    assert!(
+        findings.is_empty(),
+        "{} findings:\n{}",
+        findings.len(),
+        findings.join("\n")
+    );
+    assert!(
+        answered >= seeds * variants / 2,
+        "{answered} answered, {refused} scenes refused"
+    );
+    assert!(patches >= answered / 8, "{patches} patches of {answered}");
+    eprintln!(
+        "scenes: {answered} variants answered ({patches} patches), {refused} of {seeds} scenes refused when loading"
+    );
+}

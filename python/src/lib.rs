@@ -59,6 +59,19 @@ fn _random_mjcf(seed: u64, variant: u64) -> String {
     mjcf_forge::fuzzing::random_mjcf(seed, variant)
 }
 
+/// A random scene (``mjcf_forge::fuzzing::random_scene``): its TOML and the model files it
+/// names, ``(name, text)``, to be written into one folder. Not part of the API.
+///
+/// >>> from mjcf_forge._mjcf_forge import _random_scene
+/// >>> toml, files = _random_scene(5)
+/// >>> "arena.xml" in dict(files)
+/// True
+#[pyfunction]
+fn _random_scene(seed: u64) -> (String, Vec<(String, String)>) {
+    let scene = mjcf_forge::fuzzing::random_scene(seed);
+    (scene.toml, scene.files)
+}
+
 /// MuJoCo MJCF models loaded exactly as MuJoCo reads them, prefixed, merged into scenes,
 /// and written back; randomized scene variants generated in Rust threads.
 #[pymodule]
@@ -81,6 +94,7 @@ fn _mjcf_forge(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::PySuperset>()?;
     m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
     m.add_function(wrap_pyfunction!(_random_mjcf, m)?)?;
+    m.add_function(wrap_pyfunction!(_random_scene, m)?)?;
     split::add(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

@@ -66,3 +66,71 @@ def not_bit_identical(a, b) -> list[str]:
     if not np.array_equal(a.stat.center, b.stat.center):
         out.append("stat.center")
     return out
+
+
+def superset_check(scene, indices, trajectory_tolerance, parked_tolerance=0.0):
+    """The superset judged on each variant: every named body, geom and joint of the
+    variant's own compile has the same values in the patched superset (under its superset
+    name), the same contacts at the initial pose, parked objects never touch anything and
+    stay put over 1,000 steps, and placed objects follow the variant's own trajectory over
+    100 steps."""
+    import mujoco
+
+    import mjcf_forge
+
+    cache = mjcf_forge.ModelCache(scene, superset=True)
+    sup = cache.superset
+    for i in indices:
+        v = scene.variant(i)
+        ref = mujoco.MjModel.from_xml_string(v.xml)
+        model = cache.model(v)
+        tags = sup.names(i)
+
+        def name(n):
+            return next((t + n for p, t in tags if n.startswith(p)), n)
+
+        checks = (
+            (ref.nbody, ref.body, model.body, ("mass", "inertia", "pos", "quat", "ipos", "iquat", "subtreemass")),
+            (ref.ngeom, ref.geom, model.geom, ("rgba", "friction", "size", "pos", "quat", "contype", "conaffinity", "solref", "solimp", "margin", "gap")),
+            (ref.njnt, ref.joint, model.joint, ("qpos0", "qpos_spring", "range", "damping", "armature", "frictionloss", "M0")),
+        )
+        for count, ours, theirs, fields in checks:
+            for k in range(count):
+                n = ours(k).name
+                # The world's subtree holds the parked objects too.
+                if not n or n == "world":
+                    continue
+                for f in fields:
+                    a, b = getattr(ours(k), f), getattr(theirs(name(n)), f)
+                    assert np.array_equal(a, b), (i, n, f, a, b)
+        d_ref, d = mujoco.MjData(ref), mujoco.MjData(model)
+        mujoco.mj_forward(ref, d_ref)
+        mujoco.mj_forward(model, d)
+
+        def contacts(m, dd, rename):
+            # By the geoms' names (an unnamed geom of the variant's, which the superset
+            # names, by "?"), then where and how deep.
+            def label(g):
+                n = m.geom(g).name
+                return "?" if not n or "unnamed_geom" in n else rename(n)
+
+            return sorted(
+                (tuple(sorted((label(c.geom[0]), label(c.geom[1])))), tuple(c.pos), c.dist)
+                for c in dd.contact[: dd.ncon]
+            )
+
+        assert contacts(ref, d_ref, name) == contacts(model, d, lambda n: n)
+        parked = [model.body(r).id for r in sup.parked(i)]
+        start = d.xpos[parked].copy()
+        for step in range(1000):
+            if step < 100:
+                mujoco.mj_step(ref, d_ref)
+            mujoco.mj_step(model, d)
+            if step == 99:
+                for o in v.params["objects"]:
+                    dev = np.abs(d_ref.body(o["body"]).xpos - d.body(name(o["body"])).xpos).max()
+                    assert dev <= trajectory_tolerance, (i, o["body"], dev)
+            parked_geoms = set(np.flatnonzero(np.isin(model.body_rootid[model.geom_bodyid], parked)))
+            assert not any(c.geom[0] in parked_geoms or c.geom[1] in parked_geoms for c in d.contact[: d.ncon])
+        assert np.abs(d.xpos[parked] - start).max(initial=0.0) <= parked_tolerance, (i, np.abs(d.xpos[parked] - start).max())
+    return cache

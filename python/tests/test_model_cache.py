@@ -18,7 +18,7 @@ import pytest
 
 import judge
 import mjcf_forge
-from helpers import ROOT, RS_ASSETS, not_bit_identical
+from helpers import ROOT, RS_ASSETS, not_bit_identical, superset_check
 
 PATCH = ROOT / "corpora" / "scenes" / "patch"
 LIFT5_FIXED = ROOT / "benches" / "scenes" / "lift5_fixed.toml"
@@ -126,7 +126,7 @@ def test_mass_of_bodies_without_inertial_is_a_patch():
             check_exact(v, cache.model(v))
         seen.add(v.structure_key)
     assert cache.patches >= 2
-    _superset_check(scene, range(4), trajectory_tolerance=0.0)
+    superset_check(scene, range(4), trajectory_tolerance=0.0)
 
 
 def test_masses_of_geom_bodies_are_patches_by_default(monkeypatch):
@@ -174,7 +174,7 @@ def test_masses_of_geom_bodies_are_patches_by_default(monkeypatch):
         v = auto.variant(i)
         check_exact(v, cache.model(v))
     assert cache.patches >= 12, cache.patches
-    _superset_check(auto, range(4), trajectory_tolerance=0.0)
+    superset_check(auto, range(4), trajectory_tolerance=0.0)
     assert compiled == []
     # Set to false, the geoms' densities are scaled (mass.toml), through body models.
     assert all("<inertial" not in densities.variant(i).xml for i in range(4))
@@ -205,7 +205,7 @@ def test_written_inertials_make_masses_patches_without_compiles(monkeypatch):
     for v in variants:
         check_exact(v, cache.model(v))
     assert cache.patches >= 12, cache.patches
-    _superset_check(scene, range(4), trajectory_tolerance=0.0)
+    superset_check(scene, range(4), trajectory_tolerance=0.0)
     assert compiled == []
     # Absolute masses too (a body without <inertial> refuses them, saying why).
     absolute = text.replace("scale = true\nlog_uniform = [0.5, 2.0]", "uniform = [0.05, 0.5]")
@@ -226,7 +226,7 @@ def test_superset_varies_fixed_base_objects_per_world():
     scene = mjcf_forge.Scene.load(PATCH / "fixed.toml")
     groups = [{o["group"] for o in scene.variant(i).params["objects"]} for i in range(8)]
     assert {"fixtures"} <= set().union(*groups) and any("fixtures" not in g for g in groups)
-    _superset_check(scene, range(8), trajectory_tolerance=0.0)
+    superset_check(scene, range(8), trajectory_tolerance=0.0)
 
 
 LIBERO = ROOT / "benches" / "scenes" / "libero.toml"
@@ -241,7 +241,7 @@ def test_superset_on_a_real_libero_scene():
     scene = mjcf_forge.Scene.load(LIBERO)
     counts = {len(scene.variant(i).params["objects"]) for i in range(8)}
     assert len(counts) > 1 and counts <= set(range(3, 7))
-    _superset_check(scene, range(4), trajectory_tolerance=1e-4)
+    superset_check(scene, range(4), trajectory_tolerance=1e-4)
 
 
 MENAGERIE = ROOT / "benches" / "scenes" / "menagerie.toml"
@@ -298,7 +298,7 @@ def test_superset_on_a_menagerie_robot_with_its_keyframe():
     scene = mjcf_forge.Scene.load(MENAGERIE)
     counts = {len(scene.variant(i).params["objects"]) for i in range(8)}
     assert len(counts) > 1 and counts <= set(range(3, 7))
-    cache = _superset_check(scene, range(4), trajectory_tolerance=1e-4)
+    cache = superset_check(scene, range(4), trajectory_tolerance=1e-4)
     assert cache.compiles == 1
     for i in range(4):
         # The robot's 6 joints, the gripper's and each placed object's free joint.
@@ -419,68 +419,10 @@ def test_discard_visual_is_exact_and_drops_what_only_rendering_uses(path):
     assert cache.patches > 0
 
 
-def _superset_check(scene, indices, trajectory_tolerance):
-    """The superset judged on each variant: every named body, geom and joint of the
-    variant's own compile has the same values in the patched superset (under its superset
-    name), the same contacts at the initial pose, parked objects never touch anything and
-    stay put over 1,000 steps, and placed objects follow the variant's own trajectory over
-    100 steps."""
-    cache = mjcf_forge.ModelCache(scene, superset=True)
-    sup = cache.superset
-    for i in indices:
-        v = scene.variant(i)
-        ref = mujoco.MjModel.from_xml_string(v.xml)
-        model = cache.model(v)
-        tags = sup.names(i)
-
-        def name(n):
-            return next((t + n for p, t in tags if n.startswith(p)), n)
-
-        checks = (
-            (ref.nbody, ref.body, model.body, ("mass", "inertia", "pos", "quat", "ipos", "iquat", "subtreemass")),
-            (ref.ngeom, ref.geom, model.geom, ("rgba", "friction", "size", "pos", "quat", "contype", "conaffinity", "solref", "solimp", "margin", "gap")),
-            (ref.njnt, ref.joint, model.joint, ("qpos0", "qpos_spring", "range", "damping", "armature", "frictionloss", "M0")),
-        )
-        for count, ours, theirs, fields in checks:
-            for k in range(count):
-                n = ours(k).name
-                # The world's subtree holds the parked objects too.
-                if not n or n == "world":
-                    continue
-                for f in fields:
-                    a, b = getattr(ours(k), f), getattr(theirs(name(n)), f)
-                    assert np.array_equal(a, b), (i, n, f, a, b)
-        d_ref, d = mujoco.MjData(ref), mujoco.MjData(model)
-        mujoco.mj_forward(ref, d_ref)
-        mujoco.mj_forward(model, d)
-
-        def contacts(m, dd, rename):
-            return sorted(
-                tuple(sorted((rename(m.geom(c.geom[0]).name), rename(m.geom(c.geom[1]).name))))
-                for c in dd.contact[: dd.ncon]
-            )
-
-        assert contacts(ref, d_ref, name) == contacts(model, d, lambda n: n)
-        parked = [model.body(r).id for r in sup.parked(i)]
-        start = d.xpos[parked].copy()
-        for step in range(1000):
-            if step < 100:
-                mujoco.mj_step(ref, d_ref)
-            mujoco.mj_step(model, d)
-            if step == 99:
-                for o in v.params["objects"]:
-                    dev = np.abs(d_ref.body(o["body"]).xpos - d.body(name(o["body"])).xpos).max()
-                    assert dev <= trajectory_tolerance, (i, o["body"], dev)
-            parked_geoms = set(np.flatnonzero(np.isin(model.body_rootid[model.geom_bodyid], parked)))
-            assert not any(c.geom[0] in parked_geoms or c.geom[1] in parked_geoms for c in d.contact[: d.ncon])
-        assert np.array_equal(d.xpos[parked], start)
-    return cache
-
-
 def test_superset_every_variant_is_a_patch_of_one_model():
     scene = mjcf_forge.Scene.load(PATCH / "patch.toml")
     # The patch scene: placed objects follow their own model's trajectory bit for bit.
-    cache = _superset_check(scene, range(6), trajectory_tolerance=0.0)
+    cache = superset_check(scene, range(6), trajectory_tolerance=0.0)
     assert cache.compiles == 1 and cache.patches == 6
     # Per-world arrays for batched simulators: one row per variant, where they differ.
     variants = [scene.variant(i) for i in range(5)]
@@ -501,7 +443,7 @@ def test_superset_lift5_varying_objects():
     # Five slots of six robosuite objects: 30 candidates. Contact rows come in another
     # order than in each variant's own model (other geom ids), so the solver's answer
     # differs in rounding: placed objects stay within 0.1 mm of their own trajectory.
-    _superset_check(mjcf_forge.Scene.load(LIFT5), range(3), trajectory_tolerance=1e-4)
+    superset_check(mjcf_forge.Scene.load(LIFT5), range(3), trajectory_tolerance=1e-4)
 
 
 def test_placements_under_keyframes_are_patches():
@@ -520,7 +462,7 @@ def test_placements_under_keyframes_are_patches():
     # placed one's geom ids, so contact rows come in another order than in the variant's
     # own model and the solver's answer differs in rounding (as lift5's; the same without
     # keyframes): within 0.1 mm of the variant's own trajectory.
-    sup = _superset_check(scene, range(4), trajectory_tolerance=1e-4)
+    sup = superset_check(scene, range(4), trajectory_tolerance=1e-4)
     assert sup.compiles == 1
     for i in range(4):
         v = scene.variant(i)
@@ -558,7 +500,7 @@ def test_superset_names_unnamed_geoms_itself():
     roots = {ref.body(o["body"]).id for o in v.params["objects"]}
     unnamed = [g for g in range(ref.ngeom) if not ref.geom(g).name and ref.body_rootid[ref.geom_bodyid[g]] in roots]
     assert unnamed  # the placed objects' geoms are unnamed in the variant's own model
-    cache = _superset_check(scene, range(2), trajectory_tolerance=1e-4)
+    cache = superset_check(scene, range(2), trajectory_tolerance=1e-4)
     model = cache.model(v)
     assert sum("unnamed_geom" in model.geom(g).name for g in range(model.ngeom)) >= len(unnamed)
 
@@ -566,7 +508,7 @@ def test_superset_names_unnamed_geoms_itself():
 def test_superset_carries_the_demo_scene():
     # The demo turns a block's slab (a geom's orientation): carried by the block's body
     # model, placed or parked.
-    cache = _superset_check(mjcf_forge.Scene.demo(), range(4), trajectory_tolerance=1e-4)
+    cache = superset_check(mjcf_forge.Scene.demo(), range(4), trajectory_tolerance=1e-4)
     assert cache.compiles == 1
 
 

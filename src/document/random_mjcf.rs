@@ -353,3 +353,148 @@ pub fn random_mjcf(seed: u64, variant: u64) -> String {
     g.out.push_str("</mujoco>\n");
     g.out
 }
+
+/// A random scene description and the model files it names (file name, MJCF text), to be
+/// written into one folder: see [`random_scene`].
+#[derive(Debug, Clone)]
+pub struct RandomScene {
+    /// The scene file's TOML.
+    pub toml: String,
+    /// The model files it names, each `(file name, text)`.
+    pub files: Vec<(String, String)>,
+}
+
+/// A random scene (the differential tests' scenes): an arena with a table, one to three
+/// object groups whose pools hold random objects (named and unnamed geoms of every
+/// primitive kind, densities or masses, some with an inner body or an `<inertial>`),
+/// counts fixed or drawn, placements, and randomizers of random kinds over them (colours,
+/// frictions, solver parameters, masses scaled or set, sizes, the light and the camera),
+/// sometimes with `discard_visual`.
+///
+/// ```
+/// use mjcf_forge::fuzzing::random_scene;
+/// let scene = random_scene(5);
+/// assert!(scene.toml.contains("[[objects]]"));
+/// assert!(scene.files.iter().any(|(name, _)| name == "arena.xml"));
+/// ```
+pub fn random_scene(seed: u64) -> RandomScene {
+    let mut r = Rng::new(seed, 0x5ce4e);
+    let mut files = vec![(
+        "arena.xml".to_string(),
+        format!(
+            r#"<mujoco model="arena">
+  <worldbody>
+    <light name="sun" pos="0 0 3" dir="0 0 -1" diffuse="0.8 0.8 0.8"/>
+    <camera name="front" pos="1.6 0 1.4" xyaxes="0 1 0 -0.6 0 0.8" fovy="45"/>
+    <geom name="floor" type="plane" size="3 3 0.1"/>
+    <body name="table" pos="0 0 0.4">
+      <geom name="top" type="box" size="0.5 0.6 0.025" pos="0 0 0.375" friction="{} 0.005 0.0001"/>
+      <site name="table_top" pos="0 0 0.4" size="0.01"/>
+    </body>
+  </worldbody>
+</mujoco>
+"#,
+            r.value(0.5, 1.5)
+        ),
+    )];
+    let mut toml = format!("seed = {}\nbase = \"arena.xml\"\n", r.below(1000));
+    if r.chance(0.2) {
+        toml.push_str("discard_visual = true\n");
+    }
+    let groups = 1 + r.below(3) as usize;
+    for g in 0..groups {
+        let mut pool = Vec::new();
+        for k in 0..1 + r.below(3) {
+            let name = format!("object_{g}_{k}.xml");
+            let mut body = String::new();
+            for n in 0..1 + r.below(3) {
+                let kind = GEOM_TYPES[r.below(5) as usize];
+                let size = match kind {
+                    "sphere" => r.values(1, 0.01, 0.05),
+                    "capsule" | "cylinder" => r.values(2, 0.01, 0.05),
+                    _ => r.values(3, 0.01, 0.05),
+                };
+                let named = if r.chance(0.8) {
+                    format!(r#" name="g{n}""#)
+                } else {
+                    String::new()
+                };
+                let weight = if r.chance(0.7) {
+                    format!(r#" density="{}""#, r.value(200.0, 2000.0))
+                } else {
+                    format!(r#" mass="{}""#, r.value(0.05, 1.0))
+                };
+                let _ = writeln!(
+                    body,
+                    r#"      <geom{named} type="{kind}" size="{size}" pos="{}" rgba="{} 1"{weight}/>"#,
+                    r.values(3, -0.02, 0.02),
+                    r.values(3, 0.0, 1.0)
+                );
+            }
+            if r.chance(0.2) {
+                let _ = writeln!(
+                    body,
+                    r#"      <body name="inner" pos="0 0 0.03"><geom name="cap" type="sphere" size="{}"/></body>"#,
+                    r.value(0.01, 0.03)
+                );
+            }
+            let inertial = if r.chance(0.2) {
+                format!(
+                    "      <inertial pos=\"0 0 0\" mass=\"{}\" diaginertia=\"0.001 0.001 0.001\"/>\n",
+                    r.value(0.1, 1.0)
+                )
+            } else {
+                String::new()
+            };
+            files.push((
+                name.clone(),
+                format!(
+                    "<mujoco model=\"object\">\n  <worldbody>\n    <body name=\"obj\">\n{inertial}{body}    </body>\n  </worldbody>\n</mujoco>\n"
+                ),
+            ));
+            pool.push(format!("\"{name}\""));
+        }
+        let count = if r.chance(0.5) {
+            format!("{}", 1 + r.below(2))
+        } else {
+            "[0, 2]".to_string()
+        };
+        let _ = write!(
+            toml,
+            "\n[[objects]]\nname = \"group{g}\"\npool = [{}]\ncount = {count}\nprefix = \"group{g}_{{i}}_\"\n",
+            pool.join(", ")
+        );
+        match r.below(3) {
+            0 => toml.push_str("write_inertials = false\n"),
+            1 => toml.push_str("name_unnamed_geoms = true\n"),
+            _ => {}
+        }
+        let _ = write!(
+            toml,
+            "[objects.placement]\non = \"table_top\"\nx = [-0.4, 0.4]\ny = [-0.5, 0.5]\ngap = 0.005\nrotation = {{ axis = \"z\", range_deg = [0, 360] }}\n"
+        );
+    }
+    let randomizers: [&str; 9] = [
+        "kind = \"geom\"\nattribute = \"rgba\"\ncomponents = [0, 1, 2]\nuniform = [[0, 0, 0], [1, 1, 1]]",
+        "kind = \"geom\"\nattribute = \"friction\"\nscale = true\ncomponents = [0]\nuniform = [0.5, 1.5]",
+        "kind = \"geom\"\nattribute = \"solref\"\nuniform = [[0.01, 0.8], [0.03, 1.2]]",
+        "kind = \"geom\"\nattribute = \"margin\"\nuniform = [0, 0.002]",
+        "kind = \"body\"\nattribute = \"mass\"\nscale = true\nlog_uniform = [0.5, 2.0]",
+        "kind = \"geom\"\nattribute = \"size\"\nscale = true\nuniform = [0.8, 1.2]",
+        "kind = \"light\"\nattribute = \"diffuse\"\nuniform = [[0.3, 0.3, 0.3], [1, 1, 1]]",
+        "kind = \"camera\"\nattribute = \"fovy\"\nuniform = [40, 60]",
+        "kind = \"geom\"\nattribute = \"density\"\nscale = true\nuniform = [0.5, 2.0]",
+    ];
+    for (k, body) in randomizers.iter().enumerate() {
+        if !r.chance(0.35) {
+            continue;
+        }
+        let part = if (6..8).contains(&k) {
+            String::new()
+        } else {
+            format!("part = \"group{}\"\n", r.below(groups as u64))
+        };
+        let _ = write!(toml, "\n[[randomize]]\n{part}{body}\n");
+    }
+    RandomScene { toml, files }
+}
