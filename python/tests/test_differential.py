@@ -16,6 +16,7 @@ import judge
 import mjcf_forge
 from helpers import not_bit_identical, superset_check
 from mjcf_forge._mjcf_forge import _random_mjcf, _random_scene
+from mjcf_forge.batch import WorldBatch
 
 # MJCF_FORGE_DIFFERENTIAL=SEEDS,VARIANTS for a longer run (scripts/differential.sh).
 SEEDS, VARIANTS = (int(x) for x in os.environ.get("MJCF_FORGE_DIFFERENTIAL", "40,6").split(","))
@@ -152,10 +153,18 @@ def test_random_scenes_through_the_model_cache_and_the_superset(tmp_path):
                 findings.append(f"scene {seed}, variant {i}: {problem}")
             answered += 1
         try:
-            superset_check(scene, range(3), trajectory_tolerance=1e-2, parked_tolerance=1e-12)
-            supersets += 1
+            sup = superset_check(scene, range(3), trajectory_tolerance=1e-2, parked_tolerance=1e-12)
         except mjcf_forge.MjcfError:
-            pass  # structure a superset cannot carry: refused, said so
+            continue  # structure a superset cannot carry: refused, said so
+        supersets += 1
+        # WorldBatch: each world's rows are its variant's superset model (judged above).
+        batch = WorldBatch(sup, range(4))
+        for w in range(4):
+            model = sup.model(scene.variant(w))
+            for field in batch.per_world:
+                want = getattr(model.stat, field[5:]) if field.startswith("stat.") else getattr(model, field)
+                if not np.array_equal(batch.arrays[field][w], want):
+                    findings.append(f"scene {seed}, world {w}: {field}")
     assert findings == [], "\n".join(findings)
     assert answered >= SEEDS, (answered, refused)
     assert supersets >= SEEDS // 8, supersets
