@@ -337,7 +337,15 @@ class DocumentCache:
             except ValueError as e:
                 raise error(doc._mujoco_error(xml, str(e))) from None
             structure = _Structure(self._mujoco, key, model, doc, fixed)
-            working = _Working(self._mujoco, model, structure)
+            try:
+                working = _Working(self._mujoco, model, structure)
+            except MjcfError:
+                # A patch layout this model cannot take (an element the split names that
+                # the compile does not have): the compile is the answer, and nothing is
+                # kept, so documents of this structure compile (as the Rust cache does).
+                with self._lock:
+                    self.compiles += 1
+                return model
             del model  # calibrate() counts the cache's own references
             working.calibrate()
             structure.keep(threading.get_ident(), working)

@@ -244,6 +244,23 @@ def test_files_meant_for_inclusion_are_answered_as_mujoco_compiles_them():
     assert (cache.compiles, cache.patches) == (2, 2)
 
 
+def test_a_layout_the_compile_cannot_take_is_answered_by_compiling(monkeypatch):
+    # Where the patch's layout cannot be resolved against the compiled model (an element
+    # the split names that the compile does not have), the compile itself is the answer
+    # and nothing is kept: every such document compiles, exact (the Rust cache does the
+    # same).
+    def refuse(self, patch):
+        raise mjcf_forge.MjcfError("the patch names body 'x', which the compiled model does not have")
+
+    monkeypatch.setattr(mjcf_forge._plan.Plan, "resolve", refuse)
+    cache = mjcf_forge.DocumentCache()
+    xml = '<mujoco><worldbody><body name="b"><geom size="0.1" rgba="{} 0 0 1"/></body></worldbody></mujoco>'
+    for k, red in enumerate(["1", "0.5"]):
+        doc = mjcf_forge.Document.from_string(xml.format(red))
+        check_exact(doc, cache.model(doc), f"document {k}")
+    assert (cache.compiles, cache.patches) == (2, 0)
+
+
 def test_structural_edits_are_compiled_and_exact():
     cache = mjcf_forge.DocumentCache(max_models=64)
     for path, doc in sample_docs():
