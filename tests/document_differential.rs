@@ -168,3 +168,65 @@ fn random_scenes_variants_are_patched_as_mujoco_compiles_them() {
         "scenes: {answered} variants answered ({patches} patches), {refused} of {seeds} scenes refused when loading"
     );
 }
+
+#[test]
+fn random_documents_with_includes_are_answered_as_mujoco_compiles_them() {
+    use mjcf_forge::fuzzing::random_mjcf_files;
+    use mjcf_forge::mujoco::compile_file;
+    let (seeds, variants) = extent();
+    let mut cache = DocumentCache::new(8, None);
+    let mut findings = Vec::new();
+    let mut included = 0u64;
+    for seed in 0..seeds * 2 {
+        if random_mjcf_files(seed, 0).len() < 2 {
+            continue;
+        }
+        let dir =
+            std::env::temp_dir().join(format!("mjcf-forge-include-{}-{seed}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for variant in 0..variants {
+            let files = random_mjcf_files(seed, variant);
+            for (name, text) in &files {
+                std::fs::write(dir.join(name), text).unwrap();
+            }
+            let path = dir.join("model.xml");
+            let want = compile_file(&path);
+            let Ok(doc) = Document::load(&path) else {
+                if want.is_ok() {
+                    findings.push(format!(
+                        "{seed}/{variant}: MuJoCo compiles it, we cannot load it"
+                    ));
+                }
+                continue;
+            };
+            included += u64::from(files.len() == 2);
+            match (want, cache.model(&doc)) {
+                (Ok(want), Ok(got)) => {
+                    let diffs = got.differences(&want);
+                    if !diffs.is_empty() {
+                        findings.push(format!("{seed}/{variant}: {diffs:?}"));
+                    }
+                }
+                (Err(_), Err(_)) => {}
+                (want, got) => findings.push(format!(
+                    "{seed}/{variant}: MuJoCo {}, the cache {}",
+                    if want.is_ok() {
+                        "compiles it"
+                    } else {
+                        "refuses it"
+                    },
+                    if got.is_ok() { "answers" } else { "refuses" }
+                )),
+            }
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+    assert!(
+        findings.is_empty(),
+        "{} findings:\n{}",
+        findings.len(),
+        findings.join("\n")
+    );
+    assert!(included >= seeds, "{included} documents with an include");
+    eprintln!("includes: {included} documents with an include judged");
+}

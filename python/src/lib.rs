@@ -59,6 +59,17 @@ fn _random_mjcf(seed: u64, variant: u64) -> String {
     mjcf_forge::fuzzing::random_mjcf(seed, variant)
 }
 
+/// ``_random_mjcf`` as files, ``(name, text)``, ``model.xml`` first; for some seeds its
+/// first body is in ``part.xml``, which ``model.xml`` includes. Not part of the API.
+///
+/// >>> from mjcf_forge._mjcf_forge import _random_mjcf_files
+/// >>> _random_mjcf_files(3, 0)[0][0]
+/// 'model.xml'
+#[pyfunction]
+fn _random_mjcf_files(seed: u64, variant: u64) -> Vec<(String, String)> {
+    mjcf_forge::fuzzing::random_mjcf_files(seed, variant)
+}
+
 /// A random scene (``mjcf_forge::fuzzing::random_scene``): its TOML and the model files it
 /// names, ``(name, text)``, to be written into one folder. Not part of the API.
 ///
@@ -95,6 +106,7 @@ fn _mjcf_forge(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
     m.add_function(wrap_pyfunction!(_random_mjcf, m)?)?;
     m.add_function(wrap_pyfunction!(_random_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(_random_mjcf_files, m)?)?;
     split::add(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

@@ -15,18 +15,18 @@ import numpy as np
 import judge
 import mjcf_forge
 from helpers import not_bit_identical, superset_check
-from mjcf_forge._mjcf_forge import _random_mjcf, _random_scene
+from mjcf_forge._mjcf_forge import _random_mjcf, _random_mjcf_files, _random_scene
 from mjcf_forge.batch import WorldBatch
 
 # MJCF_FORGE_DIFFERENTIAL=SEEDS,VARIANTS for a longer run (scripts/differential.sh).
 SEEDS, VARIANTS = (int(x) for x in os.environ.get("MJCF_FORGE_DIFFERENTIAL", "40,6").split(","))
 
 
-def verdict(text: str, answer) -> str | None:
+def verdict(text: str, answer, path=None) -> str | None:
     """``None`` when ``answer`` (a model, or the exception the cache raised) is MuJoCo's own
-    verdict on ``text``; else what differs."""
+    verdict on ``text`` (or on the file ``path``); else what differs."""
     try:
-        ref = mujoco.MjModel.from_xml_string(text)
+        ref = mujoco.MjModel.from_xml_path(str(path)) if path else mujoco.MjModel.from_xml_string(text)
     except ValueError as e:
         return None if isinstance(answer, Exception) else f"MuJoCo refuses it ({e}), the cache answers"
     if isinstance(answer, Exception):
@@ -169,3 +169,29 @@ def test_random_scenes_through_the_model_cache_and_the_superset(tmp_path):
     assert answered >= SEEDS, (answered, refused)
     assert supersets >= SEEDS // 8, supersets
     print(f"scenes: {answered} variants answered, {supersets} supersets judged, {refused} scenes refused when loading")
+
+
+def test_random_documents_with_includes_are_answered_as_mujoco_compiles_them(tmp_path):
+    # A model whose first body is in a file its <worldbody> includes: loaded from the file,
+    # answered as MuJoCo compiles the file.
+    cache = mjcf_forge.DocumentCache()
+    findings, included = [], 0
+    for seed in range(SEEDS * 2):
+        if len(_random_mjcf_files(seed, 0)) < 2:
+            continue
+        folder = tmp_path / str(seed)
+        folder.mkdir()
+        for variant in range(VARIANTS):
+            for name, text in _random_mjcf_files(seed, variant):
+                (folder / name).write_text(text)
+            path = folder / "model.xml"
+            try:
+                answer = cache.model(mjcf_forge.Document.load(path))
+            except (mjcf_forge.MjcfError, ValueError) as e:
+                answer = e
+            problem = verdict(None, answer, path)
+            if problem:
+                findings.append(f"{seed}/{variant}: {problem}")
+            included += 1
+    assert findings == [], "\n".join(findings)
+    assert included >= SEEDS, included

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-pub use super::random_mjcf::{RandomScene, random_mjcf, random_scene};
+pub use super::random_mjcf::{RandomScene, random_mjcf, random_mjcf_files, random_scene};
 
 /// The outcome of loading `bytes` through the fast reader (falling back as every load does)
 /// and through quick-xml's path alone, each as text (see `load::describe_load`): equal for

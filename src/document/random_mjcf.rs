@@ -354,6 +354,36 @@ pub fn random_mjcf(seed: u64, variant: u64) -> String {
     g.out
 }
 
+/// [`random_mjcf`] as files to write into one folder, `(file name, text)`, the model
+/// `model.xml` first: for some seeds its first top-level body moved into `part.xml`, which
+/// the model's `<worldbody>` includes where the body was (MuJoCo's `<include>`).
+///
+/// ```
+/// use mjcf_forge::fuzzing::random_mjcf_files;
+/// let with_include = (0..40).find(|&s| random_mjcf_files(s, 0).len() == 2).unwrap();
+/// let files = random_mjcf_files(with_include, 0);
+/// assert!(files[0].1.contains(r#"<include file="part.xml"/>"#));
+/// ```
+pub fn random_mjcf_files(seed: u64, variant: u64) -> Vec<(String, String)> {
+    let text = random_mjcf(seed, variant);
+    let lines: Vec<&str> = text.lines().collect();
+    let start = lines.iter().position(|l| l.starts_with("    <body"));
+    let end = lines.iter().position(|l| *l == "    </body>");
+    match (start, end) {
+        (Some(a), Some(b)) if a < b && Rng::new(seed, 0x1c1d).chance(0.3) => {
+            let mut model: Vec<&str> = lines[..a].to_vec();
+            model.push(r#"    <include file="part.xml"/>"#);
+            model.extend(&lines[b + 1..]);
+            let part = format!("<mujoco>\n{}\n</mujoco>\n", lines[a..=b].join("\n"));
+            vec![
+                ("model.xml".to_string(), model.join("\n") + "\n"),
+                ("part.xml".to_string(), part),
+            ]
+        }
+        _ => vec![("model.xml".to_string(), text)],
+    }
+}
+
 /// A random scene description and the model files it names (file name, MJCF text), to be
 /// written into one folder: see [`random_scene`].
 #[derive(Debug, Clone)]
