@@ -92,6 +92,26 @@ def test_resets_of_a_fixed_structure_are_patches(judged):
             assert judged[name + mode]["kept_simulations"] == RESETS, (name, mode, judged[name + mode])
 
 
+def test_random_arms_and_environments_get_mujocos_compile(tmp_path):
+    # The differential harness over the switch: environments and arms drawn from a seed
+    # (the driver's --robots random:SEED), hard-reset plain and inside the randomization
+    # wrapper; every model a simulation gets is MuJoCo's compile of its XML.
+    import random
+
+    names = random.Random(29).sample([e for e in ENVS if e != "Wipe"], 3)
+    run_in_robosuite(
+        tmp_path, "judge", str(tmp_path / "out.json"), "--resets", str(RESETS),
+        "--envs", ",".join(names), "--robots", "random:29",
+    )
+    out = json.loads((tmp_path / "out.json").read_text())
+    assert {k: v.get("error") for k, v in out.items() if "error" in v} == {}
+    for key, got in out.items():
+        assert got["judged"] == 1 + RESETS and got["diffs"] == [], (key, got)
+    assert len(out) == 6, sorted(out)
+    # Arms other than Panda were drawn.
+    assert {r for got in out.values() for r in got["robots"]} - {"Panda"}, out
+
+
 @pytest.fixture(scope="module")
 def task_xmls(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("robosuite_xml")

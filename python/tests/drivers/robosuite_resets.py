@@ -3,10 +3,11 @@
 Run in the robosuite venv (robosuite 1.5.2, MuJoCo 3.9.0) by test_robosuite_resets.py,
 with a PYTHONPATH holding only this checkout's mjcf_forge and tests/judge:
 
-    python robosuite_resets.py judge OUT.json [--resets N] [--envs Lift,Door]
+    python robosuite_resets.py judge OUT.json [--resets N] [--envs Lift,Door] [--robots random:SEED]
     python robosuite_resets.py xml OUT_DIR [--resets N] [--envs ...]
 
-``judge``: every robosuite environment with Panda (two for the TwoArm ones), made and
+``judge``: every robosuite environment with Panda (two for the TwoArm ones; with
+``--robots random:SEED`` arms drawn per environment), made and
 hard-reset N times with use() on, plain and inside robosuite's DomainRandomizationWrapper
 (camera, lighting, dynamics; colour needs an OpenGL context). At every
 ``MjSim.from_xml_string`` (the environment's construction and each hard reset), the model
@@ -53,8 +54,25 @@ def envs(names: str | None) -> list[str]:
     return names.split(",") if names else sorted(robosuite.ALL_ENVIRONMENTS)
 
 
+# The arms --robots random:SEED draws from (robosuite 1.5.2's single arms).
+ARMS = ["Panda", "Sawyer", "IIWA", "Jaco", "Kinova3", "UR5e"]
+ROBOTS: str | None = None
+
+
+def robots_for(name: str) -> list[str]:
+    """Panda (two for the TwoArm environments), or with ``--robots random:SEED`` arms drawn
+    per environment from ARMS (seeded by SEED and the environment's name)."""
+    n = 2 if name.startswith("TwoArm") else 1
+    if not ROBOTS:
+        return ["Panda"] * n
+    seed = int(ROBOTS.split(":")[1])
+    rng = np.random.default_rng([seed, sum(map(ord, name))])
+    return [ARMS[int(k)] for k in rng.integers(len(ARMS), size=n)]
+
+
 def make(name: str) -> object:
-    robots = ["Panda", "Panda"] if name.startswith("TwoArm") else "Panda"
+    robots = robots_for(name)
+    robots = robots if len(robots) > 1 else robots[0]
     with contextlib.redirect_stdout(sys.stderr):
         return robosuite.make(
             name, robots=robots, has_renderer=False, has_offscreen_renderer=False,
@@ -150,6 +168,7 @@ def judge_env(name: str, resets: int, dr: bool) -> dict:
         "randomized_resets": changed,
         "kept_simulations": kept,
         "robot_models_compiled": robots_compiled,
+        "robots": robots_for(name),
     }
 
 
@@ -173,7 +192,10 @@ def main() -> None:
     ap.add_argument("out")
     ap.add_argument("--resets", type=int, default=3)
     ap.add_argument("--envs")
+    ap.add_argument("--robots", help="random:SEED: arms drawn per environment (default Panda)")
     args = ap.parse_args()
+    global ROBOTS
+    ROBOTS = args.robots
     np.random.seed(0)
     remember_xml()
     if args.mode == "judge":
