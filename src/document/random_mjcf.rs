@@ -68,6 +68,8 @@ struct Gen {
     bodies: usize,
     geoms: usize,
     geometry: bool,
+    /// Materials `m0`.. in the assets.
+    materials: u64,
 }
 
 const GEOM_TYPES: [&str; 5] = ["sphere", "box", "capsule", "cylinder", "ellipsoid"];
@@ -121,6 +123,29 @@ impl Gen {
                 self.v.value(0.0, 0.1),
                 self.v.value(0.0, 0.01)
             );
+        }
+        if self.s.chance(0.2) {
+            let _ = write!(
+                attrs,
+                r#" solref="{} {}" solimp="{} {} {} 0.5 2""#,
+                self.v.value(0.005, 0.05),
+                self.v.value(0.5, 1.5),
+                self.v.value(0.8, 0.9),
+                self.v.value(0.91, 0.99),
+                self.v.value(0.001, 0.01)
+            );
+        }
+        if self.s.chance(0.2) {
+            let _ = write!(
+                attrs,
+                r#" margin="{}" gap="{}""#,
+                self.v.value(0.0, 0.01),
+                self.v.value(0.0, 0.001)
+            );
+        }
+        if self.materials > 0 && self.s.chance(0.3) {
+            // Which material is a patch (the geom's matid).
+            let _ = write!(attrs, r#" material="m{}""#, self.v.below(self.materials));
         }
         match self.s.below(3) {
             0 => {
@@ -225,9 +250,10 @@ impl Gen {
         if self.s.chance(0.3) {
             let _ = writeln!(
                 self.out,
-                r#"{inner}<site name="s{}" pos="{}" size="0.01"/>"#,
+                r#"{inner}<site name="s{}" pos="{}" size="0.01" rgba="{} 1"/>"#,
                 self.bodies,
-                self.s.values(3, -0.1, 0.1)
+                self.s.values(3, -0.1, 0.1),
+                self.v.values(3, 0.0, 1.0)
             );
         }
         if self.s.chance(0.2) {
@@ -252,10 +278,11 @@ impl Gen {
 /// A random MJCF model: structure from `seed`, values from `(seed, variant)`; variants of a
 /// seed share their structure but for about one in eight, which changes one thing.
 ///
-/// Drawn: an `<option>`, default classes with `class` and `childclass`, a tree of named and
-/// unnamed bodies (free, hinge, slide and ball joints with their values, primitives of
-/// every kind with sizes, frames, colours, frictions, densities or masses, visual geoms,
-/// some explicit `<inertial>`s, sites, `<frame>`s), motors and position actuators,
+/// Drawn: `<option>` values, materials, default classes with `class` and `childclass`, a
+/// light and a camera, a tree of named and unnamed bodies (free, hinge, slide and ball
+/// joints with their values, primitives of every kind with sizes, frames, colours,
+/// frictions, solver parameters, margins, materials, densities or masses, visual geoms,
+/// some explicit `<inertial>`s, coloured sites, `<frame>`s), motors and position actuators,
 /// keyframes, and now and then a `<body>` directly under `<mujoco>` (a file meant to be
 /// included, which MuJoCo compiles to the world alone). Values include their ranges'
 /// limits. Not every document is one MuJoCo accepts: a cache must then refuse it too.
@@ -282,6 +309,7 @@ pub fn random_mjcf(seed: u64, variant: u64) -> String {
         bodies: 0,
         geoms: 0,
         geometry: false,
+        materials: 0,
     };
     g.geometry = g.s.chance(0.3);
     let classes = g.s.chance(0.4);
@@ -289,12 +317,40 @@ pub fn random_mjcf(seed: u64, variant: u64) -> String {
     if g.s.chance(0.3) {
         g.out.push_str("  <compiler angle=\"radian\"/>\n");
     }
+    let fluid = if g.s.chance(0.5) {
+        format!(
+            r#" impratio="{}" tolerance="{}" wind="{}" density="{}" viscosity="{}""#,
+            g.v.value(1.0, 10.0),
+            g.v.value(1e-10, 1e-6),
+            g.v.values(3, -1.0, 1.0),
+            g.v.value(0.0, 1.3),
+            g.v.value(0.0, 2e-5)
+        )
+    } else {
+        String::new()
+    };
     let _ = writeln!(
         g.out,
-        r#"  <option timestep="{}" gravity="0 0 {}"/>"#,
+        r#"  <option timestep="{}" gravity="0 0 {}"{fluid}/>"#,
         g.v.value(0.001, 0.01),
         g.v.value(-12.0, -1.0)
     );
+    g.materials = g.s.below(4);
+    if g.materials > 0 {
+        g.out.push_str("  <asset>\n");
+        for k in 0..g.materials {
+            let _ = writeln!(
+                g.out,
+                r#"    <material name="m{k}" rgba="{} 1" specular="{}" shininess="{}" reflectance="{}" emission="{}"/>"#,
+                g.v.values(3, 0.0, 1.0),
+                g.v.value(0.0, 1.0),
+                g.v.value(0.0, 1.0),
+                g.v.value(0.0, 1.0),
+                g.v.value(0.0, 1.0)
+            );
+        }
+        g.out.push_str("  </asset>\n");
+    }
     if classes {
         let _ = writeln!(
             g.out,
@@ -307,7 +363,20 @@ pub fn random_mjcf(seed: u64, variant: u64) -> String {
     g.out.push_str("  <worldbody>\n");
     if g.s.chance(0.6) {
         g.out
-            .push_str("    <geom name=\"floor\" type=\"plane\" size=\"2 2 0.1\"/>\n    <light name=\"sun\" pos=\"0 0 3\"/>\n");
+            .push_str("    <geom name=\"floor\" type=\"plane\" size=\"2 2 0.1\"/>\n");
+        let _ = writeln!(
+            g.out,
+            r#"    <light name="sun" pos="0 0 3" diffuse="{}" specular="{}" ambient="{}" attenuation="1 {} 0"/>"#,
+            g.v.values(3, 0.0, 1.0),
+            g.v.values(3, 0.0, 0.5),
+            g.v.values(3, 0.0, 0.3),
+            g.v.value(0.0, 0.1)
+        );
+        let _ = writeln!(
+            g.out,
+            r#"    <camera name="eye" pos="1.5 0 1" xyaxes="0 1 0 -0.5 0 1" fovy="{}"/>"#,
+            g.v.value(30.0, 90.0)
+        );
     }
     for _ in 0..1 + g.s.below(3) {
         g.body(0, "    ", true, classes);
@@ -328,7 +397,7 @@ pub fn random_mjcf(seed: u64, variant: u64) -> String {
                 let _ = writeln!(
                     g.out,
                     r#"    <position joint="{j}" kp="{}"/>"#,
-                    g.s.value(1.0, 100.0)
+                    g.v.value(1.0, 100.0)
                 );
             }
         }
