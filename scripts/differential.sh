@@ -12,7 +12,10 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 export MJCF_FORGE_DIFFERENTIAL="${1:-2000},${2:-8}"
 echo "== Rust DocumentCache, MuJoCo 3.17.0 ($MJCF_FORGE_DIFFERENTIAL)"
 cargo test --release --features mujoco --test document_differential -- --nocapture 2>&1 | grep -E "answered|findings|test result|^[0-9]+/|^scene"
+status=0
 for py in .cache/venv/bin/python .cache/venv-mj4/bin/python; do
-  echo "== Python DocumentCache, MuJoCo $($py -c 'import mujoco; print(mujoco.__version__)')"
-  $py -m pytest python/tests/test_differential.py -q -s -p no:cacheprovider -k "answered or scenes" 2>&1 | grep -E "^python:|^scenes:|passed|failed|^E  " || true
+  echo "== Python caches, MuJoCo $($py -c 'import mujoco; print(mujoco.__version__)')"
+  $py -m pytest python/tests/test_differential.py -q -s -p no:cacheprovider > "${TMPDIR:-/tmp}/differential.log" 2>&1 || status=1
+  grep -E "^python:|^scenes:|passed|failed|^E  " "${TMPDIR:-/tmp}/differential.log" || true
 done
+exit $status
