@@ -76,6 +76,20 @@ class _Variant:
         self.index = index
 
 
+def _bodies_from_geoms(model: Any) -> None:
+    """What ``mj_setConst`` also derives from the geoms and no tree derivation does: each
+    body's ``contype`` and ``conaffinity`` (its geoms' flags or-ed) and ``margin`` (their
+    largest margin, 0 without geoms). A body's geoms are contiguous, in body order."""
+    num = model.body_geomnum
+    has = np.flatnonzero(num > 0)
+    if not len(has):
+        return
+    starts = model.body_geomadr[has]
+    model.body_margin[has] = np.maximum(np.maximum.reduceat(model.geom_margin, starts), 0.0)
+    model.body_contype[has] = np.bitwise_or.reduceat(model.geom_contype, starts)
+    model.body_conaffinity[has] = np.bitwise_or.reduceat(model.geom_conaffinity, starts)
+
+
 class ModelCache:
     """Compiled models of a :class:`Scene`'s variants, one per structure, patched per
     variant (``scene`` is a :class:`Scene` or the path of a scene file); bounded in count (``max_models``) and bytes (``max_bytes``: the models, their
@@ -265,7 +279,13 @@ class ModelCache:
                     derivations.clear()
                 entry = derivations[id(layout)] = (layout, TreeDerivation.build(self._mujoco, model, layout))
             derivation = entry[1]
-            if derivation is None:
+            # mj_setConst also counts the bodies with gravity compensation (ngravcomp,
+            # which the engines read only to apply it at all: zero or not), a size the
+            # bindings cannot set and no tree derivation writes: where the patch turns
+            # that count to or from zero (objects parked after a variant that placed them
+            # all), mj_setConst itself.
+            compensated = bool((model.body_gravcomp > 0).any())  # as mj_setConst counts
+            if derivation is None or compensated != bool(model.ngravcomp):
                 self._mujoco.mj_setConst(model, data)
                 return False
             if plan.derived_at != self.patches:
@@ -273,7 +293,9 @@ class ModelCache:
             self.by_tree += 1
             # The caller counts this patch next (self.patches + 1): nothing between.
             plan.derived_at = self.patches + 1
-            return derivation(model, data, roots)
+            fresh = derivation(model, data, roots)
+            _bodies_from_geoms(model)
+            return fresh
 
         return derive
 

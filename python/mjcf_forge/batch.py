@@ -66,6 +66,9 @@ _WRITTEN = (
     "body_mass", "body_inertia", "body_ipos", "body_iquat",
     "body_sameframe", "geom_sameframe", "site_sameframe",
 )
+# What the tree-by-tree derivation writes from the geoms, as mj_setConst does
+# (_cache._bodies_from_geoms): a world's geom margins move its bodies' margins.
+_FROM_GEOMS = ("body_margin", "body_contype", "body_conaffinity")
 # A model's keyframe arrays (each world's rows: WorldBatch.keys).
 _KEYS = ("key_qpos", "key_qvel", "key_act", "key_ctrl", "key_mpos", "key_mquat", "key_time")
 # The compiler's statistics, per world (``stat.<name>`` in :attr:`WorldBatch.arrays`).
@@ -125,6 +128,7 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         # world 0 keeps the shared fields.
         self._scratch = cache.model(_Index(indices[0]))
         self.model = copy.copy(self._scratch)
+        self._count_every_gravcomp(self.superset.patch(indices[0]))
         #: The keyframe every world starts at (its id), or None: ``qpos0``.
         self.key = self._key_id(key)
         self._patched = _patched_arrays(self.superset.patch(indices[0]))
@@ -148,6 +152,7 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         self._layouts: dict[tuple, Any] = {}
         self._written = [n for n in _WRITTEN if n in self._others]
         self._flags = [n for n in self._written if n.endswith("_sameframe")]
+        self._from_geoms = [n for n in _FROM_GEOMS if n in self._others]
         #: Worlds whose derived values came tree by tree (the others: mj_setConst; see
         #: ``_trees.py``: the same bits).
         self.derived_by_tree = 0
@@ -177,6 +182,31 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         self._mjx: Any = None
         self._mjx_shared: Any = None
         self._mjx_impl: str | None = None
+
+    def _count_every_gravcomp(self, patch: Any) -> None:
+        """The shared model counts every body any world may compensate for gravity: MuJoCo
+        (and MuJoCo Warp and MJX, from the shared model) applies gravity compensation only
+        when ``ngravcomp``, which ``mj_setConst`` counts from ``body_gravcomp`` and nothing
+        else can set, is not zero; a world 0 that places every object counts none, and the
+        parked objects of the other worlds would fall. Every candidate body (a parked one is
+        compensated) gets a nonzero ``body_gravcomp`` here, counted by ``mj_setConst``
+        (per-world rows hold each world's own); nothing else of the model may change."""
+        model = self.model
+        ids = [model.body(e[1]).id for e in patch if e[0] == "body" and e[2] == "gravcomp"]
+        missing = [b for b in ids if model.body_gravcomp[b] <= 0]  # counted: > 0
+        if not missing:
+            return
+        fields = [
+            n for n in dir(model)
+            if not n.startswith("_") and n != "body_gravcomp" and isinstance(getattr(model, n, None), np.ndarray)
+        ]
+        before = {n: getattr(model, n).tobytes() for n in fields}
+        model.body_gravcomp[missing] = 1.0
+        mujoco = self.cache._mujoco
+        mujoco.mj_setConst(model, mujoco.MjData(model))
+        changed = [n for n in fields if getattr(model, n).tobytes() != before[n]]
+        if changed:
+            raise error(f"counting gravity compensation changed the shared model's {changed}")
 
     @property
     def nworld(self) -> int:
@@ -278,9 +308,9 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         if not by_tree:
             others = self._others
         elif self._plan_of_scratch().bodies:
-            others = self._written
+            others = self._written + self._from_geoms
         else:
-            others = self._flags
+            others = self._flags + self._from_geoms
         for n in others:
             value = getattr(model, n)
             if value.tobytes() != self._others[n]:

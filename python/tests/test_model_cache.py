@@ -19,6 +19,7 @@ import pytest
 import judge
 import mjcf_forge
 from helpers import ROOT, RS_ASSETS, not_bit_identical, superset_check
+from mjcf_forge.batch import WorldBatch
 
 PATCH = ROOT / "corpora" / "scenes" / "patch"
 LIFT5_FIXED = ROOT / "benches" / "scenes" / "lift5_fixed.toml"
@@ -417,6 +418,36 @@ def test_discard_visual_is_exact_and_drops_what_only_rendering_uses(path):
         for v in variants[:3]:
             check_exact(v, cache.model(v))
     assert cache.patches > 0
+
+
+def test_objects_parked_after_a_variant_that_placed_them_all_stay_put():
+    # A superset patched first for a variant that places every candidate (so no body is
+    # compensated for gravity and mj_setConst counts ngravcomp = 0), then for one that
+    # parks some: the parked objects must be held (MuJoCo applies gravity compensation
+    # only when ngravcomp counts a body; the random scenes of test_differential.py found
+    # them falling). Likewise WorldBatch's shared model, whose world 0 places them all.
+    text = """
+seed = 3
+base = "arena.xml"
+[[objects]]
+name = "clutter"
+pool = ["../demo/box.xml"]
+count = [0, 2]
+prefix = "clutter{i}_"
+[objects.placement]
+on = "table_top"
+x = [-0.3, 0.3]
+y = [-0.4, 0.4]
+"""
+    scene = mjcf_forge.Scene.from_toml(text, base_dir=PATCH)
+    placed = [len(scene.variant(i).params["objects"]) for i in range(40)]
+    full, partial = placed.index(2), placed.index(0)
+    cache = superset_check(scene, [full, partial], trajectory_tolerance=0.0)
+    model = cache.model(scene.variant(partial))
+    assert model.ngravcomp == np.count_nonzero(model.body_gravcomp) > 0
+    batch = WorldBatch(cache, [full, partial])
+    assert np.count_nonzero(batch.arrays["body_gravcomp"][0]) == 0
+    assert batch.model.ngravcomp >= np.count_nonzero(batch.arrays["body_gravcomp"][1]) > 0
 
 
 def test_superset_every_variant_is_a_patch_of_one_model():

@@ -4,6 +4,13 @@
 //! array the worlds differ in is kept with one row per world, in MuJoCo's own element
 //! types; the others are the shared model's. MuJoCo Warp and MJX take such arrays with a
 //! leading world axis; MuJoCo's batch API takes one model per world.
+//!
+//! The shared model must count every body any world compensates for gravity: the
+//! engines apply gravity compensation only when `ngravcomp` (which `mj_setConst` counts
+//! from `body_gravcomp`) is not zero, and a world that places every object counts none,
+//! so its model as the shared one would let the other worlds' parked objects fall. The
+//! Python `WorldBatch` gives its shared model every candidate body's compensation for that
+//! count; a Rust caller takes a world that parks objects, or counts them likewise.
 
 use std::ffi::CStr;
 
