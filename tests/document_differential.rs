@@ -114,6 +114,7 @@ fn random_scenes_variants_are_patched_as_mujoco_compiles_them() {
     let (seeds, variants) = (seeds / 2, variants + 4);
     let mut findings = Vec::new();
     let (mut answered, mut patches, mut refused) = (0u64, 0u64, 0u64);
+    let mut supersets = 0u64;
     for seed in 0..seeds {
         let random = random_scene(seed);
         let dir = written(seed, &random);
@@ -151,6 +152,7 @@ fn random_scenes_variants_are_patched_as_mujoco_compiles_them() {
             }
         }
         patches += cache.patches();
+        supersets += superset_findings(&scene, &dir, variants.min(4), &mut findings);
         let _ = std::fs::remove_dir_all(&dir);
     }
     assert!(
@@ -164,8 +166,12 @@ fn random_scenes_variants_are_patched_as_mujoco_compiles_them() {
         "{answered} answered, {refused} scenes refused"
     );
     assert!(patches >= answered / 8, "{patches} patches of {answered}");
+    assert!(
+        supersets >= seeds / 8,
+        "{supersets} supersets of {seeds} scenes"
+    );
     eprintln!(
-        "scenes: {answered} variants answered ({patches} patches), {refused} of {seeds} scenes refused when loading"
+        "scenes: {answered} variants answered ({patches} patches), {supersets} supersets judged, {refused} of {seeds} scenes refused when loading"
     );
 }
 
@@ -229,4 +235,55 @@ fn random_documents_with_includes_are_answered_as_mujoco_compiles_them() {
     );
     assert!(included >= seeds, "{included} documents with an include");
     eprintln!("includes: {included} documents with an include judged");
+}
+
+/// `scene`'s superset patched for variants `0..n` in turn: every body of each variant's own
+/// compile has the same mass, inertia and frames (bit for bit) under its superset name.
+/// Returns 1 when the superset was judged, 0 when the scene has none (refused, said so).
+fn superset_findings(
+    scene: &mjcf_forge::scene::Scene,
+    dir: &Path,
+    n: u64,
+    findings: &mut Vec<String>,
+) -> u64 {
+    use mjcf_forge::compiled::ModelCache;
+    use mjcf_forge::mujoco::ObjType;
+    let Ok(superset) = scene.superset() else {
+        return 0;
+    };
+    let Ok(mut cache) = ModelCache::new(scene, 2, None).with_superset() else {
+        return 0;
+    };
+    for i in 0..n {
+        let (xml, _) = scene.variant_xml(i).unwrap();
+        let Ok(want) = compile_str(&xml, dir) else {
+            continue;
+        };
+        let Ok(tags) = scene.superset_names(&superset, i) else {
+            return 0;
+        };
+        let Ok(got) = cache.model(i) else {
+            return 0;
+        };
+        let names = got.names(ObjType::Body);
+        for (b, name) in want.names(ObjType::Body).iter().enumerate().skip(1) {
+            let tagged = tags
+                .iter()
+                .find(|(p, _)| name.starts_with(p.as_str()))
+                .map_or(name.clone(), |(_, t)| format!("{t}{name}"));
+            let Some(k) = names.iter().position(|x| *x == tagged) else {
+                findings.push(format!("variant {i}: no body {tagged} in the superset"));
+                continue;
+            };
+            let rows = |a: &[f64], w: usize, r: usize| a[w * r..w * (r + 1)].to_vec();
+            let same = got.body_mass()[k].to_bits() == want.body_mass()[b].to_bits()
+                && rows(got.body_inertia(), 3, k) == rows(want.body_inertia(), 3, b)
+                && rows(got.body_ipos(), 3, k) == rows(want.body_ipos(), 3, b)
+                && rows(got.body_iquat(), 4, k) == rows(want.body_iquat(), 4, b);
+            if !same {
+                findings.push(format!("variant {i}: body {name} differs in the superset"));
+            }
+        }
+    }
+    1
 }
