@@ -11,7 +11,7 @@ set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 export MJCF_FORGE_DIFFERENTIAL="${1:-2000},${2:-8}"
 echo "== Rust DocumentCache, MuJoCo 3.17.0 ($MJCF_FORGE_DIFFERENTIAL)"
-cargo test --release --features mujoco --test document_differential -- --nocapture 2>&1 | grep -E "answered|findings|test result|^[0-9]+/|^scene"
+cargo test --release --features mujoco --test document_differential -- --nocapture 2>&1 | grep -E "answered|findings|test result|^[0-9]+/|^scene|^includes"
 status=0
 for py in .cache/venv/bin/python .cache/venv-mj4/bin/python; do
   echo "== Python caches, MuJoCo $($py -c 'import mujoco; print(mujoco.__version__)')"
