@@ -24,6 +24,34 @@ fn extent() -> (u64, u64) {
         .unwrap_or((60, 6))
 }
 
+/// What a cache's answer is against MuJoCo's own verdict on the same input: `Some(true)`
+/// answered alike, `Some(false)` refused by both, `None` a finding (pushed, named by
+/// `what`).
+fn verdict<E1: std::fmt::Display, E2: std::fmt::Display>(
+    what: &str,
+    want: Result<mjcf_forge::mujoco::CompiledModel, E1>,
+    got: Result<&mjcf_forge::mujoco::CompiledModel, E2>,
+    findings: &mut Vec<String>,
+) -> Option<bool> {
+    match (want, got) {
+        (Ok(want), Ok(got)) => {
+            let diffs = got.differences(&want);
+            if diffs.is_empty() {
+                return Some(true);
+            }
+            findings.push(format!("{what}: {diffs:?}"));
+        }
+        (Err(_), Err(_)) => return Some(false),
+        (Ok(_), Err(e)) => findings.push(format!(
+            "{what}: MuJoCo compiles it, the cache refuses: {e}"
+        )),
+        (Err(e), Ok(_)) => findings.push(format!(
+            "{what}: MuJoCo refuses it ({e}), the cache answers"
+        )),
+    }
+    None
+}
+
 #[test]
 fn random_documents_are_answered_as_mujoco_compiles_them() {
     let (seeds, variants) = extent();
@@ -45,25 +73,15 @@ fn random_documents_are_answered_as_mujoco_compiles_them() {
                     continue;
                 }
             };
-            match (want, cache.model(&doc)) {
-                (Ok(want), Ok(got)) => {
-                    answered += 1;
-                    let diffs = got.differences(&want);
-                    if !diffs.is_empty() {
-                        findings.push(format!("{seed}/{variant}: {diffs:?}"));
-                    }
-                }
-                (Err(_), Err(_)) => refused += 1,
-                (Ok(_), Err(e)) => {
-                    findings.push(format!(
-                        "{seed}/{variant}: MuJoCo compiles it, the cache refuses: {e}"
-                    ));
-                }
-                (Err(e), Ok(_)) => {
-                    findings.push(format!(
-                        "{seed}/{variant}: MuJoCo refuses it ({e}), the cache answers"
-                    ));
-                }
+            match verdict(
+                &format!("{seed}/{variant}"),
+                want,
+                cache.model(&doc),
+                &mut findings,
+            ) {
+                Some(true) => answered += 1,
+                Some(false) => refused += 1,
+                None => {}
             }
         }
     }
@@ -131,24 +149,15 @@ fn random_scenes_variants_are_patched_as_mujoco_compiles_them() {
         let mut cache = ModelCache::new(&scene, 4, None);
         for i in 0..variants {
             let (xml, _) = scene.variant_xml(i).unwrap();
-            match (compile_str(&xml, &dir), cache.model(i)) {
-                (Ok(want), Ok(got)) => {
-                    answered += 1;
-                    let diffs = got.differences(&want);
-                    if !diffs.is_empty() {
-                        findings.push(format!("scene {seed}, variant {i}: {diffs:?}"));
-                    }
-                }
-                (Err(_), Err(_)) => {}
-                (want, got) => findings.push(format!(
-                    "scene {seed}, variant {i}: MuJoCo {}, the cache {}",
-                    if want.is_ok() {
-                        "compiles it"
-                    } else {
-                        "refuses it"
-                    },
-                    if got.is_ok() { "answers" } else { "refuses" }
-                )),
+            let what = format!("scene {seed}, variant {i}");
+            if verdict(
+                &what,
+                compile_str(&xml, &dir),
+                cache.model(i),
+                &mut findings,
+            ) == Some(true)
+            {
+                answered += 1;
             }
         }
         patches += cache.patches();
@@ -206,24 +215,12 @@ fn random_documents_with_includes_are_answered_as_mujoco_compiles_them() {
                 continue;
             };
             included += u64::from(files.len() == 2);
-            match (want, cache.model(&doc)) {
-                (Ok(want), Ok(got)) => {
-                    let diffs = got.differences(&want);
-                    if !diffs.is_empty() {
-                        findings.push(format!("{seed}/{variant}: {diffs:?}"));
-                    }
-                }
-                (Err(_), Err(_)) => {}
-                (want, got) => findings.push(format!(
-                    "{seed}/{variant}: MuJoCo {}, the cache {}",
-                    if want.is_ok() {
-                        "compiles it"
-                    } else {
-                        "refuses it"
-                    },
-                    if got.is_ok() { "answers" } else { "refuses" }
-                )),
-            }
+            verdict(
+                &format!("{seed}/{variant}"),
+                want,
+                cache.model(&doc),
+                &mut findings,
+            );
         }
         let _ = std::fs::remove_dir_all(&dir);
     }
