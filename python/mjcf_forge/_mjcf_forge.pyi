@@ -37,6 +37,14 @@ class ModelArrays:
     def __init__(self, model: Any) -> None: ...
     def copy_body_model(self, body: int, name: str, part: ModelArrays) -> None: ...
 
+class PatchLanding:
+    """Where each entry of a patch of one layout lands in a model, found once
+    (``mjcf_forge::split::land``), and the writer of that layout's numbers and ids."""
+
+    options: list[tuple[str, int, int]]
+    def __init__(self, model: Any, patch: Sequence[Any], ids: Sequence[Optional[int]]) -> None: ...
+    def write(self, values: npt.NDArray[np.float64], material_ids: Sequence[int]) -> None: ...
+
 _Path = Union[str, os.PathLike[str]]
 #: What Element.set and Element.append take as an attribute value.
 _AttrValue = Union[str, bool, int, float, Sequence[Union[int, float]], npt.NDArray[Any]]

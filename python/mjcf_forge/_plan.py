@@ -1,9 +1,9 @@
 """How one compiled model is patched in place: :class:`Plan`, made once per model (the
 model caches, ``_cache.py`` and ``_doc_cache.py``, hold one per model they patch).
 
-A plan resolves where each entry of a patch lands (per target array, the flat indices and
-where the numbers come from, once per layout), writes a patch's numbers, material ids and
-the body models, then what follows from the values: ``mj_setConst`` (or a
+A plan resolves where each entry of a patch lands (once per layout: the extension's
+``PatchLanding``, ``mjcf_forge::split::land``, the rule the C face follows too), writes a
+patch's numbers and material ids through it, and the options and body models itself, then what follows from the values: ``mj_setConst`` (or a
 caller's derivation that writes the same, see ``_trees.py``), the model statistics the
 compiler derives at ``qpos0`` (which ``mj_setConst`` of 3.17 and 4.0 leaves: this module
 runs the kinematics, the extension's ``Statistics`` computes them in place, the one
@@ -20,7 +20,7 @@ import numpy as np
 
 from ._errors import error
 from . import _mujoco
-from ._mjcf_forge import DOF_FIELDS, PATCH_OBJECTS, QPOS_FIELDS, ModelArrays, Statistics, joint_widths, target_array
+from ._mjcf_forge import PATCH_OBJECTS, ModelArrays, PatchLanding, Statistics
 
 # The split tier's tables (``mjcf_forge::split::targets``, through the extension): each
 # patched object's array prefix, mjtObj name and count; the joints' dof and qpos fields.
@@ -50,10 +50,9 @@ class Plan:
         # of its string values are a body model (the others: material names).
         self.source: Any = None
         self.string_geoms: list[bool] = []
-        self.groups: list[tuple[Any, np.ndarray, np.ndarray]] = []
-        # (flat array, index, which material name of the patch) per matid entry.
-        self.matids: list[tuple[Any, int, int]] = []
-        # (field of model.opt, first of its numbers, how many) per option entry.
+        # Where the patch's numbers and material ids land (the extension's PatchLanding),
+        # and (field of model.opt, first of its numbers, how many) per option entry.
+        self.landing: Any = None
         self.options: list[tuple[str, int, int]] = []
         # The bodies of the patch's "geoms" entries, in order, and the body models of
         # their geoms compiled so far (MJCF text -> model), the newest last.
@@ -79,23 +78,19 @@ class Plan:
         self.statistics_arrays = Statistics(model, data, inertia, diagonal)
 
     def resolve(self, patch: list) -> None:
-        """Where every entry of ``patch`` lands: per target array, the flat indices its
-        numbers go to and where they come from in the patch's numbers laid end to end
-        (a one-number entry fills all its rows, as a joint's damping fills each of its
-        dofs); material names apart."""
+        """Where every entry of ``patch`` lands: the extension's ``PatchLanding``
+        (``mjcf_forge::split::land``, the rule both faces share) over this model, given
+        each entry's element id as this MuJoCo finds it; the options and body models
+        apart."""
         mujoco, model = self.mujoco, self.model
-        groups: dict[str, tuple[Any, list[int], list[int]]] = {}
-        matids: list[tuple[Any, int, int]] = []
-        options: list[tuple[str, int, int]] = []
+        ids: list[int | None] = []
         bodies: list[int] = []
         body_xml: list[str] = []
-        numbers = 0
         for obj, name, field, value in patch:
             if obj == "option":
                 if isinstance(value, str) or not hasattr(model.opt, field):
                     raise error(f"this MuJoCo's mjOption has no field {field}")
-                options.append((field, numbers, len(value)))
-                numbers += len(value)
+                ids.append(None)
                 continue
             if isinstance(name, int):
                 i = name if name < getattr(model, PATCH_OBJECTS[obj][2]) else -1
@@ -105,46 +100,15 @@ class Plan:
                 raise error(
                     f"the patch names {obj} '{name}', which the compiled model does not have"
                 )
+            ids.append(int(i))
             if field == "geoms":
                 bodies.append(int(i))
                 body_xml.append(value)
-                continue
-            array = target_array(obj, field)
-            if obj == "joint" and field in DOF_FIELDS:
-                first = int(model.jnt_dofadr[i])
-                rows = range(first, first + joint_widths(int(model.jnt_type[i]))[0])
-            elif obj == "joint" and field == "key_qpos":
-                # The joint's rows of every keyframe (one row of nq per key).
-                first = int(model.jnt_qposadr[i])
-                width = joint_widths(int(model.jnt_type[i]))[1]
-                _, targets, sources = groups.setdefault(array, (model.key_qpos.reshape(-1), [], []))
-                for k in range(model.nkey):
-                    targets.extend(range(k * model.nq + first, k * model.nq + first + width))
-                    sources.extend(range(numbers, numbers + len(value)))
-                numbers += len(value)
-                continue
-            elif obj == "joint" and field in QPOS_FIELDS:
-                first = int(model.jnt_qposadr[i])
-                rows = range(first, first + joint_widths(int(model.jnt_type[i]))[1])
-            else:
-                width = 1 if isinstance(value, str) else len(value)
-                rows = range(i * width, (i + 1) * width)
-            whole = getattr(model, array)
-            flat = whole.reshape(-1)
-            if not np.shares_memory(flat, whole):
-                raise error(f"mjModel.{array} is not one contiguous array here")
-            if isinstance(value, str):
-                matids.append((flat, rows[0], len(matids)))
-                continue
-            _, targets, sources = groups.setdefault(array, (flat, [], []))
-            targets.extend(rows)
-            sources.extend(
-                [numbers] * len(rows) if len(value) == 1 else range(numbers, numbers + len(value))
-            )
-            numbers += len(value)
-        self.groups = [(flat, np.array(t), np.array(s)) for flat, t, s in groups.values()]
-        self.matids = matids
-        self.options = options
+        try:
+            self.landing = PatchLanding(model, patch, ids)
+        except ValueError as e:
+            raise error(str(e)) from None
+        self.options = self.landing.options
         self.bodies = bodies
         self.body_xml0 = body_xml
         self.body_written = [None] * len(bodies)
@@ -174,14 +138,16 @@ class Plan:
     def write(self, values: np.ndarray, materials: list, bodies: list = ()) -> None:
         """Writes a patch of the resolved layout: its numbers end to end (``values``), the
         names of its materials in order, and the body models of its bodies' geoms."""
-        for flat, targets, sources in self.groups:
-            # A float32 array takes the numbers rounded as MuJoCo rounds them (they are).
-            flat[targets] = values[sources]
-        for flat, index, k in self.matids:
-            i = self.mujoco.mj_name2id(self.model, self.mujoco.mjtObj.mjOBJ_MATERIAL, materials[k])
+        ids = []
+        for name in materials:
+            i = self.mujoco.mj_name2id(self.model, self.mujoco.mjtObj.mjOBJ_MATERIAL, name)
             if i < 0:
-                raise error(f"no material named '{materials[k]}'")
-            flat[index] = i
+                raise error(f"no material named '{name}'")
+            ids.append(int(i))
+        try:
+            self.landing.write(values, ids)
+        except ValueError as e:
+            raise error(str(e)) from None
         opt = self.model.opt
         for field, first, n in self.options:
             if n == 1:

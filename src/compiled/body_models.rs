@@ -4,68 +4,11 @@
 //! both faces share; this is the C face's side: the linked MuJoCo's arrays by name, and the
 //! body models compiled so far).
 
-use std::ffi::CString;
 use std::path::Path;
 
-use super::sys::mjf_patch_array;
+use super::arrays::Arrays;
 use crate::mujoco::{CompiledModel, MjModel, compile_str};
-use crate::split::{MasslessFrame, ModelArrays, ModelArraysMut, copy_body_model, massless_frames};
-
-/// A live model's arrays by name, through `patch.c`.
-struct Arrays(*mut MjModel);
-
-impl Arrays {
-    /// `name`'s pointer and element count, checked to hold elements of `T`.
-    fn find<T>(&self, name: &str) -> Result<(*mut T, usize), String> {
-        let c = CString::new(name).map_err(|e| e.to_string())?;
-        let (mut elem, mut count) = (0usize, 0usize);
-        // SAFETY: the model is live; `c` is NUL-terminated.
-        let p = unsafe { mjf_patch_array(self.0, c.as_ptr(), &mut elem, &mut count) };
-        if elem != std::mem::size_of::<T>() || (p.is_null() && count > 0) {
-            return Err(format!(
-                "this MuJoCo's mjModel has no array {name} of that type"
-            ));
-        }
-        Ok((p.cast(), count))
-    }
-
-    fn get<T>(&self, name: &str) -> Result<&[T], String> {
-        let (p, n) = self.find::<T>(name)?;
-        // SAFETY: `n` elements of the live model at `p`, read while `self` is borrowed.
-        Ok(unsafe { crate::mujoco::slice_or_empty(p.cast_const(), n) })
-    }
-
-    fn get_mut<T>(&mut self, name: &str) -> Result<&mut [T], String> {
-        let (p, n) = self.find::<T>(name)?;
-        if n == 0 {
-            return Ok(&mut []);
-        }
-        // SAFETY: `n` elements of the live model at `p`, the only view while `self` is
-        // borrowed mutably.
-        Ok(unsafe { std::slice::from_raw_parts_mut(p, n) })
-    }
-}
-
-impl ModelArrays for Arrays {
-    fn floats(&self, name: &str) -> Result<&[f64], String> {
-        self.get(name)
-    }
-    fn ints(&self, name: &str) -> Result<&[i32], String> {
-        self.get(name)
-    }
-    fn bytes(&self, name: &str) -> Result<&[u8], String> {
-        self.get(name)
-    }
-}
-
-impl ModelArraysMut for Arrays {
-    fn floats_mut(&mut self, name: &str) -> Result<&mut [f64], String> {
-        self.get_mut(name)
-    }
-    fn bytes_mut(&mut self, name: &str) -> Result<&mut [u8], String> {
-        self.get_mut(name)
-    }
-}
+use crate::split::{MasslessFrame, copy_body_model, massless_frames};
 
 /// Body models compiled so far, by their MJCF text, the newest last; and the inertial
 /// frames of the structure's massless bodies.

@@ -27,6 +27,7 @@
 // compiles against the linked MuJoCo's headers), as the FFI tier does.
 #![allow(unsafe_code)]
 
+mod arrays;
 mod body_models;
 mod cache;
 mod document;

@@ -10,19 +10,18 @@
 //! over the raw model, its serial number and the writable pointer through `pub(crate)` items.
 
 use std::collections::HashMap;
-use std::ffi::{CString, c_int};
+use std::ffi::CString;
 use std::ptr::NonNull;
 
+use super::arrays::{Arrays, array_mut};
 use super::body_models::BodyModels;
 use super::sys::{
-    RawData, mjf_patch_array, mjf_patch_delete_data, mjf_patch_get_stat, mjf_patch_make_data,
-    mjf_patch_name2id, mjf_patch_names, mjf_patch_nbytes, mjf_patch_option, mjf_patch_size,
-    mjf_patch_size_name,
+    RawData, mjf_patch_delete_data, mjf_patch_get_stat, mjf_patch_make_data, mjf_patch_name2id,
+    mjf_patch_names, mjf_patch_nbytes, mjf_patch_option, mjf_patch_size, mjf_patch_size_name,
 };
 use crate::mujoco::{CompiledModel, MjModel};
 use crate::split::{
-    DOF_FIELDS, PatchEntry, PatchValue, QPOS_FIELDS, SIGNATURE_ARRAYS, SIGNATURE_SKIPPED_SIZES,
-    joint_widths, target_array,
+    Carried, Landing, PatchEntry, PatchValue, Run, SIGNATURE_ARRAYS, SIGNATURE_SKIPPED_SIZES, land,
 };
 
 /// Scratch mjData for `mj_setConst` (which overwrites the qpos of the data it is given).
@@ -48,21 +47,14 @@ impl Drop for Scratch {
     }
 }
 
-/// Where one patch entry lands: `n` elements at `ptr` (`elem` bytes each; a one-value
-/// entry fills all `n`, as a joint's damping fills each of its dofs).
+/// Where one patch entry lands ([`land`], the rule both faces share), with its array found
+/// once: its start, element size and count (an option: its `mjOption` field's; a body
+/// model: none).
 pub(super) struct Target {
+    landing: Landing,
     ptr: *mut u8,
     elem: usize,
-    n: usize,
-    /// The field holds integers: an id (`geom_matid`, the value a material's name) or
-    /// collision bits (`geom_contype`, `geom_conaffinity`).
-    int: bool,
-    /// The `n` elements again every `stride` elements, `runs` times in all: a joint's rows
-    /// of every keyframe (`key_qpos`, one row of `nq` per key). One run elsewhere.
-    runs: usize,
-    stride: usize,
-    /// A body whose body model the entry is (`PatchValue::BodyModel`): nothing at `ptr`.
-    body: Option<usize>,
+    count: usize,
 }
 
 /// How to patch one model: its structure key, scratch data and resolved targets.
@@ -98,10 +90,9 @@ impl Signature {
         let arrays = SIGNATURE_ARRAYS
             .iter()
             .map(|name| {
-                let c = CString::new(*name).expect("array names hold no NUL");
-                let (mut elem, mut count) = (0usize, 0usize);
-                // SAFETY: the model is live and only read; `c` is NUL-terminated.
-                let p = unsafe { mjf_patch_array(raw, c.as_ptr(), &mut elem, &mut count) };
+                let Ok((p, elem, count)) = Arrays(raw).find(name) else {
+                    return Vec::new();
+                };
                 if p.is_null() {
                     return Vec::new();
                 }
@@ -321,9 +312,9 @@ impl State {
         }
         let ptr = model.as_mut_ptr();
         for (t, e) in plan.targets.iter().zip(entries) {
-            match (t.body, &e.value) {
-                (Some(body), PatchValue::BodyModel(xml)) => {
-                    plan.body_models.write(ptr, body, xml)?
+            match (&t.landing, &e.value) {
+                (Landing::BodyModel { body }, PatchValue::BodyModel(xml)) => {
+                    plan.body_models.write(ptr, *body, xml)?
                 }
                 _ => write(ptr, t, &e.value)?,
             }
@@ -338,170 +329,100 @@ impl State {
     }
 }
 
-/// Writes one entry's value at its target.
+/// Writes one entry's value at its target (not a body model: its plan writes those).
 fn write(model: *mut MjModel, t: &Target, value: &PatchValue) -> Result<(), String> {
+    let (run, option);
+    let run = match &t.landing {
+        Landing::Numbers(r) => r,
+        Landing::Option { field, n } => {
+            option = Run {
+                array: field.clone(),
+                offset: 0,
+                n: *n,
+                runs: 1,
+                stride: 0,
+                int: false,
+                id: false,
+            };
+            run = &option;
+            run
+        }
+        Landing::BodyModel { .. } => return Err("a body model is written by its plan".into()),
+    };
+    // SAFETY: `ptr` is the start of the live model's array (or option field) of `count`
+    // elements of `elem` bytes, found by `resolve`; nothing else views it meanwhile.
+    let whole = unsafe { array_mut(t.ptr, t.elem, t.count, run.int) };
     match value {
+        PatchValue::Numbers(v) => run.write(whole, v),
         PatchValue::Id { object, name } => {
             let kind = CString::new(*object).map_err(|e| e.to_string())?;
-            let name = CString::new(name.as_str()).map_err(|e| e.to_string())?;
+            let c = CString::new(name.as_str()).map_err(|e| e.to_string())?;
             // SAFETY: the model is live; both strings are NUL-terminated.
-            let id = unsafe { mjf_patch_name2id(model, kind.as_ptr(), name.as_ptr()) };
-            if id < 0 || !t.int || t.elem != 4 {
-                return Err(format!("no {} named '{}'", object, name.to_string_lossy()));
-            }
-            // SAFETY: `ptr` points at `n` >= 1 ints of the live model (see `resolve`).
-            unsafe { t.ptr.cast::<c_int>().write_unaligned(id) };
+            let id = unsafe { mjf_patch_name2id(model, kind.as_ptr(), c.as_ptr()) };
+            let id = usize::try_from(id).map_err(|_| format!("no {object} named '{name}'"))?;
+            run.write_id(whole, id)
         }
-        PatchValue::BodyModel(_) => {
-            return Err("a body model is written by its plan".to_string());
-        }
-        PatchValue::Numbers(v) => {
-            for run in 0..t.runs {
-                for k in 0..t.n {
-                    let x = if v.len() == 1 { v[0] } else { v[k] };
-                    let at = run * t.stride + k;
-                    // SAFETY: `ptr` points at `runs` runs of `n` elements of `elem` bytes
-                    // of the live model, `stride` apart, checked against the array's
-                    // length in `resolve`.
-                    unsafe {
-                        match (t.elem, t.int) {
-                            (4, true) => t.ptr.cast::<c_int>().add(at).write_unaligned(x as c_int),
-                            (4, false) => t.ptr.cast::<f32>().add(at).write_unaligned(x as f32),
-                            _ => t.ptr.cast::<f64>().add(at).write_unaligned(x),
-                        }
-                    }
-                }
-            }
-        }
+        PatchValue::BodyModel(_) => Err("a body model is written by its plan".into()),
     }
-    Ok(())
 }
 
-/// Where every entry lands in `model`.
+/// Where every entry lands in `model`: [`land`], with ids found by the linked MuJoCo.
 fn resolve(model: &mut CompiledModel, entries: &[PatchEntry]) -> Result<Vec<Target>, String> {
-    let ptr = model.as_mut_ptr();
-    let array = |name: &str| -> Result<(*mut u8, usize, usize), String> {
-        let c = CString::new(name).map_err(|e| e.to_string())?;
-        let (mut elem, mut count) = (0usize, 0usize);
-        // SAFETY: the model is live; `c` is NUL-terminated.
-        let p = unsafe { mjf_patch_array(ptr, c.as_ptr(), &mut elem, &mut count) };
-        if p.is_null() && count > 0 || elem == 0 {
-            return Err(format!("this MuJoCo's mjModel has no array {name}"));
-        }
-        Ok((p.cast(), elem, count))
-    };
-    let int_at = |name: &str, i: usize| -> Result<usize, String> {
-        let (p, elem, count) = array(name)?;
-        if elem != 4 || i >= count {
-            return Err(format!("{name}[{i}] out of range"));
-        }
-        // SAFETY: `i` < count ints at `p`.
-        let v = unsafe { p.cast::<c_int>().add(i).read_unaligned() };
-        usize::try_from(v).map_err(|_| format!("{name}[{i}] is negative"))
-    };
+    let arrays = Arrays(model.as_mut_ptr());
     let mut out = Vec::with_capacity(entries.len());
     for e in entries {
-        if e.object == "option" {
-            out.push(option_target(ptr, e)?);
-            continue;
-        }
-        let id = match e.id {
-            Some(id) => id,
-            None => {
-                let kind = CString::new(e.object).map_err(|x| x.to_string())?;
+        let id = match (e.object, e.id) {
+            ("option", _) => None,
+            (_, Some(id)) => Some(id),
+            (object, None) => {
+                let kind = CString::new(object).map_err(|x| x.to_string())?;
                 let name = CString::new(e.name.as_str()).map_err(|x| x.to_string())?;
                 // SAFETY: the model is live; both strings are NUL-terminated.
-                let id = unsafe { mjf_patch_name2id(ptr, kind.as_ptr(), name.as_ptr()) };
-                usize::try_from(id).map_err(|_| {
+                let id = unsafe { mjf_patch_name2id(arrays.0, kind.as_ptr(), name.as_ptr()) };
+                Some(usize::try_from(id).map_err(|_| {
                     format!(
                         "the patch names {} '{}', which the compiled model does not have",
                         e.object, e.name
                     )
-                })?
+                })?)
             }
         };
-        let width = match &e.value {
-            PatchValue::Numbers(v) => v.len(),
-            PatchValue::Id { .. } => 1,
-            PatchValue::BodyModel(_) => {
-                out.push(Target {
-                    ptr: std::ptr::null_mut(),
-                    elem: 0,
-                    n: 0,
-                    int: false,
-                    runs: 0,
-                    stride: 0,
-                    body: Some(id),
-                });
-                continue;
-            }
+        let carried = match &e.value {
+            PatchValue::Numbers(v) => Carried::Numbers(v.len()),
+            PatchValue::Id { .. } => Carried::Id,
+            PatchValue::BodyModel(_) => Carried::BodyModel,
         };
-        let (mut runs, mut stride) = (1, 0);
-        let target = target_array(e.object, e.field)
-            .ok_or_else(|| format!("a patch names no array for {}.{}", e.object, e.field))?;
-        let (name, offset, n) = match (e.object, e.field) {
-            ("joint", f) if DOF_FIELDS.contains(&f) => {
-                let (dofs, _) = joint_widths(int_at("jnt_type", id)? as i64);
-                (target, int_at("jnt_dofadr", id)?, dofs)
-            }
-            ("joint", f) if QPOS_FIELDS.contains(&f) => {
-                let (_, n) = joint_widths(int_at("jnt_type", id)? as i64);
-                if f == "key_qpos" {
-                    // The joint's rows of every keyframe: one row of nq per key.
-                    let (_, _, nq) = array("qpos0")?;
-                    let (_, _, all) = array("key_qpos")?;
-                    runs = all.checked_div(nq).unwrap_or(0);
-                    stride = nq;
-                }
-                (target, int_at("jnt_qposadr", id)?, n)
-            }
-            _ => (target, id * width, width),
+        let landing = land(e.object, id, e.field, carried, &arrays)
+            .map_err(|x| format!("{} '{}': {x}", e.object, e.name))?;
+        let (ptr, elem, count) = match &landing {
+            Landing::Numbers(run) => arrays.find(&run.array)?,
+            Landing::Option { field, n } => option_field(arrays.0, field, *n)?,
+            Landing::BodyModel { .. } => (std::ptr::null_mut(), 0, 0),
         };
-        let (p, elem, count) = array(&name)?;
-        let end = offset + n + runs.saturating_sub(1) * stride;
-        if runs > 0 && end > count {
-            return Err(format!(
-                "{} '{}': {name}[{offset}..{end}] is outside the model's {count}",
-                e.object, e.name,
-            ));
-        }
         out.push(Target {
-            // SAFETY: in bounds, checked above (no key: nothing is written).
-            ptr: unsafe { p.add(offset.min(count) * elem) },
+            landing,
+            ptr,
             elem,
-            n,
-            int: matches!(e.field, "matid" | "contype" | "conaffinity"),
-            runs,
-            stride,
-            body: None,
+            count,
         });
     }
     Ok(out)
 }
 
-/// Where an `<option>` value lands: its `mjOption` field.
-fn option_target(model: *mut MjModel, e: &PatchEntry) -> Result<Target, String> {
-    let c = CString::new(e.field).map_err(|x| x.to_string())?;
+/// The `mjOption` field `field` of `n` numbers: its address, element size and count.
+fn option_field(
+    model: *mut MjModel,
+    field: &str,
+    n: usize,
+) -> Result<(*mut u8, usize, usize), String> {
+    let c = CString::new(field).map_err(|x| x.to_string())?;
     let (mut elem, mut count) = (0usize, 0usize);
     // SAFETY: the model is live; `c` is NUL-terminated.
     let p = unsafe { mjf_patch_option(model, c.as_ptr(), &mut elem, &mut count) };
-    let width = match &e.value {
-        PatchValue::Numbers(v) => v.len(),
-        PatchValue::Id { .. } | PatchValue::BodyModel(_) => 0,
-    };
-    if p.is_null() || elem != std::mem::size_of::<f64>() || count != width {
+    if p.is_null() || elem != std::mem::size_of::<f64>() || count != n {
         return Err(format!(
-            "this MuJoCo's mjOption has no field {} of {width}",
-            e.field
+            "this MuJoCo's mjOption has no field {field} of {n}"
         ));
     }
-    Ok(Target {
-        ptr: p.cast(),
-        elem,
-        n: count,
-        int: false,
-        runs: 1,
-        stride: 0,
-        body: None,
-    })
+    Ok((p.cast(), elem, count))
 }

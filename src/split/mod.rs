@@ -27,7 +27,8 @@
 //! Files: `rules.rs` (the attribute-to-field rules, [`PATCHABLE`], the patch entry types),
 //! `targets.rs` (the `mjModel` array each entry writes, the arrays no patch changes, the
 //! arrays that tell structures apart: the one copy the model caches of both faces read),
-//! `document.rs` (any document split by reading it), `body_model.rs` (a body's geoms as a
+//! `landing.rs` (where each patch entry lands in a compiled model and how its numbers are
+//! written, for both faces), `document.rs` (any document split by reading it), `body_model.rs` (a body's geoms as a
 //! model of their own, for what MuJoCo derives from their sizes), `body_copy.rs` (that
 //! model's compile copied into a structure's model, for both faces), `statistics.rs` (the
 //! compiler's statistics at `qpos0`, computed over a model's arrays for both faces). The scene tier reads its
@@ -39,6 +40,7 @@
 mod body_copy;
 mod body_model;
 mod document;
+mod landing;
 mod rules;
 mod statistics;
 mod targets;
@@ -47,6 +49,7 @@ pub use body_copy::{MasslessFrame, ModelArrays, ModelArraysMut, copy_body_model,
 pub use document::{
     DocumentPatch, PATCHABLE_OPTIONS, SplitOptions, split_document, split_document_with,
 };
+pub use landing::{ArrayMut, Carried, Landing, ModelLayout, Run, land};
 pub use rules::{PATCHABLE, PatchEntry, PatchValue};
 pub use statistics::{
     STATISTIC_NAMES, StatArrays, Statistics, fixed_statistics, fixed_statistics_mask, keep_fixed,

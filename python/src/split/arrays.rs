@@ -15,6 +15,10 @@ impl Element for f64 {
     const TYPESTR: &'static str = "<f8";
 }
 
+impl Element for f32 {
+    const TYPESTR: &'static str = "<f4";
+}
+
 impl Element for i32 {
     const TYPESTR: &'static str = "<i4";
 }

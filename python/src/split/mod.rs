@@ -1,12 +1,14 @@
 //! The split tier's face in Python: its tables (`tables.rs`, the one copy of each the
 //! package's caches read) and the rules the caches run over the user's `MjModel` in place
-//! (`statistics.rs`, `body_models.rs`, through `arrays.rs`).
+//! (`patch.rs`, `statistics.rs`, `body_models.rs`, through `arrays.rs`).
 
 // NumPy's memory read in place: the bindings' only unsafe code.
 #[allow(unsafe_code)]
 mod arrays;
 #[allow(unsafe_code)]
 mod body_models;
+#[allow(unsafe_code)]
+mod patch;
 #[allow(unsafe_code)]
 mod statistics;
 mod tables;
@@ -18,5 +20,6 @@ pub(crate) fn add(m: &Bound<'_, PyModule>) -> PyResult<()> {
     tables::add(m)?;
     m.add_class::<statistics::PyStatistics>()?;
     m.add_class::<body_models::PyModelArrays>()?;
+    m.add_class::<patch::PyPatchLanding>()?;
     Ok(())
 }
