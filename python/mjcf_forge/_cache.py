@@ -21,6 +21,7 @@ import numpy as np
 
 from ._errors import error
 from ._mjcf_forge import (
+    MODEL_FIELDS,
     SIGNATURE_ARRAYS,
     SIGNATURE_SKIPPED_SIZES,
     STATIC_PREFIXES,
@@ -354,7 +355,7 @@ class ModelCache:
         if plan.source is not patch0:
             plan.resolve(patch0)
             plan.source = patch0
-            plan.string_geoms = [e[2] == "geoms" for e in patch0 if isinstance(e[3], str)]
+            plan.string_geoms = [e[2] in MODEL_FIELDS for e in patch0 if isinstance(e[3], str)]
         values = np.frombuffer(numbers, dtype=np.float64)
         if strings:
             geoms = plan.string_geoms

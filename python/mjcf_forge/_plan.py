@@ -20,7 +20,7 @@ import numpy as np
 
 from ._errors import error
 from . import _mujoco
-from ._mjcf_forge import PATCH_OBJECTS, ModelArrays, PatchLanding, Statistics
+from ._mjcf_forge import MODEL_FIELDS, PATCH_OBJECTS, ModelArrays, PatchLanding, Statistics
 
 # The split tier's tables (``mjcf_forge::split::targets``, through the extension): each
 # patched object's array prefix, mjtObj name and count; the joints' dof and qpos fields.
@@ -54,13 +54,15 @@ class Plan:
         # and (field of model.opt, first of its numbers, how many) per option entry.
         self.landing: Any = None
         self.options: list[tuple[str, int, int]] = []
-        # The bodies of the patch's "geoms" entries, in order, and the body models of
-        # their geoms compiled so far (MJCF text -> model), the newest last.
-        self.bodies: list[int] = []
+        # The bodies of the patch's body-model and unit-model entries (MODEL_FIELDS), in
+        # order, with their fields, and the models of their geoms compiled so far (MJCF
+        # text -> model), the newest last; the unit model of each body with one.
+        self.bodies: list[tuple[int, str]] = []
         self.body_models: dict[str, tuple[Any, Any]] = {}
-        # Per "geoms" entry: its body model as the structure compiled it (what the
-        # snapshot's arrays hold), and the one last written into this model (None: not
-        # known; the bounding volumes are not restored before a patch).
+        self.units: dict[int, Any] = {}
+        # Per such entry: its model as the structure compiled it (what the snapshot's
+        # arrays hold), and the one last written into this model (None: not known; the
+        # bounding volumes are not restored before a patch).
         self.body_xml0: list[str] = []
         self.body_written: list[Any] = []
         # The <statistic> values the scene sets: MuJoCo keeps them over what it computes.
@@ -84,7 +86,7 @@ class Plan:
         apart."""
         mujoco, model = self.mujoco, self.model
         ids: list[int | None] = []
-        bodies: list[int] = []
+        bodies: list[tuple[int, str]] = []
         body_xml: list[str] = []
         for obj, name, field, value in patch:
             if obj == "option":
@@ -101,8 +103,8 @@ class Plan:
                     f"the patch names {obj} '{name}', which the compiled model does not have"
                 )
             ids.append(int(i))
-            if field == "geoms":
-                bodies.append(int(i))
+            if field in MODEL_FIELDS:
+                bodies.append((int(i), field))
                 body_xml.append(value)
         try:
             self.landing = PatchLanding(model, patch, ids)
@@ -131,8 +133,8 @@ class Plan:
             itertools.chain.from_iterable(e[3] for e in patch if not isinstance(e[3], str)),
             dtype=np.float64,
         )
-        materials = [e[3] for e in patch if isinstance(e[3], str) and e[2] != "geoms"]
-        self.write(values, materials, [e[3] for e in patch if e[2] == "geoms"])
+        materials = [e[3] for e in patch if isinstance(e[3], str) and e[2] not in MODEL_FIELDS]
+        self.write(values, materials, [e[3] for e in patch if e[2] in MODEL_FIELDS])
         self.finish(derive)
 
     def write(self, values: np.ndarray, materials: list, bodies: list = ()) -> None:
@@ -155,20 +157,28 @@ class Plan:
             else:
                 getattr(opt, field)[:] = values[first : first + n]
         if self.bodies:
-            for k, (body, xml) in enumerate(zip(self.bodies, bodies)):
+            for k, ((body, field), xml) in enumerate(zip(self.bodies, bodies)):
+                if field != "geoms":
+                    # A unit model: its geom factors' entry follows.
+                    self.units[body] = self.compiled(body, xml)
+                    continue
                 # As compiled and as last written: the arrays already hold it.
                 if xml == self.body_xml0[k] and self.body_written[k] == xml:
                     continue
                 self.body_written[k] = None
                 self.body_model(body, xml)
                 self.body_written[k] = xml
+        for body, first, n in self.landing.geom_factors:
+            try:
+                self.arrays.write_geom_masses(
+                    body, self.model.body(body).name, self.units[body], values[first : first + n].tolist()
+                )
+            except ValueError as e:
+                raise error(str(e)) from None
 
-    def body_model(self, body: int, xml: str) -> None:
-        """Writes what MuJoCo derives from ``body``'s geoms, read off its compile of their
-        body model ``xml`` (the same computation on the same numbers: each geom's size,
-        bounding radius and box, the body's mass, inertia and inertial frame, its bounding
-        volumes). Raises when the body model's layout is not the body's (the document is
-        then compiled)."""
+    def compiled(self, body: int, xml: str) -> Any:
+        """The arrays of ``xml``, a model of ``body``'s geoms, compiled by this MuJoCo once
+        (the last 64 kept)."""
         entry = self.body_models.get(xml)
         if entry is None:
             try:
@@ -178,8 +188,16 @@ class Plan:
             if len(self.body_models) >= 64:
                 del self.body_models[next(iter(self.body_models))]
             entry = self.body_models[xml] = (mini, ModelArrays(mini))
+        return entry[1]
+
+    def body_model(self, body: int, xml: str) -> None:
+        """Writes what MuJoCo derives from ``body``'s geoms, read off its compile of their
+        body model ``xml`` (the same computation on the same numbers: each geom's size,
+        bounding radius and box, the body's mass, inertia and inertial frame, its bounding
+        volumes). Raises when the body model's layout is not the body's (the document is
+        then compiled)."""
         try:
-            self.arrays.copy_body_model(body, self.model.body(body).name, entry[1])
+            self.arrays.copy_body_model(body, self.model.body(body).name, self.compiled(body, xml))
         except ValueError as e:
             raise error(str(e)) from None
 

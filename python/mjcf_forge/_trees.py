@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from ._mjcf_forge import target_array
+from ._mjcf_forge import GEOM_FACTORS, MODEL_FIELDS, target_array
 from . import _mujoco
 from ._plan import OBJ
 
@@ -237,7 +237,7 @@ class TreeDerivation:
             if obj == "option":
                 continue
             target = target_array(obj, field)
-            if field == "geoms":
+            if field in MODEL_FIELDS or field == GEOM_FACTORS:
                 target = "body_mass"
             if target in ("geom_pos", "geom_quat", "site_pos", "site_quat"):
                 i = _id_of(mujoco, model, obj, name)
@@ -255,7 +255,7 @@ class TreeDerivation:
             if field == "geoms":  # a body model writes the geoms' frames too
                 framed_bodies.add(body)
                 framed.update(("geom", int(g)) for g in np.flatnonzero(model.geom_bodyid == body))
-            elif target in ("body_ipos", "body_iquat"):
+            elif target in ("body_ipos", "body_iquat") or field == GEOM_FACTORS:
                 framed_bodies.add(body)
         roots.discard(0)
         # A geom or site whose own frame no patch writes and whose orientation is its

@@ -103,6 +103,9 @@ impl ModelArraysMut for Arrays {
     fn bytes_mut(&mut self, name: &str) -> Result<&mut [u8], String> {
         self.get_mut(name)
     }
+    fn ints_mut(&mut self, name: &str) -> Result<&mut [i32], String> {
+        self.get_mut(name)
+    }
 }
 
 impl ModelLayout for Arrays {

@@ -8,13 +8,15 @@ use std::path::Path;
 
 use super::arrays::Arrays;
 use crate::mujoco::{CompiledModel, MjModel, compile_str};
-use crate::split::{MasslessFrame, copy_body_model, massless_frames};
+use crate::split::{MasslessFrame, copy_body_model, massless_frames, write_geom_masses};
 
-/// Body models compiled so far, by their MJCF text, the newest last; and the inertial
-/// frames of the structure's massless bodies.
+/// Body models and unit models compiled so far, by their MJCF text, the newest last; the
+/// inertial frames of the structure's massless bodies; and the unit model of the patch's
+/// last `unit_geoms` entry, whose `geom_factors` entry follows it.
 pub(super) struct BodyModels {
     models: Vec<(String, CompiledModel)>,
     massless: Vec<(usize, MasslessFrame)>,
+    unit: Option<String>,
 }
 
 /// How many body models a plan keeps.
@@ -28,6 +30,22 @@ impl BodyModels {
         Ok(BodyModels {
             models: Vec::new(),
             massless: massless_frames(&arrays)?,
+            unit: None,
+        })
+    }
+
+    /// The index of the compile of `xml`, compiled on first sight (and kept).
+    fn compiled(&mut self, xml: &str) -> Result<usize, String> {
+        Ok(match self.models.iter().position(|(x, _)| x == xml) {
+            Some(at) => at,
+            None => {
+                let part = compile_str(xml, Path::new(".")).map_err(|e| e.to_string())?;
+                if self.models.len() >= KEPT {
+                    self.models.remove(0);
+                }
+                self.models.push((xml.to_string(), part));
+                self.models.len() - 1
+            }
         })
     }
 
@@ -39,17 +57,7 @@ impl BodyModels {
         body: usize,
         xml: &str,
     ) -> Result<(), String> {
-        let at = match self.models.iter().position(|(x, _)| x == xml) {
-            Some(at) => at,
-            None => {
-                let part = compile_str(xml, Path::new(".")).map_err(|e| e.to_string())?;
-                if self.models.len() >= KEPT {
-                    self.models.remove(0);
-                }
-                self.models.push((xml.to_string(), part));
-                self.models.len() - 1
-            }
-        };
+        let at = self.compiled(xml)?;
         let part = Arrays(self.models[at].1.as_mut_ptr());
         let kept = self
             .massless
@@ -57,5 +65,35 @@ impl BodyModels {
             .find(|(b, _)| *b == body)
             .map(|(_, k)| k);
         copy_body_model(&mut Arrays(model), body, &body.to_string(), kept, &part)
+    }
+
+    /// Makes the unit model `xml` (compiled once, kept) the one the next
+    /// [`BodyModels::write_masses`] reads.
+    pub(super) fn unit(&mut self, xml: &str) -> Result<(), String> {
+        self.compiled(xml)?;
+        self.unit = Some(xml.to_string());
+        Ok(())
+    }
+
+    /// Writes into body `body` (named `name`) of `model` its mass properties for its unit
+    /// model's geoms at densities or masses `factors`.
+    pub(super) fn write_masses(
+        &mut self,
+        model: *mut MjModel,
+        body: usize,
+        name: &str,
+        factors: &[f64],
+    ) -> Result<(), String> {
+        let xml = self
+            .unit
+            .as_deref()
+            .ok_or_else(|| format!("body '{name}': geom factors without a unit model"))?;
+        let at = self
+            .models
+            .iter()
+            .position(|(x, _)| x == xml)
+            .ok_or_else(|| format!("body '{name}': its unit model is gone"))?;
+        let unit = Arrays(self.models[at].1.as_mut_ptr());
+        write_geom_masses(&mut Arrays(model), body, name, &unit, factors)
     }
 }

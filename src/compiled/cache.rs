@@ -30,6 +30,33 @@ impl CompiledModel {
     /// assert!(b.differences(&a).iter().any(|d| d.starts_with("geom_size")));
     /// ```
     pub fn differences(&self, other: &CompiledModel) -> Vec<String> {
+        self.compare(other, None)
+    }
+
+    /// Where `other` differs from this model beyond `bound`: integer and `float` arrays
+    /// bit for bit, `mjtNum` arrays and the statistics within `bound` relative to the
+    /// larger magnitude of the two values (or of the array, for values near zero: a box's
+    /// centre), for results MuJoCo's own arithmetic cannot be reproduced in, such as mass
+    /// properties combined from geoms' densities (docs/compiled.md). Each difference names the array and its first element beyond.
+    ///
+    /// ```
+    /// use mjcf_forge::mujoco::compile_str;
+    /// let m = |s: &str| compile_str(&format!("<mujoco><worldbody><body><freejoint/><geom size='{s}'/></body></worldbody></mujoco>"), ".".as_ref()).unwrap();
+    /// assert!(m("1").differences_beyond(&m("1.0000000000000002"), 1e-12).is_empty());
+    /// assert!(!m("1").differences_beyond(&m("1.001"), 1e-12).is_empty());
+    /// ```
+    pub fn differences_beyond(&self, other: &CompiledModel, bound: f64) -> Vec<String> {
+        self.compare(other, Some(bound))
+    }
+
+    fn compare(&self, other: &CompiledModel, bound: Option<f64>) -> Vec<String> {
+        let close = |a: f64, b: f64| match bound {
+            None => a.to_bits() == b.to_bits(),
+            Some(bound) => {
+                a.to_bits() == b.to_bits()
+                    || (a - b).abs() <= bound * a.abs().max(b.abs()).max(f64::MIN_POSITIVE)
+            }
+        };
         let mut out = Vec::new();
         if self.sizes() != other.sizes() {
             out.push("sizes".to_string());
@@ -41,22 +68,45 @@ impl CompiledModel {
             if name.is_null() {
                 break;
             }
-            let bytes = |m: &CompiledModel| -> &[u8] {
+            let bytes = |m: &CompiledModel| -> (&[u8], usize) {
                 let (mut elem, mut count) = (0usize, 0usize);
                 // The C side hands back a writable pointer; nothing is written through it here.
                 let raw = std::ptr::from_ref(m.raw()).cast_mut();
                 // SAFETY: the model is live (only read here); `name` is NUL-terminated.
                 let p = unsafe { mjf_patch_array(raw, name, &mut elem, &mut count) };
                 // SAFETY: `elem * count` bytes at `p` belong to the live model.
-                unsafe { crate::mujoco::slice_or_empty(p.cast::<u8>().cast_const(), elem * count) }
+                let b = unsafe {
+                    crate::mujoco::slice_or_empty(p.cast::<u8>().cast_const(), elem * count)
+                };
+                (b, elem)
             };
-            let (a, b) = (bytes(self), bytes(other));
-            if a != b {
-                // SAFETY: NUL-terminated static string.
-                let name = unsafe { std::ffi::CStr::from_ptr(name) }.to_string_lossy();
-                let at = a.iter().zip(b).position(|(x, y)| x != y).unwrap_or(0);
-                out.push(format!("{name} (byte {at})"));
+            let ((a, elem), (b, _)) = (bytes(self), bytes(other));
+            if a == b {
+                continue;
             }
+            let at = if let Some(bound) = bound
+                && elem == 8
+                && a.len() == b.len()
+            {
+                let float = |x: &[u8]| f64::from_ne_bytes(x.try_into().unwrap_or([0; 8]));
+                // Values near zero (a box's centre) against the array's magnitude.
+                let scale = a
+                    .chunks_exact(8)
+                    .map(|x| float(x).abs())
+                    .fold(0.0, f64::max);
+                match a.chunks_exact(8).zip(b.chunks_exact(8)).position(|(x, y)| {
+                    let (x, y) = (float(x), float(y));
+                    !close(x, y) && (x - y).abs() > bound * scale
+                }) {
+                    Some(k) => 8 * k,
+                    None => continue,
+                }
+            } else {
+                a.iter().zip(b).position(|(x, y)| x != y).unwrap_or(0)
+            };
+            // SAFETY: NUL-terminated static string.
+            let name = unsafe { std::ffi::CStr::from_ptr(name) }.to_string_lossy();
+            out.push(format!("{name} (byte {at})"));
         }
         let (mut a, mut b) = ([0.0; 7], [0.0; 7]);
         // SAFETY: live models; 7 values each.
@@ -76,7 +126,7 @@ impl CompiledModel {
         .iter()
         .enumerate()
         {
-            if a[k].to_bits() != b[k].to_bits() {
+            if !close(a[k], b[k]) {
                 out.push(format!("stat.{name}: {} != {}", a[k], b[k]));
             }
         }

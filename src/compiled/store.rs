@@ -313,9 +313,15 @@ impl State {
         let ptr = model.as_mut_ptr();
         for (t, e) in plan.targets.iter().zip(entries) {
             match (&t.landing, &e.value) {
-                (Landing::BodyModel { body }, PatchValue::BodyModel(xml)) => {
+                (Landing::BodyModel { body }, PatchValue::BodyModel(xml)) if e.field == "geoms" => {
                     plan.body_models.write(ptr, *body, xml)?
                 }
+                (Landing::BodyModel { .. }, PatchValue::BodyModel(xml)) => {
+                    plan.body_models.unit(xml)?
+                }
+                (Landing::GeomFactors { body, .. }, PatchValue::Numbers(factors)) => plan
+                    .body_models
+                    .write_masses(ptr, *body, &e.name, factors)?,
                 _ => write(ptr, t, &e.value)?,
             }
         }
@@ -347,7 +353,9 @@ fn write(model: *mut MjModel, t: &Target, value: &PatchValue) -> Result<(), Stri
             run = &option;
             run
         }
-        Landing::BodyModel { .. } => return Err("a body model is written by its plan".into()),
+        Landing::BodyModel { .. } | Landing::GeomFactors { .. } => {
+            return Err("a body model is written by its plan".into());
+        }
     };
     // SAFETY: `ptr` is the start of the live model's array (or option field) of `count`
     // elements of `elem` bytes, found by `resolve`; nothing else views it meanwhile.
@@ -397,7 +405,7 @@ fn resolve(model: &mut CompiledModel, entries: &[PatchEntry]) -> Result<Vec<Targ
         let (ptr, elem, count) = match &landing {
             Landing::Numbers(run) => arrays.find(&run.array)?,
             Landing::Option { field, n } => option_field(arrays.0, field, *n)?,
-            Landing::BodyModel { .. } => (std::ptr::null_mut(), 0, 0),
+            Landing::BodyModel { .. } | Landing::GeomFactors { .. } => (std::ptr::null_mut(), 0, 0),
         };
         out.push(Target {
             landing,

@@ -10,8 +10,8 @@
 use super::Drawn;
 use crate::document::tree::Node;
 use crate::split::{
-    PatchEntry, PatchValue, Rules, body_model, carried_by, dropped, entry, free_joint, massless,
-    normalized, numbers,
+    PatchEntry, PatchValue, Rules, body_model_entries, carried_by, dropped, entry, free_joint,
+    massless, normalized, numbers,
 };
 
 /// Variant `index` as a structure key and a patch (see [`super::Scene::patch`]).
@@ -110,17 +110,17 @@ pub(crate) fn split_parts(
             let mut applied = doc.clone();
             overlay.apply_to(&mut applied);
             for body in modelled {
-                if let (Some(model), Some(name)) =
-                    (body_model(&applied, body), applied.attr(body, "name"))
+                // Only densities and masses vary: its unit model, compiled once.
+                let masses_only = carried
+                    .iter()
+                    .filter(|c| c.0 == body)
+                    .all(|c| matches!(c.2, "density" | "mass"));
+                if let Some(name) = applied.attr(body, "name")
+                    && let Some(made) =
+                        body_model_entries(&applied, body, name.to_string(), masses_only)
                 {
-                    entries.push(PatchEntry {
-                        object: "body",
-                        name: name.to_string(),
-                        id: None,
-                        field: "geoms",
-                        value: PatchValue::BodyModel(model),
-                    });
-                    parts.push(part);
+                    parts.extend(std::iter::repeat_n(part, made.len()));
+                    entries.extend(made);
                     continue;
                 }
                 // No body model after all: its values are structure.

@@ -259,15 +259,18 @@ impl Scene {
             let doc = &m.named;
             // Bodies whose body models carry randomized values of their geoms (sizes,
             // frames, densities): one entry each, placed or parked.
-            let mut modelled: Vec<Node> = Vec::new();
+            // With whether only their geoms' densities and masses vary.
+            let mut modelled: Vec<(Node, bool)> = Vec::new();
             for (r, targets) in &inst.targets {
                 for t in targets {
                     for attr in self.randomizers[*r].attributes_set(doc, t.node) {
                         if rules.body_models
                             && let Some(body) = split::carried_by(doc, t.node, attr)
                         {
-                            if !modelled.contains(&body) {
-                                modelled.push(body);
+                            let masses = matches!(attr, "density" | "mass");
+                            match modelled.iter_mut().find(|(b, _)| *b == body) {
+                                Some((_, only)) => *only &= masses,
+                                None => modelled.push((body, masses)),
                             }
                             continue;
                         }
@@ -309,23 +312,23 @@ impl Scene {
                     }
                     None => doc,
                 };
-                for body in modelled {
-                    let (Some(model), Some(name)) =
-                        (split::body_model(source, body), source.attr(body, "name"))
-                    else {
+                for (body, masses_only) in modelled {
+                    let made = source.attr(body, "name").and_then(|name| {
+                        split::body_model_entries(
+                            source,
+                            body,
+                            format!("{}{name}", m.tag),
+                            masses_only,
+                        )
+                    });
+                    let Some(made) = made else {
                         return Err(Errors(vec![Error::bare(ErrorKind::Invalid(format!(
                             "variant {index}: a geom of '{}' changes what its body derives, \
                              and the body cannot be compiled alone",
                             m.root
                         )))]));
                     };
-                    entries.push(PatchEntry {
-                        object: "body",
-                        name: format!("{}{name}", m.tag),
-                        id: None,
-                        field: "geoms",
-                        value: PatchValue::BodyModel(model),
-                    });
+                    entries.extend(made);
                 }
             }
             let active = overlay.is_some();

@@ -22,6 +22,8 @@ pub trait ModelArraysMut: ModelArrays {
     fn floats_mut(&mut self, name: &str) -> Result<&mut [f64], String>;
     /// An array of `mjtByte`, to write.
     fn bytes_mut(&mut self, name: &str) -> Result<&mut [u8], String>;
+    /// An array of `int`, to write.
+    fn ints_mut(&mut self, name: &str) -> Result<&mut [i32], String>;
 }
 
 /// The arrays copied from a body model, each with its width: per geom of the body, per

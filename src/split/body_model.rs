@@ -21,6 +21,9 @@ use crate::document::Document;
 use crate::document::tree::Node;
 use crate::document::write::escape_attr;
 
+use super::rules::{PatchEntry, PatchValue};
+use super::targets::GEOM_FACTORS;
+
 /// Geom types whose `size` alone sets their shape (with the type's defaults).
 const PRIMITIVES: [&str; 5] = ["sphere", "capsule", "ellipsoid", "cylinder", "box"];
 
@@ -181,6 +184,162 @@ pub(crate) fn body_model(doc: &Document, body: Node) -> Option<String> {
     xml.push_str(&inner);
     xml.push_str("</body></worldbody></mujoco>");
     Some(xml)
+}
+
+/// The entries of `body` (named `name` in the compiled model) for what its geoms derive:
+/// with `masses_only` (its geoms' densities and masses are all that vary), its unit model
+/// and those numbers (`unit_geoms`, `geom_factors`: see [`unit_model`]) when it has one;
+/// else its body model (`geoms`). `None`: the body cannot be compiled alone.
+pub(crate) fn body_model_entries(
+    doc: &Document,
+    body: Node,
+    name: String,
+    masses_only: bool,
+) -> Option<Vec<PatchEntry>> {
+    let entry = |field: &'static str, value: PatchValue| PatchEntry {
+        object: "body",
+        name: name.clone(),
+        id: None,
+        field,
+        value,
+    };
+    if masses_only && let Some((unit, factors)) = unit_model(doc, body) {
+        return Some(vec![
+            entry("unit_geoms", PatchValue::BodyModel(unit)),
+            entry(GEOM_FACTORS, PatchValue::Numbers(factors)),
+        ]);
+    }
+    Some(vec![entry(
+        "geoms",
+        PatchValue::BodyModel(body_model(doc, body)?),
+    )])
+}
+
+/// The unit model of `body` and its geoms' factors: every geom that counts for its
+/// inertia (its group in the compiler's `inertiagrouprange`), in order, alone in a body of
+/// its own (inside its `<frame>`s) at `density="1"` (or `mass="1"` where it sets a mass),
+/// and each one's density (MuJoCo's 1000 where unset) or mass. A geom's mass and inertia
+/// are linear in those, so one compile of the unit model serves every variant whose
+/// geoms differ in them alone ([`write_geom_masses`](super::write_geom_masses)). `None`
+/// when the body model is not [`complete`], the body has an `<inertial>` or the compiler
+/// does not take inertias from geoms the default way, or a number does not read.
+pub(crate) fn unit_model(doc: &Document, body: Node) -> Option<(String, Vec<f64>)> {
+    if !complete(doc, body) || doc.elements(body).any(|c| doc.tag(c) == "inertial") {
+        return None;
+    }
+    let compilers: Vec<Node> = doc
+        .elements(doc.root())
+        .filter(|&n| doc.tag(n) == "compiler")
+        .collect();
+    let setting = |attr: &str| compilers.iter().rev().find_map(|&c| doc.attr(c, attr));
+    if setting("inertiafromgeom").is_some_and(|v| v.trim() != "auto") {
+        return None;
+    }
+    let range: Vec<i64> = match setting("inertiagrouprange") {
+        Some(v) => v
+            .split_whitespace()
+            .map(|x| x.parse().ok())
+            .collect::<Option<_>>()?,
+        None => vec![0, 5],
+    };
+    let [low, high] = range[..] else {
+        return None;
+    };
+    let mut geoms: Vec<(Node, Vec<Node>)> = Vec::new();
+    collect_geoms(doc, body, &mut Vec::new(), &mut geoms);
+    let mut xml = String::from("<mujoco>");
+    for &compiler in &compilers {
+        xml.push_str("<compiler");
+        for (attr, value) in doc.attrs(compiler) {
+            if !matches!(attr, "meshdir" | "texturedir" | "assetdir") {
+                push_attr(&mut xml, attr, value);
+            }
+        }
+        xml.push_str("/>");
+    }
+    let mut meshes: Vec<Node> = Vec::new();
+    let mut bodies = String::new();
+    let mut factors = Vec::new();
+    for (geom, frames) in geoms {
+        let group: i64 = match doc.attr(geom, "group") {
+            Some(g) => g.trim().parse().ok()?,
+            None => 0,
+        };
+        if group < low || group > high {
+            continue;
+        }
+        let (attr, factor) = match (doc.attr(geom, "mass"), doc.attr(geom, "density")) {
+            (Some(m), _) => ("mass", m.trim().parse().ok()?),
+            (None, Some(d)) => ("density", d.trim().parse().ok()?),
+            (None, None) => ("density", 1000.0),
+        };
+        factors.push(factor);
+        if let Some(mesh) = mesh_asset(doc, geom)
+            && !meshes.contains(&mesh)
+        {
+            meshes.push(mesh);
+        }
+        bodies.push_str("<body>");
+        for &frame in &frames {
+            bodies.push_str("<frame");
+            for (a, v) in doc.attrs(frame) {
+                if !LEFT_OUT.contains(&a) && a != "childclass" {
+                    push_attr(&mut bodies, a, v);
+                }
+            }
+            bodies.push('>');
+        }
+        bodies.push_str("<geom");
+        for (a, v) in doc.attrs(geom) {
+            if !LEFT_OUT.contains(&a) && !matches!(a, "mass" | "density") {
+                push_attr(&mut bodies, a, v);
+            }
+        }
+        push_attr(&mut bodies, attr, "1");
+        bodies.push_str("/>");
+        for _ in &frames {
+            bodies.push_str("</frame>");
+        }
+        bodies.push_str("</body>");
+    }
+    if factors.is_empty() {
+        return None;
+    }
+    if !meshes.is_empty() {
+        xml.push_str("<asset>");
+        for mesh in meshes {
+            xml.push_str("<mesh");
+            for (attr, value) in doc.attrs(mesh) {
+                push_attr(&mut xml, attr, value);
+            }
+            xml.push_str("/>");
+        }
+        xml.push_str("</asset>");
+    }
+    xml.push_str("<worldbody>");
+    xml.push_str(&bodies);
+    xml.push_str("</worldbody></mujoco>");
+    Some((xml, factors))
+}
+
+/// The geoms of `node` in document order, each with the `<frame>`s around it.
+fn collect_geoms(
+    doc: &Document,
+    node: Node,
+    frames: &mut Vec<Node>,
+    out: &mut Vec<(Node, Vec<Node>)>,
+) {
+    for child in doc.elements(node) {
+        match doc.tag(child) {
+            "geom" => out.push((child, frames.clone())),
+            "frame" => {
+                frames.push(child);
+                collect_geoms(doc, child, frames, out);
+                frames.pop();
+            }
+            _ => {}
+        }
+    }
 }
 
 /// Writes the `<inertial>`, geoms and `<frame>`s (with their geoms) of `node` as the body

@@ -28,7 +28,7 @@
 //! # Ok::<(), String>(())
 //! ```
 
-use super::targets::{DOF_FIELDS, QPOS_FIELDS, joint_widths, target_array};
+use super::targets::{DOF_FIELDS, GEOM_FACTORS, QPOS_FIELDS, joint_widths, target_array};
 
 /// What a model's layout tells [`land`]: its integer arrays and every array's length.
 pub trait ModelLayout {
@@ -47,7 +47,7 @@ pub enum Carried {
     Numbers(usize),
     /// A name, whose element's id is written (a material chosen for a geom).
     Id,
-    /// A body model (what MuJoCo derives from a body's geoms).
+    /// A body model or unit model (MJCF text: what MuJoCo derives from a body's geoms).
     BodyModel,
 }
 
@@ -56,10 +56,19 @@ pub enum Carried {
 pub enum Landing {
     /// Numbers, or an id, in one array of the model.
     Numbers(Run),
-    /// The body model of body `body`: copied by [`copy_body_model`](super::copy_body_model).
+    /// The body model or unit model of body `body` (the entry's field tells which; see
+    /// [`MODEL_FIELDS`](super::MODEL_FIELDS)).
     BodyModel {
         /// The body's id.
         body: usize,
+    },
+    /// The densities or masses of the geoms of body `body`'s unit model, `n` numbers:
+    /// written by [`write_geom_masses`](super::write_geom_masses).
+    GeomFactors {
+        /// The body's id.
+        body: usize,
+        /// How many numbers.
+        n: usize,
     },
     /// A field of the model's `mjOption`, `n` numbers.
     Option {
@@ -128,6 +137,9 @@ pub fn land(
         Carried::Id => 1,
         Carried::BodyModel => return Ok(Landing::BodyModel { body: id }),
     };
+    if object == "body" && field == GEOM_FACTORS {
+        return Ok(Landing::GeomFactors { body: id, n: width });
+    }
     let array = target_array(object, field)
         .ok_or_else(|| format!("a patch names no array for {object}.{field}"))?;
     let index = |name: &str, i: usize| -> Result<usize, String> {

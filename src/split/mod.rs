@@ -30,7 +30,8 @@
 //! `landing.rs` (where each patch entry lands in a compiled model and how its numbers are
 //! written, for both faces), `document.rs` (any document split by reading it), `body_model.rs` (a body's geoms as a
 //! model of their own, for what MuJoCo derives from their sizes), `body_copy.rs` (that
-//! model's compile copied into a structure's model, for both faces), `statistics.rs` (the
+//! model's compile copied into a structure's model, for both faces), `geom_masses.rs` (a
+//! body's mass properties from its geoms' densities or masses, at patch cost), `statistics.rs` (the
 //! compiler's statistics at `qpos0`, computed over a model's arrays for both faces). The scene tier reads its
 //! drawn variants through the same rules (`scene/patch.rs`).
 //!
@@ -40,6 +41,7 @@
 mod body_copy;
 mod body_model;
 mod document;
+mod geom_masses;
 mod landing;
 mod rules;
 mod statistics;
@@ -49,6 +51,10 @@ pub use body_copy::{MasslessFrame, ModelArrays, ModelArraysMut, copy_body_model,
 pub use document::{
     DocumentPatch, PATCHABLE_OPTIONS, SplitOptions, split_document, split_document_with,
 };
+pub use geom_masses::{
+    BodyMass, GeomMass, Volume, VolumeNode, body_frame_flag, body_mass, bounding_volumes,
+    frame_flag, write_geom_masses,
+};
 pub use landing::{ArrayMut, Carried, Landing, ModelLayout, Run, land};
 pub use rules::{PATCHABLE, PatchEntry, PatchValue};
 pub use statistics::{
@@ -56,11 +62,11 @@ pub use statistics::{
     mean_inertia, statistics,
 };
 pub use targets::{
-    DOF_FIELDS, PATCH_OBJECTS, PatchObject, QPOS_FIELDS, SIGNATURE_ARRAYS, SIGNATURE_SKIPPED_SIZES,
-    STATIC_PREFIXES, joint_widths, target_array,
+    DOF_FIELDS, GEOM_FACTORS, MODEL_FIELDS, PATCH_OBJECTS, PatchObject, QPOS_FIELDS,
+    SIGNATURE_ARRAYS, SIGNATURE_SKIPPED_SIZES, STATIC_PREFIXES, joint_widths, target_array,
 };
 
-pub(crate) use body_model::{body_model, carried_by};
+pub(crate) use body_model::{body_model_entries, carried_by};
 pub(crate) use rules::{
     Rules, discarded, dropped, entry, free_joint, massless, normalized, numbers, setting,
 };

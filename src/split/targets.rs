@@ -78,6 +78,18 @@ pub const PATCH_OBJECTS: [PatchObject; 8] = [
     },
 ];
 
+/// Fields of `body` entries whose value is the MJCF text of a model of the body's geoms,
+/// not numbers: `geoms`, the body model (its geoms as written, whose compile is copied
+/// whole: [`copy_body_model`](super::copy_body_model)), and `unit_geoms`, its unit model
+/// (each geom that counts for inertia alone, at unit density or mass:
+/// [`write_geom_masses`](super::write_geom_masses)), which the body's [`GEOM_FACTORS`]
+/// entry follows.
+pub const MODEL_FIELDS: [&str; 2] = ["geoms", "unit_geoms"];
+
+/// The field of a `body` entry whose numbers are the densities or masses of its unit
+/// model's geoms, in order.
+pub const GEOM_FACTORS: &str = "geom_factors";
+
 /// A joint's fields that are per degree of freedom (`dof_<field>`).
 pub const DOF_FIELDS: [&str; 3] = ["damping", "armature", "frictionloss"];
 

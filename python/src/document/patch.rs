@@ -54,8 +54,12 @@ pub(crate) fn patch_entry(
         .ok_or_else(unknown)?;
     let field = if field == "matid" {
         "matid"
-    } else if field == "geoms" {
-        "geoms"
+    } else if let Some(f) = mjcf_forge::split::MODEL_FIELDS
+        .iter()
+        .chain([&mjcf_forge::split::GEOM_FACTORS])
+        .find(|f| **f == field)
+    {
+        f
     } else {
         mjcf_forge::split::PATCHABLE
             .iter()
@@ -75,7 +79,9 @@ pub(crate) fn patch_entry(
     };
     let value = match value.extract::<String>() {
         // A body model: its geoms as MJCF text.
-        Ok(model) if field == "geoms" => PatchValue::BodyModel(model),
+        Ok(model) if mjcf_forge::split::MODEL_FIELDS.contains(&field) => {
+            PatchValue::BodyModel(model)
+        }
         Ok(target) => PatchValue::Id {
             object: "material",
             name: target,

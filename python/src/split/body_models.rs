@@ -25,7 +25,7 @@ const FLOATS: [&str; 12] = [
     "geom_quat",
     "bvh_aabb",
 ];
-const INTS: [&str; 8] = [
+const INTS: [&str; 10] = [
     "body_geomadr",
     "body_geomnum",
     "body_bvhadr",
@@ -34,6 +34,8 @@ const INTS: [&str; 8] = [
     "bvh_child",
     "bvh_depth",
     "bvh_nodeid",
+    "geom_contype",
+    "geom_conaffinity",
 ];
 const BYTES: [&str; 2] = ["body_sameframe", "geom_sameframe"];
 
@@ -124,6 +126,14 @@ impl split::ModelArraysMut for Writer<'_> {
             .map(|a| unsafe { a.slice_mut() })
             .ok_or_else(|| missing(name))
     }
+    fn ints_mut(&mut self, name: &str) -> Result<&mut [i32], String> {
+        // SAFETY: as above.
+        self.0
+            .ints
+            .get(name)
+            .map(|a| unsafe { a.slice_mut() })
+            .ok_or_else(|| missing(name))
+    }
 }
 
 #[pymethods]
@@ -144,7 +154,7 @@ impl PyModelArrays {
         for name in INTS {
             arrays
                 .ints
-                .insert(name, Array::of(&model.getattr(name)?, name, false)?);
+                .insert(name, Array::of(&model.getattr(name)?, name, true)?);
         }
         for name in BYTES {
             arrays
@@ -178,6 +188,26 @@ impl PyModelArrays {
             .find(|(b, _)| *b == body)
             .map(|(_, k)| k);
         split::copy_body_model(&mut Writer(self), body, name, kept, part)
+            .map_err(PyValueError::new_err)
+    }
+
+    /// Writes into body ``body`` (``name`` in errors) of this model its mass properties
+    /// for geoms of densities or masses ``factors``, read off ``unit``, the compile of the
+    /// body's unit model (``mjcf_forge::split::write_geom_masses``); raises ``ValueError``,
+    /// with nothing written, when the result is not a patch of this model.
+    fn write_geom_masses(
+        &self,
+        body: usize,
+        name: &str,
+        unit: &Bound<'_, PyModelArrays>,
+        factors: Vec<f64>,
+    ) -> PyResult<()> {
+        let unit = unit.get();
+        let address = |a: &PyModelArrays| a.floats.get("body_mass").map(Array::address);
+        if address(unit) == address(self) {
+            return Err(PyValueError::new_err("a unit model is another model"));
+        }
+        split::write_geom_masses(&mut Writer(self), body, name, unit, &factors)
             .map_err(PyValueError::new_err)
     }
 }

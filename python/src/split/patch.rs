@@ -83,8 +83,9 @@ struct Target {
 ///
 /// ``PatchLanding(model, patch, ids)``: ``patch`` a sequence of ``(object, name, field,
 /// value)``, ``ids`` each entry's element id in ``model`` (``None`` for an option).
-/// ``options`` lists the option entries as ``(field, first, n)``, the body-model entries
-/// (field ``geoms``) are left to the caller.
+/// ``options`` lists the option entries as ``(field, first, n)`` and ``geom_factors`` the
+/// ``geom_factors`` entries as ``(body, first, n)``; they and the body-model entries
+/// (``MODEL_FIELDS``) are the caller's to write.
 ///
 /// >>> import mujoco, numpy as np
 /// >>> from mjcf_forge._mjcf_forge import PatchLanding
@@ -102,6 +103,9 @@ pub(crate) struct PyPatchLanding {
     /// The option entries: `(field, first, n)`.
     #[pyo3(get)]
     options: Vec<(String, usize, usize)>,
+    /// The `geom_factors` entries: `(body, first, n)`.
+    #[pyo3(get)]
+    geom_factors: Vec<(usize, usize, usize)>,
 }
 
 #[pymethods]
@@ -119,6 +123,7 @@ impl PyPatchLanding {
             numbers: Vec::new(),
             ids: Vec::new(),
             options: Vec::new(),
+            geom_factors: Vec::new(),
         };
         let layout = Layout(model);
         let mut first = 0;
@@ -126,7 +131,7 @@ impl PyPatchLanding {
             let (object, _, field, value): (String, Bound<'_, PyAny>, String, Bound<'_, PyAny>) =
                 entry.extract()?;
             let carried = if value.is_instance_of::<PyString>() {
-                if field == "geoms" {
+                if split::MODEL_FIELDS.contains(&field.as_str()) {
                     Carried::BodyModel
                 } else {
                     Carried::Id
@@ -156,6 +161,10 @@ impl PyPatchLanding {
                 }
                 Landing::Option { field, n } => {
                     out.options.push((field, first, n));
+                    first += n;
+                }
+                Landing::GeomFactors { body, n } => {
+                    out.geom_factors.push((body, first, n));
                     first += n;
                 }
                 Landing::BodyModel { .. } => {}

@@ -25,6 +25,8 @@ pub(super) fn add(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "SIGNATURE_SKIPPED_SIZES",
         PyTuple::new(py, split::SIGNATURE_SKIPPED_SIZES)?,
     )?;
+    m.add("MODEL_FIELDS", PyTuple::new(py, split::MODEL_FIELDS)?)?;
+    m.add("GEOM_FACTORS", split::GEOM_FACTORS)?;
     m.add_function(wrap_pyfunction!(target_array, m)?)?;
     m.add_function(wrap_pyfunction!(joint_widths, m)?)?;
     Ok(())

@@ -1,0 +1,598 @@
+//! A body's mass properties from its geoms' densities or masses, at patch cost: what the
+//! compiler derives when a body takes its inertia from its geoms (its mass, principal
+//! inertia and inertial frame, the same-frame flags and its bounding volumes, which the
+//! compiler builds in the inertial frame), computed from each geom's properties at unit
+//! density (or unit mass) read off one compile of the body's *unit model* (every geom
+//! that counts for inertia alone in a body of its own, `density="1"` or `mass="1"`).
+//! Each geom's mass and inertia are linear in its density or mass, so the unit model is
+//! compiled once per structure, whatever the draws; meshes are never processed again.
+//!
+//! The arithmetic follows the compiler's (sums in its order, the same parallel-axis terms,
+//! a Jacobi eigen-decomposition for the principal axes), so masses are the compiler's bit
+//! for bit and inertias and inertial frames agree within a few units in the last place
+//! (relative 1e-12 is the bound the tests hold; docs/compiled.md). Both faces call
+//! [`write_geom_masses`] with their own MuJoCo's arrays.
+
+use super::body_copy::{ModelArrays, ModelArraysMut};
+
+/// MuJoCo's `mjEPS`.
+const EPS: f64 = 1e-14;
+/// The compiler's tolerance for "the same frame" (flags `mjtSameFrame`).
+const FRAME_EPS: f64 = 1e-6;
+/// The eigen-decomposition's tolerance between eigenvalues it orders.
+const EIG_EPS: f64 = 1e-12;
+/// The largest off-diagonal element the eigen-decomposition leaves, relative to the
+/// diagonal's size.
+const OFF_DIAGONAL: f64 = 1e-15;
+
+/// One geom's mass properties in its body's frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GeomMass {
+    /// Its mass.
+    pub mass: f64,
+    /// Its principal inertia about its centre of mass, in its own frame.
+    pub inertia: [f64; 3],
+    /// Its frame (for a mesh, the mesh's centre of mass and principal axes).
+    pub pos: [f64; 3],
+    /// Its orientation.
+    pub quat: [f64; 4],
+}
+
+/// A body's mass properties: mass, principal inertia, inertial frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodyMass {
+    /// The body's mass.
+    pub mass: f64,
+    /// Its principal inertia, in decreasing order.
+    pub inertia: [f64; 3],
+    /// Its centre of mass, in the body's frame.
+    pub ipos: [f64; 3],
+    /// Its principal axes.
+    pub iquat: [f64; 4],
+}
+
+fn quat_to_mat(q: &[f64; 4]) -> [f64; 9] {
+    let (q0, q1, q2, q3) = (q[0], q[1], q[2], q[3]);
+    let (q00, q01, q02, q03) = (q0 * q0, q0 * q1, q0 * q2, q0 * q3);
+    let (q11, q12, q13) = (q1 * q1, q1 * q2, q1 * q3);
+    let (q22, q23, q33) = (q2 * q2, q2 * q3, q3 * q3);
+    [
+        q00 + q11 - q22 - q33,
+        2.0 * (q12 - q03),
+        2.0 * (q13 + q02),
+        2.0 * (q12 + q03),
+        q00 - q11 + q22 - q33,
+        2.0 * (q23 - q01),
+        2.0 * (q13 - q02),
+        2.0 * (q23 + q01),
+        q00 - q11 - q22 + q33,
+    ]
+}
+
+fn mul_quat(a: &[f64; 4], b: &[f64; 4]) -> [f64; 4] {
+    [
+        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+        a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+        a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
+    ]
+}
+
+fn normalized(mut q: [f64; 4]) -> [f64; 4] {
+    let norm = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
+    if norm < EPS {
+        return [1.0, 0.0, 0.0, 0.0];
+    }
+    for x in &mut q {
+        *x /= norm;
+    }
+    q
+}
+
+/// `v` rotated by `q` (unchanged for the zero vector and the unit quaternion).
+fn rotate(v: &[f64; 3], q: &[f64; 4]) -> [f64; 3] {
+    if v == &[0.0; 3] {
+        return [0.0; 3];
+    }
+    if q == &[1.0, 0.0, 0.0, 0.0] {
+        return *v;
+    }
+    // t = w v + q x v, then v + 2 q x t.
+    let t = [
+        q[0] * v[0] + q[2] * v[2] - q[3] * v[1],
+        q[0] * v[1] + q[3] * v[0] - q[1] * v[2],
+        q[0] * v[2] + q[1] * v[1] - q[2] * v[0],
+    ];
+    [
+        v[0] + 2.0 * (q[2] * t[2] - q[3] * t[1]),
+        v[1] + 2.0 * (q[3] * t[0] - q[1] * t[2]),
+        v[2] + 2.0 * (q[1] * t[1] - q[2] * t[0]),
+    ]
+}
+
+fn mat_mul(a: &[f64; 9], b: &[f64; 9]) -> [f64; 9] {
+    let mut out = [0.0; 9];
+    for r in 0..3 {
+        for c in 0..3 {
+            out[3 * r + c] = a[3 * r] * b[c] + a[3 * r + 1] * b[3 + c] + a[3 * r + 2] * b[6 + c];
+        }
+    }
+    out
+}
+
+fn transpose(a: &[f64; 9]) -> [f64; 9] {
+    [a[0], a[3], a[6], a[1], a[4], a[7], a[2], a[5], a[8]]
+}
+
+/// The eigenvalues (decreasing) and principal axes (as a quaternion) of the symmetric
+/// matrix `m`: Jacobi rotations accumulated in a quaternion, as the compiler computes a
+/// body's principal axes.
+fn eigen(m: &[f64; 9]) -> ([f64; 3], [f64; 4]) {
+    let mut quat = [1.0, 0.0, 0.0, 0.0];
+    let mut values = [m[0], m[4], m[8]];
+    for _ in 0..500 {
+        let axes = quat_to_mat(&quat);
+        let d = mat_mul(&mat_mul(&transpose(&axes), m), &axes);
+        values = [d[0], d[4], d[8]];
+        // The largest off-diagonal element: (row, column, rotation axis).
+        let (r, c, k) = if d[1].abs() > d[2].abs() && d[1].abs() > d[5].abs() {
+            (0, 1, 2)
+        } else if d[2].abs() > d[5].abs() {
+            (0, 2, 1)
+        } else {
+            (1, 2, 0)
+        };
+        let scale = d[0].abs() + d[4].abs() + d[8].abs();
+        if d[3 * r + c].abs() < EIG_EPS.min(OFF_DIAGONAL * scale) {
+            break;
+        }
+        let tau = (d[4 * c] - d[4 * r]) / (2.0 * d[3 * r + c]);
+        let t = if tau >= 0.0 {
+            1.0 / (tau + (1.0 + tau * tau).sqrt())
+        } else {
+            -1.0 / (-tau + (1.0 + tau * tau).sqrt())
+        };
+        // The half angle from the angle itself: precise for the small rotations that
+        // finish the job (from the cosine, they round to none).
+        let half = 0.5 * t.abs().atan();
+        if half.sin() == 0.0 {
+            break;
+        }
+        let mut rot = [half.cos(), 0.0, 0.0, 0.0];
+        rot[k + 1] = if tau >= 0.0 { -half.sin() } else { half.sin() };
+        if k == 1 {
+            rot[k + 1] = -rot[k + 1];
+        }
+        quat = normalized(mul_quat(&quat, &normalized(rot)));
+    }
+    // Decreasing order: swap neighbours (0-1, 1-2, 0-1), turning the axes with them.
+    for j in 0..3 {
+        let lead = j % 2;
+        if values[lead] + EIG_EPS < values[lead + 1] {
+            values.swap(lead, lead + 1);
+            // The compiler's rounded cos(pi/4), not FRAC_1_SQRT_2: the same turn, the same bits.
+            #[allow(clippy::approx_constant)]
+            let mut rot = [0.707106781186548, 0.0, 0.0, 0.0];
+            rot[(lead + 2) % 3 + 1] = rot[0];
+            quat = normalized(mul_quat(&quat, &rot));
+        }
+    }
+    (values, quat)
+}
+
+/// A principal inertia in the frame `quat`, as a full inertia `[xx, yy, zz, xy, xz, yz]`
+/// of the frame it is given in.
+fn global_inertia(local: &[f64; 3], quat: &[f64; 4]) -> [f64; 6] {
+    let m = quat_to_mat(quat);
+    let t = [
+        m[0] * local[0],
+        m[3] * local[0],
+        m[6] * local[0],
+        m[1] * local[1],
+        m[4] * local[1],
+        m[7] * local[1],
+        m[2] * local[2],
+        m[5] * local[2],
+        m[8] * local[2],
+    ];
+    [
+        m[0] * t[0] + m[1] * t[3] + m[2] * t[6],
+        m[3] * t[1] + m[4] * t[4] + m[5] * t[7],
+        m[6] * t[2] + m[7] * t[5] + m[8] * t[8],
+        m[0] * t[1] + m[1] * t[4] + m[2] * t[7],
+        m[0] * t[2] + m[1] * t[5] + m[2] * t[8],
+        m[3] * t[2] + m[4] * t[5] + m[5] * t[8],
+    ]
+}
+
+/// The parallel-axis term of `mass` at `d` from the centre of mass.
+fn off_center(mass: f64, d: &[f64; 3]) -> [f64; 6] {
+    [
+        mass * (d[1] * d[1] + d[2] * d[2]),
+        mass * (d[0] * d[0] + d[2] * d[2]),
+        mass * (d[0] * d[0] + d[1] * d[1]),
+        -mass * d[0] * d[1],
+        -mass * d[0] * d[2],
+        -mass * d[1] * d[2],
+    ]
+}
+
+/// The mass properties of a body whose inertia comes from `geoms` (those that count for
+/// inertia, in the body's order), as the compiler combines them: one geom's are the
+/// body's; several add up about their common centre of mass, then turn to principal axes.
+///
+/// ```
+/// use mjcf_forge::split::{GeomMass, body_mass};
+/// let unit = GeomMass { mass: 1.0, inertia: [0.1; 3], pos: [0.0; 3], quat: [1.0, 0.0, 0.0, 0.0] };
+/// let two = [unit, GeomMass { pos: [1.0, 0.0, 0.0], ..unit }];
+/// let body = body_mass(&two)?;
+/// assert_eq!((body.mass, body.ipos), (2.0, [0.5, 0.0, 0.0]));
+/// # Ok::<(), String>(())
+/// ```
+pub fn body_mass(geoms: &[GeomMass]) -> Result<BodyMass, String> {
+    match geoms {
+        [] => Err("no geom counts for its inertia".to_string()),
+        [one] => Ok(BodyMass {
+            mass: one.mass,
+            inertia: one.inertia,
+            ipos: one.pos,
+            iquat: one.quat,
+        }),
+        _ => {
+            let mut mass = 0.0;
+            let mut com = [0.0; 3];
+            for g in geoms {
+                mass += g.mass;
+                for (c, p) in com.iter_mut().zip(g.pos) {
+                    *c += g.mass * p;
+                }
+            }
+            if mass < EPS {
+                return Err("its mass is too small for a centre of mass".to_string());
+            }
+            let ipos = [com[0] / mass, com[1] / mass, com[2] / mass];
+            let mut total = [0.0; 6];
+            for g in geoms {
+                let d = [g.pos[0] - ipos[0], g.pos[1] - ipos[1], g.pos[2] - ipos[2]];
+                let own = global_inertia(&g.inertia, &g.quat);
+                let shift = off_center(g.mass, &d);
+                for ((t, o), s) in total.iter_mut().zip(own).zip(shift) {
+                    *t = *t + o + s;
+                }
+            }
+            let full = [
+                total[0], total[3], total[4], total[3], total[1], total[5], total[4], total[5],
+                total[2],
+            ];
+            let (inertia, iquat) = eigen(&full);
+            if inertia[2] < EPS {
+                return Err("its inertia has an eigenvalue that is not positive".to_string());
+            }
+            Ok(BodyMass {
+                mass,
+                inertia,
+                ipos,
+                iquat,
+            })
+        }
+    }
+}
+
+fn null3(v: &[f64; 3]) -> bool {
+    v.iter().all(|x| x.abs() < FRAME_EPS)
+}
+
+fn same3(a: &[f64; 3], b: &[f64; 3]) -> bool {
+    a.iter().zip(b).all(|(x, y)| (x - y).abs() < FRAME_EPS)
+}
+
+fn same_quat(a: &[f64; 4], b: &[f64; 4]) -> bool {
+    a.iter().zip(b).all(|(x, y)| (x - y).abs() < FRAME_EPS)
+        || a.iter().zip(b).all(|(x, y)| (x + y).abs() < FRAME_EPS)
+}
+
+const UNIT: [f64; 4] = [1.0, 0.0, 0.0, 0.0];
+
+/// A body's same-frame flag (`mjtSameFrame`) from its inertial frame: its own frame (1),
+/// its own orientation (3), or neither (0).
+pub fn body_frame_flag(ipos: &[f64; 3], iquat: &[f64; 4]) -> u8 {
+    match (same_quat(iquat, &UNIT), null3(ipos)) {
+        (true, true) => 1,
+        (true, false) => 3,
+        _ => 0,
+    }
+}
+
+/// A geom's or site's same-frame flag from its frame and its body's inertial frame: the
+/// body's frame (1), the body's orientation (3), the inertial frame (2), its orientation
+/// (4), or none (0).
+pub fn frame_flag(pos: &[f64; 3], quat: &[f64; 4], ipos: &[f64; 3], iquat: &[f64; 4]) -> u8 {
+    let null_quat = same_quat(quat, &UNIT);
+    if null3(pos) && null_quat {
+        1
+    } else if null_quat {
+        3
+    } else if same3(pos, ipos) && same_quat(quat, iquat) {
+        2
+    } else if same_quat(quat, iquat) {
+        4
+    } else {
+        0
+    }
+}
+
+/// One geom as its body's bounding volumes see it.
+#[derive(Clone, Copy, Debug)]
+pub struct Volume {
+    /// The geom's id (what a leaf names).
+    pub id: i32,
+    /// Whether it collides (`contype` or `conaffinity`): the others are left out.
+    pub collides: bool,
+    /// Its frame in the body's.
+    pub pos: [f64; 3],
+    /// Its orientation in the body's frame.
+    pub quat: [f64; 4],
+    /// Its box (`geom_aabb`: centre and half sizes, in its own frame).
+    pub aabb: [f64; 6],
+}
+
+/// A node of a body's bounding-volume tree, as `mjModel` holds it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VolumeNode {
+    /// Its box in the body's inertial frame: centre and half sizes.
+    pub aabb: [f64; 6],
+    /// Its children (-1: none).
+    pub child: [i32; 2],
+    /// The geom of a leaf (-1 for an inner node).
+    pub nodeid: i32,
+    /// Its depth.
+    pub depth: i32,
+}
+
+/// The bounding-volume tree of a body's geoms in its inertial frame `(ipos, iquat)`: the
+/// compiler's construction (boxes of the geoms' boxes' corners, split at the median along
+/// the longest edge), nodes in its order.
+pub fn bounding_volumes(volumes: &[Volume], ipos: &[f64; 3], iquat: &[f64; 4]) -> Vec<VolumeNode> {
+    let inverse = [iquat[0], -iquat[1], -iquat[2], -iquat[3]];
+    let mut elements: Vec<(usize, [f64; 3])> = volumes
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| v.collides)
+        .map(|(i, v)| {
+            let d = [v.pos[0] - ipos[0], v.pos[1] - ipos[1], v.pos[2] - ipos[2]];
+            (i, rotate(&d, &inverse))
+        })
+        .collect();
+    let mut nodes = Vec::new();
+    build(volumes, &mut elements, ipos, &inverse, 0, &mut nodes);
+    nodes
+}
+
+fn build(
+    volumes: &[Volume],
+    elements: &mut [(usize, [f64; 3])],
+    ipos: &[f64; 3],
+    inverse: &[f64; 4],
+    depth: i32,
+    nodes: &mut Vec<VolumeNode>,
+) -> i32 {
+    if elements.is_empty() {
+        return -1;
+    }
+    let mut lo = [f64::MAX; 3];
+    let mut hi = [-f64::MAX; 3];
+    for &(i, _) in elements.iter() {
+        let v = &volumes[i];
+        let a = &v.aabb;
+        let (min, max) = (
+            [a[0] - a[3], a[1] - a[4], a[2] - a[5]],
+            [a[0] + a[3], a[1] + a[4], a[2] + a[5]],
+        );
+        for corner in 0..8 {
+            let c = [
+                if corner & 1 != 0 { max[0] } else { min[0] },
+                if corner & 2 != 0 { max[1] } else { min[1] },
+                if corner & 4 != 0 { max[2] } else { min[2] },
+            ];
+            let mut b = rotate(&c, &v.quat);
+            for k in 0..3 {
+                b[k] += v.pos[k] - ipos[k];
+            }
+            let p = rotate(&b, inverse);
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+    }
+    for k in 0..3 {
+        if (lo[k] - hi[k]).abs() < EPS {
+            lo[k] -= EPS;
+            hi[k] += EPS;
+        }
+    }
+    let index = nodes.len();
+    nodes.push(VolumeNode {
+        aabb: [
+            (hi[0] + lo[0]) / 2.0,
+            (hi[1] + lo[1]) / 2.0,
+            (hi[2] + lo[2]) / 2.0,
+            (hi[0] - lo[0]) / 2.0,
+            (hi[1] - lo[1]) / 2.0,
+            (hi[2] - lo[2]) / 2.0,
+        ],
+        child: [-1, -1],
+        nodeid: -1,
+        depth,
+    });
+    if elements.len() == 1 {
+        nodes[index].nodeid = volumes[elements[0].0].id;
+        return index as i32;
+    }
+    let edges = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
+    let mut axis = 0;
+    if edges[1] >= edges[0] + EPS {
+        axis = 1;
+    }
+    if edges[2] >= edges[axis] + EPS {
+        axis = 2;
+    }
+    // The median along the axis (ties within mjEPS in the geoms' order).
+    elements.sort_by(|a, b| {
+        if (a.1[axis] - b.1[axis]).abs() > EPS {
+            a.1[axis].total_cmp(&b.1[axis])
+        } else {
+            a.0.cmp(&b.0)
+        }
+    });
+    let m = elements.len() / 2;
+    let (left, right) = elements.split_at_mut(m);
+    if m > 0 {
+        nodes[index].child[0] = build(volumes, left, ipos, inverse, depth + 1, nodes);
+    }
+    nodes[index].child[1] = build(volumes, right, ipos, inverse, depth + 1, nodes);
+    index as i32
+}
+
+fn row<const N: usize>(a: &[f64], i: usize) -> Result<[f64; N], String> {
+    a.get(N * i..N * (i + 1))
+        .and_then(|r| r.try_into().ok())
+        .ok_or_else(|| format!("row {i} out of range"))
+}
+
+fn at(a: &[i32], i: usize, what: &str) -> Result<usize, String> {
+    a.get(i)
+        .and_then(|&v| usize::try_from(v).ok())
+        .ok_or_else(|| format!("{what}[{i}] out of range"))
+}
+
+/// Writes into body `body` (named `name` in errors) of `model` its mass properties for
+/// geoms of densities or masses `factors`: `unit` is the compile of the body's unit model
+/// (body `k + 1` holds the `k`-th geom that counts for inertia alone, at density or mass
+/// 1; see the module). The geoms' same-frame flags and the bounding-volume tree are written
+/// in the new inertial frame. Refused, with nothing written, when the result would not be
+/// a patch of the structure (the body's own same-frame flag would change, which the
+/// compiler's other choices follow).
+pub fn write_geom_masses(
+    model: &mut impl ModelArraysMut,
+    body: usize,
+    name: &str,
+    unit: &impl ModelArrays,
+    factors: &[f64],
+) -> Result<(), String> {
+    let (um, ui) = (unit.floats("body_mass")?, unit.floats("body_inertia")?);
+    let (up, uq) = (unit.floats("body_ipos")?, unit.floats("body_iquat")?);
+    if um.len() != factors.len() + 1 {
+        return Err(format!(
+            "body '{name}': its unit model has {} bodies for {} geoms",
+            um.len().saturating_sub(1),
+            factors.len()
+        ));
+    }
+    let geoms = factors
+        .iter()
+        .enumerate()
+        .map(|(k, &f)| {
+            let i: [f64; 3] = row(ui, k + 1)?;
+            Ok(GeomMass {
+                mass: f * um[k + 1],
+                inertia: [f * i[0], f * i[1], f * i[2]],
+                pos: row(up, k + 1)?,
+                quat: row(uq, k + 1)?,
+            })
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    let b = body_mass(&geoms).map_err(|e| format!("body '{name}': {e}"))?;
+    let not_a_patch = |what: &str| {
+        format!(
+            "body '{name}': its geoms' densities or masses move its inertial frame so that \
+             {what} would change: not a patch of this structure"
+        )
+    };
+    if model.bytes("body_sameframe")?.get(body).copied() != Some(body_frame_flag(&b.ipos, &b.iquat))
+    {
+        return Err(not_a_patch("its same-frame flag"));
+    }
+    let first = at(model.ints("body_geomadr")?, body, "body_geomadr")?;
+    let count = at(model.ints("body_geomnum")?, body, "body_geomnum")?;
+    let (pos, quat) = (model.floats("geom_pos")?, model.floats("geom_quat")?);
+    let aabb = model.floats("geom_aabb")?;
+    let (contype, conaffinity) = (model.ints("geom_contype")?, model.ints("geom_conaffinity")?);
+    let mut volumes = Vec::with_capacity(count);
+    let mut flags = Vec::with_capacity(count);
+    for g in first..first + count {
+        let (p, q) = (row(pos, g)?, row(quat, g)?);
+        flags.push(frame_flag(&p, &q, &b.ipos, &b.iquat));
+        volumes.push(Volume {
+            id: i32::try_from(g).map_err(|_| "too many geoms".to_string())?,
+            collides: contype.get(g).copied().unwrap_or(0) != 0
+                || conaffinity.get(g).copied().unwrap_or(0) != 0,
+            pos: p,
+            quat: q,
+            aabb: row(aabb, g)?,
+        });
+    }
+    // The tree in the new inertial frame: its boxes, and its shape where the frame's turn
+    // reorders the geoms (as many nodes: one per geom that collides, and the inner ones).
+    let nodes = if count > 0 {
+        bounding_volumes(&volumes, &b.ipos, &b.iquat)
+    } else {
+        Vec::new()
+    };
+    let adr = at(model.ints("body_bvhadr")?, body, "body_bvhadr").unwrap_or(0);
+    let num = at(model.ints("body_bvhnum")?, body, "body_bvhnum")?;
+    if nodes.len() != num {
+        return Err(not_a_patch("its bounding-volume tree's size"));
+    }
+    model.floats_mut("body_mass")?[body] = b.mass;
+    model.floats_mut("body_inertia")?[3 * body..3 * body + 3].copy_from_slice(&b.inertia);
+    model.floats_mut("body_ipos")?[3 * body..3 * body + 3].copy_from_slice(&b.ipos);
+    model.floats_mut("body_iquat")?[4 * body..4 * body + 4].copy_from_slice(&b.iquat);
+    model.bytes_mut("geom_sameframe")?[first..first + count].copy_from_slice(&flags);
+    let boxes = model.floats_mut("bvh_aabb")?;
+    for (k, n) in nodes.iter().enumerate() {
+        boxes[6 * (adr + k)..6 * (adr + k + 1)].copy_from_slice(&n.aabb);
+    }
+    let child = model.ints_mut("bvh_child")?;
+    for (k, n) in nodes.iter().enumerate() {
+        child[2 * (adr + k)..2 * (adr + k + 1)].copy_from_slice(&n.child);
+    }
+    let nodeid = model.ints_mut("bvh_nodeid")?;
+    for (k, n) in nodes.iter().enumerate() {
+        nodeid[adr + k] = n.nodeid;
+    }
+    let depth = model.ints_mut("bvh_depth")?;
+    for (k, n) in nodes.iter().enumerate() {
+        depth[adr + k] = n.depth;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn principal_axes_of_a_diagonal_inertia_are_sorted() {
+        let (values, quat) = eigen(&[1.0, 0.0, 0.0, 0.0, 3.0, 0.0, 0.0, 0.0, 2.0]);
+        assert_eq!(values, [3.0, 2.0, 1.0]);
+        // The axes turn with the values: the first principal axis is the old y.
+        let m = quat_to_mat(&quat);
+        assert!((m[3].abs() - 1.0).abs() < 1e-12, "{m:?}");
+    }
+
+    #[test]
+    fn one_geom_is_its_body() {
+        let g = GeomMass {
+            mass: 2.0,
+            inertia: [3.0, 2.0, 1.0],
+            pos: [1.0, 2.0, 3.0],
+            quat: [0.0, 1.0, 0.0, 0.0],
+        };
+        let b = body_mass(&[g]).unwrap();
+        assert_eq!(
+            (b.mass, b.inertia, b.ipos, b.iquat),
+            (g.mass, g.inertia, g.pos, g.quat)
+        );
+    }
+}
