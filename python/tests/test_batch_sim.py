@@ -5,7 +5,7 @@ its own JAX implementation and MuJoCo Warp's kernels under it, impl="warp").
 CI runs MuJoCo Warp on the patch scene, MJX's JAX implementation on the fixed-base one
 and MJX over MuJoCo Warp on the patch scene, CPU MuJoCo and the refusals; the others
 (marked ``full``: the big scenes, lift5, LIBERO, the demo, Menagerie's UR5e, and the
-other small ones) run with MJCF_FORGE_FULL=1 (scripts/test_full.sh).
+other small ones, densities.toml among them) run with MJCF_FORGE_FULL=1 (scripts/test_full.sh).
 
 Per scene: 8 worlds, each holding a variant of the scene's superset, stepped 500 steps;
 every placed body within 1e-4 m of its variant compiled alone and stepped on CPU MuJoCo
@@ -35,6 +35,8 @@ LIFT5 = ROOT / "benches" / "scenes" / "lift5.toml"
 BOXES = ROOT / "corpora" / "scenes" / "patch" / "boxes.toml"
 # Fixed-base objects varying per world beside free ones (boxes only, for MJX too).
 FIXED = ROOT / "corpora" / "scenes" / "patch" / "fixed.toml"
+# A density drawn per geom: per world, centres of mass move and principal axes turn.
+DENSITIES = ROOT / "corpora" / "scenes" / "patch" / "densities.toml"
 WORLDS = 8
 STEPS = 500
 TOLERANCE = 1e-4
@@ -138,7 +140,9 @@ def warp_step(m, d):
 
 
 @pytest.mark.parametrize(
-    "path", [PATCH, pytest.param(FIXED, marks=pytest.mark.full)], ids=["patch", "fixed"]
+    "path",
+    [PATCH, pytest.param(FIXED, marks=pytest.mark.full), pytest.param(DENSITIES, marks=pytest.mark.full)],
+    ids=["patch", "fixed", "densities"],
 )
 def test_mujoco_warp_worlds_agree_with_each_variant(path):
     """The patch scene (and fixed-base objects varying per world) in MuJoCo Warp, with
@@ -520,17 +524,21 @@ def test_mjx_worlds_agree_with_each_variant(path):
     print("mjx", path.stem, report)
 
 
-def test_mjx_warp_worlds_agree_with_each_variant():
-    """The patch scene (a cylinder arm, cylinder and box clutter) in MJX with
-    impl="warp": every world within 1e-4 m of its variant on CPU MuJoCo."""
-    scene = mjcf_forge.Scene.load(PATCH)
+@pytest.mark.parametrize(
+    "path", [PATCH, pytest.param(DENSITIES, marks=pytest.mark.full)], ids=["patch", "densities"]
+)
+def test_mjx_warp_worlds_agree_with_each_variant(path):
+    """The patch scene (a cylinder arm, cylinder and box clutter; and its objects with a
+    density per geom) in MJX with impl="warp": every world within 1e-4 m of its variant
+    on CPU MuJoCo."""
+    scene = mjcf_forge.Scene.load(path)
     batch = WorldBatch(scene, range(WORLDS))
     run, contacts, overflow = mjx_sim("warp")(batch)
     report = judge(scene, batch, run, contacts)
     assert not overflow()
     # Without impl, to_mjx keeps the implementation it was put with.
     assert str(batch.to_mjx()[0].impl.value) == "warp"
-    print("mjx warp patch", report)
+    print("mjx warp", path.stem, report)
 
 
 @pytest.mark.full
