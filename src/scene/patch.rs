@@ -8,10 +8,11 @@
 //! values through them.
 
 use super::Drawn;
+use super::randomize::AttrTarget;
 use crate::document::tree::Node;
 use crate::split::{
     PatchEntry, PatchValue, Rules, body_model_entries, carried_by, dropped, entry, free_joint,
-    massless, normalized, numbers,
+    massless, normalized, numbers, unit_model_entries,
 };
 
 /// Variant `index` as a structure key and a patch (see [`super::Scene::patch`]).
@@ -106,18 +107,33 @@ pub(crate) fn split_parts(
                 }
             }
         }
+        // Bodies whose geoms' densities and masses alone vary: their unit models (compiled
+        // once), the values read through the overlay (no copy of the document).
+        modelled.retain(|&body| {
+            let masses_only = carried
+                .iter()
+                .filter(|c| c.0 == body)
+                .all(|c| matches!(c.2, "density" | "mass"));
+            let value = |n: Node, a: &str| overlay.get(n, a).map(str::to_string);
+            let made = match doc.attr(body, "name") {
+                Some(name) if masses_only => unit_model_entries(doc, body, name, &value, None),
+                _ => None,
+            };
+            match made {
+                Some(made) => {
+                    parts.extend(std::iter::repeat_n(part, made.len()));
+                    entries.extend(made);
+                    false
+                }
+                None => true,
+            }
+        });
         if !modelled.is_empty() {
             let mut applied = doc.clone();
             overlay.apply_to(&mut applied);
             for body in modelled {
-                // Only densities and masses vary: its unit model, compiled once.
-                let masses_only = carried
-                    .iter()
-                    .filter(|c| c.0 == body)
-                    .all(|c| matches!(c.2, "density" | "mass"));
                 if let Some(name) = applied.attr(body, "name")
-                    && let Some(made) =
-                        body_model_entries(&applied, body, name.to_string(), masses_only)
+                    && let Some(made) = body_model_entries(&applied, body, name.to_string(), false)
                 {
                     parts.extend(std::iter::repeat_n(part, made.len()));
                     entries.extend(made);

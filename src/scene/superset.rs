@@ -78,6 +78,26 @@ struct Member {
     /// The instance with its unnamed bodies and geoms named (see [`name_internally`]),
     /// before the tag: what its patch entries are read from.
     named: Document,
+    /// Its bodies' unit models' text, made once.
+    units: split::UnitCache,
+    /// Which body carries an element's attribute ([`split::carried_by`]), found once.
+    carried: std::sync::Mutex<ahash::AHashMap<(Node, String), Option<Node>>>,
+}
+
+impl Member {
+    /// The body whose body model carries `attr` of `node` in [`Member::named`], if any:
+    /// the same for every variant, so found once.
+    fn carried_by(&self, node: Node, attr: &str) -> Option<Node> {
+        let key = (node, attr.to_string());
+        if let Some(found) = self.carried.lock().ok().and_then(|c| c.get(&key).copied()) {
+            return found;
+        }
+        let found = split::carried_by(&self.named, node, attr);
+        if let Ok(mut c) = self.carried.lock() {
+            c.insert(key, found);
+        }
+        found
+    }
 }
 
 /// Names the unnamed bodies and geoms below `root` (itself included) of an instance whose
@@ -265,7 +285,7 @@ impl Scene {
                 for t in targets {
                     for attr in self.randomizers[*r].attributes_set(doc, t.node) {
                         if rules.body_models
-                            && let Some(body) = split::carried_by(doc, t.node, attr)
+                            && let Some(body) = m.carried_by(t.node, attr)
                         {
                             let masses = matches!(attr, "density" | "mass");
                             match modelled.iter_mut().find(|(b, _)| *b == body) {
@@ -300,6 +320,45 @@ impl Scene {
                     }
                 }
             }
+            // Bodies whose geoms' densities and masses alone vary: their unit models, the
+            // values read through the variant's (no copy of the document).
+            let mut whole = Vec::new();
+            // The variant's densities and masses by element, found at once.
+            let drawn_masses: ahash::AHashMap<(Node, &str), &str> = overlay
+                .map(|o| {
+                    o.values
+                        .iter()
+                        .filter(|(_, a, _)| matches!(a.as_str(), "density" | "mass"))
+                        .map(|(n, a, v)| ((*n, a.as_str()), v.as_str()))
+                        .collect()
+                })
+                .unwrap_or_default();
+            for (body, masses_only) in modelled {
+                let made = match doc.attr(body, "name") {
+                    Some(name) if masses_only => {
+                        let value = |n: Node, a: &str| {
+                            drawn_masses
+                                .get(&(n, a))
+                                .copied()
+                                .or_else(|| doc.attr(n, a))
+                                .map(str::to_string)
+                        };
+                        split::unit_model_entries(
+                            doc,
+                            body,
+                            &format!("{}{name}", m.tag),
+                            &value,
+                            Some(&m.units),
+                        )
+                    }
+                    _ => None,
+                };
+                match made {
+                    Some(made) => entries.extend(made),
+                    None => whole.push((body, false)),
+                }
+            }
+            let modelled = whole;
             if !modelled.is_empty() {
                 // Placed: the variant's values; parked: as authored.
                 let applied;
@@ -515,5 +574,7 @@ fn member(
         bodies,
         geoms,
         named,
+        units: split::UnitCache::default(),
+        carried: Default::default(),
     })
 }

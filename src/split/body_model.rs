@@ -196,23 +196,54 @@ pub(crate) fn body_model_entries(
     name: String,
     masses_only: bool,
 ) -> Option<Vec<PatchEntry>> {
+    if masses_only
+        && let Some(made) = unit_model_entries(
+            doc,
+            body,
+            &name,
+            &|n, a| doc.attr(n, a).map(str::to_string),
+            None,
+        )
+    {
+        return Some(made);
+    }
+    Some(vec![PatchEntry {
+        object: "body",
+        name,
+        id: None,
+        field: "geoms",
+        value: PatchValue::BodyModel(body_model(doc, body)?),
+    }])
+}
+
+/// Unit models' text already made, by body (its node's index) and which of its geoms set a
+/// mass (all the text depends on besides the document): a superset's variants make the
+/// same ones again and again.
+pub(crate) type UnitCache = std::sync::Mutex<ahash::AHashMap<(usize, Vec<bool>), String>>;
+
+/// The unit model's entries of `body` (named `name`), its geoms' densities and masses
+/// read through `value` (a variant's values over the document's: no copy of the document
+/// with them applied is needed, since the unit model's text holds none of them), its text
+/// kept in `cache` when given.
+pub(crate) fn unit_model_entries(
+    doc: &Document,
+    body: Node,
+    name: &str,
+    value: &dyn Fn(Node, &str) -> Option<String>,
+    cache: Option<&UnitCache>,
+) -> Option<Vec<PatchEntry>> {
+    let (unit, factors) = unit_model(doc, body, value, cache)?;
     let entry = |field: &'static str, value: PatchValue| PatchEntry {
         object: "body",
-        name: name.clone(),
+        name: name.to_string(),
         id: None,
         field,
         value,
     };
-    if masses_only && let Some((unit, factors)) = unit_model(doc, body) {
-        return Some(vec![
-            entry("unit_geoms", PatchValue::BodyModel(unit)),
-            entry(GEOM_FACTORS, PatchValue::Numbers(factors)),
-        ]);
-    }
-    Some(vec![entry(
-        "geoms",
-        PatchValue::BodyModel(body_model(doc, body)?),
-    )])
+    Some(vec![
+        entry("unit_geoms", PatchValue::BodyModel(unit)),
+        entry(GEOM_FACTORS, PatchValue::Numbers(factors)),
+    ])
 }
 
 /// The unit model of `body` and its geoms' factors: every geom that counts for its
@@ -222,8 +253,14 @@ pub(crate) fn body_model_entries(
 /// are linear in those, so one compile of the unit model serves every variant whose
 /// geoms differ in them alone ([`write_geom_masses`](super::write_geom_masses)). `None`
 /// when the body model is not [`complete`], the body has an `<inertial>` or the compiler
-/// does not take inertias from geoms the default way, or a number does not read.
-pub(crate) fn unit_model(doc: &Document, body: Node) -> Option<(String, Vec<f64>)> {
+/// does not take inertias from geoms the default way, or a number does not read. The
+/// geoms' `mass` and `density` are read through `value`; the text is kept in `cache`.
+pub(crate) fn unit_model(
+    doc: &Document,
+    body: Node,
+    value: &dyn Fn(Node, &str) -> Option<String>,
+    cache: Option<&UnitCache>,
+) -> Option<(String, Vec<f64>)> {
     if !complete(doc, body) || doc.elements(body).any(|c| doc.tag(c) == "inertial") {
         return None;
     }
@@ -247,6 +284,36 @@ pub(crate) fn unit_model(doc: &Document, body: Node) -> Option<(String, Vec<f64>
     };
     let mut geoms: Vec<(Node, Vec<Node>)> = Vec::new();
     collect_geoms(doc, body, &mut Vec::new(), &mut geoms);
+    // The geoms that count, whether each sets a mass, and its density or mass.
+    let mut counted = Vec::new();
+    let (mut masses, mut factors) = (Vec::new(), Vec::new());
+    for (geom, frames) in geoms {
+        let group: i64 = match doc.attr(geom, "group") {
+            Some(g) => g.trim().parse().ok()?,
+            None => 0,
+        };
+        if group < low || group > high {
+            continue;
+        }
+        let (mass, factor) = match (
+            value(geom, "mass").as_deref(),
+            value(geom, "density").as_deref(),
+        ) {
+            (Some(m), _) => (true, m.trim().parse().ok()?),
+            (None, Some(d)) => (false, d.trim().parse().ok()?),
+            (None, None) => (false, 1000.0),
+        };
+        counted.push((geom, frames));
+        masses.push(mass);
+        factors.push(factor);
+    }
+    if factors.is_empty() {
+        return None;
+    }
+    let key = (crate::document::tree::Tree::index(body), masses);
+    if let Some(text) = cache.and_then(|c| c.lock().ok()?.get(&key).cloned()) {
+        return Some((text, factors));
+    }
     let mut xml = String::from("<mujoco>");
     for &compiler in &compilers {
         xml.push_str("<compiler");
@@ -259,28 +326,14 @@ pub(crate) fn unit_model(doc: &Document, body: Node) -> Option<(String, Vec<f64>
     }
     let mut meshes: Vec<Node> = Vec::new();
     let mut bodies = String::new();
-    let mut factors = Vec::new();
-    for (geom, frames) in geoms {
-        let group: i64 = match doc.attr(geom, "group") {
-            Some(g) => g.trim().parse().ok()?,
-            None => 0,
-        };
-        if group < low || group > high {
-            continue;
-        }
-        let (attr, factor) = match (doc.attr(geom, "mass"), doc.attr(geom, "density")) {
-            (Some(m), _) => ("mass", m.trim().parse().ok()?),
-            (None, Some(d)) => ("density", d.trim().parse().ok()?),
-            (None, None) => ("density", 1000.0),
-        };
-        factors.push(factor);
-        if let Some(mesh) = mesh_asset(doc, geom)
+    for ((geom, frames), &mass) in counted.iter().zip(&key.1) {
+        if let Some(mesh) = mesh_asset(doc, *geom)
             && !meshes.contains(&mesh)
         {
             meshes.push(mesh);
         }
         bodies.push_str("<body>");
-        for &frame in &frames {
+        for &frame in frames {
             bodies.push_str("<frame");
             for (a, v) in doc.attrs(frame) {
                 if !LEFT_OUT.contains(&a) && a != "childclass" {
@@ -290,20 +343,17 @@ pub(crate) fn unit_model(doc: &Document, body: Node) -> Option<(String, Vec<f64>
             bodies.push('>');
         }
         bodies.push_str("<geom");
-        for (a, v) in doc.attrs(geom) {
+        for (a, v) in doc.attrs(*geom) {
             if !LEFT_OUT.contains(&a) && !matches!(a, "mass" | "density") {
                 push_attr(&mut bodies, a, v);
             }
         }
-        push_attr(&mut bodies, attr, "1");
+        push_attr(&mut bodies, if mass { "mass" } else { "density" }, "1");
         bodies.push_str("/>");
-        for _ in &frames {
+        for _ in frames {
             bodies.push_str("</frame>");
         }
         bodies.push_str("</body>");
-    }
-    if factors.is_empty() {
-        return None;
     }
     if !meshes.is_empty() {
         xml.push_str("<asset>");
@@ -319,6 +369,9 @@ pub(crate) fn unit_model(doc: &Document, body: Node) -> Option<(String, Vec<f64>
     xml.push_str("<worldbody>");
     xml.push_str(&bodies);
     xml.push_str("</worldbody></mujoco>");
+    if let Some(mut held) = cache.and_then(|c| c.lock().ok()) {
+        held.insert(key, xml.clone());
+    }
     Some((xml, factors))
 }
 

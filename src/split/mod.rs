@@ -66,7 +66,7 @@ pub use targets::{
     SIGNATURE_ARRAYS, SIGNATURE_SKIPPED_SIZES, STATIC_PREFIXES, joint_widths, target_array,
 };
 
-pub(crate) use body_model::{body_model_entries, carried_by};
+pub(crate) use body_model::{UnitCache, body_model_entries, carried_by, unit_model_entries};
 pub(crate) use rules::{
     Rules, discarded, dropped, entry, free_joint, massless, normalized, numbers, setting,
 };
