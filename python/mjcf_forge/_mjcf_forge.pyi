@@ -18,6 +18,8 @@ QPOS_FIELDS: tuple[str, ...]
 STATIC_PREFIXES: tuple[str, ...]
 SIGNATURE_ARRAYS: tuple[str, ...]
 SIGNATURE_SKIPPED_SIZES: tuple[str, ...]
+MODEL_FIELDS: tuple[str, ...]
+GEOM_FACTORS: str
 
 def target_array(object: str, field: str) -> Optional[str]: ...
 def joint_widths(jnt_type: int) -> tuple[int, int]: ...
@@ -36,12 +38,14 @@ class ModelArrays:
 
     def __init__(self, model: Any) -> None: ...
     def copy_body_model(self, body: int, name: str, part: ModelArrays) -> None: ...
+    def write_geom_masses(self, body: int, name: str, unit: ModelArrays, factors: Sequence[float]) -> None: ...
 
 class PatchLanding:
     """Where each entry of a patch of one layout lands in a model, found once
     (``mjcf_forge::split::land``), and the writer of that layout's numbers and ids."""
 
     options: list[tuple[str, int, int]]
+    geom_factors: list[tuple[int, int, int]]
     def __init__(self, model: Any, patch: Sequence[Any], ids: Sequence[Optional[int]]) -> None: ...
     def write(self, values: npt.NDArray[np.float64], material_ids: Sequence[int]) -> None: ...
 
