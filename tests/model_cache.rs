@@ -27,6 +27,20 @@ fn superset_name(tags: &[(String, String)], name: &str) -> String {
         .map_or(name.to_string(), |(_, t)| format!("{t}{name}"))
 }
 
+/// A unit model's patch against MuJoCo's compile: what follows from mass properties
+/// ([`mjcf_forge::split::MASS_DERIVED`]) within 1e-12 relative, the rest bit for bit.
+fn within_mass_bound(got: &CompiledModel, want: &CompiledModel, i: u64) {
+    assert_eq!(got.differences_beyond(want, 1e-12), Vec::<String>::new());
+    for d in got.differences(want) {
+        assert!(
+            mjcf_forge::split::MASS_DERIVED
+                .iter()
+                .any(|a| d.starts_with(a)),
+            "variant {i}: {d}"
+        );
+    }
+}
+
 fn by_structure(scene: &Scene, n: u64) -> HashMap<String, Vec<u64>> {
     let mut groups: HashMap<String, Vec<u64>> = HashMap::new();
     for i in 0..n {
@@ -352,15 +366,7 @@ fn mass_of_bodies_without_inertial_scales_their_geoms() {
     let mut cache = ModelCache::new(&scene, 4, None);
     for indices in by_structure(&scene, 24).values() {
         for &i in indices.iter().take(3) {
-            let want = compiled(&scene, i);
-            let got = cache.model(i).unwrap();
-            assert_eq!(got.differences_beyond(&want, 1e-12), Vec::<String>::new());
-            for d in got.differences(&want) {
-                assert!(
-                    MASS_DERIVED.iter().any(|a| d.starts_with(a)),
-                    "variant {i}: {d}"
-                );
-            }
+            within_mass_bound(cache.model(i).unwrap(), &compiled(&scene, i), i);
         }
     }
     let groups: Vec<usize> = by_structure(&scene, 24).values().map(Vec::len).collect();
@@ -395,15 +401,8 @@ fn densities_per_geom_are_patches_of_unit_models() {
     let mut moved = 0;
     for indices in groups.values() {
         for &i in indices.iter().take(4) {
-            let want = compiled(&scene, i);
             let got = cache.model(i).unwrap();
-            assert_eq!(got.differences_beyond(&want, 1e-12), Vec::<String>::new());
-            for d in got.differences(&want) {
-                assert!(
-                    MASS_DERIVED.iter().any(|a| d.starts_with(a)),
-                    "variant {i}: {d}"
-                );
-            }
+            within_mass_bound(got, &compiled(&scene, i), i);
             moved += usize::from(got.body_ipos() != compiled(&scene, indices[0]).body_ipos());
         }
     }
@@ -416,19 +415,6 @@ fn densities_per_geom_are_patches_of_unit_models() {
     }
     assert_eq!(cache.compiles(), 1);
 }
-
-/// What MuJoCo derives from a body's mass properties: where a unit model's patch may
-/// differ from the compile in the last bits.
-const MASS_DERIVED: [&str; 8] = [
-    "body_inertia",
-    "body_iquat",
-    "bvh_aabb",
-    "body_invweight0",
-    "dof_invweight0",
-    "dof_M0",
-    "actuator_acc0",
-    "stat.meaninertia",
-];
 
 /// One of a compiled model's body arrays.
 type BodyArray = fn(&CompiledModel) -> &[f64];

@@ -20,6 +20,7 @@ SIGNATURE_ARRAYS: tuple[str, ...]
 SIGNATURE_SKIPPED_SIZES: tuple[str, ...]
 MODEL_FIELDS: tuple[str, ...]
 GEOM_FACTORS: str
+MASS_DERIVED: tuple[str, ...]
 
 def target_array(object: str, field: str) -> Optional[str]: ...
 def joint_widths(jnt_type: int) -> tuple[int, int]: ...

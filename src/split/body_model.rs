@@ -153,33 +153,15 @@ pub(crate) fn body_model(doc: &Document, body: Node) -> Option<String> {
         return None;
     }
     let mut xml = String::from("<mujoco>");
-    for compiler in doc
+    let compilers: Vec<Node> = doc
         .elements(doc.root())
         .filter(|&n| doc.tag(n) == "compiler")
-    {
-        xml.push_str("<compiler");
-        for (attr, value) in doc.attrs(compiler) {
-            // Mesh files are absolute (documents are loaded so): the folders do not matter.
-            if !matches!(attr, "meshdir" | "texturedir" | "assetdir") {
-                push_attr(&mut xml, attr, value);
-            }
-        }
-        xml.push_str("/>");
-    }
+        .collect();
+    push_compilers(doc, &compilers, &mut xml);
     let mut meshes: Vec<Node> = Vec::new();
     let mut inner = String::new();
     push_children(doc, body, &mut inner, &mut meshes);
-    if !meshes.is_empty() {
-        xml.push_str("<asset>");
-        for mesh in meshes {
-            xml.push_str("<mesh");
-            for (attr, value) in doc.attrs(mesh) {
-                push_attr(&mut xml, attr, value);
-            }
-            xml.push_str("/>");
-        }
-        xml.push_str("</asset>");
-    }
+    push_meshes(doc, &meshes, &mut xml);
     xml.push_str("<worldbody><body>");
     xml.push_str(&inner);
     xml.push_str("</body></worldbody></mujoco>");
@@ -315,15 +297,7 @@ pub(crate) fn unit_model(
         return Some((text, factors));
     }
     let mut xml = String::from("<mujoco>");
-    for &compiler in &compilers {
-        xml.push_str("<compiler");
-        for (attr, value) in doc.attrs(compiler) {
-            if !matches!(attr, "meshdir" | "texturedir" | "assetdir") {
-                push_attr(&mut xml, attr, value);
-            }
-        }
-        xml.push_str("/>");
-    }
+    push_compilers(doc, &compilers, &mut xml);
     let mut meshes: Vec<Node> = Vec::new();
     let mut bodies = String::new();
     for ((geom, frames), &mass) in counted.iter().zip(&key.1) {
@@ -355,17 +329,7 @@ pub(crate) fn unit_model(
         }
         bodies.push_str("</body>");
     }
-    if !meshes.is_empty() {
-        xml.push_str("<asset>");
-        for mesh in meshes {
-            xml.push_str("<mesh");
-            for (attr, value) in doc.attrs(mesh) {
-                push_attr(&mut xml, attr, value);
-            }
-            xml.push_str("/>");
-        }
-        xml.push_str("</asset>");
-    }
+    push_meshes(doc, &meshes, &mut xml);
     xml.push_str("<worldbody>");
     xml.push_str(&bodies);
     xml.push_str("</worldbody></mujoco>");
@@ -373,6 +337,36 @@ pub(crate) fn unit_model(
         held.insert(key, xml.clone());
     }
     Some((xml, factors))
+}
+
+/// The document's `<compiler>`s as a body or unit model has them: their folders left out
+/// (mesh files are absolute, as documents are loaded, so the folders do not matter).
+fn push_compilers(doc: &Document, compilers: &[Node], xml: &mut String) {
+    for &compiler in compilers {
+        xml.push_str("<compiler");
+        for (attr, value) in doc.attrs(compiler) {
+            if !matches!(attr, "meshdir" | "texturedir" | "assetdir") {
+                push_attr(xml, attr, value);
+            }
+        }
+        xml.push_str("/>");
+    }
+}
+
+/// The `<mesh>` assets a body or unit model's geoms use, as written.
+fn push_meshes(doc: &Document, meshes: &[Node], xml: &mut String) {
+    if meshes.is_empty() {
+        return;
+    }
+    xml.push_str("<asset>");
+    for &mesh in meshes {
+        xml.push_str("<mesh");
+        for (attr, value) in doc.attrs(mesh) {
+            push_attr(xml, attr, value);
+        }
+        xml.push_str("/>");
+    }
+    xml.push_str("</asset>");
 }
 
 /// The geoms of `node` in document order, each with the `<frame>`s around it.

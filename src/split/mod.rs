@@ -62,7 +62,7 @@ pub use statistics::{
     mean_inertia, statistics,
 };
 pub use targets::{
-    DOF_FIELDS, GEOM_FACTORS, MODEL_FIELDS, PATCH_OBJECTS, PatchObject, QPOS_FIELDS,
+    DOF_FIELDS, GEOM_FACTORS, MASS_DERIVED, MODEL_FIELDS, PATCH_OBJECTS, PatchObject, QPOS_FIELDS,
     SIGNATURE_ARRAYS, SIGNATURE_SKIPPED_SIZES, STATIC_PREFIXES, joint_widths, target_array,
 };
 

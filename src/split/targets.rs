@@ -90,6 +90,21 @@ pub const MODEL_FIELDS: [&str; 2] = ["geoms", "unit_geoms"];
 /// model's geoms, in order.
 pub const GEOM_FACTORS: &str = "geom_factors";
 
+/// What follows from a body's mass properties: the arrays (and statistic) in which a unit
+/// model's patch ([`write_geom_masses`](super::write_geom_masses)) may differ from
+/// MuJoCo's compile in the last bits (within 1e-12 relative, docs/compiled.md); every
+/// other array of such a patch is MuJoCo's bit for bit.
+pub const MASS_DERIVED: [&str; 8] = [
+    "body_inertia",
+    "body_iquat",
+    "bvh_aabb",
+    "body_invweight0",
+    "dof_invweight0",
+    "dof_M0",
+    "actuator_acc0",
+    "stat.meaninertia",
+];
+
 /// A joint's fields that are per degree of freedom (`dof_<field>`).
 pub const DOF_FIELDS: [&str; 3] = ["damping", "armature", "frictionloss"];
 

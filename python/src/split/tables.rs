@@ -27,6 +27,7 @@ pub(super) fn add(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     m.add("MODEL_FIELDS", PyTuple::new(py, split::MODEL_FIELDS)?)?;
     m.add("GEOM_FACTORS", split::GEOM_FACTORS)?;
+    m.add("MASS_DERIVED", PyTuple::new(py, split::MASS_DERIVED)?)?;
     m.add_function(wrap_pyfunction!(target_array, m)?)?;
     m.add_function(wrap_pyfunction!(joint_widths, m)?)?;
     Ok(())
