@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from ._mjcf_forge import GEOM_FACTORS, MODEL_FIELDS, target_array
+from ._mjcf_forge import GEOM_FACTORS, MODEL_FIELDS, ModelArrays, target_array
 from . import _mujoco
 from ._plan import OBJ
 
@@ -200,9 +200,11 @@ class TreeDerivation:
         # world: nothing to derive but its flags), and its bodies, geoms and sites whose
         # same-frame flags its patch may change (``framed``: those of the whole model).
         self.trees = {root: _Tree(mujoco, model, root) if root in moving else None for root in roots}
-        # Set again in every world that changes a tree (a few vectorized passes: cheaper
-        # than picking the changed trees' elements).
-        self.framed = tuple(np.array(sorted(f), dtype=int) for f in framed)
+        # Set again in every world that changes a tree (one pass: cheaper than picking the
+        # changed trees' elements), by the rule both faces share
+        # (mjcf_forge::split::write_frame_flags, through the extension's ModelArrays).
+        self.framed = tuple(sorted(int(i) for i in f) for f in framed)
+        self.arrays = ModelArrays(model)
         # Each tree's values as last written ("parked" or "placed"), and the derived
         # values of parked trees (the same in every world).
         self.state: dict[int, str] = {}
@@ -297,7 +299,7 @@ class TreeDerivation:
             if now != "parked" or self.state.get(root) != "parked":
                 changed.append((root, now))
         if self.sameframe and changed:
-            _sameframe(model, *self.framed)
+            self.arrays.write_frame_flags(*self.framed)
         for root, now in changed:
             tree = self.trees[root]
             if tree is not None:
@@ -434,44 +436,9 @@ def _recomputes_sameframe(mujoco: Any) -> bool:
     return int(model.body_sameframe[1]) != int(mujoco.mjtSameFrame.mjSAMEFRAME_NONE)
 
 
-def _null3(v: np.ndarray) -> np.ndarray:
-    return (np.abs(v) < _FRAME_EPS).all(axis=-1)
-
-
 def _same(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return (np.abs(a - b) < _FRAME_EPS).all(axis=-1)
 
 
 def _same_quat(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return _same(a, b) | (np.abs(a + b) < _FRAME_EPS).all(axis=-1)
-
-
-def _frame_flags(pos: np.ndarray, quat: np.ndarray, ipos: np.ndarray, iquat: np.ndarray) -> np.ndarray:
-    """A geom's or site's flag (mjtSameFrame) from its frame and its body's inertial frame,
-    by mj_setConst's rule and order."""
-    null_quat = _same_quat(quat, _UNIT)
-    same_quat = _same_quat(quat, iquat)
-    return np.select(
-        [_null3(pos) & null_quat, null_quat, _same(pos, ipos) & same_quat, same_quat],
-        [1, 3, 2, 4],
-        default=0,
-    )
-
-
-def _sameframe(model: Any, bodies: np.ndarray, geoms: np.ndarray, sites: np.ndarray) -> None:
-    """The same-frame flags of ``bodies`` (not the world), ``geoms`` and ``sites``, as
-    mj_setConst sets them."""
-    ipos, iquat = model.body_ipos, model.body_iquat
-    if len(bodies):
-        null_iquat = _same_quat(iquat[bodies], _UNIT)
-        model.body_sameframe[bodies] = np.where(null_iquat, np.where(_null3(ipos[bodies]), 1, 3), 0)
-    if len(geoms):
-        b = model.geom_bodyid[geoms]
-        model.geom_sameframe[geoms] = _frame_flags(
-            model.geom_pos[geoms], model.geom_quat[geoms], ipos[b], iquat[b]
-        )
-    if len(sites):
-        b = model.site_bodyid[sites]
-        model.site_sameframe[sites] = _frame_flags(
-            model.site_pos[sites], model.site_quat[sites], ipos[b], iquat[b]
-        )

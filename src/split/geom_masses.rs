@@ -321,6 +321,59 @@ pub fn frame_flag(pos: &[f64; 3], quat: &[f64; 4], ipos: &[f64; 3], iquat: &[f64
     }
 }
 
+/// Sets the same-frame flags of `bodies`, `geoms` and `sites` from their frames and their
+/// bodies' inertial frames ([`body_frame_flag`], [`frame_flag`]): what MuJoCo 4.0's
+/// `mj_setConst` sets again (3.17.0's keeps the compiler's), for a superset world derived
+/// tree by tree (`python/mjcf_forge/_trees.py`).
+pub fn write_frame_flags(
+    model: &mut impl ModelArraysMut,
+    bodies: &[usize],
+    geoms: &[usize],
+    sites: &[usize],
+) -> Result<(), String> {
+    let (ipos, iquat) = (model.floats("body_ipos")?, model.floats("body_iquat")?);
+    let mut body_flags = Vec::with_capacity(bodies.len());
+    for &b in bodies {
+        body_flags.push((b, body_frame_flag(&row(ipos, b)?, &row(iquat, b)?)));
+    }
+    let element_flags = |kind: &str, list: &[usize]| -> Result<Vec<(usize, u8)>, String> {
+        let (pos, quat) = (
+            model.floats(&format!("{kind}_pos"))?,
+            model.floats(&format!("{kind}_quat"))?,
+        );
+        let owner = model.ints(&format!("{kind}_bodyid"))?;
+        list.iter()
+            .map(|&i| {
+                let b = at(owner, i, "bodyid")?;
+                let flag = frame_flag(
+                    &row(pos, i)?,
+                    &row(quat, i)?,
+                    &row(ipos, b)?,
+                    &row(iquat, b)?,
+                );
+                Ok((i, flag))
+            })
+            .collect()
+    };
+    let geom_flags = element_flags("geom", geoms)?;
+    let site_flags = element_flags("site", sites)?;
+    for (name, flags) in [
+        ("body_sameframe", body_flags),
+        ("geom_sameframe", geom_flags),
+        ("site_sameframe", site_flags),
+    ] {
+        if flags.is_empty() {
+            continue;
+        }
+        let out = model.bytes_mut(name)?;
+        for (i, flag) in flags {
+            *out.get_mut(i)
+                .ok_or_else(|| format!("{name}[{i}] out of range"))? = flag;
+        }
+    }
+    Ok(())
+}
+
 /// One geom as its body's bounding volumes see it.
 #[derive(Clone, Copy, Debug)]
 pub struct Volume {

@@ -53,7 +53,7 @@ pub use document::{
 };
 pub use geom_masses::{
     BodyMass, GeomMass, Volume, VolumeNode, body_frame_flag, body_mass, bounding_volumes,
-    frame_flag, write_geom_masses,
+    frame_flag, write_frame_flags, write_geom_masses,
 };
 pub use landing::{ArrayMut, Carried, Landing, ModelLayout, Run, land};
 pub use rules::{PATCHABLE, PatchEntry, PatchValue};

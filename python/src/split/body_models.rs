@@ -11,7 +11,7 @@ use super::arrays::Array;
 use mjcf_forge::split::{self, MasslessFrame};
 
 /// The arrays the copy reads or writes, by type.
-const FLOATS: [&str; 12] = [
+const FLOATS: [&str; 14] = [
     "body_mass",
     "body_inertia",
     "body_pos",
@@ -24,8 +24,10 @@ const FLOATS: [&str; 12] = [
     "geom_pos",
     "geom_quat",
     "bvh_aabb",
+    "site_pos",
+    "site_quat",
 ];
-const INTS: [&str; 10] = [
+const INTS: [&str; 12] = [
     "body_geomadr",
     "body_geomnum",
     "body_bvhadr",
@@ -36,8 +38,10 @@ const INTS: [&str; 10] = [
     "bvh_nodeid",
     "geom_contype",
     "geom_conaffinity",
+    "geom_bodyid",
+    "site_bodyid",
 ];
-const BYTES: [&str; 2] = ["body_sameframe", "geom_sameframe"];
+const BYTES: [&str; 3] = ["body_sameframe", "geom_sameframe", "site_sameframe"];
 
 /// A compiled model's arrays a body model is copied from or into, found once.
 ///
@@ -188,6 +192,19 @@ impl PyModelArrays {
             .find(|(b, _)| *b == body)
             .map(|(_, k)| k);
         split::copy_body_model(&mut Writer(self), body, name, kept, part)
+            .map_err(PyValueError::new_err)
+    }
+
+    /// Sets the same-frame flags of ``bodies``, ``geoms`` and ``sites`` of this model from
+    /// their frames (``mjcf_forge::split::write_frame_flags``: what MuJoCo 4.0's
+    /// ``mj_setConst`` sets again).
+    fn write_frame_flags(
+        &self,
+        bodies: Vec<usize>,
+        geoms: Vec<usize>,
+        sites: Vec<usize>,
+    ) -> PyResult<()> {
+        split::write_frame_flags(&mut Writer(self), &bodies, &geoms, &sites)
             .map_err(PyValueError::new_err)
     }
 
