@@ -14,16 +14,11 @@
 //! [`write_geom_masses`] with their own MuJoCo's arrays.
 
 use super::body_copy::{ModelArrays, ModelArraysMut};
+use super::rotation::{EPS, eigen, quat_to_mat};
+use super::volumes::{Volume, bounding_volumes};
 
-/// MuJoCo's `mjEPS`.
-const EPS: f64 = 1e-14;
 /// The compiler's tolerance for "the same frame" (flags `mjtSameFrame`).
 const FRAME_EPS: f64 = 1e-6;
-/// The eigen-decomposition's tolerance between eigenvalues it orders.
-const EIG_EPS: f64 = 1e-12;
-/// The largest off-diagonal element the eigen-decomposition leaves, relative to the
-/// diagonal's size.
-const OFF_DIAGONAL: f64 = 1e-15;
 
 /// One geom's mass properties in its body's frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -49,135 +44,6 @@ pub struct BodyMass {
     pub ipos: [f64; 3],
     /// Its principal axes.
     pub iquat: [f64; 4],
-}
-
-fn quat_to_mat(q: &[f64; 4]) -> [f64; 9] {
-    let (q0, q1, q2, q3) = (q[0], q[1], q[2], q[3]);
-    let (q00, q01, q02, q03) = (q0 * q0, q0 * q1, q0 * q2, q0 * q3);
-    let (q11, q12, q13) = (q1 * q1, q1 * q2, q1 * q3);
-    let (q22, q23, q33) = (q2 * q2, q2 * q3, q3 * q3);
-    [
-        q00 + q11 - q22 - q33,
-        2.0 * (q12 - q03),
-        2.0 * (q13 + q02),
-        2.0 * (q12 + q03),
-        q00 - q11 + q22 - q33,
-        2.0 * (q23 - q01),
-        2.0 * (q13 - q02),
-        2.0 * (q23 + q01),
-        q00 - q11 - q22 + q33,
-    ]
-}
-
-fn mul_quat(a: &[f64; 4], b: &[f64; 4]) -> [f64; 4] {
-    [
-        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
-        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
-        a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
-        a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
-    ]
-}
-
-fn normalized(mut q: [f64; 4]) -> [f64; 4] {
-    let norm = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
-    if norm < EPS {
-        return [1.0, 0.0, 0.0, 0.0];
-    }
-    for x in &mut q {
-        *x /= norm;
-    }
-    q
-}
-
-/// `v` rotated by `q` (unchanged for the zero vector and the unit quaternion).
-fn rotate(v: &[f64; 3], q: &[f64; 4]) -> [f64; 3] {
-    if v == &[0.0; 3] {
-        return [0.0; 3];
-    }
-    if q == &[1.0, 0.0, 0.0, 0.0] {
-        return *v;
-    }
-    // t = w v + q x v, then v + 2 q x t.
-    let t = [
-        q[0] * v[0] + q[2] * v[2] - q[3] * v[1],
-        q[0] * v[1] + q[3] * v[0] - q[1] * v[2],
-        q[0] * v[2] + q[1] * v[1] - q[2] * v[0],
-    ];
-    [
-        v[0] + 2.0 * (q[2] * t[2] - q[3] * t[1]),
-        v[1] + 2.0 * (q[3] * t[0] - q[1] * t[2]),
-        v[2] + 2.0 * (q[1] * t[1] - q[2] * t[0]),
-    ]
-}
-
-fn mat_mul(a: &[f64; 9], b: &[f64; 9]) -> [f64; 9] {
-    let mut out = [0.0; 9];
-    for r in 0..3 {
-        for c in 0..3 {
-            out[3 * r + c] = a[3 * r] * b[c] + a[3 * r + 1] * b[3 + c] + a[3 * r + 2] * b[6 + c];
-        }
-    }
-    out
-}
-
-fn transpose(a: &[f64; 9]) -> [f64; 9] {
-    [a[0], a[3], a[6], a[1], a[4], a[7], a[2], a[5], a[8]]
-}
-
-/// The eigenvalues (decreasing) and principal axes (as a quaternion) of the symmetric
-/// matrix `m`: Jacobi rotations accumulated in a quaternion, as the compiler computes a
-/// body's principal axes.
-fn eigen(m: &[f64; 9]) -> ([f64; 3], [f64; 4]) {
-    let mut quat = [1.0, 0.0, 0.0, 0.0];
-    let mut values = [m[0], m[4], m[8]];
-    for _ in 0..500 {
-        let axes = quat_to_mat(&quat);
-        let d = mat_mul(&mat_mul(&transpose(&axes), m), &axes);
-        values = [d[0], d[4], d[8]];
-        // The largest off-diagonal element: (row, column, rotation axis).
-        let (r, c, k) = if d[1].abs() > d[2].abs() && d[1].abs() > d[5].abs() {
-            (0, 1, 2)
-        } else if d[2].abs() > d[5].abs() {
-            (0, 2, 1)
-        } else {
-            (1, 2, 0)
-        };
-        let scale = d[0].abs() + d[4].abs() + d[8].abs();
-        if d[3 * r + c].abs() < EIG_EPS.min(OFF_DIAGONAL * scale) {
-            break;
-        }
-        let tau = (d[4 * c] - d[4 * r]) / (2.0 * d[3 * r + c]);
-        let t = if tau >= 0.0 {
-            1.0 / (tau + (1.0 + tau * tau).sqrt())
-        } else {
-            -1.0 / (-tau + (1.0 + tau * tau).sqrt())
-        };
-        // The half angle from the angle itself: precise for the small rotations that
-        // finish the job (from the cosine, they round to none).
-        let half = 0.5 * t.abs().atan();
-        if half.sin() == 0.0 {
-            break;
-        }
-        let mut rot = [half.cos(), 0.0, 0.0, 0.0];
-        rot[k + 1] = if tau >= 0.0 { -half.sin() } else { half.sin() };
-        if k == 1 {
-            rot[k + 1] = -rot[k + 1];
-        }
-        quat = normalized(mul_quat(&quat, &normalized(rot)));
-    }
-    // Decreasing order: swap neighbours (0-1, 1-2, 0-1), turning the axes with them.
-    for j in 0..3 {
-        let lead = j % 2;
-        if values[lead] + EIG_EPS < values[lead + 1] {
-            values.swap(lead, lead + 1);
-            // The compiler's rounded cos(pi/4), not FRAC_1_SQRT_2: the same turn, the same bits.
-            #[allow(clippy::approx_constant)]
-            let mut rot = [0.707106781186548, 0.0, 0.0, 0.0];
-            rot[(lead + 2) % 3 + 1] = rot[0];
-            quat = normalized(mul_quat(&quat, &rot));
-        }
-    }
-    (values, quat)
 }
 
 /// A principal inertia in the frame `quat`, as a full inertia `[xx, yy, zz, xy, xz, yz]`
@@ -374,139 +240,6 @@ pub fn write_frame_flags(
     Ok(())
 }
 
-/// One geom as its body's bounding volumes see it.
-#[derive(Clone, Copy, Debug)]
-pub struct Volume {
-    /// The geom's id (what a leaf names).
-    pub id: i32,
-    /// Whether it collides (`contype` or `conaffinity`): the others are left out.
-    pub collides: bool,
-    /// Its frame in the body's.
-    pub pos: [f64; 3],
-    /// Its orientation in the body's frame.
-    pub quat: [f64; 4],
-    /// Its box (`geom_aabb`: centre and half sizes, in its own frame).
-    pub aabb: [f64; 6],
-}
-
-/// A node of a body's bounding-volume tree, as `mjModel` holds it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct VolumeNode {
-    /// Its box in the body's inertial frame: centre and half sizes.
-    pub aabb: [f64; 6],
-    /// Its children (-1: none).
-    pub child: [i32; 2],
-    /// The geom of a leaf (-1 for an inner node).
-    pub nodeid: i32,
-    /// Its depth.
-    pub depth: i32,
-}
-
-/// The bounding-volume tree of a body's geoms in its inertial frame `(ipos, iquat)`: the
-/// compiler's construction (boxes of the geoms' boxes' corners, split at the median along
-/// the longest edge), nodes in its order.
-pub fn bounding_volumes(volumes: &[Volume], ipos: &[f64; 3], iquat: &[f64; 4]) -> Vec<VolumeNode> {
-    let inverse = [iquat[0], -iquat[1], -iquat[2], -iquat[3]];
-    let mut elements: Vec<(usize, [f64; 3])> = volumes
-        .iter()
-        .enumerate()
-        .filter(|(_, v)| v.collides)
-        .map(|(i, v)| {
-            let d = [v.pos[0] - ipos[0], v.pos[1] - ipos[1], v.pos[2] - ipos[2]];
-            (i, rotate(&d, &inverse))
-        })
-        .collect();
-    let mut nodes = Vec::new();
-    build(volumes, &mut elements, ipos, &inverse, 0, &mut nodes);
-    nodes
-}
-
-fn build(
-    volumes: &[Volume],
-    elements: &mut [(usize, [f64; 3])],
-    ipos: &[f64; 3],
-    inverse: &[f64; 4],
-    depth: i32,
-    nodes: &mut Vec<VolumeNode>,
-) -> i32 {
-    if elements.is_empty() {
-        return -1;
-    }
-    let mut lo = [f64::MAX; 3];
-    let mut hi = [-f64::MAX; 3];
-    for &(i, _) in elements.iter() {
-        let v = &volumes[i];
-        let a = &v.aabb;
-        let (min, max) = (
-            [a[0] - a[3], a[1] - a[4], a[2] - a[5]],
-            [a[0] + a[3], a[1] + a[4], a[2] + a[5]],
-        );
-        for corner in 0..8 {
-            let c = [
-                if corner & 1 != 0 { max[0] } else { min[0] },
-                if corner & 2 != 0 { max[1] } else { min[1] },
-                if corner & 4 != 0 { max[2] } else { min[2] },
-            ];
-            let mut b = rotate(&c, &v.quat);
-            for k in 0..3 {
-                b[k] += v.pos[k] - ipos[k];
-            }
-            let p = rotate(&b, inverse);
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
-            }
-        }
-    }
-    for k in 0..3 {
-        if (lo[k] - hi[k]).abs() < EPS {
-            lo[k] -= EPS;
-            hi[k] += EPS;
-        }
-    }
-    let index = nodes.len();
-    nodes.push(VolumeNode {
-        aabb: [
-            (hi[0] + lo[0]) / 2.0,
-            (hi[1] + lo[1]) / 2.0,
-            (hi[2] + lo[2]) / 2.0,
-            (hi[0] - lo[0]) / 2.0,
-            (hi[1] - lo[1]) / 2.0,
-            (hi[2] - lo[2]) / 2.0,
-        ],
-        child: [-1, -1],
-        nodeid: -1,
-        depth,
-    });
-    if elements.len() == 1 {
-        nodes[index].nodeid = volumes[elements[0].0].id;
-        return index as i32;
-    }
-    let edges = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
-    let mut axis = 0;
-    if edges[1] >= edges[0] + EPS {
-        axis = 1;
-    }
-    if edges[2] >= edges[axis] + EPS {
-        axis = 2;
-    }
-    // The median along the axis (ties within mjEPS in the geoms' order).
-    elements.sort_by(|a, b| {
-        if (a.1[axis] - b.1[axis]).abs() > EPS {
-            a.1[axis].total_cmp(&b.1[axis])
-        } else {
-            a.0.cmp(&b.0)
-        }
-    });
-    let m = elements.len() / 2;
-    let (left, right) = elements.split_at_mut(m);
-    if m > 0 {
-        nodes[index].child[0] = build(volumes, left, ipos, inverse, depth + 1, nodes);
-    }
-    nodes[index].child[1] = build(volumes, right, ipos, inverse, depth + 1, nodes);
-    index as i32
-}
-
 fn row<const N: usize>(a: &[f64], i: usize) -> Result<[f64; N], String> {
     a.get(N * i..N * (i + 1))
         .and_then(|r| r.try_into().ok())
@@ -624,15 +357,6 @@ pub fn write_geom_masses(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn principal_axes_of_a_diagonal_inertia_are_sorted() {
-        let (values, quat) = eigen(&[1.0, 0.0, 0.0, 0.0, 3.0, 0.0, 0.0, 0.0, 2.0]);
-        assert_eq!(values, [3.0, 2.0, 1.0]);
-        // The axes turn with the values: the first principal axis is the old y.
-        let m = quat_to_mat(&quat);
-        assert!((m[3].abs() - 1.0).abs() < 1e-12, "{m:?}");
-    }
 
     #[test]
     fn one_geom_is_its_body() {

@@ -31,7 +31,9 @@
 //! written, for both faces), `document.rs` (any document split by reading it), `body_model.rs` (a body's geoms as a
 //! model of their own, for what MuJoCo derives from their sizes), `body_copy.rs` (that
 //! model's compile copied into a structure's model, for both faces), `geom_masses.rs` (a
-//! body's mass properties from its geoms' densities or masses, at patch cost), `statistics.rs` (the
+//! body's mass properties from its geoms' densities or masses, at patch cost; with
+//! `rotation.rs`, the compiler's rotations and eigen-decomposition, and `volumes.rs`, its
+//! bounding-volume trees), `statistics.rs` (the
 //! compiler's statistics at `qpos0`, computed over a model's arrays for both faces). The scene tier reads its
 //! drawn variants through the same rules (`scene/patch.rs`).
 //!
@@ -43,17 +45,19 @@ mod body_model;
 mod document;
 mod geom_masses;
 mod landing;
+mod rotation;
 mod rules;
 mod statistics;
 mod targets;
+mod volumes;
 
 pub use body_copy::{MasslessFrame, ModelArrays, ModelArraysMut, copy_body_model, massless_frames};
 pub use document::{
     DocumentPatch, PATCHABLE_OPTIONS, SplitOptions, split_document, split_document_with,
 };
 pub use geom_masses::{
-    BodyMass, GeomMass, Volume, VolumeNode, body_frame_flag, body_mass, bounding_volumes,
-    frame_flag, write_frame_flags, write_geom_masses,
+    BodyMass, GeomMass, body_frame_flag, body_mass, frame_flag, write_frame_flags,
+    write_geom_masses,
 };
 pub use landing::{ArrayMut, Carried, Landing, ModelLayout, Run, land};
 pub use rules::{PATCHABLE, PatchEntry, PatchValue};
@@ -65,6 +69,7 @@ pub use targets::{
     DOF_FIELDS, GEOM_FACTORS, MASS_DERIVED, MODEL_FIELDS, PATCH_OBJECTS, PatchObject, QPOS_FIELDS,
     SIGNATURE_ARRAYS, SIGNATURE_SKIPPED_SIZES, STATIC_PREFIXES, joint_widths, target_array,
 };
+pub use volumes::{Volume, VolumeNode, bounding_volumes};
 
 pub(crate) use body_model::{UnitCache, body_model_entries, carried_by, unit_model_entries};
 pub(crate) use rules::{

@@ -1,0 +1,154 @@
+//! Rotations as the compiler computes them: quaternions to matrices, products, a vector
+//! turned by a quaternion, and the Jacobi eigen-decomposition that gives a body's principal
+//! axes (`geom_masses.rs`, `volumes.rs`).
+
+/// MuJoCo's `mjEPS`.
+pub(super) const EPS: f64 = 1e-14;
+/// The eigen-decomposition's tolerance between eigenvalues it orders.
+const EIG_EPS: f64 = 1e-12;
+/// The largest off-diagonal element the eigen-decomposition leaves, relative to the
+/// diagonal's size.
+const OFF_DIAGONAL: f64 = 1e-15;
+
+pub(super) fn quat_to_mat(q: &[f64; 4]) -> [f64; 9] {
+    let (q0, q1, q2, q3) = (q[0], q[1], q[2], q[3]);
+    let (q00, q01, q02, q03) = (q0 * q0, q0 * q1, q0 * q2, q0 * q3);
+    let (q11, q12, q13) = (q1 * q1, q1 * q2, q1 * q3);
+    let (q22, q23, q33) = (q2 * q2, q2 * q3, q3 * q3);
+    [
+        q00 + q11 - q22 - q33,
+        2.0 * (q12 - q03),
+        2.0 * (q13 + q02),
+        2.0 * (q12 + q03),
+        q00 - q11 + q22 - q33,
+        2.0 * (q23 - q01),
+        2.0 * (q13 - q02),
+        2.0 * (q23 + q01),
+        q00 - q11 - q22 + q33,
+    ]
+}
+
+pub(super) fn mul_quat(a: &[f64; 4], b: &[f64; 4]) -> [f64; 4] {
+    [
+        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+        a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+        a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
+    ]
+}
+
+pub(super) fn normalized(mut q: [f64; 4]) -> [f64; 4] {
+    let norm = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
+    if norm < EPS {
+        return [1.0, 0.0, 0.0, 0.0];
+    }
+    for x in &mut q {
+        *x /= norm;
+    }
+    q
+}
+
+/// `v` rotated by `q` (unchanged for the zero vector and the unit quaternion).
+pub(super) fn rotate(v: &[f64; 3], q: &[f64; 4]) -> [f64; 3] {
+    if v == &[0.0; 3] {
+        return [0.0; 3];
+    }
+    if q == &[1.0, 0.0, 0.0, 0.0] {
+        return *v;
+    }
+    // t = w v + q x v, then v + 2 q x t.
+    let t = [
+        q[0] * v[0] + q[2] * v[2] - q[3] * v[1],
+        q[0] * v[1] + q[3] * v[0] - q[1] * v[2],
+        q[0] * v[2] + q[1] * v[1] - q[2] * v[0],
+    ];
+    [
+        v[0] + 2.0 * (q[2] * t[2] - q[3] * t[1]),
+        v[1] + 2.0 * (q[3] * t[0] - q[1] * t[2]),
+        v[2] + 2.0 * (q[1] * t[1] - q[2] * t[0]),
+    ]
+}
+
+pub(super) fn mat_mul(a: &[f64; 9], b: &[f64; 9]) -> [f64; 9] {
+    let mut out = [0.0; 9];
+    for r in 0..3 {
+        for c in 0..3 {
+            out[3 * r + c] = a[3 * r] * b[c] + a[3 * r + 1] * b[3 + c] + a[3 * r + 2] * b[6 + c];
+        }
+    }
+    out
+}
+
+pub(super) fn transpose(a: &[f64; 9]) -> [f64; 9] {
+    [a[0], a[3], a[6], a[1], a[4], a[7], a[2], a[5], a[8]]
+}
+
+/// The eigenvalues (decreasing) and principal axes (as a quaternion) of the symmetric
+/// matrix `m`: Jacobi rotations accumulated in a quaternion, as the compiler computes a
+/// body's principal axes.
+pub(super) fn eigen(m: &[f64; 9]) -> ([f64; 3], [f64; 4]) {
+    let mut quat = [1.0, 0.0, 0.0, 0.0];
+    let mut values = [m[0], m[4], m[8]];
+    for _ in 0..500 {
+        let axes = quat_to_mat(&quat);
+        let d = mat_mul(&mat_mul(&transpose(&axes), m), &axes);
+        values = [d[0], d[4], d[8]];
+        // The largest off-diagonal element: (row, column, rotation axis).
+        let (r, c, k) = if d[1].abs() > d[2].abs() && d[1].abs() > d[5].abs() {
+            (0, 1, 2)
+        } else if d[2].abs() > d[5].abs() {
+            (0, 2, 1)
+        } else {
+            (1, 2, 0)
+        };
+        let scale = d[0].abs() + d[4].abs() + d[8].abs();
+        if d[3 * r + c].abs() < EIG_EPS.min(OFF_DIAGONAL * scale) {
+            break;
+        }
+        let tau = (d[4 * c] - d[4 * r]) / (2.0 * d[3 * r + c]);
+        let t = if tau >= 0.0 {
+            1.0 / (tau + (1.0 + tau * tau).sqrt())
+        } else {
+            -1.0 / (-tau + (1.0 + tau * tau).sqrt())
+        };
+        // The half angle from the angle itself: precise for the small rotations that
+        // finish the job (from the cosine, they round to none).
+        let half = 0.5 * t.abs().atan();
+        if half.sin() == 0.0 {
+            break;
+        }
+        let mut rot = [half.cos(), 0.0, 0.0, 0.0];
+        rot[k + 1] = if tau >= 0.0 { -half.sin() } else { half.sin() };
+        if k == 1 {
+            rot[k + 1] = -rot[k + 1];
+        }
+        quat = normalized(mul_quat(&quat, &normalized(rot)));
+    }
+    // Decreasing order: swap neighbours (0-1, 1-2, 0-1), turning the axes with them.
+    for j in 0..3 {
+        let lead = j % 2;
+        if values[lead] + EIG_EPS < values[lead + 1] {
+            values.swap(lead, lead + 1);
+            // The compiler's rounded cos(pi/4), not FRAC_1_SQRT_2: the same turn, the same bits.
+            #[allow(clippy::approx_constant)]
+            let mut rot = [0.707106781186548, 0.0, 0.0, 0.0];
+            rot[(lead + 2) % 3 + 1] = rot[0];
+            quat = normalized(mul_quat(&quat, &rot));
+        }
+    }
+    (values, quat)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn principal_axes_of_a_diagonal_inertia_are_sorted() {
+        let (values, quat) = eigen(&[1.0, 0.0, 0.0, 0.0, 3.0, 0.0, 0.0, 0.0, 2.0]);
+        assert_eq!(values, [3.0, 2.0, 1.0]);
+        // The axes turn with the values: the first principal axis is the old y.
+        let m = quat_to_mat(&quat);
+        assert!((m[3].abs() - 1.0).abs() < 1e-12, "{m:?}");
+    }
+}
