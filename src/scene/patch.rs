@@ -133,7 +133,7 @@ pub(crate) fn split_parts(
             overlay.apply_to(&mut applied);
             for body in modelled {
                 if let Some(name) = applied.attr(body, "name")
-                    && let Some(made) = body_model_entries(&applied, body, name.to_string(), false)
+                    && let Some(made) = body_model_entries(&applied, body, name.to_string())
                 {
                     parts.extend(std::iter::repeat_n(part, made.len()));
                     entries.extend(made);

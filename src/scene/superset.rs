@@ -355,7 +355,7 @@ impl Scene {
                 };
                 match made {
                     Some(made) => entries.extend(made),
-                    None => whole.push((body, false)),
+                    None => whole.push(body),
                 }
             }
             let modelled = whole;
@@ -371,14 +371,9 @@ impl Scene {
                     }
                     None => doc,
                 };
-                for (body, masses_only) in modelled {
+                for body in modelled {
                     let made = source.attr(body, "name").and_then(|name| {
-                        split::body_model_entries(
-                            source,
-                            body,
-                            format!("{}{name}", m.tag),
-                            masses_only,
-                        )
+                        split::body_model_entries(source, body, format!("{}{name}", m.tag))
                     });
                     let Some(made) = made else {
                         return Err(Errors(vec![Error::bare(ErrorKind::Invalid(format!(

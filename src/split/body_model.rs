@@ -168,27 +168,14 @@ pub(crate) fn body_model(doc: &Document, body: Node) -> Option<String> {
     Some(xml)
 }
 
-/// The entries of `body` (named `name` in the compiled model) for what its geoms derive:
-/// with `masses_only` (its geoms' densities and masses are all that vary), its unit model
-/// and those numbers (`unit_geoms`, `geom_factors`: see [`unit_model`]) when it has one;
-/// else its body model (`geoms`). `None`: the body cannot be compiled alone.
+/// The entry of `body` (named `name` in the compiled model) for what its geoms derive:
+/// its body model (`geoms`), when it has one. (Bodies whose geoms' densities and masses
+/// alone vary take [`unit_model_entries`] instead.)
 pub(crate) fn body_model_entries(
     doc: &Document,
     body: Node,
     name: String,
-    masses_only: bool,
 ) -> Option<Vec<PatchEntry>> {
-    if masses_only
-        && let Some(made) = unit_model_entries(
-            doc,
-            body,
-            &name,
-            &|n, a| doc.attr(n, a).map(str::to_string),
-            None,
-        )
-    {
-        return Some(made);
-    }
     Some(vec![PatchEntry {
         object: "body",
         name,
