@@ -54,6 +54,7 @@ pub mod mujoco;
 pub mod output;
 #[cfg(mjcf_mujoco)]
 pub mod preview;
+mod rotation;
 pub mod scene;
 pub mod split;
 
@@ -65,6 +66,7 @@ pub use document::inertia::{CompiledInertia, InertiaCompiler};
 pub use document::limits::Limits;
 pub use document::load_cache::LoadCache;
 pub use document::tree::Node;
+pub use document::urdf::{UrdfActuators, UrdfImporter, UrdfOptions};
 pub use document::vocab;
 pub use document::{Document, Section};
 pub use error::{Error, ErrorKind, Errors, Location};

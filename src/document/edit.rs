@@ -44,7 +44,7 @@ impl Document {
 
     /// A document with no element yet: its root is a placeholder for the caller to
     /// replace (as the reader does), its positions in `files`.
-    fn bare(
+    pub(crate) fn bare(
         files: Arc<Vec<SourceFile>>,
         model_dir: Arc<Path>,
         limits: Limits,

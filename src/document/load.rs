@@ -12,6 +12,7 @@ use std::path::Path;
 use crate::document::Document;
 use crate::document::limits::Limits;
 use crate::document::read;
+use crate::document::urdf::{self, UrdfOptions};
 use crate::error::Errors;
 
 impl Document {
@@ -39,7 +40,22 @@ impl Document {
     /// # std::fs::remove_file(&path).unwrap();
     /// ```
     pub fn load_with(path: impl AsRef<Path>, limits: &Limits) -> Result<Document, Errors> {
-        finish(read::read_file(path.as_ref(), limits)?)
+        Document::load_full(path.as_ref(), limits, &UrdfOptions::default())
+    }
+
+    /// A file read within `limits`, URDF with `urdf` (MJCF ignores it).
+    pub(crate) fn load_full(
+        path: &Path,
+        limits: &Limits,
+        urdf: &UrdfOptions,
+    ) -> Result<Document, Errors> {
+        if let Some(xacro) = urdf::xacro_text(path, limits)? {
+            return finish(
+                read::read_str(&xacro, path.parent().unwrap_or(Path::new("")), limits)?,
+                urdf,
+            );
+        }
+        finish(read::read_file(path, limits)?, urdf)
     }
 
     /// Loads MJCF text; `base_dir` plays the part of the main file's folder (includes and
@@ -72,14 +88,29 @@ impl Document {
         base_dir: impl AsRef<Path>,
         limits: &Limits,
     ) -> Result<Document, Errors> {
-        finish(read::read_str(xml, base_dir.as_ref(), limits)?)
+        Document::from_str_full(xml, base_dir.as_ref(), limits, &UrdfOptions::default())
+    }
+
+    /// Text read within `limits`, URDF with `urdf` (MJCF ignores it).
+    pub(crate) fn from_str_full(
+        xml: &str,
+        base_dir: &Path,
+        limits: &Limits,
+        urdf: &UrdfOptions,
+    ) -> Result<Document, Errors> {
+        finish(read::read_str(xml, base_dir, limits)?, urdf)
     }
 }
 
-/// The passes after reading, in order: default classes inlined (the classes are gone
-/// after it), every file reference made absolute (on the elements as they now are), then
-/// repeated sections joined.
-fn finish(mut doc: Document) -> Result<Document, Errors> {
+/// The passes after reading, in order: a URDF model converted to MJCF, default classes
+/// inlined (the classes are gone after it), every file reference made absolute (on the
+/// elements as they now are), then repeated sections joined.
+fn finish(doc: Document, urdf: &UrdfOptions) -> Result<Document, Errors> {
+    let mut doc = if doc.is_urdf() {
+        urdf::convert(&doc, urdf)?
+    } else {
+        doc
+    };
     crate::document::defaults::inline_defaults(&mut doc)?;
     crate::document::paths::absolutize_paths(&mut doc)?;
     doc.merge_repeated_sections();
@@ -91,7 +122,9 @@ fn finish(mut doc: Document) -> Result<Document, Errors> {
 /// first (as every load does); without, only quick-xml's path is used. The tests and the
 /// `readers` fuzz target hold the two to the same outcome.
 pub(crate) fn describe_load(bytes: &[u8], dir: &Path, fast: bool) -> String {
-    match read::read_bytes_as_text(bytes, dir, &Limits::default(), fast).and_then(finish) {
+    match read::read_bytes_as_text(bytes, dir, &Limits::default(), fast)
+        .and_then(|d| finish(d, &UrdfOptions::default()))
+    {
         Ok(d) => {
             let mut out = format!("{}\n{}", d.to_xml_string(), d.to_pretty_string());
             for n in d.descendants(d.root()) {

@@ -44,6 +44,7 @@ pub(crate) mod schema;
 pub(crate) mod skin;
 pub(crate) mod text;
 pub(crate) mod tree;
+pub(crate) mod urdf;
 pub(crate) mod validate;
 pub mod vocab;
 pub(crate) mod write;

@@ -14,8 +14,8 @@
 //! [`write_geom_masses`] with their own MuJoCo's arrays.
 
 use super::body_copy::{ModelArrays, ModelArraysMut};
-use super::rotation::{EPS, eigen, quat_to_mat};
 use super::volumes::{Volume, bounding_volumes};
+use crate::rotation::{EPS, eigen, quat_to_mat};
 
 /// The compiler's tolerance for "the same frame" (flags `mjtSameFrame`).
 const FRAME_EPS: f64 = 1e-6;

@@ -32,7 +32,7 @@
 //! model of their own, for what MuJoCo derives from their sizes), `body_copy.rs` (that
 //! model's compile copied into a structure's model, for both faces), `geom_masses.rs` (a
 //! body's mass properties from its geoms' densities or masses, at patch cost; with
-//! `rotation.rs`, the compiler's rotations and eigen-decomposition, and `volumes.rs`, its
+//! `crate::rotation`, the compiler's rotations and eigen-decomposition, and `volumes.rs`, its
 //! bounding-volume trees), `statistics.rs` (the
 //! compiler's statistics at `qpos0`, computed over a model's arrays for both faces). The scene tier reads its
 //! drawn variants through the same rules (`scene/patch.rs`).
@@ -45,7 +45,6 @@ mod body_model;
 mod document;
 mod geom_masses;
 mod landing;
-mod rotation;
 mod rules;
 mod statistics;
 mod targets;

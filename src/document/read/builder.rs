@@ -35,6 +35,8 @@ pub(super) struct Builder {
     /// hashed: thousands of sibling includes stay linear.
     pub(super) seen_set: ahash::AHashSet<PathBuf>,
     pub(super) limits: Limits,
+    /// Whether the root is URDF's `<robot>` (whose names may hold a `:`).
+    pub(super) urdf: bool,
     /// The depth of the element the file being read inserts its elements under (0 for the
     /// main file, whose root element is level 1).
     pub(super) depth_base: u32,
@@ -95,6 +97,7 @@ impl Builder {
             open_names: Vec::new(),
             seen_set: ahash::AHashSet::new(),
             limits: *limits,
+            urdf: false,
             depth_base: 0,
             include_depth: 0,
         }
@@ -229,7 +232,11 @@ impl Builder {
     /// [`Builder::name_sym`] for a name not seen before (rare: most are vocabulary).
     #[cold]
     fn new_name_sym(&mut self, name: &str) -> Result<Sym, String> {
-        match name_problem(name, &self.limits) {
+        // The first name read is the root's: a `<robot>` root makes the file URDF.
+        if self.doc.tree.count() <= 1 && self.depth_base == 0 && name == "robot" {
+            self.urdf = true;
+        }
+        match name_problem(name, &self.limits, self.urdf) {
             Some(why) => Err(why),
             None => Ok(self.doc.names.intern(name)),
         }

@@ -79,7 +79,10 @@ fn is_name_char(c: char) -> bool {
 /// be an XML name, within the length limit. A `:` is refused too: it would need a namespace
 /// declaration that namespace-aware parsers (Python's, for one) check, and no MJCF name
 /// has one.
-pub(super) fn name_problem(name: &str, limits: &Limits) -> Option<String> {
+///
+/// A URDF file (`urdf`) may use `:` (`xmlns:xacro`, `<gazebo>` blocks): the reader reads
+/// them and converts none of them to MJCF.
+pub(super) fn name_problem(name: &str, limits: &Limits, urdf: bool) -> Option<String> {
     if name.len() > limits.max_name_len as usize {
         return Some(format!(
             "name of {} bytes, longer than {} (Limits::max_name_len)",
@@ -90,7 +93,10 @@ pub(super) fn name_problem(name: &str, limits: &Limits) -> Option<String> {
     let mut chars = name.chars();
     match chars.next() {
         None => Some("a tag without a name".into()),
-        Some(c) if !is_name_start(c) || !chars.all(is_name_char) => {
+        Some(c)
+            if !(is_name_start(c) || urdf && c == ':')
+                || !chars.all(|c| is_name_char(c) || urdf && c == ':') =>
+        {
             Some(format!("'{}' is not an XML name", clip(name, 40)))
         }
         Some(_) => None,

@@ -119,11 +119,11 @@ impl Builder {
                                     Some(n) => n,
                                     None => self.element(&e, span, &reader, &lines, offset)?,
                                 };
-                                if self.doc.tag(n) != "mujoco" {
+                                if !matches!(self.doc.tag(n), "mujoco" | "robot") {
                                     return Err(Error::at(
                                         self.loc(file, line, col),
                                         ErrorKind::NotMjcf(format!(
-                                            "root element is <{}>, not <mujoco>",
+                                            "root element is <{}>, not <mujoco> (MJCF) or <robot> (URDF)",
                                             self.doc.tag(n)
                                         )),
                                     )

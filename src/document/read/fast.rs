@@ -132,7 +132,7 @@ impl Builder {
                         match parent {
                             None => {
                                 let n = self.commit_scanned(content, name_len, span, None)?;
-                                if self.doc.tag(n) != "mujoco" {
+                                if !matches!(self.doc.tag(n), "mujoco" | "robot") {
                                     break None;
                                 }
                                 self.doc.root = n;

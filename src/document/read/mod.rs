@@ -121,6 +121,11 @@ fn read_bytes_with(
     limits: &Limits,
     try_fast: bool,
 ) -> Result<Document, Errors> {
+    // NUL bytes that end a file (padding some exporters leave) are where MuJoCo's XML
+    // parser stops reading, as a C string ends: they are not read either. A NUL before the
+    // markup's end stays an error.
+    let end = bytes.iter().rposition(|&b| b != 0).map_or(0, |i| i + 1);
+    let bytes = &bytes[..end];
     let model_dir: Arc<Path> = Arc::from(dir);
     // Models are read by `Builder::parse_fast` when it can; anything outside what it handles
     // (and every error) sends the whole load, includes and all, through quick-xml.

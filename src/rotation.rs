@@ -1,16 +1,18 @@
 //! Rotations as the compiler computes them: quaternions to matrices, products, a vector
 //! turned by a quaternion, and the Jacobi eigen-decomposition that gives a body's principal
-//! axes (`geom_masses.rs`, `volumes.rs`).
+//! axes (the split tier's `geom_masses.rs` and `volumes.rs`, the URDF reader's inertials).
+//!
+//! Below every tier (each may use it), so it uses nothing of the crate.
 
 /// MuJoCo's `mjEPS`.
-pub(super) const EPS: f64 = 1e-14;
+pub(crate) const EPS: f64 = 1e-14;
 /// The eigen-decomposition's tolerance between eigenvalues it orders.
 const EIG_EPS: f64 = 1e-12;
 /// The largest off-diagonal element the eigen-decomposition leaves, relative to the
 /// diagonal's size.
 const OFF_DIAGONAL: f64 = 1e-15;
 
-pub(super) fn quat_to_mat(q: &[f64; 4]) -> [f64; 9] {
+pub(crate) fn quat_to_mat(q: &[f64; 4]) -> [f64; 9] {
     let (q0, q1, q2, q3) = (q[0], q[1], q[2], q[3]);
     let (q00, q01, q02, q03) = (q0 * q0, q0 * q1, q0 * q2, q0 * q3);
     let (q11, q12, q13) = (q1 * q1, q1 * q2, q1 * q3);
@@ -28,7 +30,7 @@ pub(super) fn quat_to_mat(q: &[f64; 4]) -> [f64; 9] {
     ]
 }
 
-pub(super) fn mul_quat(a: &[f64; 4], b: &[f64; 4]) -> [f64; 4] {
+pub(crate) fn mul_quat(a: &[f64; 4], b: &[f64; 4]) -> [f64; 4] {
     [
         a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
         a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
@@ -37,7 +39,7 @@ pub(super) fn mul_quat(a: &[f64; 4], b: &[f64; 4]) -> [f64; 4] {
     ]
 }
 
-pub(super) fn normalized(mut q: [f64; 4]) -> [f64; 4] {
+pub(crate) fn normalized(mut q: [f64; 4]) -> [f64; 4] {
     let norm = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
     if norm < EPS {
         return [1.0, 0.0, 0.0, 0.0];
@@ -49,7 +51,7 @@ pub(super) fn normalized(mut q: [f64; 4]) -> [f64; 4] {
 }
 
 /// `v` rotated by `q` (unchanged for the zero vector and the unit quaternion).
-pub(super) fn rotate(v: &[f64; 3], q: &[f64; 4]) -> [f64; 3] {
+pub(crate) fn rotate(v: &[f64; 3], q: &[f64; 4]) -> [f64; 3] {
     if v == &[0.0; 3] {
         return [0.0; 3];
     }
@@ -69,7 +71,7 @@ pub(super) fn rotate(v: &[f64; 3], q: &[f64; 4]) -> [f64; 3] {
     ]
 }
 
-pub(super) fn mat_mul(a: &[f64; 9], b: &[f64; 9]) -> [f64; 9] {
+pub(crate) fn mat_mul(a: &[f64; 9], b: &[f64; 9]) -> [f64; 9] {
     let mut out = [0.0; 9];
     for r in 0..3 {
         for c in 0..3 {
@@ -79,14 +81,28 @@ pub(super) fn mat_mul(a: &[f64; 9], b: &[f64; 9]) -> [f64; 9] {
     out
 }
 
-pub(super) fn transpose(a: &[f64; 9]) -> [f64; 9] {
+pub(crate) fn transpose(a: &[f64; 9]) -> [f64; 9] {
     [a[0], a[3], a[6], a[1], a[4], a[7], a[2], a[5], a[8]]
+}
+
+/// The rotation of Euler angles (radians) in MJCF's extrinsic `XYZ` sequence (URDF's
+/// `rpy`): each turn about a fixed axis of the parent, pre-multiplied, then normalized, as
+/// MuJoCo resolves an `euler` orientation.
+pub(crate) fn euler_xyz(angles: [f64; 3]) -> [f64; 4] {
+    let mut q = [1.0, 0.0, 0.0, 0.0];
+    for (i, a) in angles.into_iter().enumerate() {
+        let (sin, cos) = (a / 2.0).sin_cos();
+        let mut rot = [cos, 0.0, 0.0, 0.0];
+        rot[i + 1] = sin;
+        q = mul_quat(&rot, &q);
+    }
+    normalized(q)
 }
 
 /// The eigenvalues (decreasing) and principal axes (as a quaternion) of the symmetric
 /// matrix `m`: Jacobi rotations accumulated in a quaternion, as the compiler computes a
 /// body's principal axes.
-pub(super) fn eigen(m: &[f64; 9]) -> ([f64; 3], [f64; 4]) {
+pub(crate) fn eigen(m: &[f64; 9]) -> ([f64; 3], [f64; 4]) {
     let mut quat = [1.0, 0.0, 0.0, 0.0];
     let mut values = [m[0], m[4], m[8]];
     for _ in 0..500 {

@@ -1,0 +1,982 @@
+//! A URDF `<robot>` written as the MJCF document MuJoCo's importer builds from it.
+//!
+//! The importer's rules, as MuJoCo 3.17.0 and 4.0.0 apply them (docs/urdf.md):
+//! - compiler: angles in radians; `fusestatic` and `discardvisual` on unless the file's
+//!   own `<mujoco><compiler>` says otherwise; that block's `<option>` and `<size>` kept;
+//! - links become bodies in the order of [`Robot::order`]; a link called `world` is the
+//!   world body; a joint's `<origin>` places its child body (`rpy` is MJCF's `XYZ` Euler
+//!   sequence, written as such);
+//! - `<inertial>`: its origin's `xyz`, its mass, and its six inertia numbers as
+//!   `fullinertia` (whose principal axes the compiler takes, so the origin's `rpy` has no
+//!   effect); all six zero leave the inertia undefined and the `rpy` in force;
+//! - geoms: each `<collision>`, and each `<visual>` when visuals are kept, in file order,
+//!   links in file order; a collision geom takes the colour of the last visual of its link
+//!   seen before it; names are kept when not taken yet, and a geom without one keeps the
+//!   name of the previous geom of its link (so that it ends up unnamed);
+//! - meshes are named after their file's stem; the same stem at another `scale` gets the
+//!   stem with the count of its earlier scales appended;
+//! - joints: revolute and continuous are hinges, prismatic slides, floating free,
+//!   spherical balls, fixed nothing; `<limit>` gives the range (`limited="false"` when
+//!   only one bound is given or they are reversed) and `effort` the actuator force range;
+//!   `<dynamics>` damping and friction; `<mimic>` a joint equality.
+
+use ahash::{AHashMap, AHashSet};
+
+use super::packages::{Packages, Resolved};
+use super::robot::Robot;
+use super::{UrdfActuators, UrdfImporter, UrdfOptions};
+use crate::document::Document;
+use crate::document::tree::{Node, Tree};
+use crate::error::{Error, ErrorKind, Errors};
+
+/// How `<visual>` elements are read.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Visuals {
+    /// Dropped (MuJoCo's default, `discardvisual`).
+    Dropped,
+    /// Made as MuJoCo makes them when the file's own compiler keeps them: the same name
+    /// and mesh rules as the collision geoms, colours as `rgba`.
+    AsMuJoCo,
+    /// Kept by [`UrdfOptions::visuals`]: the collision geoms read exactly as when visuals
+    /// are dropped; the visuals' meshes and names after them; URDF materials as MuJoCo
+    /// materials.
+    Kept,
+}
+
+/// The URDF document `raw` converted with `options`.
+pub(crate) fn convert(raw: &Document, options: &UrdfOptions) -> Result<Document, Errors> {
+    let mut errors = Vec::new();
+    let robot = Robot::read(raw, &mut errors);
+    let Some(robot) = robot else {
+        return Err(Errors(errors));
+    };
+    let mut w = Writer::new(raw, options);
+    w.write(&robot);
+    if w.errors.is_empty() {
+        Ok(w.doc)
+    } else {
+        Err(Errors(w.errors))
+    }
+}
+
+/// One mesh asset the importer made: its name and scale.
+struct MeshEntry {
+    name: String,
+    scale: [f64; 3],
+}
+
+struct Writer<'r> {
+    raw: &'r Document,
+    options: &'r UrdfOptions,
+    doc: Document,
+    errors: Vec<Error>,
+    visuals: Visuals,
+    strippath: bool,
+    meshdir: Option<String>,
+    /// URDF material name -> its colour text (the first definition with a colour).
+    materials: AHashMap<&'r str, &'r str>,
+    /// Mesh assets by file stem, as the importer keys them.
+    meshes: AHashMap<String, Vec<MeshEntry>>,
+    /// Kept visuals' mesh assets: (file, scale text) -> name.
+    visual_meshes: AHashMap<(String, String), String>,
+    /// Every mesh asset name given so far.
+    mesh_names: AHashSet<String>,
+    /// Geom names given so far (the importer's set: the empty name counts once).
+    geom_names: AHashSet<String>,
+    /// Kept visuals: the names every collision geom ends up with, so that no visual
+    /// takes one.
+    collision_names: AHashSet<String>,
+    /// Kept visuals: MuJoCo material names made so far.
+    made_materials: AHashSet<String>,
+    packages: Packages<'r>,
+    asset_meshes: Vec<Node>,
+    asset_visual: Vec<Node>,
+    root: Node,
+    worldbody: Node,
+}
+
+/// The text of an `f64` that reads back as it.
+fn num(x: f64) -> String {
+    let plain = format!("{x}");
+    let exp = format!("{x:e}");
+    if exp.len() < plain.len() { exp } else { plain }
+}
+
+/// MuJoCo's `mjuu_strippath`: the text after the last `/` or `\`.
+fn strip_path(file: &str) -> &str {
+    file.rsplit(['/', '\\']).next().unwrap_or(file)
+}
+
+/// MuJoCo's `mjuu_stripext`: the text before the last `.`.
+fn strip_ext(file: &str) -> &str {
+    file.rfind('.').map_or(file, |i| &file[..i])
+}
+
+impl<'r> Writer<'r> {
+    fn new(raw: &'r Document, options: &'r UrdfOptions) -> Writer<'r> {
+        let mut doc = Document::bare(
+            raw.files.clone(),
+            raw.model_dir.clone(),
+            raw.limits,
+            raw.node_count(),
+        );
+        let tag = doc.intern("mujoco");
+        doc.root = doc.new_element(tag, None);
+        let root = doc.root;
+        doc.set_span(root, raw.spans[Tree::index(raw.root())]);
+        let wb = doc.intern("worldbody");
+        let worldbody = doc.new_element(wb, None);
+        Writer {
+            raw,
+            options,
+            doc,
+            errors: Vec::new(),
+            visuals: Visuals::Dropped,
+            strippath: false,
+            meshdir: None,
+            materials: AHashMap::new(),
+            meshes: AHashMap::new(),
+            visual_meshes: AHashMap::new(),
+            mesh_names: AHashSet::new(),
+            geom_names: AHashSet::new(),
+            collision_names: AHashSet::new(),
+            made_materials: AHashSet::new(),
+            packages: Packages {
+                map: &options.packages,
+                start: &raw.model_dir,
+            },
+            asset_meshes: Vec::new(),
+            asset_visual: Vec::new(),
+            root,
+            worldbody,
+        }
+    }
+
+    fn error(&mut self, at: Node, msg: String) {
+        self.errors
+            .push(self.raw.error_at(at, ErrorKind::Invalid(msg)));
+    }
+
+    /// A new element `tag` of the output, placed at `from`'s source position.
+    fn element(&mut self, tag: &str, from: Node) -> Node {
+        let sym = self.doc.intern(tag);
+        let n = self.doc.new_element(sym, None);
+        self.doc.set_span(n, self.raw.spans[Tree::index(from)]);
+        n
+    }
+
+    fn child(&mut self, parent: Node, tag: &str, from: Node) -> Node {
+        let n = self.element(tag, from);
+        self.doc.tree.append(parent, n);
+        n
+    }
+
+    fn set(&mut self, node: Node, name: &str, value: &str) {
+        self.doc.set_attr(node, name, value);
+    }
+
+    /// The first child element of `node` called `tag`, as the importer finds it.
+    fn sub(&self, node: Node, tag: &str) -> Option<Node> {
+        self.raw.elements(node).find(|&n| self.raw.tag(n) == tag)
+    }
+
+    /// A required attribute, or an error naming it.
+    fn required(&mut self, node: Node, attr: &str) -> Option<&'r str> {
+        let v = self.raw.attr(node, attr);
+        if v.is_none() {
+            let tag = self.raw.tag(node).to_string();
+            self.error(node, format!("<{tag}> without '{attr}'"));
+        }
+        v
+    }
+
+    /// `count` numbers of an attribute, or an error.
+    fn numbers(&mut self, node: Node, attr: &str, text: &str, count: usize) -> Option<Vec<f64>> {
+        let v: Result<Vec<f64>, _> = text.split_ascii_whitespace().map(str::parse).collect();
+        match v {
+            Ok(v) if v.len() == count => Some(v),
+            _ => {
+                self.error(
+                    node,
+                    format!("'{attr}' must be {count} number(s), not '{text}'"),
+                );
+                None
+            }
+        }
+    }
+
+    /// A copy of the `<mujoco>` block's element `src` (attributes and child elements).
+    fn copy_tree(&mut self, parent: Node, src: Node, skip: &[&str]) -> Node {
+        let tag = self.raw.tag(src).to_string();
+        let n = self.child(parent, &tag, src);
+        for (k, v) in self.raw.attrs(src) {
+            if !skip.contains(&k) {
+                self.doc.set_attr(n, k, v);
+            }
+        }
+        for c in self.raw.elements(src).collect::<Vec<_>>() {
+            self.copy_tree(n, c, &[]);
+        }
+        n
+    }
+
+    fn write(&mut self, robot: &Robot<'r>) {
+        let raw = self.raw;
+        let root = raw.root();
+        if let Some(name) = raw.attr(root, "name") {
+            self.set(self.root, "model", name);
+        }
+        self.compiler(root);
+        self.register_materials(root);
+        let asset = self.element("asset", root);
+        self.doc.tree.append(self.root, asset);
+        self.doc.tree.append(self.root, self.worldbody);
+
+        // Bodies, in the importer's tree order.
+        let mut bodies = vec![self.worldbody; robot.links.len()];
+        for &i in &robot.order {
+            let link = &robot.links[i];
+            if link.name == "world" {
+                continue;
+            }
+            let parent = match link.joint {
+                Some(j) => {
+                    let p = robot.links.iter().position(|l| l.children.contains(&i));
+                    let _ = j;
+                    p.map_or(self.worldbody, |p| bodies[p])
+                }
+                None => self.worldbody,
+            };
+            let body = self.child(parent, "body", link.node);
+            self.set(body, "name", link.name);
+            if self.options.keep_links.iter().any(|k| k == link.name) {
+                self.set(body, "fuse", "false");
+            }
+            bodies[i] = body;
+        }
+        for k in &self.options.keep_links {
+            if !robot.links.iter().any(|l| l.name == k) {
+                self.error(
+                    root,
+                    format!("keep_links names '{k}', which no <link> defines"),
+                );
+            }
+        }
+        // Kept visuals: the collision geoms' names as they are when visuals are dropped.
+        if self.visuals == Visuals::Kept {
+            self.collision_names = self.names_without_visuals(robot);
+            self.geom_names.clear();
+        }
+        // Inertials and geoms, links in file order.
+        let mut by_node: AHashMap<Node, usize> = AHashMap::new();
+        for (i, l) in robot.links.iter().enumerate() {
+            by_node.insert(l.node, i);
+        }
+        for (i, link) in robot.links.iter().enumerate() {
+            self.link(link.node, link.name, bodies[i]);
+        }
+        // Joints, in file order.
+        let mut equalities = Vec::new();
+        let mut actuated = Vec::new();
+        for &j in &robot.joints {
+            let Some(child) = self
+                .sub(j, "child")
+                .and_then(|c| raw.attr(c, "link"))
+                .and_then(|name| robot.links.iter().position(|l| l.name == name))
+            else {
+                continue;
+            };
+            if let Some(kind) = self.joint(j, bodies[child]) {
+                if let Some(m) = self.sub(j, "mimic").filter(|_| kind.mimics()) {
+                    equalities.push((j, m));
+                }
+                if kind.mimics() {
+                    actuated.push(j);
+                }
+            }
+        }
+        if !equalities.is_empty() {
+            let eq = self.child(self.root, "equality", root);
+            for (j, m) in equalities {
+                self.mimic(eq, j, m);
+            }
+        }
+        if let Some(kind) = self.options.actuators.clone() {
+            self.actuators(&kind, &actuated);
+        }
+        for n in std::mem::take(&mut self.asset_meshes)
+            .into_iter()
+            .chain(std::mem::take(&mut self.asset_visual))
+        {
+            self.doc.tree.append(asset, n);
+        }
+        if self.doc.elements(asset).next().is_none() {
+            self.doc.tree.detach(asset);
+        }
+    }
+
+    /// `<compiler>`, `<option>` and `<size>`: the file's `<mujoco>` block over the
+    /// importer's defaults.
+    fn compiler(&mut self, root: Node) {
+        let raw = self.raw;
+        let block = self.sub(root, "mujoco");
+        let given = block.and_then(|b| self.sub(b, "compiler"));
+        let setting = |attr: &str| given.and_then(|c| raw.attr(c, attr)).map(str::trim);
+        self.visuals = if setting("discardvisual") == Some("false") {
+            Visuals::AsMuJoCo
+        } else if self.options.visuals {
+            Visuals::Kept
+        } else {
+            Visuals::Dropped
+        };
+        self.strippath = setting("strippath") == Some("true");
+        self.meshdir = setting("meshdir").map(str::to_string);
+        let fuse = if self.options.fuse_static {
+            setting("fusestatic").unwrap_or("true")
+        } else {
+            "false"
+        };
+        let handled = [
+            "angle",
+            "eulerseq",
+            "discardvisual",
+            "strippath",
+            "fusestatic",
+        ];
+        let c = match given {
+            Some(g) => self.copy_tree(self.root, g, &handled),
+            None => self.child(self.root, "compiler", root),
+        };
+        self.set(c, "angle", "radian");
+        self.set(c, "eulerseq", "XYZ");
+        self.set(c, "fusestatic", fuse);
+        for tag in ["option", "size"] {
+            if let Some(e) = block.and_then(|b| self.sub(b, tag)) {
+                self.copy_tree(self.root, e, &[]);
+            }
+        }
+    }
+
+    /// Every `<material>` with a name and a `<color>`, anywhere in the file (the first
+    /// of a name wins), as the importer registers them before reading links.
+    fn register_materials(&mut self, root: Node) {
+        let raw = self.raw;
+        for m in raw.descendants(root) {
+            if !raw.is_element(m) || raw.tag(m) != "material" {
+                continue;
+            }
+            let Some(name) = raw.attr(m, "name") else {
+                continue;
+            };
+            if self.materials.contains_key(name) {
+                continue;
+            }
+            if let Some(rgba) = self
+                .sub(m, "color")
+                .and_then(|color| self.required(color, "rgba"))
+            {
+                self.materials.insert(name, rgba);
+            }
+        }
+    }
+
+    /// The colour a `<visual>`'s material gives, if any.
+    fn visual_rgba(&mut self, visual: Node) -> Option<&'r str> {
+        let m = self.sub(visual, "material")?;
+        if let Some(color) = self.sub(m, "color") {
+            return self.required(color, "rgba");
+        }
+        let name = self.required(m, "name")?;
+        self.materials.get(name).copied()
+    }
+
+    /// The names the collision geoms get when visuals are dropped.
+    fn names_without_visuals(&mut self, robot: &Robot<'r>) -> AHashSet<String> {
+        let raw = self.raw;
+        let mut used = AHashSet::new();
+        for link in &robot.links {
+            let mut name = "";
+            for g in raw
+                .elements(link.node)
+                .filter(|&g| raw.tag(g) == "collision")
+            {
+                if let Some(n) = raw.attr(g, "name") {
+                    name = n;
+                }
+                used.insert(name.to_string());
+            }
+        }
+        used.remove("");
+        used
+    }
+
+    /// A link's `<inertial>` and geoms, into `body`.
+    fn link(&mut self, link: Node, name: &str, body: Node) {
+        let raw = self.raw;
+        if let Some(inertial) = self.sub(link, "inertial") {
+            if body == self.worldbody {
+                self.error(
+                    inertial,
+                    format!("the link '{name}' is the world body, which has no <inertial>"),
+                );
+            } else {
+                self.inertial(inertial, body);
+            }
+        }
+        let mut rgba: Option<&'r str> = None;
+        let mut geom_name: &'r str = "";
+        for e in raw.elements(link).collect::<Vec<_>>() {
+            match raw.tag(e) {
+                "visual" => {
+                    if let Some(c) = self.visual_rgba(e) {
+                        rgba = Some(c);
+                    }
+                    match self.visuals {
+                        Visuals::Dropped => {}
+                        Visuals::AsMuJoCo => {
+                            if let Some(g) = self.geom(e, body, false) {
+                                if let Some(c) = rgba {
+                                    self.set(g, "rgba", c);
+                                }
+                                if let Some(n) = raw.attr(e, "name") {
+                                    geom_name = n;
+                                }
+                                self.name_geom(g, geom_name);
+                            }
+                        }
+                        Visuals::Kept => self.kept_visual(e, body),
+                    }
+                }
+                "collision" => {
+                    if let Some(g) = self.geom(e, body, true) {
+                        if let Some(c) = rgba {
+                            self.set(g, "rgba", c);
+                        }
+                        if let Some(n) = raw.attr(e, "name") {
+                            geom_name = n;
+                        }
+                        self.name_geom(g, geom_name);
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+
+    /// The importer's naming: a name not given yet is kept, any other left off.
+    fn name_geom(&mut self, geom: Node, name: &str) {
+        if self.geom_names.insert(name.to_string()) && !name.is_empty() {
+            self.set(geom, "name", name);
+        }
+    }
+
+    /// A visual kept by [`UrdfOptions::visuals`]: its own name if no collision geom and no
+    /// earlier visual has it, its material as a MuJoCo material.
+    fn kept_visual(&mut self, visual: Node, body: Node) {
+        let raw = self.raw;
+        let Some(g) = self.geom(visual, body, false) else {
+            return;
+        };
+        if let Some(n) = raw
+            .attr(visual, "name")
+            .filter(|n| !self.collision_names.contains(*n))
+            && self.geom_names.insert(n.to_string())
+        {
+            self.set(g, "name", n);
+        }
+        let Some(m) = self.sub(visual, "material") else {
+            return;
+        };
+        let color = self
+            .sub(m, "color")
+            .and_then(|c| raw.attr(c, "rgba"))
+            .or_else(|| {
+                raw.attr(m, "name")
+                    .and_then(|n| self.materials.get(n).copied())
+            });
+        let texture = self
+            .sub(m, "texture")
+            .and_then(|t| raw.attr(t, "filename"))
+            .and_then(|f| self.file_reference(m, f));
+        match raw.attr(m, "name") {
+            Some(name) => {
+                if self.made_materials.insert(name.to_string()) {
+                    let mat = self.element("material", m);
+                    self.set(mat, "name", name);
+                    if let Some(c) = color {
+                        self.set(mat, "rgba", c);
+                    }
+                    if let Some(file) = texture {
+                        let tex = self.element("texture", m);
+                        self.set(tex, "name", name);
+                        self.set(tex, "type", "2d");
+                        self.set(tex, "file", &file);
+                        self.set(mat, "texture", name);
+                        self.asset_visual.push(tex);
+                    }
+                    self.asset_visual.push(mat);
+                }
+                self.set(g, "material", name);
+            }
+            None => {
+                if let Some(c) = color {
+                    self.set(g, "rgba", c);
+                }
+            }
+        }
+    }
+
+    /// `<inertial>`: position, mass, and the full inertia (or, all six numbers zero, an
+    /// undefined inertia in the origin's orientation).
+    fn inertial(&mut self, inertial: Node, body: Node) {
+        let out = self.child(body, "inertial", inertial);
+        let origin = self.sub(inertial, "origin");
+        let xyz = origin.and_then(|o| self.raw.attr(o, "xyz"));
+        self.set(out, "pos", xyz.unwrap_or("0 0 0"));
+        if let Some(mass) = self.sub(inertial, "mass") {
+            if let Some(v) = self.required(mass, "value") {
+                self.set(out, "mass", v);
+            }
+        } else {
+            self.error(inertial, "<inertial> without <mass>".into());
+        }
+        let Some(inertia) = self.sub(inertial, "inertia") else {
+            self.error(inertial, "<inertial> without <inertia>".into());
+            return;
+        };
+        let mut texts = Vec::with_capacity(6);
+        let mut defined = false;
+        for attr in ["ixx", "iyy", "izz", "ixy", "ixz", "iyz"] {
+            let Some(t) = self.required(inertia, attr) else {
+                return;
+            };
+            let Some(v) = self.numbers(inertia, attr, t, 1) else {
+                return;
+            };
+            defined |= v[0] != 0.0;
+            texts.push(t.trim());
+        }
+        let rpy = origin.and_then(|o| self.raw.attr(o, "rpy"));
+        let turned = match rpy {
+            Some(t) => {
+                let Some(v) = self.numbers(origin.unwrap_or(inertial), "rpy", t, 3) else {
+                    return;
+                };
+                v.iter().any(|&a| a != 0.0).then(|| [v[0], v[1], v[2]])
+            }
+            None => None,
+        };
+        if defined && turned.is_none() {
+            // The compiler takes the principal axes itself: the same computation.
+            self.set(out, "fullinertia", &texts.join(" "));
+        } else if let (true, Some(rpy)) = (defined, turned) {
+            // The importer turns the principal axes by the origin's rpy; MJCF has no
+            // fullinertia beside an orientation, so the axes are written out (the
+            // compiler's eigen-decomposition, within the bound of docs/urdf.md).
+            let v: Vec<f64> = texts.iter().map(|t| t.parse().unwrap_or(0.0)).collect();
+            let full = [v[0], v[3], v[4], v[3], v[1], v[5], v[4], v[5], v[2]];
+            let (values, axes) = crate::rotation::eigen(&full);
+            let quat = crate::rotation::normalized(crate::rotation::mul_quat(
+                &crate::rotation::euler_xyz(rpy),
+                &axes,
+            ));
+            let q: Vec<String> = quat.iter().map(|&x| num(x)).collect();
+            let d: Vec<String> = values.iter().map(|&x| num(x)).collect();
+            self.set(out, "quat", &q.join(" "));
+            self.set(out, "diaginertia", &d.join(" "));
+        } else {
+            self.set(out, "diaginertia", "0 0 0");
+            if let Some(rpy) = rpy {
+                self.set(out, "euler", rpy);
+            }
+        }
+    }
+
+    /// The `<origin>` of `of` as `pos` and `euler` on `out`.
+    fn origin(&mut self, of: Node, out: Node) {
+        if let Some(o) = self.sub(of, "origin") {
+            if let Some(xyz) = self.raw.attr(o, "xyz") {
+                self.set(out, "pos", xyz);
+            }
+            if let Some(rpy) = self.raw.attr(o, "rpy") {
+                self.set(out, "euler", rpy);
+            }
+        }
+    }
+
+    /// A geom for a `<visual>` or `<collision>`, appended to `body`.
+    fn geom(&mut self, e: Node, body: Node, collision: bool) -> Option<Node> {
+        let raw = self.raw;
+        let Some(geometry) = self.sub(e, "geometry") else {
+            let tag = raw.tag(e).to_string();
+            self.error(e, format!("<{tag}> without <geometry>"));
+            return None;
+        };
+        let g = self.element("geom", e);
+        let shape = ["box", "cylinder", "sphere", "capsule", "mesh"]
+            .into_iter()
+            .find_map(|t| self.sub(geometry, t).map(|n| (t, n)));
+        let Some((shape, s)) = shape else {
+            self.error(
+                geometry,
+                "visual geometry specification not found: <geometry> holds none of box, cylinder, sphere, capsule, mesh"
+                    .into(),
+            );
+            return None;
+        };
+        match shape {
+            "box" => {
+                let size = self.required(s, "size")?;
+                let v = self.numbers(s, "size", size, 3)?;
+                let half: Vec<String> = v.iter().map(|x| num(x / 2.0)).collect();
+                self.set(g, "size", &half.join(" "));
+                self.set(g, "type", "box");
+            }
+            "cylinder" | "capsule" => {
+                let r = self.required(s, "radius")?;
+                let l = self.required(s, "length")?;
+                let r = self.numbers(s, "radius", r, 1)?;
+                let l = self.numbers(s, "length", l, 1)?;
+                self.set(g, "size", &format!("{} {}", num(r[0]), num(l[0] / 2.0)));
+                self.set(g, "type", shape);
+            }
+            "sphere" => {
+                let r = self.required(s, "radius")?;
+                let r = self.numbers(s, "radius", r, 1)?;
+                self.set(g, "size", &num(r[0]));
+                self.set(g, "type", "sphere");
+            }
+            _ => {
+                let mesh = self.mesh(s, collision)?;
+                self.set(g, "type", "mesh");
+                self.set(g, "mesh", &mesh);
+            }
+        }
+        self.origin(e, g);
+        if !collision {
+            self.set(g, "contype", "0");
+            self.set(g, "conaffinity", "0");
+            self.set(g, "group", "1");
+            self.set(g, "density", "0");
+        }
+        self.doc.tree.append(body, g);
+        Some(g)
+    }
+
+    /// The file a URDF reference names, as MJCF will name it: `package://` and `file://`
+    /// resolved, MuJoCo's `strippath` applied, COLLADA and missing files refused.
+    fn file_reference(&mut self, at: Node, file: &'r str) -> Option<String> {
+        let resolved = if self.options.resolve_packages {
+            self.packages.resolve(file)
+        } else {
+            Resolved::Plain
+        };
+        let path = match resolved {
+            Resolved::Plain => {
+                let f = if self.strippath {
+                    strip_path(file)
+                } else {
+                    file
+                };
+                f.to_string()
+            }
+            Resolved::File(p) => p.to_string_lossy().into_owned(),
+            Resolved::Unfound(pkg) => {
+                self.error(
+                    at,
+                    format!(
+                        "'{file}': package '{pkg}' is found nowhere: give its folder \
+                         (UrdfOptions::packages, --urdf-package {pkg}=DIR), or list it on \
+                         ROS_PACKAGE_PATH"
+                    ),
+                );
+                return None;
+            }
+        };
+        if file.starts_with("package://") && !self.options.resolve_packages {
+            return Some(path);
+        }
+        if path.to_ascii_lowercase().ends_with(".dae") {
+            self.error(
+                at,
+                format!(
+                    "'{file}' is a COLLADA mesh, which MuJoCo cannot read (it reads STL, OBJ \
+                     and MSH): convert it, for example with `assimp export {name} {stem}.obj`, \
+                     and point the URDF at the converted file",
+                    name = strip_path(&path),
+                    stem = strip_ext(strip_path(&path)),
+                ),
+            );
+            return None;
+        }
+        let full = {
+            let p = std::path::Path::new(&path);
+            if p.is_absolute() {
+                p.to_path_buf()
+            } else {
+                let dir = match &self.meshdir {
+                    Some(m) => self.raw.model_dir.join(m),
+                    None => self.raw.model_dir.to_path_buf(),
+                };
+                dir.join(p)
+            }
+        };
+        if !full.is_file() {
+            self.error(at, format!("'{file}': no such file ({})", full.display()));
+            return None;
+        }
+        Some(path)
+    }
+
+    /// The mesh asset for a `<mesh>` geometry, made when new; its name.
+    fn mesh(&mut self, m: Node, collision: bool) -> Option<String> {
+        let raw = self.raw;
+        let file = self.required(m, "filename")?;
+        let scale_text = raw.attr(m, "scale");
+        let scale = match scale_text {
+            Some(t) => {
+                let v = self.numbers(m, "scale", t, 3)?;
+                [v[0], v[1], v[2]]
+            }
+            None => [1.0; 3],
+        };
+        let path = self.file_reference(m, file)?;
+        let stem_of = |f: &str| strip_ext(strip_path(f)).to_string();
+        let stem = stem_of(if self.strippath {
+            strip_path(file)
+        } else {
+            file
+        });
+        if self.visuals == Visuals::Kept && !collision {
+            let key = (path.clone(), scale_text.unwrap_or("1 1 1").to_string());
+            if let Some(name) = self.visual_meshes.get(&key) {
+                return Some(name.clone());
+            }
+            let mut name = stem.clone();
+            let mut i = 0;
+            while self.mesh_names.contains(&name) || self.meshes.contains_key(&name) {
+                name = format!(
+                    "{stem}_visual{}",
+                    if i == 0 { String::new() } else { i.to_string() }
+                );
+                i += 1;
+            }
+            let n = self.mesh_element(m, &name, &path, scale_text);
+            self.asset_visual.push(n);
+            self.visual_meshes.insert(key, name.clone());
+            return Some(name);
+        }
+        let entries = self.meshes.entry(stem.clone()).or_default();
+        if let Some(e) = entries.iter().find(|e| e.scale == scale) {
+            return Some(e.name.clone());
+        }
+        let name = if entries.is_empty() {
+            stem
+        } else {
+            format!("{stem}{}", entries.len())
+        };
+        entries.push(MeshEntry {
+            name: name.clone(),
+            scale,
+        });
+        let n = self.mesh_element(m, &name, &path, scale_text);
+        self.asset_meshes.push(n);
+        Some(name)
+    }
+
+    fn mesh_element(&mut self, m: Node, name: &str, path: &str, scale: Option<&str>) -> Node {
+        let n = self.element("mesh", m);
+        self.set(n, "name", name);
+        self.set(n, "file", path);
+        if let Some(s) = scale {
+            self.set(n, "scale", s);
+        }
+        self.mesh_names.insert(name.to_string());
+        n
+    }
+
+    /// A `<joint>`'s origin on its child body, and the MJCF joint(s) it makes.
+    fn joint(&mut self, j: Node, body: Node) -> Option<JointKind> {
+        let raw = self.raw;
+        let ty = self.required(j, "type")?;
+        let name = self.required(j, "name")?;
+        let continuous = ty == "continuous";
+        let kind = match ty {
+            "revolute" | "continuous" => JointKind::Hinge,
+            "prismatic" => JointKind::Slide,
+            "fixed" => JointKind::Fixed,
+            "floating" => JointKind::Free,
+            "spherical" => JointKind::Ball,
+            "planar" => {
+                self.error(
+                    j,
+                    format!("URDF joint '{name}' is planar, which this reader does not read yet"),
+                );
+                return None;
+            }
+            other => {
+                self.error(
+                    j,
+                    format!(
+                        "invalid joint type '{other}' in URDF joint '{name}' (revolute, \
+                         continuous, prismatic, fixed, floating, planar or spherical)"
+                    ),
+                );
+                return None;
+            }
+        };
+        if body != self.worldbody {
+            self.origin(j, body);
+        }
+        let axis = match self.sub(j, "axis") {
+            Some(a) => self.required(a, "xyz")?,
+            None => "1 0 0",
+        };
+        let out = match kind {
+            JointKind::Fixed => return Some(kind),
+            _ => self.child(body, "joint", j),
+        };
+        self.set(out, "name", name);
+        match kind {
+            JointKind::Slide => self.set(out, "type", "slide"),
+            JointKind::Free => self.set(out, "type", "free"),
+            JointKind::Ball => self.set(out, "type", "ball"),
+            _ => {}
+        }
+        if kind != JointKind::Free {
+            self.set(out, "axis", axis);
+        }
+        if let Some(d) = self.sub(j, "dynamics") {
+            if let Some(v) = raw.attr(d, "damping") {
+                self.set(out, "damping", v);
+            }
+            if let Some(v) = raw.attr(d, "friction") {
+                self.set(out, "frictionloss", v);
+            }
+        }
+        if continuous && self.options.importer == UrdfImporter::MuJoCo4 {
+            // 4.0.0 reads no range for a continuous joint.
+            self.set(out, "limited", "false");
+        }
+        if let Some(limit) = self.sub(j, "limit") {
+            let (mut lower, mut upper) = (raw.attr(limit, "lower"), raw.attr(limit, "upper"));
+            if continuous && self.options.importer == UrdfImporter::MuJoCo4 {
+                (lower, upper) = (None, None);
+            }
+            let mut value = |t: Option<&str>, attr| match t {
+                Some(t) => self.numbers(limit, attr, t, 1).map(|v| v[0]),
+                None => Some(0.0),
+            };
+            let (lo, hi) = (value(lower, "lower")?, value(upper, "upper")?);
+            if lower.is_some() || upper.is_some() {
+                let range = format!(
+                    "{} {}",
+                    lower.map_or("0", str::trim),
+                    upper.map_or("0", str::trim)
+                );
+                self.set(out, "range", &range);
+            }
+            if lower.is_some() != upper.is_some() || lo > hi {
+                self.set(out, "limited", "false");
+            }
+            if let Some(e) = raw.attr(limit, "effort") {
+                let e = self.numbers(limit, "effort", e, 1)?[0].abs();
+                if e > 0.0 {
+                    self.set(out, "actuatorfrcrange", &format!("{} {}", num(-e), num(e)));
+                }
+            }
+        }
+        Some(kind)
+    }
+
+    /// A `<mimic>` as the importer writes it: a joint equality, the follower first, with
+    /// `polycoef="offset multiplier 0 0 0"`.
+    fn mimic(&mut self, eq: Node, j: Node, m: Node) {
+        let raw = self.raw;
+        let (Some(name), Some(leader)) = (raw.attr(j, "name"), self.required(m, "joint")) else {
+            return;
+        };
+        let e = self.child(eq, "joint", m);
+        self.set(e, "joint1", name);
+        self.set(e, "joint2", leader);
+        let (mult, off) = (raw.attr(m, "multiplier"), raw.attr(m, "offset"));
+        if mult.is_some() || off.is_some() {
+            let coef = format!(
+                "{} {} 0 0 0",
+                off.map_or("0", str::trim),
+                mult.map_or("1", str::trim)
+            );
+            self.set(e, "polycoef", &coef);
+        }
+    }
+
+    /// [`UrdfOptions::actuators`]: one actuator per hinge and slide joint.
+    fn actuators(&mut self, kind: &UrdfActuators, joints: &[Node]) {
+        let raw = self.raw;
+        let root = raw.root();
+        let section = self.child(self.root, "actuator", root);
+        for &j in joints {
+            let Some(name) = raw.attr(j, "name") else {
+                continue;
+            };
+            let limit = self.sub(j, "limit");
+            let read = |attr: &str| {
+                limit
+                    .and_then(|l| raw.attr(l, attr))
+                    .and_then(|t| t.trim().parse::<f64>().ok())
+            };
+            let effort = read("effort").map(f64::abs).filter(|&e| e > 0.0);
+            let tag = match kind {
+                UrdfActuators::Position { .. } => "position",
+                UrdfActuators::Velocity { .. } => "velocity",
+                UrdfActuators::Motor => "motor",
+            };
+            let a = self.child(section, tag, j);
+            self.set(a, "name", name);
+            self.set(a, "joint", name);
+            let ctrl = match kind {
+                UrdfActuators::Position { kp, kv } => {
+                    self.set(a, "kp", &num(*kp));
+                    if *kv > 0.0 {
+                        self.set(a, "kv", &num(*kv));
+                    }
+                    match (read("lower"), read("upper")) {
+                        (Some(lo), Some(hi)) if lo < hi => Some((lo, hi)),
+                        _ => None,
+                    }
+                }
+                UrdfActuators::Velocity { kv } => {
+                    self.set(a, "kv", &num(*kv));
+                    read("velocity")
+                        .map(f64::abs)
+                        .filter(|&v| v > 0.0)
+                        .map(|v| (-v, v))
+                }
+                UrdfActuators::Motor => effort.map(|e| (-e, e)),
+            };
+            if let Some((lo, hi)) = ctrl {
+                self.set(a, "ctrlrange", &format!("{} {}", num(lo), num(hi)));
+            }
+            if let (Some(e), false) = (effort, matches!(kind, UrdfActuators::Motor)) {
+                self.set(a, "forcerange", &format!("{} {}", num(-e), num(e)));
+            }
+        }
+    }
+}
+
+/// What a URDF joint becomes.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum JointKind {
+    Hinge,
+    Slide,
+    Fixed,
+    Free,
+    Ball,
+}
+
+impl JointKind {
+    /// Whether a `<mimic>` on it is read (MuJoCo warns about and drops the others).
+    fn mimics(self) -> bool {
+        matches!(self, JointKind::Hinge | JointKind::Slide)
+    }
+}
