@@ -183,7 +183,7 @@ fn bad_urdf_gives_every_problem_at_its_place() {
     );
     assert_eq!(
         errors_of("<robot name=\"r\"><link name=\"a\"></robot>"),
-        "DIR/bad.urdf:1:30: malformed XML: expected `</link>`, but `</robot>` was found"
+        "DIR/bad.urdf:1:32: malformed XML: ill-formed document: expected `</link>`, but `</robot>` was found"
     );
 }
 
