@@ -11,6 +11,8 @@ use mjcf_forge::Document;
 pub struct Args {
     #[command(flatten)]
     limits: super::LimitArgs,
+    #[command(flatten)]
+    urdf: super::UrdfArgs,
     /// Input MJCF file.
     input: PathBuf,
     /// Print the sizes as one JSON object.
@@ -19,13 +21,17 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> ExitCode {
-    compile(&args.input, args.json, &args.limits.limits())
+    compile(
+        &args.input,
+        args.json,
+        &super::Loader::new(&args.limits, &args.urdf),
+    )
 }
 
 /// `compile IN [--json]`.
 #[cfg(mjcf_mujoco)]
-fn compile(input: &Path, json: bool, limits: &mjcf_forge::Limits) -> ExitCode {
-    let doc = match Document::load_with(input, limits) {
+fn compile(input: &Path, json: bool, limits: &super::Loader) -> ExitCode {
+    let doc = match limits.load(input) {
         Ok(doc) => doc,
         Err(e) => {
             eprintln!("{e}");
@@ -63,7 +69,7 @@ fn compile(input: &Path, json: bool, limits: &mjcf_forge::Limits) -> ExitCode {
 
 /// `compile` in a build without MuJoCo: says how to get one.
 #[cfg(not(mjcf_mujoco))]
-fn compile(_input: &Path, _json: bool, _limits: &mjcf_forge::Limits) -> ExitCode {
+fn compile(_input: &Path, _json: bool, _limits: &super::Loader) -> ExitCode {
     eprintln!("mjcf-forge: compile: {}", super::NO_MUJOCO);
     ExitCode::from(super::USAGE)
 }

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use mjcf_forge::output::AtomicFile;
-use mjcf_forge::{AssetStore, Document, OutputDir, TarWriter};
+use mjcf_forge::{AssetStore, OutputDir, TarWriter};
 
 use super::{USAGE, WriteOptions, finish, refuse_validate_without_mujoco, render};
 
@@ -14,6 +14,8 @@ use super::{USAGE, WriteOptions, finish, refuse_validate_without_mujoco, render}
 pub struct Args {
     #[command(flatten)]
     limits: super::LimitArgs,
+    #[command(flatten)]
+    urdf: super::UrdfArgs,
     /// Input MJCF file.
     input: PathBuf,
     /// Output folder (created if missing); with `--tar`, the tar file (`-` for standard
@@ -48,7 +50,12 @@ pub fn run(args: Args) -> ExitCode {
         eprintln!("{e}");
         return ExitCode::FAILURE;
     }
-    let result = prepare(&args.input, options, &args.limits.limits()).and_then(|(store, text)| {
+    let result = prepare(
+        &args.input,
+        options,
+        &super::Loader::new(&args.limits, &args.urdf),
+    )
+    .and_then(|(store, text)| {
         if args.tar {
             export_tar(&store, name, &text, &args.output).map_err(|e| {
                 if args.output == Path::new("-") {
@@ -69,9 +76,9 @@ pub fn run(args: Args) -> ExitCode {
 fn prepare(
     input: &Path,
     options: WriteOptions,
-    limits: &mjcf_forge::Limits,
+    limits: &super::Loader,
 ) -> Result<(AssetStore, String), String> {
-    let mut doc = Document::load_with(input, limits).map_err(|e| e.to_string())?;
+    let mut doc = limits.load(input).map_err(|e| e.to_string())?;
     if options.validate {
         super::validate(&doc)?;
     }

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use mjcf_forge::{Document, XmlModel, XmlModelOptions};
+use mjcf_forge::{XmlModel, XmlModelOptions};
 
 use super::{finish, write_stdout};
 
@@ -11,6 +11,8 @@ use super::{finish, write_stdout};
 pub struct Args {
     #[command(flatten)]
     limits: super::LimitArgs,
+    #[command(flatten)]
+    urdf: super::UrdfArgs,
     /// Input MJCF file (exactly one top-level body).
     input: PathBuf,
     /// Naming prefix of the instance (none by default).
@@ -23,8 +25,9 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> ExitCode {
-    let limits = args.limits.limits();
-    let result = Document::load_with(&args.input, &limits)
+    let limits = super::Loader::new(&args.limits, &args.urdf);
+    let result = limits
+        .load(&args.input)
         .map_err(|e| e.to_string())
         .and_then(|doc| {
             let options = XmlModelOptions {

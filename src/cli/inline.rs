@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use std::collections::HashMap;
 
-use mjcf_forge::{Document, OutputDir};
+use mjcf_forge::OutputDir;
 use rayon::prelude::*;
 
 use super::{USAGE, WriteOptions, emit, finish, refuse_validate_without_mujoco, render};
@@ -14,6 +14,8 @@ use super::{USAGE, WriteOptions, emit, finish, refuse_validate_without_mujoco, r
 pub struct Args {
     #[command(flatten)]
     limits: super::LimitArgs,
+    #[command(flatten)]
+    urdf: super::UrdfArgs,
     /// Input MJCF files.
     #[arg(required = true)]
     inputs: Vec<PathBuf>,
@@ -33,7 +35,7 @@ pub fn run(args: Args) -> ExitCode {
         return code;
     }
     let options = args.write;
-    let limits = args.limits.limits();
+    let limits = super::Loader::new(&args.limits, &args.urdf);
     match args.out_dir {
         Some(dir) => inline_to_dir(&args.inputs, &dir, options, &limits),
         None => inline_one_input(&args.inputs, args.output.as_deref(), options, &limits),
@@ -44,7 +46,7 @@ fn inline_one_input(
     inputs: &[PathBuf],
     output: Option<&Path>,
     options: WriteOptions,
-    limits: &mjcf_forge::Limits,
+    limits: &super::Loader,
 ) -> ExitCode {
     if inputs.len() > 1 {
         eprintln!("mjcf-forge: several inputs need --out-dir DIR");
@@ -61,7 +63,7 @@ fn inline_to_dir(
     inputs: &[PathBuf],
     dir: &Path,
     options: WriteOptions,
-    limits: &mjcf_forge::Limits,
+    limits: &super::Loader,
 ) -> ExitCode {
     let jobs = match plan_outputs(inputs, dir) {
         Ok(jobs) => jobs,
@@ -82,7 +84,7 @@ fn inline_to_dir(
     let mut results: Vec<Result<(), String>> = jobs
         .par_iter()
         .map(|job| {
-            let doc = Document::load_with(job.input, limits).map_err(|e| e.to_string())?;
+            let doc = limits.load(job.input).map_err(|e| e.to_string())?;
             let text = render(&doc, options)?;
             out.write(job.output, text.as_bytes())
                 .map_err(|e| e.to_string())
@@ -164,9 +166,9 @@ fn inline_model(
     input: &Path,
     output: Option<&Path>,
     options: WriteOptions,
-    limits: &mjcf_forge::Limits,
+    limits: &super::Loader,
 ) -> Result<(), String> {
-    let doc = Document::load_with(input, limits).map_err(|e| e.to_string())?;
+    let doc = limits.load(input).map_err(|e| e.to_string())?;
     emit(&doc, output, options)
 }
 

@@ -12,6 +12,8 @@ use super::{USAGE, WriteOptions, emit, finish, refuse_validate_without_mujoco};
 pub struct Args {
     #[command(flatten)]
     limits: super::LimitArgs,
+    #[command(flatten)]
+    urdf: super::UrdfArgs,
     /// The base model.
     base: PathBuf,
     /// A part: FILE, FILE:PREFIX or FILE:PREFIX:BODY (in order of merging).
@@ -45,7 +47,7 @@ pub fn run(args: Args) -> ExitCode {
         args.fuse_keys,
         args.output.as_deref(),
         options,
-        &args.limits.limits(),
+        &super::Loader::new(&args.limits, &args.urdf),
     )])
 }
 
@@ -80,14 +82,14 @@ fn merge(
     fuse_keys: bool,
     output: Option<&Path>,
     options: WriteOptions,
-    limits: &mjcf_forge::Limits,
+    limits: &super::Loader,
 ) -> Result<(), String> {
-    let mut scene = Document::load_with(base, limits).map_err(|e| e.to_string())?;
+    let mut scene = limits.load(base).map_err(|e| e.to_string())?;
     // Parts load in parallel; they merge in the order given.
     let loaded: Vec<Result<Document, String>> = parts
         .par_iter()
         .map(|p| {
-            let mut doc = Document::load_with(&p.file, limits).map_err(|e| e.to_string())?;
+            let mut doc = limits.load(&p.file).map_err(|e| e.to_string())?;
             doc.apply_prefix(&p.prefix).map_err(|e| e.to_string())?;
             Ok(doc)
         })

@@ -14,7 +14,7 @@ pub mod preview;
 pub mod progress;
 
 use std::io::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use mjcf_forge::Document;
@@ -217,6 +217,107 @@ pub struct LimitArgs {
     /// Longest element or attribute name, in bytes [default: 1000].
     #[arg(long, value_name = "BYTES")]
     max_name_len: Option<u32>,
+}
+
+/// How a URDF input is read (see `mjcf_forge::UrdfOptions`), for every subcommand that
+/// loads models; an MJCF input ignores them.
+#[derive(clap::Args, Clone, Debug, Default)]
+pub struct UrdfArgs {
+    /// URDF: keep each <visual> as a geom of group 1 (no mass, no contacts), its material
+    /// as a MuJoCo material (MuJoCo's importer drops them).
+    #[arg(long)]
+    urdf_visuals: bool,
+    /// URDF: keep every link a body (MuJoCo's importer fuses static links into their
+    /// parents).
+    #[arg(long)]
+    urdf_keep_static: bool,
+    /// URDF: keep this link a body even when static links are fused (repeatable).
+    #[arg(long, value_name = "LINK")]
+    urdf_keep_link: Vec<String>,
+    /// URDF: the folder of a package named by `package://NAME/...` (repeatable); else
+    /// ROS_PACKAGE_PATH, AMENT_PREFIX_PATH and the folders above the file are searched.
+    #[arg(long, value_name = "NAME=DIR")]
+    urdf_package: Vec<String>,
+    /// URDF: an actuator for each hinge and slide joint: `position:KP[:KV]`,
+    /// `velocity:KV` or `motor`.
+    #[arg(long, value_name = "KIND")]
+    urdf_actuators: Option<String>,
+    /// URDF: read as this MuJoCo version's importer [default: the linked MuJoCo's, else
+    /// 4.0.0].
+    #[arg(long, value_name = "VERSION")]
+    urdf_mujoco: Option<String>,
+}
+
+impl UrdfArgs {
+    /// The options these flags ask for, or what is wrong with them.
+    pub fn options(&self) -> Result<mjcf_forge::UrdfOptions, String> {
+        let mut o = mjcf_forge::UrdfOptions {
+            visuals: self.urdf_visuals,
+            fuse_static: !self.urdf_keep_static,
+            keep_links: self.urdf_keep_link.clone(),
+            ..Default::default()
+        };
+        for p in &self.urdf_package {
+            let (name, dir) = p
+                .split_once('=')
+                .ok_or_else(|| format!("--urdf-package {p}: expected NAME=DIR"))?;
+            o.packages.push((name.to_string(), PathBuf::from(dir)));
+        }
+        if let Some(v) = &self.urdf_mujoco {
+            o.importer = mjcf_forge::UrdfImporter::of_version(v);
+        }
+        if let Some(kind) = &self.urdf_actuators {
+            let bad = || {
+                format!("--urdf-actuators {kind}: expected position:KP[:KV], velocity:KV or motor")
+            };
+            let mut parts = kind.split(':');
+            let gain = |parts: &mut std::str::Split<'_, char>| -> Result<Option<f64>, String> {
+                parts
+                    .next()
+                    .map(|g| g.parse::<f64>().map_err(|_| bad()))
+                    .transpose()
+            };
+            o.actuators = Some(match parts.next() {
+                Some("position") => {
+                    let kp = gain(&mut parts)?.ok_or_else(bad)?;
+                    let kv = gain(&mut parts)?.unwrap_or(0.0);
+                    mjcf_forge::UrdfActuators::Position { kp, kv }
+                }
+                Some("velocity") => mjcf_forge::UrdfActuators::Velocity {
+                    kv: gain(&mut parts)?.ok_or_else(bad)?,
+                },
+                Some("motor") => mjcf_forge::UrdfActuators::Motor,
+                _ => return Err(bad()),
+            });
+            if parts.next().is_some() {
+                return Err(bad());
+            }
+        }
+        Ok(o)
+    }
+}
+
+/// What a subcommand loads models with: its limits, and how URDF is read.
+pub struct Loader {
+    limits: mjcf_forge::Limits,
+    urdf: Result<mjcf_forge::UrdfOptions, String>,
+}
+
+impl Loader {
+    /// The loader of a subcommand's flags (a bad URDF flag is reported on first load).
+    pub fn new(limits: &LimitArgs, urdf: &UrdfArgs) -> Loader {
+        Loader {
+            limits: limits.limits(),
+            urdf: urdf.options(),
+        }
+    }
+
+    /// A model read as `Document::load` reads it, within the limits; its problems (or a
+    /// bad URDF flag) as text.
+    pub fn load(&self, path: &Path) -> Result<mjcf_forge::Document, String> {
+        let urdf = self.urdf.as_ref().map_err(Clone::clone)?;
+        mjcf_forge::Document::load_urdf_with(path, &self.limits, urdf).map_err(|e| e.to_string())
+    }
 }
 
 impl LimitArgs {

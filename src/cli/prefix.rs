@@ -3,14 +3,14 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use mjcf_forge::Document;
-
 use super::{WriteOptions, emit, finish, refuse_validate_without_mujoco};
 
 #[derive(clap::Args)]
 pub struct Args {
     #[command(flatten)]
     limits: super::LimitArgs,
+    #[command(flatten)]
+    urdf: super::UrdfArgs,
     /// Input MJCF file.
     input: PathBuf,
     /// The prefix.
@@ -28,8 +28,9 @@ pub fn run(args: Args) -> ExitCode {
         return code;
     }
     let options = args.write;
-    let limits = args.limits.limits();
-    let result = Document::load_with(&args.input, &limits)
+    let limits = super::Loader::new(&args.limits, &args.urdf);
+    let result = limits
+        .load(&args.input)
         .map_err(|e| e.to_string())
         .and_then(|mut doc| {
             doc.apply_prefix(&args.prefix).map_err(|e| e.to_string())?;

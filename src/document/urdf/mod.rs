@@ -169,6 +169,22 @@ impl Document {
         Document::load_full(path.as_ref(), &Limits::default(), options)
     }
 
+    /// [`Document::load_urdf`] within other [`Limits`] than the default ones; an MJCF file
+    /// loads as [`Document::load_with`] loads it.
+    ///
+    /// ```no_run
+    /// use mjcf_forge::{Document, Limits, UrdfOptions};
+    /// let doc = Document::load_urdf_with("arm.urdf", &Limits::default(), &UrdfOptions::default())?;
+    /// # Ok::<(), mjcf_forge::Errors>(())
+    /// ```
+    pub fn load_urdf_with(
+        path: impl AsRef<Path>,
+        limits: &Limits,
+        options: &UrdfOptions,
+    ) -> Result<Document, Errors> {
+        Document::load_full(path.as_ref(), limits, options)
+    }
+
     /// URDF text read with `options`; `base_dir` plays the part of the file's folder
     /// (relative mesh paths and `package.xml` searches start there).
     ///

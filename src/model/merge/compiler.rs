@@ -114,6 +114,44 @@ pub(crate) fn builtin_compiler() -> Option<CompileFn> {
 }
 
 impl Document {
+    /// When the part fuses static bodies (`fusestatic="true"`: a URDF robot, as MuJoCo's
+    /// importer reads one) and this document does not, this document takes the setting
+    /// and keeps each of its own bodies with `fuse="false"`, so that both compile as before
+    /// (3.17.0 and 4.0.0): the conversion the other way round has no spelling.
+    pub(super) fn adopt_static_fusion(&mut self, part: &Document) {
+        let fuses = |d: &Document| {
+            compiler_settings(d)
+                .get("fusestatic")
+                .is_some_and(|(v, _)| v == "true")
+        };
+        if !fuses(part) || fuses(self) {
+            return;
+        }
+        let bodies: Vec<Node> = self
+            .descendants(self.root)
+            .filter(|&n| self.tag(n) == "body")
+            .collect();
+        for b in bodies {
+            self.set_attr(b, "fuse", "false");
+        }
+        let compiler = crate::document::names::sym("compiler");
+        let last = self
+            .elements(self.root)
+            .filter(|&n| self.tag_sym(n) == Some(compiler))
+            .last();
+        match last {
+            Some(c) => self.set_attr(c, "fusestatic", "true"),
+            None => {
+                let c = self.new_element(compiler, None);
+                match self.tree.first_child(self.root) {
+                    Some(first) => self.tree.insert_before(first, c),
+                    None => self.tree.append(self.root, c),
+                }
+                self.set_attr(c, "fusestatic", "true");
+            }
+        }
+    }
+
     /// `part` converted as [`Document::merge`] converts it, carrying this document's
     /// `<compiler>` settings instead of its own, so that merging it here later converts
     /// nothing more (the batch tier prepares each object once and merges it into every

@@ -295,6 +295,7 @@ impl Document {
     ) -> Result<(MergeReport, NodeMap), Errors> {
         let mut report = MergeReport::default();
         let mut errors: Vec<Error> = Vec::new();
+        self.adopt_static_fusion(part);
         self.adopt_angle_unit_if_smaller(part);
         let converted = self.converted_part(part, &mut errors, compile);
         if !errors.is_empty() {
