@@ -210,3 +210,56 @@ fn xacro_files_name_the_expansion() {
         "{err}"
     );
 }
+
+#[test]
+fn a_urdf_arm_with_an_mjcf_gripper_in_a_scene_compiles_steps_and_keeps_its_physics() {
+    use mjcf_forge::scene::Scene;
+    let scene_file = root().join("corpora/scenes/urdf/urdf_arm.toml");
+    let scene = Scene::load(&scene_file).unwrap();
+    let dir = scratch("urdf_scene");
+    for i in 0..20 {
+        let v = scene.variant(i).unwrap();
+        std::fs::write(dir.join(format!("{i:02}.xml")), v.xml()).unwrap();
+    }
+    // Each variant steps; the arm's bodies (fused as MuJoCo fuses them) keep the masses,
+    // inertias and joints of MuJoCo's own import of the URDF, the gripper its own.
+    let check = r#"
+import glob, sys, mujoco, numpy as np
+arm = mujoco.MjModel.from_xml_path(sys.argv[1])
+grip = mujoco.MjModel.from_xml_path(sys.argv[2])
+def same(m, ref, prefix):
+    for b in range(1, ref.nbody):
+        i = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, prefix + ref.body(b).name)
+        assert i >= 0, ref.body(b).name
+        for f in ["body_mass", "body_inertia", "body_ipos", "body_iquat"]:
+            assert np.array_equal(getattr(m, f)[i], getattr(ref, f)[b]), (f, ref.body(b).name)
+    for j in range(ref.njnt):
+        i = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, prefix + ref.joint(j).name)
+        for f in ["jnt_range", "jnt_limited", "jnt_axis", "jnt_actfrcrange"]:
+            assert np.array_equal(getattr(m, f)[i], getattr(ref, f)[j]), (f, ref.joint(j).name)
+n = 0
+for f in sorted(glob.glob(sys.argv[3] + "/*.xml")):
+    m = mujoco.MjModel.from_xml_path(f)
+    same(m, arm, "robot0_")
+    same(m, grip, "gripper0_")
+    d = mujoco.MjData(m)
+    for _ in range(200):
+        mujoco.mj_step(m, d)
+    assert np.isfinite(d.qpos).all(), f
+    n += 1
+print(n, "variants")
+"#;
+    let out = std::process::Command::new(common::python())
+        .args(["-c", check])
+        .arg(root().join("corpora/scenes/urdf/arm.urdf"))
+        .arg(root().join("corpora/scenes/demo/gripper.xml"))
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && stdout.trim() == "20 variants",
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
