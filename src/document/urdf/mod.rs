@@ -66,8 +66,9 @@ pub struct UrdfOptions {
     pub keep_links: Vec<String>,
     /// Resolve `package://NAME/...` and `file://...` mesh paths. The package folder is
     /// found in [`UrdfOptions::packages`], then `ROS_PACKAGE_PATH`, then
-    /// `AMENT_PREFIX_PATH` (`share/NAME`), then by walking up from the URDF's folder to a
-    /// folder named `NAME` or holding a `package.xml` that names it.
+    /// `AMENT_PREFIX_PATH` (`share/NAME`), then a folder `NAME` beside the URDF, then by
+    /// walking up from the URDF's folder to a folder named `NAME` or holding a
+    /// `package.xml` that names it.
     pub resolve_packages: bool,
     /// Package folders given by the user: (package name, folder).
     pub packages: Vec<(String, PathBuf)>,

@@ -3,9 +3,9 @@
 //! MuJoCo opens neither (4.0.0 looks for `package:/NAME/rest` literally), so resolving
 //! them changes no model MuJoCo builds. A package's folder is looked for, in order: in the
 //! user's map, on `ROS_PACKAGE_PATH` (each entry a package folder, or a folder holding
-//! packages), under `AMENT_PREFIX_PATH`'s `share/NAME`, then by walking up from the URDF's
-//! folder to a folder named `NAME`, or holding a `package.xml` that names it, or holding a
-//! folder `NAME`.
+//! packages), under `AMENT_PREFIX_PATH`'s `share/NAME`, then a folder `NAME` beside the
+//! URDF, then by walking up from the URDF's folder to a folder named `NAME` or holding a
+//! `package.xml` that names it, or holding a package folder `NAME` (with its `package.xml`).
 
 use std::path::{Path, PathBuf};
 
@@ -65,11 +65,16 @@ impl Packages<'_> {
             }
         }
         let start = std::path::absolute(self.start).unwrap_or_else(|_| self.start.to_path_buf());
+        // The URDF's own folder may hold the package as a plain folder (pybullet's
+        // `package://meshes/...` beside the file); above it, a package has its manifest.
+        if start.join(name).is_dir() {
+            return Some(start.join(name));
+        }
         for dir in start.ancestors() {
             if names_package(dir, name) {
                 return Some(dir.to_path_buf());
             }
-            if dir.join(name).is_dir() && dir.join(name).join("package.xml").is_file() {
+            if dir.join(name).join("package.xml").is_file() {
                 return Some(dir.join(name));
             }
         }
