@@ -34,6 +34,8 @@ impl Packages<'_> {
         let Some(rest) = reference.strip_prefix("package://") else {
             return Resolved::Plain;
         };
+        // `package:///NAME/...` (a slash too many) names the same package.
+        let rest = rest.trim_start_matches('/');
         let (name, inner) = rest.split_once('/').unwrap_or((rest, ""));
         match self.package_dir(name) {
             Some(dir) => Resolved::File(dir.join(inner)),
