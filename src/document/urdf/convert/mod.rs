@@ -22,9 +22,12 @@
 
 use ahash::{AHashMap, AHashSet};
 
+mod actuators;
+mod visuals;
+
 use super::packages::{Packages, Resolved};
 use super::robot::Robot;
-use super::{UrdfActuators, UrdfImporter, UrdfOptions};
+use super::{UrdfImporter, UrdfOptions};
 use crate::document::Document;
 use crate::document::tree::{Node, Tree};
 use crate::error::{Error, ErrorKind, Errors};
@@ -357,59 +360,6 @@ impl<'r> Writer<'r> {
         }
     }
 
-    /// Every `<material>` with a name and a `<color>`, anywhere in the file (the first
-    /// of a name wins), as the importer registers them before reading links.
-    fn register_materials(&mut self, root: Node) {
-        let raw = self.raw;
-        for m in raw.descendants(root) {
-            if !raw.is_element(m) || raw.tag(m) != "material" {
-                continue;
-            }
-            let Some(name) = raw.attr(m, "name") else {
-                continue;
-            };
-            if self.materials.contains_key(name) {
-                continue;
-            }
-            if let Some(rgba) = self
-                .sub(m, "color")
-                .and_then(|color| self.required(color, "rgba"))
-            {
-                self.materials.insert(name, rgba);
-            }
-        }
-    }
-
-    /// The colour a `<visual>`'s material gives, if any.
-    fn visual_rgba(&mut self, visual: Node) -> Option<&'r str> {
-        let m = self.sub(visual, "material")?;
-        if let Some(color) = self.sub(m, "color") {
-            return self.required(color, "rgba");
-        }
-        let name = self.required(m, "name")?;
-        self.materials.get(name).copied()
-    }
-
-    /// The names the collision geoms get when visuals are dropped.
-    fn names_without_visuals(&mut self, robot: &Robot<'r>) -> AHashSet<String> {
-        let raw = self.raw;
-        let mut used = AHashSet::new();
-        for link in &robot.links {
-            let mut name = "";
-            for g in raw
-                .elements(link.node)
-                .filter(|&g| raw.tag(g) == "collision")
-            {
-                if let Some(n) = raw.attr(g, "name") {
-                    name = n;
-                }
-                used.insert(name.to_string());
-            }
-        }
-        used.remove("");
-        used
-    }
-
     /// A link's `<inertial>` and geoms, into `body`.
     fn link(&mut self, link: Node, name: &str, body: Node) {
         let raw = self.raw;
@@ -467,62 +417,6 @@ impl<'r> Writer<'r> {
     fn name_geom(&mut self, geom: Node, name: &str) {
         if self.geom_names.insert(name.to_string()) && !name.is_empty() {
             self.set(geom, "name", name);
-        }
-    }
-
-    /// A visual kept by [`UrdfOptions::visuals`]: its own name if no collision geom and no
-    /// earlier visual has it, its material as a MuJoCo material.
-    fn kept_visual(&mut self, visual: Node, body: Node) {
-        let raw = self.raw;
-        let Some(g) = self.geom(visual, body, false) else {
-            return;
-        };
-        if let Some(n) = raw
-            .attr(visual, "name")
-            .filter(|n| !self.collision_names.contains(*n))
-            && self.geom_names.insert(n.to_string())
-        {
-            self.set(g, "name", n);
-        }
-        let Some(m) = self.sub(visual, "material") else {
-            return;
-        };
-        let color = self
-            .sub(m, "color")
-            .and_then(|c| raw.attr(c, "rgba"))
-            .or_else(|| {
-                raw.attr(m, "name")
-                    .and_then(|n| self.materials.get(n).copied())
-            });
-        let texture = self
-            .sub(m, "texture")
-            .and_then(|t| raw.attr(t, "filename"))
-            .and_then(|f| self.file_reference(m, f));
-        match raw.attr(m, "name") {
-            Some(name) => {
-                if self.made_materials.insert(name.to_string()) {
-                    let mat = self.element("material", m);
-                    self.set(mat, "name", name);
-                    if let Some(c) = color {
-                        self.set(mat, "rgba", c);
-                    }
-                    if let Some(file) = texture {
-                        let tex = self.element("texture", m);
-                        self.set(tex, "name", name);
-                        self.set(tex, "type", "2d");
-                        self.set(tex, "file", &file);
-                        self.set(mat, "texture", name);
-                        self.asset_visual.push(tex);
-                    }
-                    self.asset_visual.push(mat);
-                }
-                self.set(g, "material", name);
-            }
-            None => {
-                if let Some(c) = color {
-                    self.set(g, "rgba", c);
-                }
-            }
         }
     }
 
@@ -907,59 +801,6 @@ impl<'r> Writer<'r> {
                 mult.map_or("1", str::trim)
             );
             self.set(e, "polycoef", &coef);
-        }
-    }
-
-    /// [`UrdfOptions::actuators`]: one actuator per hinge and slide joint.
-    fn actuators(&mut self, kind: &UrdfActuators, joints: &[Node]) {
-        let raw = self.raw;
-        let root = raw.root();
-        let section = self.child(self.root, "actuator", root);
-        for &j in joints {
-            let Some(name) = raw.attr(j, "name") else {
-                continue;
-            };
-            let limit = self.sub(j, "limit");
-            let read = |attr: &str| {
-                limit
-                    .and_then(|l| raw.attr(l, attr))
-                    .and_then(|t| t.trim().parse::<f64>().ok())
-            };
-            let effort = read("effort").map(f64::abs).filter(|&e| e > 0.0);
-            let tag = match kind {
-                UrdfActuators::Position { .. } => "position",
-                UrdfActuators::Velocity { .. } => "velocity",
-                UrdfActuators::Motor => "motor",
-            };
-            let a = self.child(section, tag, j);
-            self.set(a, "name", name);
-            self.set(a, "joint", name);
-            let ctrl = match kind {
-                UrdfActuators::Position { kp, kv } => {
-                    self.set(a, "kp", &num(*kp));
-                    if *kv > 0.0 {
-                        self.set(a, "kv", &num(*kv));
-                    }
-                    match (read("lower"), read("upper")) {
-                        (Some(lo), Some(hi)) if lo < hi => Some((lo, hi)),
-                        _ => None,
-                    }
-                }
-                UrdfActuators::Velocity { kv } => {
-                    self.set(a, "kv", &num(*kv));
-                    read("velocity")
-                        .map(f64::abs)
-                        .filter(|&v| v > 0.0)
-                        .map(|v| (-v, v))
-                }
-                UrdfActuators::Motor => effort.map(|e| (-e, e)),
-            };
-            if let Some((lo, hi)) = ctrl {
-                self.set(a, "ctrlrange", &format!("{} {}", num(lo), num(hi)));
-            }
-            if let (Some(e), false) = (effort, matches!(kind, UrdfActuators::Motor)) {
-                self.set(a, "forcerange", &format!("{} {}", num(-e), num(e)));
-            }
         }
     }
 }
