@@ -99,6 +99,37 @@ pub(crate) fn euler_xyz(angles: [f64; 3]) -> [f64; 4] {
     normalized(q)
 }
 
+/// The minimal rotation from `[0, 0, 1]` to `v` (MuJoCo's `mjuu_z2quat`): about
+/// `z x v`, by the angle `atan2(|z x v|, v_z)`; about x when `v` is (anti)parallel to z.
+pub(crate) fn z_to_quat(v: &[f64; 3]) -> [f64; 4] {
+    // z x v, normalized as mjuu_normvec does: left alone when tiny or within mjEPS of
+    // unit length.
+    let mut axis = [-v[1], v[0], 0.0];
+    let norm2 = axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2];
+    let s = if norm2 < EPS {
+        0.0
+    } else {
+        let n = norm2.sqrt();
+        if (n - 1.0).abs() > EPS {
+            for x in &mut axis {
+                *x /= n;
+            }
+        }
+        n
+    };
+    if s < 1e-10 {
+        axis = [1.0, 0.0, 0.0];
+    }
+    let ang = s.atan2(v[2]);
+    let half_sin = (ang / 2.0).sin();
+    [
+        (ang / 2.0).cos(),
+        axis[0] * half_sin,
+        axis[1] * half_sin,
+        axis[2] * half_sin,
+    ]
+}
+
 /// The eigenvalues (decreasing) and principal axes (as a quaternion) of the symmetric
 /// matrix `m`: Jacobi rotations accumulated in a quaternion, as the compiler computes a
 /// body's principal axes.

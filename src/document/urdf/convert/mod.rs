@@ -701,13 +701,7 @@ impl<'r> Writer<'r> {
             "fixed" => JointKind::Fixed,
             "floating" => JointKind::Free,
             "spherical" => JointKind::Ball,
-            "planar" => {
-                self.error(
-                    j,
-                    format!("URDF joint '{name}' is planar, which this reader does not read yet"),
-                );
-                return None;
-            }
+            "planar" => JointKind::Planar,
             other => {
                 self.error(
                     j,
@@ -730,22 +724,54 @@ impl<'r> Writer<'r> {
             JointKind::Fixed => return Some(kind),
             _ => self.child(body, "joint", j),
         };
-        self.set(out, "name", name);
+        // A planar joint is the importer's three: slides along the x and y of the frame
+        // whose z is the axis (`mjuu_z2quat`), and a hinge about the axis; the limit
+        // reaches the first only, the dynamics all three.
+        let mut all = vec![out];
+        if kind == JointKind::Planar {
+            let v = self.numbers(j, "axis", axis, 3)?;
+            let m = crate::rotation::quat_to_mat(&crate::rotation::z_to_quat(&[v[0], v[1], v[2]]));
+            self.set(out, "name", &format!("{name}_TX"));
+            self.set(out, "type", "slide");
+            self.set(
+                out,
+                "axis",
+                &format!("{} {} {}", num(m[0]), num(m[3]), num(m[6])),
+            );
+            for (suffix, ty, ax) in [
+                (
+                    "_TY",
+                    "slide",
+                    format!("{} {} {}", num(m[1]), num(m[4]), num(m[7])),
+                ),
+                ("_RZ", "hinge", axis.to_string()),
+            ] {
+                let more = self.child(body, "joint", j);
+                self.set(more, "name", &format!("{name}{suffix}"));
+                self.set(more, "type", ty);
+                self.set(more, "axis", &ax);
+                all.push(more);
+            }
+        } else {
+            self.set(out, "name", name);
+        }
         match kind {
             JointKind::Slide => self.set(out, "type", "slide"),
             JointKind::Free => self.set(out, "type", "free"),
             JointKind::Ball => self.set(out, "type", "ball"),
             _ => {}
         }
-        if kind != JointKind::Free {
+        if !matches!(kind, JointKind::Free | JointKind::Planar) {
             self.set(out, "axis", axis);
         }
         if let Some(d) = self.sub(j, "dynamics") {
-            if let Some(v) = raw.attr(d, "damping") {
-                self.set(out, "damping", v);
-            }
-            if let Some(v) = raw.attr(d, "friction") {
-                self.set(out, "frictionloss", v);
+            for &n in &all {
+                if let Some(v) = raw.attr(d, "damping") {
+                    self.set(n, "damping", v);
+                }
+                if let Some(v) = raw.attr(d, "friction") {
+                    self.set(n, "frictionloss", v);
+                }
             }
         }
         if continuous && self.options.importer == UrdfImporter::MuJoCo4 {
@@ -813,6 +839,7 @@ enum JointKind {
     Fixed,
     Free,
     Ball,
+    Planar,
 }
 
 impl JointKind {
