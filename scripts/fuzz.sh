@@ -34,7 +34,7 @@ seed() {
   mkdir -p "$dir"
   local i=0
   for f in ../corpora/features/*.xml ../corpora/errors/*.xml ../corpora/prefix/*.xml \
-           ../corpora/merge/*.xml ../corpora/fuzz/*/*; do
+           ../corpora/merge/*.xml ../corpora/urdf/*.urdf ../corpora/fuzz/*/*; do
     [ -f "$f" ] || continue
     i=$((i + 1))
     case "$target" in
