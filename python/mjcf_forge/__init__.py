@@ -1,7 +1,9 @@
 """mjcf_forge: MuJoCo MJCF models loaded exactly as MuJoCo reads them, in Rust.
 
 - :class:`Document`: a model with its includes expanded, default classes inlined and
-  asset paths absolute; prefix, merge, validate, write; its :class:`Element` s behave as
+  asset paths absolute (a URDF robot read as MuJoCo's importer reads it, or with
+  :meth:`Document.from_urdf`'s options: visuals, static links, ``package://`` folders,
+  actuators); prefix, merge, validate, write; its :class:`Element` s behave as
   ``xml.etree.ElementTree`` elements (ElementPath, live ``attrib``, ``append``, ...), and
   :mod:`mjcf_forge.etree` mirrors ``xml.etree.ElementTree``'s functions over them.
 - :class:`Model`: one instance of a model with its own name prefix and robosuite's

@@ -57,6 +57,9 @@ _AttrValue = Union[str, bool, int, float, Sequence[Union[int, float]], npt.NDArr
 #: What Element.append and friends take: an Element of ours, or one of xml.etree (or lxml).
 _AnyElement = Any
 _T = TypeVar("_T")
+#: ``Document.from_urdf(actuators=...)``: ``{"type": "position", "kp": 100.0, "kv": 10.0}``,
+#: ``{"type": "velocity", "kv": 5.0}`` or ``{"type": "motor"}``.
+_UrdfActuators = dict[str, Union[str, float]]
 
 class MjcfError(ValueError):
     """A model, scene or operation that mjcf-forge refuses.
@@ -191,12 +194,42 @@ class LoadCache:
     def __len__(self) -> int: ...
 
 class Document:
-    """An MJCF model as MuJoCo reads it (includes expanded, defaults inlined, paths absolute)."""
+    """An MJCF model as MuJoCo reads it (includes expanded, defaults inlined, paths absolute),
+    or a URDF robot as MuJoCo's importer reads it."""
 
     @staticmethod
-    def load(path: _Path) -> Document: ...
+    def load(path: _Path) -> Document:
+        """An MJCF file, or a URDF file read as the installed ``mujoco`` imports it."""
     @staticmethod
     def from_string(xml: str, base_dir: Optional[_Path] = None) -> Document: ...
+    @staticmethod
+    def from_urdf(
+        path: _Path,
+        *,
+        visuals: bool = False,
+        fuse_static: bool = True,
+        keep_links: Iterable[str] = (),
+        packages: Optional[Mapping[str, _Path]] = None,
+        resolve_packages: bool = True,
+        actuators: Optional[_UrdfActuators] = None,
+        importer: Optional[str] = None,
+    ) -> Document:
+        """A URDF robot as MuJoCo's importer reads it (``importer``: a MuJoCo version, by
+        default the installed ``mujoco``'s), with visuals kept, static links kept,
+        ``package://`` folders given and actuators written when asked."""
+    @staticmethod
+    def from_urdf_string(
+        xml: str,
+        base_dir: Optional[_Path] = None,
+        *,
+        visuals: bool = False,
+        fuse_static: bool = True,
+        keep_links: Iterable[str] = (),
+        packages: Optional[Mapping[str, _Path]] = None,
+        resolve_packages: bool = True,
+        actuators: Optional[_UrdfActuators] = None,
+        importer: Optional[str] = None,
+    ) -> Document: ...
     def to_xml(self, pretty: bool = False) -> str: ...
     def write(self, path: _Path) -> None: ...
     def prefix(

@@ -58,6 +58,9 @@ def load(fname: str, load_exact: Callable[[str], Any], error: Callable[[str], Ex
     except _XET.ParseError:
         # The exact reader says where and what, as for any unreadable file.
         return load_exact(fname)
+    if root.tag == "robot":
+        # URDF: no default classes of robosuite's to inline (the reader converts it).
+        return load_exact(fname)
     _inline_defaults(root, fname, error)
     doc = Document.from_string(_XET.tostring(root, encoding="unicode"), os.path.dirname(os.path.abspath(fname)))
     if b"<include" not in data:

@@ -6,12 +6,15 @@ looks each up here by name, and nowhere else.
 - ``preview``: a contact sheet drawn with the installed ``mujoco`` (``Scene.preview``);
 - ``progress_of``: a progress reporter (``Scene.variants(progress=...)``);
 - ``fromstring``: an element rebuilt from its XML (pickling an ``Element``);
-- ``MjcfFileNotFoundError``: the error raised when every problem is a missing file.
+- ``MjcfFileNotFoundError``: the error raised when every problem is a missing file;
+- :func:`mujoco_version`: the installed ``mujoco``'s version, whose URDF importer a URDF
+  is read as (``Document.load``, ``Document.from_urdf``).
 """
 
 from __future__ import annotations
 
-from typing import Any
+import functools
+from typing import Any, Optional
 
 from ._errors import MjcfFileNotFoundError
 from ._mjcf_utils import without_materials
@@ -20,7 +23,14 @@ from ._progress import progress_of
 from ._settings import model_cache
 from .etree import fromstring
 
-__all__ = ["MjcfFileNotFoundError", "compile_inertia", "fromstring", "preview", "progress_of"]
+__all__ = [
+    "MjcfFileNotFoundError",
+    "compile_inertia",
+    "fromstring",
+    "mujoco_version",
+    "preview",
+    "progress_of",
+]
 
 
 def compile_inertia(xml: str, model_dir: Any) -> tuple:
@@ -41,3 +51,17 @@ def compile_inertia(xml: str, model_dir: Any) -> tuple:
         model.body_iquat.ravel().tolist(),
         model.body_inertia.ravel().tolist(),
     )
+
+
+@functools.lru_cache(maxsize=None)
+def mujoco_version() -> Optional[str]:
+    """The installed ``mujoco``'s version (``mujoco.__version__``), or ``None`` when it
+    cannot be imported: the URDF importer a load follows (``Document.load`` of a URDF
+    file, ``Document.from_urdf`` without ``importer=``). Asked only when a URDF is read,
+    so that reading MJCF never imports ``mujoco``; once per process."""
+    try:
+        import mujoco
+    except Exception:  # noqa: BLE001 - not installed, or installed but broken: not importable
+        return None
+    version = getattr(mujoco, "__version__", None)
+    return version if isinstance(version, str) else None

@@ -4,24 +4,25 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::{Arc, RwLock};
 
-use mjcf_forge::{Document, MujocoModel, XmlModel, XmlModelOptions};
+use mjcf_forge::{Document, MujocoModel, UrdfOptions, XmlModel, XmlModelOptions};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::sync::RwLockExt;
 use pyo3::types::{PyDict, PyList, PyString};
 
-use crate::document::{DocCell, PyDocument, retarget};
+use crate::document::{DocCell, PyDocument, retarget, urdf};
 use crate::errors::{Failure, read, run, write};
 
 /// One instance of an MJCF model, with every name prefixed and its parts sorted by role:
 /// robosuite's ``MujocoXMLModel`` vocabulary over a :class:`Document`.
 ///
 /// ``Model(source, idn)`` takes a :class:`Document` (copied: later changes to it do not
-/// reach the model) or a path, and prefixes every name with ``f"{idn}_"`` (or exactly
-/// ``prefix=`` when given). As robosuite does, unnamed geoms of group 0 and 1 are named
-/// ``g{n}_col`` / ``g{n}_vis`` and collision geoms (group 0) are drawn in
-/// ``contact_geom_rgba`` (``None`` leaves their colours). The model must have exactly one
-/// top-level body.
+/// reach the model) or a path (MJCF, or URDF read as :meth:`Document.load` reads it; for
+/// :meth:`Document.from_urdf`'s options pass its document), and prefixes every name with
+/// ``f"{idn}_"`` (or exactly ``prefix=`` when given). As robosuite does, unnamed geoms of
+/// group 0 and 1 are named ``g{n}_col`` / ``g{n}_vis`` and collision geoms (group 0) are
+/// drawn in ``contact_geom_rgba`` (``None`` leaves their colours). The model must have
+/// exactly one top-level body.
 ///
 /// Lists (``bodies``, ``joints``, ...) hold prefixed names; ``bottom_offset``,
 /// ``top_offset`` and ``base_offset`` are numpy arrays, computed from the geometry
@@ -136,13 +137,20 @@ impl PyModel {
             // Boxed: the document is large and the enum lives only for this call.
             Doc(Box<Document>),
             Path(PathBuf),
+            Urdf(PathBuf, UrdfOptions),
         }
         let source = if let Ok(doc) = source.cast::<PyDocument>() {
             Source::Doc(Box::new(doc.get().snapshot(source.py())))
         } else {
-            Source::Path(source.extract::<PathBuf>().map_err(|_| {
+            let path = source.extract::<PathBuf>().map_err(|_| {
                 PyTypeError::new_err("Model(source, ...): source is a Document or a path")
-            })?)
+            })?;
+            // URDF as the installed mujoco imports it (Document.load's rule).
+            if py.detach(|| urdf::is_urdf_file(&path)) {
+                Source::Urdf(path, urdf::plain_options(py)?)
+            } else {
+                Source::Path(path)
+            }
         };
         let options = XmlModelOptions {
             name,
@@ -154,6 +162,7 @@ impl PyModel {
             let doc = match source {
                 Source::Doc(doc) => *doc,
                 Source::Path(path) => Document::load(&path)?,
+                Source::Urdf(path, options) => Document::load_urdf(&path, &options)?,
             };
             Ok(XmlModel::with_prefix(doc, &prefix, options)?)
         })?;

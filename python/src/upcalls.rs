@@ -7,6 +7,7 @@
 //! progress_of(progress, total, unit)
 //! fromstring(xml)                   an Element rebuilt (pickling)
 //! MjcfFileNotFoundError             the error of missing files
+//! mujoco_version()                  the user's mujoco's version (the URDF importer)
 //! ```
 //!
 //! The package's modules never import the compiled module's internals the other way

@@ -3,10 +3,10 @@
 
 use std::path::PathBuf;
 
-use mjcf_forge::LoadCache;
+use mjcf_forge::{Document, LoadCache};
 use pyo3::prelude::*;
 
-use super::PyDocument;
+use super::{PyDocument, urdf};
 use crate::errors::run;
 
 /// Documents loaded from files, kept and served again while their file holds the same
@@ -42,9 +42,27 @@ impl PyLoadCache {
     /// load of the same path while the file holds the same bytes. A new document every call: edits
     /// to it never reach the kept one.
     ///
+    /// A URDF file is read as :meth:`Document.load` reads it, as the installed ``mujoco``
+    /// imports it; under a ``mujoco`` 3.x it is read anew at each load (the kept
+    /// documents are read as MuJoCo 4.0.0 imports URDF).
+    ///
     /// Raises :class:`MjcfError` as :meth:`Document.load` does (errors are not kept).
     fn load(&self, py: Python<'_>, path: PathBuf) -> PyResult<PyDocument> {
-        run(py, || Ok(self.cache.load(&path)?)).map(PyDocument::new)
+        // The library's cache reads URDF with the library's default importer: a file that
+        // another importer reads differently is not served from it.
+        let urdf = if py.detach(|| urdf::is_urdf_file(&path)) {
+            Some(urdf::plain_options(py)?)
+                .filter(|o| o.importer != mjcf_forge::UrdfImporter::default())
+        } else {
+            None
+        };
+        run(py, || {
+            Ok(match urdf {
+                Some(options) => Document::load_urdf(&path, &options)?,
+                None => self.cache.load(&path)?,
+            })
+        })
+        .map(PyDocument::new)
     }
 
     /// How many loads were served from kept documents.

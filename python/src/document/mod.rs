@@ -21,6 +21,7 @@ mod load_cache;
 pub(crate) mod patch;
 mod path;
 mod sort;
+pub(crate) mod urdf;
 mod values;
 
 use std::path::PathBuf;
@@ -54,10 +55,11 @@ pub(crate) type SharedDoc = Arc<DocCell>;
 /// An MJCF model as MuJoCo reads it: ``<include>`` expanded, default classes inlined
 /// into explicit attributes, asset file paths absolute.
 ///
-/// Load one with :meth:`Document.load` or :meth:`Document.from_string`; edit it in place
-/// (:meth:`prefix`, :meth:`merge`, element attributes); write it with :meth:`to_xml` or
-/// :meth:`write`. Safe to share between threads; loading, writing, prefixing, merging and
-/// validating release the GIL.
+/// Load one with :meth:`Document.load` or :meth:`Document.from_string` (a URDF robot too,
+/// as the installed ``mujoco`` imports it; :meth:`Document.from_urdf` with options); edit
+/// it in place (:meth:`prefix`, :meth:`merge`, element attributes); write it with
+/// :meth:`to_xml` or :meth:`write`. Safe to share between threads; loading, writing,
+/// prefixing, merging and validating release the GIL.
 ///
 /// Example::
 ///
@@ -119,21 +121,210 @@ impl From<mjcf_forge::MergeReport> for PyMergeReport {
 impl PyDocument {
     /// Loads an MJCF file (``str`` or path-like) as MuJoCo reads it.
     ///
+    /// A URDF file (root element ``<robot>``) is read as the installed ``mujoco``'s URDF
+    /// importer reads it (3.x or 4.x; 4.0.0's when ``mujoco`` cannot be imported), into the
+    /// MJCF model it compiles to: :meth:`from_urdf` with its defaults.
+    ///
     /// Raises :class:`MjcfError` with every problem found (``file:line:col: message``).
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<PyDocument> {
-        run(py, || Ok(Document::load(&path)?)).map(PyDocument::new)
+        let urdf = if py.detach(|| urdf::is_urdf_file(&path)) {
+            Some(urdf::plain_options(py)?)
+        } else {
+            None
+        };
+        run(py, move || {
+            Ok(match urdf {
+                Some(options) => Document::load_urdf(&path, &options)?,
+                None => Document::load(&path)?,
+            })
+        })
+        .map(PyDocument::new)
     }
 
-    /// Reads MJCF text. ``base_dir`` plays the part of the main file's folder: includes
-    /// and asset files are found from there (default: the current folder). Positions in
-    /// errors name ``<string>``.
+    /// Reads MJCF text. ``base_dir`` plays the part of the main file's folder: includes and
+    /// asset files are found from there (default: the current folder). Positions in errors
+    /// name ``<string>``. URDF text (root element ``<robot>``) is read as :meth:`load`
+    /// reads a URDF file.
     #[staticmethod]
     #[pyo3(signature = (xml, base_dir = None))]
     fn from_string(py: Python<'_>, xml: &str, base_dir: Option<PathBuf>) -> PyResult<PyDocument> {
+        let urdf = if urdf::is_urdf_text(xml) {
+            Some(urdf::plain_options(py)?)
+        } else {
+            None
+        };
         let xml = xml.to_owned();
         let base_dir = base_dir.unwrap_or_else(|| PathBuf::from("."));
-        run(py, move || Ok(Document::from_str(&xml, &base_dir)?)).map(PyDocument::new)
+        run(py, move || {
+            Ok(match urdf {
+                Some(options) => Document::from_urdf_str(&xml, &base_dir, &options)?,
+                None => Document::from_str(&xml, &base_dir)?,
+            })
+        })
+        .map(PyDocument::new)
+    }
+
+    /// Loads a URDF robot (``str`` or path-like; a ``.xacro`` file is expanded with the
+    /// ``xacro`` command first) as the MJCF model MuJoCo's URDF importer compiles it to,
+    /// with options that go beyond the importer. With the defaults the document compiles
+    /// to exactly the model ``mujoco.MjModel.from_xml_path(path)`` gives.
+    ///
+    /// - ``visuals``: keep each ``<visual>`` as a geom of group 1 with no mass and no
+    ///   contacts (``contype=conaffinity=0``), its URDF material as a MuJoCo material.
+    ///   The importer drops them; the collision model is the same either way. A visual
+    ///   whose mesh MuJoCo cannot read (COLLADA ``.dae``) or that is missing is an error.
+    /// - ``fuse_static``: fuse links joined by ``fixed`` joints into their parents, as
+    ///   the importer does (``fusestatic``); ``False`` keeps every link a body.
+    /// - ``keep_links``: names of links kept as bodies even when static links are fused
+    ///   (a gripper mount, a camera frame).
+    /// - ``packages``: ``{package name: folder}`` for ``package://NAME/...`` mesh paths,
+    ///   looked up first; then ``ROS_PACKAGE_PATH``, ``AMENT_PREFIX_PATH``
+    ///   (``share/NAME``), then the folders above the URDF (one named ``NAME``, or with a
+    ///   ``package.xml`` naming it). ``resolve_packages=False`` leaves such paths as
+    ///   MuJoCo reads them (it cannot open them).
+    /// - ``actuators``: one actuator per hinge and slide joint, named after it:
+    ///   ``{"type": "position", "kp": 100, "kv": 10}`` (control range from the joint's
+    ///   ``<limit lower upper>``), ``{"type": "velocity", "kv": 5}`` (``±velocity``) or
+    ///   ``{"type": "motor"}`` (``±effort``); position and velocity actuators take the
+    ///   force range ``±effort``. The importer writes none.
+    /// - ``importer``: the MuJoCo version whose importer to follow where 3.x and 4.x
+    ///   differ (a ``continuous`` joint's ``<limit lower upper>`` limits it in 3.x only):
+    ///   ``"3.17.0"``, ``"4.0.0"``; by default the installed ``mujoco``'s version, or
+    ///   4.0.0 when ``mujoco`` cannot be imported.
+    ///
+    /// Raises :class:`MjcfError` with every problem found (``file:line:col: message``),
+    /// among them a ``package://`` path whose package is found nowhere, and a file that
+    /// is not URDF (use :meth:`load`).
+    ///
+    /// Example::
+    ///
+    ///     arm = Document.from_urdf(
+    ///         "kuka_iiwa/model.urdf",
+    ///         visuals=True,
+    ///         packages={"iiwa_description": "/opt/ros/share/iiwa_description"},
+    ///         actuators={"type": "position", "kp": 100, "kv": 10},
+    ///     )
+    ///     arm.write("kuka.xml")
+    ///     model = mujoco.MjModel.from_xml_string(arm.to_xml())
+    #[staticmethod]
+    #[pyo3(
+        text_signature = "(path, *, visuals=False, fuse_static=True, keep_links=(), \
+        packages=None, resolve_packages=True, actuators=None, importer=None)"
+    )]
+    #[pyo3(signature = (
+        path,
+        *,
+        visuals = false,
+        fuse_static = true,
+        keep_links = None,
+        packages = None,
+        resolve_packages = true,
+        actuators = None,
+        importer = None,
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn from_urdf(
+        py: Python<'_>,
+        path: PathBuf,
+        visuals: bool,
+        fuse_static: bool,
+        keep_links: Option<&Bound<'_, PyAny>>,
+        packages: Option<&Bound<'_, PyAny>>,
+        resolve_packages: bool,
+        actuators: Option<&Bound<'_, PyAny>>,
+        importer: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<PyDocument> {
+        let options = urdf::UrdfArgs {
+            caller: "from_urdf",
+            visuals,
+            fuse_static,
+            keep_links,
+            packages,
+            resolve_packages,
+            actuators,
+            importer,
+        }
+        .options(py)?;
+        run(py, move || {
+            urdf::check_urdf_file(&path)?;
+            Ok(Document::load_urdf(&path, &options)?)
+        })
+        .map(PyDocument::new)
+    }
+
+    /// URDF text read as :meth:`from_urdf` reads a file, with the same options;
+    /// ``base_dir`` plays the part of the file's folder (relative mesh paths and the
+    /// search for packages start there; default: the current folder). Positions in errors
+    /// name ``<string>``.
+    ///
+    /// >>> from mjcf_forge import Document
+    /// >>> urdf = '''<robot name="r">
+    /// ...   <link name="base"/>
+    /// ...   <link name="arm">
+    /// ...     <inertial><mass value="1"/>
+    /// ...       <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>
+    /// ...     <visual><geometry><sphere radius="0.1"/></geometry></visual>
+    /// ...     <collision><geometry><sphere radius="0.1"/></geometry></collision>
+    /// ...   </link>
+    /// ...   <joint name="j" type="revolute"><parent link="base"/><child link="arm"/>
+    /// ...     <limit lower="-1" upper="1" effort="5"/></joint>
+    /// ... </robot>'''
+    /// >>> len(Document.from_urdf_string(urdf).findall(".//geom"))  # the importer drops visuals
+    /// 1
+    /// >>> doc = Document.from_urdf_string(urdf, visuals=True, actuators={"type": "motor"})
+    /// >>> [g.get("group") for g in doc.iter("geom")]  # the link's elements in file order
+    /// ['1', None]
+    /// >>> doc.find("actuator/motor").attrib
+    /// {'name': 'j', 'joint': 'j', 'ctrlrange': '-5 5'}
+    #[staticmethod]
+    #[pyo3(
+        text_signature = "(xml, base_dir=None, *, visuals=False, fuse_static=True, \
+        keep_links=(), packages=None, resolve_packages=True, actuators=None, importer=None)"
+    )]
+    #[pyo3(signature = (
+        xml,
+        base_dir = None,
+        *,
+        visuals = false,
+        fuse_static = true,
+        keep_links = None,
+        packages = None,
+        resolve_packages = true,
+        actuators = None,
+        importer = None,
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn from_urdf_string(
+        py: Python<'_>,
+        xml: &str,
+        base_dir: Option<PathBuf>,
+        visuals: bool,
+        fuse_static: bool,
+        keep_links: Option<&Bound<'_, PyAny>>,
+        packages: Option<&Bound<'_, PyAny>>,
+        resolve_packages: bool,
+        actuators: Option<&Bound<'_, PyAny>>,
+        importer: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<PyDocument> {
+        let options = urdf::UrdfArgs {
+            caller: "from_urdf_string",
+            visuals,
+            fuse_static,
+            keep_links,
+            packages,
+            resolve_packages,
+            actuators,
+            importer,
+        }
+        .options(py)?;
+        let xml = xml.to_owned();
+        let base_dir = base_dir.unwrap_or_else(|| PathBuf::from("."));
+        run(py, move || {
+            urdf::check_urdf_text(&xml)?;
+            Ok(Document::from_urdf_str(&xml, &base_dir, &options)?)
+        })
+        .map(PyDocument::new)
     }
 
     /// The document as XML text: compact (no white space between elements) by default,
