@@ -47,8 +47,8 @@ echo "== python package (pytest: API, errors, threads, MuJoCo judge, Gymnasium, 
 # (test_batch_sim.py needs MuJoCo Warp and JAX: it runs in .cache/venv-sim below.)
 # (test_libero.py runs LIBERO in .cache/venv-libero, MuJoCo 3.3.1, stock and on the switch.)
 .cache/venv/bin/python -m pytest python/tests -q -p no:cacheprovider --ignore=python/tests/test_batch_sim.py --durations=15
-echo "== ModelCache and DocumentCache under MuJoCo 4.0.0 (patched models judged against 4.0.0's compile) [${SECONDS}s in]"
-.cache/venv-mj4/bin/python -m pytest python/tests/test_model_cache.py python/tests/test_world_batch.py python/tests/test_document_cache.py python/tests/test_differential.py -q -p no:cacheprovider
+echo "== ModelCache, DocumentCache and URDF under MuJoCo 4.0.0 (judged against 4.0.0's compile and import) [${SECONDS}s in]"
+.cache/venv-mj4/bin/python -m pytest python/tests/test_model_cache.py python/tests/test_world_batch.py python/tests/test_document_cache.py python/tests/test_differential.py python/tests/test_urdf.py -q -p no:cacheprovider
 # robosuite's task XMLs (written by the robosuite venv) through a DocumentCache, judged by 4.0.0.
 .cache/venv-mj4/bin/python -m pytest python/tests/test_robosuite_resets.py -k task_xmls -q -p no:cacheprovider
 echo "== batched simulators (MuJoCo Warp, MJX on JAX's CPU backend, CPU MuJoCo) judge WorldBatch [${SECONDS}s in]"

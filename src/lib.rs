@@ -54,7 +54,6 @@ pub mod mujoco;
 pub mod output;
 #[cfg(mjcf_mujoco)]
 pub mod preview;
-mod rotation;
 pub mod scene;
 pub mod split;
 

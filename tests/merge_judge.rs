@@ -221,6 +221,25 @@ fn cases() -> Vec<Case> {
             fuse_keys: false,
         });
     }
+    // A URDF arm (read as MuJoCo's importer reads it: its static links fuse) on an MJCF
+    // table, a robosuite gripper in its last link, an object beside it: the base takes
+    // the arm's fusestatic and keeps its own bodies.
+    let kuka = root().join(".cache/corpus/urdf/pybullet-3.2.7/pybullet_data/kuka_iiwa/model.urdf");
+    let mut arm = part(kuka, "robot0", None);
+    arm.with.push(part(
+        rs("grippers/panda_gripper.xml"),
+        "gripper0",
+        Some("robot0_lbr_iiwa_link_7"),
+    ));
+    cases.push(Case {
+        name: "urdf_kuka_with_panda_gripper_on_table".into(),
+        parts: vec![
+            base(rs("arenas/table_arena.xml")),
+            arm,
+            part(rs("objects/can.xml"), "object0", None),
+        ],
+        fuse_keys: false,
+    });
     for (arena, model) in [
         ("arenas/table_arena.xml", "suite/cartpole.xml"),
         ("arenas/table_arena.xml", "suite/acrobot.xml"),

@@ -96,8 +96,25 @@ fn keys_are_not_remapped_over_replicate() {
 #[test]
 fn settings_without_a_conversion_say_why() {
     assert_eq!(
-        merge_error("corpora/errors/merge/part_fusestatic.xml", "p_", None),
-        "corpora/errors/merge/part_fusestatic.xml:2:3: cannot merge: compiler fusestatic=\"true\" differs from the base's \"false\" and has no exact conversion: the part's static bodies are fused into their parents when it compiles alone, and a base that does not fuse them would keep them"
+        merge_error("corpora/errors/merge/part_discardvisual.xml", "p_", None),
+        "corpora/errors/merge/part_discardvisual.xml:2:3: cannot merge: compiler discardvisual=\"true\" differs from the base's \"false\" and has no exact conversion: it decides whether visual geoms, and the assets only they use, are dropped, over the whole merged model"
+    );
+}
+
+/// A part that fuses static bodies (a URDF robot, as MuJoCo's importer reads it) into a
+/// base that does not: the base takes the setting and keeps each of its own bodies
+/// (merge_judge's URDF case judges the result with MuJoCo).
+#[test]
+fn a_base_takes_a_fusing_parts_fusestatic_and_keeps_its_bodies() {
+    let mut base = load("corpora/errors/merge/base.xml");
+    let part = load("corpora/errors/merge/part_fusestatic.xml");
+    base.merge(&part, None, &MergeOptions::default()).unwrap();
+    let xml = base.to_xml_string();
+    assert!(xml.contains(r#"<compiler fusestatic="true"/>"#), "{xml}");
+    assert!(xml.contains(r#"<body name="hand" fuse="false">"#), "{xml}");
+    assert!(
+        xml.contains(r#"<body name="shelf" pos="0 0 0.5">"#),
+        "{xml}"
     );
 }
 

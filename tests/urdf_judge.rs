@@ -171,7 +171,7 @@ fn bad_urdf_gives_every_problem_at_its_place() {
         errors_of(parts),
         "DIR/bad.urdf:3:26: 'missing.stl': no such file (DIR/missing.stl)\n\
          DIR/bad.urdf:4:26: 'package://nowhere_pkg/m.stl': package 'nowhere_pkg' is found nowhere: \
-         give its folder (UrdfOptions::packages, --urdf-package nowhere_pkg=DIR), or list it on ROS_PACKAGE_PATH\n\
+         give its folder (the `packages` option; --urdf-package nowhere_pkg=DIR on the command line), or list it on ROS_PACKAGE_PATH\n\
          DIR/bad.urdf:5:26: 'arm.dae' is a COLLADA mesh, which MuJoCo cannot read (it reads STL, OBJ \
          and MSH): convert it, for example with `assimp export arm.dae arm.obj`, and point the URDF at \
          the converted file\n\

@@ -242,44 +242,6 @@ def test_reading_mjcf_never_imports_mujoco_and_urdf_does(arm):
 # reader bugs, reported, each with MuJoCo's words. A fixed one fails the test until it is
 # taken off the list.
 VISUALS_KNOWN = {
-    **{
-        name: "a visual's mesh takes the name (its file's stem) that a collision mesh read "
-        "later takes too: MuJoCo: repeated name in mesh"
-        for name in [
-            "pybullet-3.2.7/pybullet_data/kuka_iiwa/model.urdf",
-            "pybullet-3.2.7/pybullet_data/kuka_iiwa/model_free_base.urdf",
-            "pybullet-3.2.7/pybullet_data/kuka_iiwa/model_vr_limits.urdf",
-            "pybullet-3.2.7/pybullet_data/laikago/laikago_toes_zup.urdf",
-            "pybullet-3.2.7/pybullet_data/pr2_gripper.urdf",
-            "pybullet-3.2.7/pybullet_data/r2d2.urdf",
-            "pybullet-3.2.7/pybullet_data/samurai.urdf",
-            "pybullet-3.2.7/pybullet_data/teddy_large.urdf",
-            "pybullet-3.2.7/pybullet_data/teddy_vhacd.urdf",
-            "pybullet-3.2.7/pybullet_data/tray/tray.urdf",
-            "pybullet-3.2.7/pybullet_data/tray/tray_textured2.urdf",
-        ]
-    },
-    **{
-        name: "a flat visual mesh (a plane, a cloth): MuJoCo: mesh volume is too small, "
-        "try setting inertia to shell"
-        for name in [
-            "pybullet-3.2.7/pybullet_data/cloth_z_up.urdf",
-            "pybullet-3.2.7/pybullet_data/plane.urdf",
-            "pybullet-3.2.7/pybullet_data/plane100.urdf",
-            "pybullet-3.2.7/pybullet_data/plane_transparent.urdf",
-        ]
-    },
-    **{
-        name: "a visual of size 0 (a virtual link's box, a toe's sphere): MuJoCo: size 0 "
-        "must be positive in geom"
-        for name in [
-            "pybullet-3.2.7/pybullet_data/laikago/laikago_toes_zup_lores.urdf",
-            "upkie_description-2.2.0/upkie_description/urdf/upkie.urdf",
-            "upkie_description-2.2.0/upkie_description/urdf/upkie_camera.urdf",
-        ]
-    },
-    "example_robot_data-6.0.0/cmeel.prefix/share/example-robot-data/robots/double_pendulum_description/"
-    "urdf/double_pendulum_simple.urdf": 'a visual\'s <material name="">: MuJoCo: empty name in material',
     "pybullet-3.2.7/pybullet_data/table_square/table_square.urdf": "a visual OBJ MuJoCo cannot "
     "decode: mesh_facenormal normal index out of bounds",
 }
@@ -324,7 +286,20 @@ def visuals_differences(urdf: Path, model: mujoco.MjModel) -> list[str]:
             out.append("group-0 mesh vertex counts")
     # Every <visual> of every link is one geom of group 1 (those of fused links included:
     # they move into the parent's body with it).
-    visuals = sum(len(link.findall("visual")) for link in urdf_root(urdf).findall("link"))
+    # A visual of no extent (a box of size 0, a sphere of radius 0: MuJoCo refuses a size of
+    # 0) has none.
+    visuals = sum(
+        1
+        for link in urdf_root(urdf).findall("link")
+        for v in link.findall("visual")
+        if not any(
+            float(x) <= 0
+            for shape in v.findall("geometry/*")
+            if shape.tag != "mesh"
+            for key in ("size", "radius", "length")
+            for x in (shape.get(key) or "").split()
+        )
+    )
     if len(visual) != visuals:
         out.append(f"group-1 geoms: {len(visual)} for {visuals} <visual> elements")
     if np.any(model.geom_contype[visual]) or np.any(model.geom_conaffinity[visual]):
@@ -385,15 +360,10 @@ def test_visual_geoms_have_no_mass_no_contacts_and_their_material(arm):
 # fuse_static and keep_links
 # ------------------------------------------------------------------------------------
 
-# Links that keep their bodies with fuse_static=False, whose inertia has two equal
-# principal moments and an <origin rpy>: the principal axes written differ from those
-# MuJoCo's importer derives (a reader bug, reported); with static links fused, as MuJoCo
-# imports them, these links are fused and the models agree.
-NO_FUSE_KNOWN = {
-    "pybullet-3.2.7/pybullet_data/r2d2.urdf": "legs: diagonal inertia 1 1 1 turned by rpy",
-    "upkie_description-2.2.0/upkie_description/urdf/upkie.urdf": "horns, knee stators: two equal moments turned by rpy",
-    "upkie_description-2.2.0/upkie_description/urdf/upkie_camera.urdf": "horns, knee stators: two equal moments turned by rpy",
-}
+# Corpus URDFs whose links kept as bodies (fuse_static=False) differ from MuJoCo's import
+# with fusestatic off: none since the inertia turned by an <origin rpy> is written as the
+# importer turns it (R I R'), equal moments included.
+NO_FUSE_KNOWN: dict[str, str] = {}
 
 
 def test_fuse_static_false_is_mujocos_import_with_fusestatic_off(tmp_path):
@@ -456,7 +426,11 @@ def test_keep_links_names_links_that_exist(arm):
 
 
 def actuated(m: mujoco.MjModel) -> list[str]:
-    return [m.joint(j).name for j in range(m.njnt) if int(m.jnt_type[j]) in HINGE_OR_SLIDE]
+    """The hinges and slides an actuator drives: all but those a ``<mimic>`` drives through
+    its joint equality (their ``joint1``)."""
+    followers = {int(m.eq_obj1id[e]) for e in range(m.neq) if int(m.eq_type[e]) == mujoco.mjtEq.mjEQ_JOINT}
+    return [m.joint(j).name for j in range(m.njnt)
+            if int(m.jnt_type[j]) in HINGE_OR_SLIDE and j not in followers]
 
 
 @pytest.mark.parametrize("kind", ["position", "velocity", "motor"])
@@ -504,7 +478,7 @@ def test_actuators_on_the_corpus_add_only_actuators():
         m = compiled(doc)
         diffs = []
         if m.nu != len(actuated(m)):
-            diffs.append(f"nu {m.nu} for {len(actuated(m))} hinge and slide joints")
+            diffs.append(f"nu {m.nu} for {len(actuated(m))} hinge and slide joints not mimicking")
         elif [m.joint(m.actuator_trnid[a, 0]).name for a in range(m.nu)] != [m.actuator(a).name for a in range(m.nu)]:
             diffs.append("an actuator drives another joint than its name's")
         elif m.nu and not (np.all(m.actuator_gainprm[:, 0] == 50) and np.all(m.actuator_biasprm[:, 1] == -50)
@@ -673,8 +647,6 @@ def test_mujoco_xml_and_xml_model_read_a_urdf_arm():
     assert sorted(m.geom(g).name for g in range(m.ngeom)) == sorted(arm.contact_geoms)
 
 
-@pytest.mark.xfail(strict=True, reason="reader bug, reported: a body's child <body> elements come before "
-                   "its own <inertial>, <geom> and <joint>, so lists in document order run from the last link up")
 def test_a_urdf_arms_lists_run_from_its_base_as_mujocos_ids():
     kuka = corpus_urdf(KUKA)
     ref = mujocos(kuka)

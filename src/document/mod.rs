@@ -40,6 +40,7 @@ pub(crate) mod prefix;
 mod random_mjcf;
 pub(crate) mod read;
 mod relocate;
+pub(crate) mod rotation;
 pub(crate) mod schema;
 pub(crate) mod skin;
 pub(crate) mod text;

@@ -15,7 +15,7 @@
 
 use super::body_copy::{ModelArrays, ModelArraysMut};
 use super::volumes::{Volume, bounding_volumes};
-use crate::rotation::{EPS, eigen, quat_to_mat};
+use crate::document::rotation::{EPS, eigen, quat_to_mat};
 
 /// The compiler's tolerance for "the same frame" (flags `mjtSameFrame`).
 const FRAME_EPS: f64 = 1e-6;

@@ -32,7 +32,7 @@
 //! model of their own, for what MuJoCo derives from their sizes), `body_copy.rs` (that
 //! model's compile copied into a structure's model, for both faces), `geom_masses.rs` (a
 //! body's mass properties from its geoms' densities or masses, at patch cost; with
-//! `crate::rotation`, the compiler's rotations and eigen-decomposition, and `volumes.rs`, its
+//! `crate::document::rotation`, the compiler's rotations and eigen-decomposition, and `volumes.rs`, its
 //! bounding-volume trees), `statistics.rs` (the
 //! compiler's statistics at `qpos0`, computed over a model's arrays for both faces). The scene tier reads its
 //! drawn variants through the same rules (`scene/patch.rs`).

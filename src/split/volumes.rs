@@ -2,7 +2,7 @@
 //! boxes of its colliding geoms' boxes, split at the median along the longest edge
 //! (`geom_masses.rs` builds it again when a body's inertial frame moves).
 
-use crate::rotation::{EPS, rotate};
+use crate::document::rotation::{EPS, rotate};
 
 /// One geom as its body's bounding volumes see it.
 #[derive(Clone, Copy, Debug)]

@@ -17,6 +17,7 @@ mod cell;
 mod children;
 mod element;
 mod etree_text;
+mod inertia;
 mod load_cache;
 pub(crate) mod patch;
 mod path;
@@ -29,7 +30,7 @@ use std::sync::Arc;
 
 use ahash::AHashSet;
 use mjcf_forge::split::{PatchValue, SplitOptions, split_document_with};
-use mjcf_forge::{CompiledInertia, Document, MergePart, Node, Section};
+use mjcf_forge::{Document, MergePart, Node, Section};
 use pyo3::exceptions::{PyFutureWarning, PyTypeError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyString, PyTuple};
@@ -40,6 +41,7 @@ use patch::patch_list;
 pub(crate) use attrib::PyAttrib;
 pub(crate) use cell::{DocCell, retarget};
 pub(crate) use element::PyElement;
+pub(crate) use inertia::python_inertia;
 pub(crate) use load_cache::PyLoadCache;
 pub(crate) use values::check_xml_text;
 
@@ -883,27 +885,4 @@ fn tree_path(py: Python<'_>, path: &str) -> PyResult<String> {
     let message = std::ffi::CString::new(message).unwrap_or_default();
     PyErr::warn(py, &py.get_type::<PyFutureWarning>(), &message, 1)?;
     Ok(format!(".{path}"))
-}
-
-/// The inertias of `part` as the Python callable `compile` says MuJoCo compiles it alone
-/// (`Document.merge`'s `compile_inertia`), called with the GIL taken for the call.
-pub(crate) fn python_inertia(
-    compile: &Py<PyAny>,
-    part: &Document,
-) -> Result<CompiledInertia, String> {
-    let xml = part.to_xml_string();
-    let dir = part.model_dir().to_path_buf();
-    type Arrays = (Vec<String>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>);
-    Python::attach(|py| {
-        let (body_names, mass, ipos, iquat, inertia): Arrays =
-            compile.bind(py).call1((xml, dir))?.extract()?;
-        Ok::<_, PyErr>(CompiledInertia {
-            body_names,
-            mass,
-            ipos,
-            iquat,
-            inertia,
-        })
-    })
-    .map_err(|e| format!("compile_inertia: {e}"))
 }

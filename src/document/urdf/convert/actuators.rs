@@ -1,11 +1,13 @@
 //! The actuators `UrdfOptions::actuators` writes for a URDF's hinge and slide joints.
 
-use super::super::UrdfActuators;
+use super::super::{UrdfActuators, UrdfImporter};
 use super::{Writer, num};
 use crate::document::tree::Node;
 
 impl Writer<'_> {
-    /// [`UrdfOptions::actuators`]: one actuator per hinge and slide joint.
+    /// `UrdfOptions::actuators`: one actuator per hinge and slide joint, but those a
+    /// `<mimic>` drives through its equality. A position actuator's control range is the
+    /// joint's range as the importer reads it (none for a continuous joint under 4.0.0).
     pub(super) fn actuators(&mut self, kind: &UrdfActuators, joints: &[Node]) {
         let raw = self.raw;
         let root = raw.root();
@@ -14,6 +16,11 @@ impl Writer<'_> {
             let Some(name) = raw.attr(j, "name") else {
                 continue;
             };
+            if self.sub(j, "mimic").is_some() {
+                continue;
+            }
+            let unlimited = raw.attr(j, "type") == Some("continuous")
+                && self.options.importer == UrdfImporter::MuJoCo4;
             let limit = self.sub(j, "limit");
             let read = |attr: &str| {
                 limit
@@ -36,7 +43,7 @@ impl Writer<'_> {
                         self.set(a, "kv", &num(*kv));
                     }
                     match (read("lower"), read("upper")) {
-                        (Some(lo), Some(hi)) if lo < hi => Some((lo, hi)),
+                        (Some(lo), Some(hi)) if lo < hi && !unlimited => Some((lo, hi)),
                         _ => None,
                     }
                 }

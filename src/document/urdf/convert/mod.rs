@@ -7,8 +7,8 @@
 //!   world body; a joint's `<origin>` places its child body (`rpy` is MJCF's `XYZ` Euler
 //!   sequence, written as such);
 //! - `<inertial>`: its origin's `xyz`, its mass, and its six inertia numbers as
-//!   `fullinertia` (whose principal axes the compiler takes, so the origin's `rpy` has no
-//!   effect); all six zero leave the inertia undefined and the `rpy` in force;
+//!   `fullinertia` (whose principal axes the compiler takes), turned by the origin's `rpy`
+//!   first; all six zero leave the inertia undefined and the `rpy` in force;
 //! - geoms: each `<collision>`, and each `<visual>` when visuals are kept, in file order,
 //!   links in file order; a collision geom takes the colour of the last visual of its link
 //!   seen before it; names are kept when not taken yet, and a geom without one keeps the
@@ -89,6 +89,8 @@ struct Writer<'r> {
     /// Kept visuals: the names every collision geom ends up with, so that no visual
     /// takes one.
     collision_names: AHashSet<String>,
+    /// Kept visuals: the names every collision mesh asset ends up with.
+    collision_meshes: AHashSet<String>,
     /// Kept visuals: MuJoCo material names made so far.
     made_materials: AHashSet<String>,
     packages: Packages<'r>,
@@ -143,6 +145,7 @@ impl<'r> Writer<'r> {
             mesh_names: AHashSet::new(),
             geom_names: AHashSet::new(),
             collision_names: AHashSet::new(),
+            collision_meshes: AHashSet::new(),
             made_materials: AHashSet::new(),
             packages: Packages {
                 map: &options.packages,
@@ -268,6 +271,7 @@ impl<'r> Writer<'r> {
         // Kept visuals: the collision geoms' names as they are when visuals are dropped.
         if self.visuals == Visuals::Kept {
             self.collision_names = self.names_without_visuals(robot);
+            self.collision_meshes = self.collision_mesh_names(robot);
             self.geom_names.clear();
         }
         // Inertials and geoms, links in file order.
@@ -315,6 +319,35 @@ impl<'r> Writer<'r> {
         }
         if self.doc.elements(asset).next().is_none() {
             self.doc.tree.detach(asset);
+        }
+        self.bodies_last();
+    }
+
+    /// Each body's elements in the order MJCF is usually written: `<inertial>`, joints,
+    /// geoms, then child bodies (the compiled model is the same; what reads elements in
+    /// order, such as robosuite's naming and joint lists, sees a link's own first).
+    fn bodies_last(&mut self) {
+        let body = self.doc.intern("body");
+        let rank = |doc: &Document, n: Node| match doc.tag(n) {
+            "inertial" => 0,
+            "joint" => 1,
+            "body" => 3,
+            _ => 2,
+        };
+        let parents: Vec<Node> = std::iter::once(self.worldbody)
+            .chain(
+                self.doc
+                    .descendants(self.worldbody)
+                    .filter(|&n| self.doc.tag_sym(n) == Some(body)),
+            )
+            .collect();
+        for p in parents {
+            let mut kids: Vec<Node> = self.doc.elements(p).collect();
+            kids.sort_by_key(|&k| rank(&self.doc, k));
+            for k in kids {
+                self.doc.tree.detach(k);
+                self.doc.tree.append(p, k);
+            }
         }
     }
 
@@ -464,20 +497,14 @@ impl<'r> Writer<'r> {
             // The compiler takes the principal axes itself: the same computation.
             self.set(out, "fullinertia", &texts.join(" "));
         } else if let (true, Some(rpy)) = (defined, turned) {
-            // The importer turns the principal axes by the origin's rpy; MJCF has no
-            // fullinertia beside an orientation, so the axes are written out (the
-            // compiler's eigen-decomposition, within the bound of docs/urdf.md).
+            // The importer turns the inertia matrix by the origin's rpy (R I R'), whose
+            // principal axes the compiler then takes: the same matrix, written out.
+            use crate::document::rotation::{euler_xyz, quat_to_mat, rotate_matrix};
             let v: Vec<f64> = texts.iter().map(|t| t.parse().unwrap_or(0.0)).collect();
             let full = [v[0], v[3], v[4], v[3], v[1], v[5], v[4], v[5], v[2]];
-            let (values, axes) = crate::rotation::eigen(&full);
-            let quat = crate::rotation::normalized(crate::rotation::mul_quat(
-                &crate::rotation::euler_xyz(rpy),
-                &axes,
-            ));
-            let q: Vec<String> = quat.iter().map(|&x| num(x)).collect();
-            let d: Vec<String> = values.iter().map(|&x| num(x)).collect();
-            self.set(out, "quat", &q.join(" "));
-            self.set(out, "diaginertia", &d.join(" "));
+            let f = rotate_matrix(&quat_to_mat(&euler_xyz(rpy)), &full);
+            let six = [f[0], f[4], f[8], f[1], f[2], f[5]].map(num);
+            self.set(out, "fullinertia", &six.join(" "));
         } else {
             self.set(out, "diaginertia", "0 0 0");
             if let Some(rpy) = rpy {
@@ -546,6 +573,17 @@ impl<'r> Writer<'r> {
                 self.set(g, "mesh", &mesh);
             }
         }
+        // A kept visual of no extent (a placeholder box of size 0) has no MuJoCo geom:
+        // MuJoCo refuses a size of 0.
+        if self.visuals == Visuals::Kept && !collision && shape != "mesh" {
+            let flat = self.doc.attr(g, "size").is_some_and(|t| {
+                t.split_ascii_whitespace()
+                    .any(|x| x.parse::<f64>().is_ok_and(|v| v <= 0.0))
+            });
+            if flat {
+                return None;
+            }
+        }
         self.origin(e, g);
         if !collision {
             self.set(g, "contype", "0");
@@ -579,9 +617,9 @@ impl<'r> Writer<'r> {
                 self.error(
                     at,
                     format!(
-                        "'{file}': package '{pkg}' is found nowhere: give its folder \
-                         (UrdfOptions::packages, --urdf-package {pkg}=DIR), or list it on \
-                         ROS_PACKAGE_PATH"
+                        "'{file}': package '{pkg}' is found nowhere: give its folder (the \
+                         `packages` option; --urdf-package {pkg}=DIR on the command line), or \
+                         list it on ROS_PACKAGE_PATH"
                     ),
                 );
                 return None;
@@ -648,7 +686,7 @@ impl<'r> Writer<'r> {
             }
             let mut name = stem.clone();
             let mut i = 0;
-            while self.mesh_names.contains(&name) || self.meshes.contains_key(&name) {
+            while self.mesh_names.contains(&name) || self.collision_meshes.contains(&name) {
                 name = format!(
                     "{stem}_visual{}",
                     if i == 0 { String::new() } else { i.to_string() }
@@ -656,6 +694,9 @@ impl<'r> Writer<'r> {
                 i += 1;
             }
             let n = self.mesh_element(m, &name, &path, scale_text);
+            // Only massless geoms use it: its inertia is never used, and a flat mesh (a
+            // floor, a cloth) has the area a shell needs where it has no volume.
+            self.set(n, "inertia", "shell");
             self.asset_visual.push(n);
             self.visual_meshes.insert(key, name.clone());
             return Some(name);
@@ -730,7 +771,10 @@ impl<'r> Writer<'r> {
         let mut all = vec![out];
         if kind == JointKind::Planar {
             let v = self.numbers(j, "axis", axis, 3)?;
-            let m = crate::rotation::quat_to_mat(&crate::rotation::z_to_quat(&[v[0], v[1], v[2]]));
+            let m =
+                crate::document::rotation::quat_to_mat(&crate::document::rotation::z_to_quat(&[
+                    v[0], v[1], v[2],
+                ]));
             self.set(out, "name", &format!("{name}_TX"));
             self.set(out, "type", "slide");
             self.set(

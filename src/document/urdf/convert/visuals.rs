@@ -60,6 +60,50 @@ impl<'r> Writer<'r> {
         used
     }
 
+    /// The names the collision meshes get (the importer's naming by stem and scale, links
+    /// in file order), so that no kept visual's mesh takes one.
+    pub(super) fn collision_mesh_names(&mut self, robot: &Robot<'r>) -> AHashSet<String> {
+        let raw = self.raw;
+        let mut scales: ahash::AHashMap<String, Vec<[f64; 3]>> = ahash::AHashMap::new();
+        let mut names = AHashSet::new();
+        for link in &robot.links {
+            for g in raw
+                .elements(link.node)
+                .filter(|&g| raw.tag(g) == "collision")
+            {
+                let Some(mesh) = self
+                    .sub(g, "geometry")
+                    .and_then(|geo| self.sub(geo, "mesh"))
+                    .filter(|&m| raw.attr(m, "filename").is_some())
+                else {
+                    continue;
+                };
+                let file = raw.attr(mesh, "filename").unwrap_or_default();
+                let stem = super::strip_ext(super::strip_path(file)).to_string();
+                let scale = raw
+                    .attr(mesh, "scale")
+                    .and_then(|t| {
+                        let v: Vec<f64> = t
+                            .split_ascii_whitespace()
+                            .filter_map(|x| x.parse().ok())
+                            .collect();
+                        (v.len() == 3).then(|| [v[0], v[1], v[2]])
+                    })
+                    .unwrap_or([1.0; 3]);
+                let known = scales.entry(stem.clone()).or_default();
+                if !known.contains(&scale) {
+                    names.insert(if known.is_empty() {
+                        stem.clone()
+                    } else {
+                        format!("{stem}{}", known.len())
+                    });
+                    known.push(scale);
+                }
+            }
+        }
+        names
+    }
+
     /// A visual kept by [`UrdfOptions::visuals`]: its own name if no collision geom and no
     /// earlier visual has it, its material as a MuJoCo material.
     pub(super) fn kept_visual(&mut self, visual: Node, body: Node) {
@@ -88,7 +132,7 @@ impl<'r> Writer<'r> {
             .sub(m, "texture")
             .and_then(|t| raw.attr(t, "filename"))
             .and_then(|f| self.file_reference(m, f));
-        match raw.attr(m, "name") {
+        match raw.attr(m, "name").filter(|n| !n.is_empty()) {
             Some(name) => {
                 if self.made_materials.insert(name.to_string()) {
                     let mat = self.element("material", m);

@@ -2,7 +2,8 @@
 //! turned by a quaternion, and the Jacobi eigen-decomposition that gives a body's principal
 //! axes (the split tier's `geom_masses.rs` and `volumes.rs`, the URDF reader's inertials).
 //!
-//! Below every tier (each may use it), so it uses nothing of the crate.
+//! In the document tier, the lowest, so that each tier above may use it; it uses nothing
+//! of the crate.
 
 /// MuJoCo's `mjEPS`.
 pub(crate) const EPS: f64 = 1e-14;
@@ -86,17 +87,38 @@ pub(crate) fn transpose(a: &[f64; 9]) -> [f64; 9] {
 }
 
 /// The rotation of Euler angles (radians) in MJCF's extrinsic `XYZ` sequence (URDF's
-/// `rpy`): each turn about a fixed axis of the parent, pre-multiplied, then normalized, as
-/// MuJoCo resolves an `euler` orientation.
+/// `rpy`): each turn about a fixed axis of the parent, pre-multiplied (`mjuu_mulquat`,
+/// whose normalization leaves a product within mjEPS of unit length alone), as MuJoCo
+/// resolves an `euler` orientation.
 pub(crate) fn euler_xyz(angles: [f64; 3]) -> [f64; 4] {
     let mut q = [1.0, 0.0, 0.0, 0.0];
     for (i, a) in angles.into_iter().enumerate() {
-        let (sin, cos) = (a / 2.0).sin_cos();
-        let mut rot = [cos, 0.0, 0.0, 0.0];
-        rot[i + 1] = sin;
-        q = mul_quat(&rot, &q);
+        let mut rot = [(a / 2.0).cos(), 0.0, 0.0, 0.0];
+        rot[i + 1] = (a / 2.0).sin();
+        q = normvec(mul_quat(&rot, &q));
     }
-    normalized(q)
+    q
+}
+
+/// MuJoCo's `mjuu_normvec` on a quaternion: divided by its norm unless that is within
+/// mjEPS of 1 (or below mjEPS).
+pub(crate) fn normvec(mut q: [f64; 4]) -> [f64; 4] {
+    let n2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+    if n2 < EPS {
+        return q;
+    }
+    let n = n2.sqrt();
+    if (n - 1.0).abs() > EPS {
+        for x in &mut q {
+            *x /= n;
+        }
+    }
+    q
+}
+
+/// `r m r'` (MuJoCo's `mjuu_mulRMRT`), all 3-by-3, row-major.
+pub(crate) fn rotate_matrix(r: &[f64; 9], m: &[f64; 9]) -> [f64; 9] {
+    mat_mul(&mat_mul(r, m), &transpose(r))
 }
 
 /// The minimal rotation from `[0, 0, 1]` to `v` (MuJoCo's `mjuu_z2quat`): about
