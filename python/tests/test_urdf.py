@@ -686,3 +686,23 @@ def test_an_mjcf_gripper_merged_onto_a_urdf_arm(tmp_path):
     # The arm holds its pose (every control 0 is its initial pose).
     arm_joints = [m.joint(f"robot0_lbr_iiwa_joint_{i}").qposadr[0] for i in range(1, 8)]
     assert np.abs(d.qpos[arm_joints]).max() < 0.05
+
+
+def test_a_scene_reads_its_urdf_as_the_installed_mujoco(tmp_path):
+    """A scene file's URDF model follows the installed ``mujoco``'s importer (r2d2's
+    continuous joints are limited under 3.x and not under 4.x), and its variants compile
+    with the robot as MuJoCo imports it, prefixed."""
+    from mjcf_forge import Scene
+
+    r2d2 = corpus_urdf(R2D2)
+    scene = Scene.from_toml(
+        f'seed = 1\nbase = "{ROOT / "corpora/scenes/demo/arena.xml"}"\n'
+        f'[[fixture]]\nmodel = "{r2d2}"\nprefix = "r0_"\npos = [0, 0, 1]\n',
+        base_dir=tmp_path,
+    )
+    m = mujoco.MjModel.from_xml_string(scene.variant(0).xml)
+    ref = mujocos(r2d2)
+    for j in range(ref.njnt):
+        i = m.joint("r0_" + ref.joint(j).name).id
+        assert m.jnt_limited[i] == ref.jnt_limited[j], ref.joint(j).name
+        assert np.array_equal(m.jnt_range[i], ref.jnt_range[j]), ref.joint(j).name

@@ -91,6 +91,7 @@ impl PyScene {
             None => Source::Demo,
         };
         let mujoco = python_mujoco(py)?;
+        follow_installed_mujoco(py)?;
         let scene = run(py, || {
             Ok(match &path {
                 Some(path) => Scene::load_with(path, &mut |d| python_inertia(&mujoco, d))?,
@@ -114,6 +115,7 @@ impl PyScene {
         let text = text.to_owned();
         let base_dir = base_dir.unwrap_or_else(|| PathBuf::from("."));
         let mujoco = python_mujoco(py)?;
+        follow_installed_mujoco(py)?;
         let scene = run(py, || {
             let mut compile = |d: &Document| python_inertia(&mujoco, d);
             Ok(Scene::from_toml_str_with(&text, &base_dir, &mut compile)?)
@@ -142,6 +144,7 @@ impl PyScene {
             })?
             .extract()?;
         let mujoco = python_mujoco(py)?;
+        follow_installed_mujoco(py)?;
         let scene = run(py, || {
             let mut compile = |d: &Document| python_inertia(&mujoco, d);
             Ok(Scene::from_json_str_with(&json, &base_dir, &mut compile)?)
@@ -354,4 +357,12 @@ pub(crate) fn variant_index(value: &Bound<'_, PyAny>) -> PyResult<u64> {
 /// (another current folder) finds the same files. Messages keep the path as given.
 fn absolute(path: PathBuf) -> PathBuf {
     std::path::absolute(&path).unwrap_or(path)
+}
+
+/// A scene's URDF models are read as the installed `mujoco`'s importer reads them (the
+/// scene compiles with it): made the process's default before the scene loads.
+fn follow_installed_mujoco(py: Python<'_>) -> PyResult<()> {
+    let importer = crate::document::urdf::installed_importer(py)?;
+    mjcf_forge::UrdfImporter::set_default(Some(importer));
+    Ok(())
 }

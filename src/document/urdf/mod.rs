@@ -89,9 +89,19 @@ pub enum UrdfImporter {
     MuJoCo4,
 }
 
+/// The process's default importer, set by [`UrdfImporter::set_default`]: 0 for none (the
+/// build's), else 1 + the variant's index. An atomic, read once per URDF read.
+static PROCESS_DEFAULT: std::sync::atomic::AtomicU8 = std::sync::atomic::AtomicU8::new(0);
+
 impl Default for UrdfImporter {
-    /// The importer of the MuJoCo this build links (the `mujoco` feature), else 4.0.0's.
+    /// The one [`UrdfImporter::set_default`] set; else the importer of the MuJoCo this
+    /// build links (the `mujoco` feature), else 4.0.0's.
     fn default() -> Self {
+        match PROCESS_DEFAULT.load(std::sync::atomic::Ordering::Relaxed) {
+            1 => return UrdfImporter::MuJoCo3,
+            2 => return UrdfImporter::MuJoCo4,
+            _ => {}
+        }
         #[cfg(mjcf_mujoco)]
         {
             UrdfImporter::of_version(env!("MJCF_FORGE_MUJOCO_VERSION"))
@@ -104,6 +114,26 @@ impl Default for UrdfImporter {
 }
 
 impl UrdfImporter {
+    /// Makes `importer` the default of every later URDF read in this process that names
+    /// none (`Document::load`, scene files); `None` goes back to the build's. For a host
+    /// that knows which MuJoCo compiles what it reads: the Python package sets the
+    /// installed `mujoco`'s before it loads a scene.
+    ///
+    /// ```
+    /// use mjcf_forge::UrdfImporter;
+    /// UrdfImporter::set_default(Some(UrdfImporter::MuJoCo3));
+    /// assert_eq!(UrdfImporter::default(), UrdfImporter::MuJoCo3);
+    /// UrdfImporter::set_default(None);
+    /// ```
+    pub fn set_default(importer: Option<UrdfImporter>) {
+        let v = match importer {
+            None => 0,
+            Some(UrdfImporter::MuJoCo3) => 1,
+            Some(UrdfImporter::MuJoCo4) => 2,
+        };
+        PROCESS_DEFAULT.store(v, std::sync::atomic::Ordering::Relaxed);
+    }
+
     /// The importer of a MuJoCo version (`"3.17.0"`, `"4.0.0"`): 3.x reads as 3.17.0,
     /// anything else as 4.0.0.
     ///
