@@ -263,3 +263,56 @@ print(n, "variants")
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+#[test]
+fn xacro_files_are_expanded_by_the_installed_xacro() {
+    // scripts/setup.sh installs PyPI's xacro into .cache/venv; with it on PATH, a .xacro
+    // file loads as its expansion, which MuJoCo judges against its own import of it.
+    let bin = root().join(".cache/venv/bin");
+    assert!(
+        bin.join("xacro").is_file(),
+        "{}: missing: run scripts/setup.sh",
+        bin.join("xacro").display()
+    );
+    let path = format!(
+        "{}:{}",
+        bin.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let dir = scratch("urdf_xacro");
+    let xacro = root().join("corpora/urdf/xacro/arm.urdf.xacro");
+    let expanded = std::process::Command::new(bin.join("xacro"))
+        .arg(&xacro)
+        .output()
+        .unwrap();
+    assert!(expanded.status.success());
+    let urdf = dir.join("arm.urdf");
+    std::fs::write(&urdf, &expanded.stdout).unwrap();
+    let ours = dir.join("arm.xml");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_mjcf-forge"))
+        .args([
+            "inline",
+            xacro.to_str().unwrap(),
+            "-o",
+            ours.to_str().unwrap(),
+        ])
+        .env("PATH", path)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let failed = judge_each(
+        |_| {
+            vec![Pair {
+                a: urdf.clone(),
+                b: ours.clone(),
+                prefix: String::new(),
+            }]
+        },
+        &dir,
+    );
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
+}
