@@ -111,7 +111,10 @@ fn a_base_takes_a_fusing_parts_fusestatic_and_keeps_its_bodies() {
     base.merge(&part, None, &MergeOptions::default()).unwrap();
     let xml = base.to_xml_string();
     assert!(xml.contains(r#"<compiler fusestatic="true"/>"#), "{xml}");
-    assert!(xml.contains(r#"<body name="hand" pos="0 0 1" fuse="false">"#), "{xml}");
+    assert!(
+        xml.contains(r#"<body name="hand" pos="0 0 1" fuse="false">"#),
+        "{xml}"
+    );
     assert!(
         xml.contains(r#"<body name="shelf" pos="0 0 0.5">"#),
         "{xml}"

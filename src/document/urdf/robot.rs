@@ -18,6 +18,8 @@ pub(super) struct Link<'a> {
     pub(super) name: &'a str,
     /// The `<joint>` that makes this link a child, if any.
     pub(super) joint: Option<Node>,
+    /// Its parent link (an index into `Robot::links`), if any.
+    pub(super) parent: Option<usize>,
     pub(super) children: Vec<usize>,
 }
 
@@ -74,6 +76,7 @@ impl<'a> Robot<'a> {
                 node: n,
                 name,
                 joint: None,
+                parent: None,
                 children: Vec::new(),
             });
         }
@@ -112,6 +115,7 @@ impl<'a> Robot<'a> {
                 continue;
             }
             links[c].joint = Some(j);
+            links[c].parent = Some(p);
             links[p].children.push(c);
         }
         if errors.len() > before {
@@ -131,8 +135,7 @@ impl<'a> Robot<'a> {
             for &i in &order {
                 seen[i] = true;
             }
-            for (i, link) in links.iter().enumerate().filter(|(i, _)| !seen[*i]) {
-                let _ = i;
+            for (_, link) in links.iter().enumerate().filter(|(i, _)| !seen[*i]) {
                 errors.push(invalid(
                     doc,
                     link.node,

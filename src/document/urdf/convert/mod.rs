@@ -245,14 +245,7 @@ impl<'r> Writer<'r> {
             if link.name == "world" {
                 continue;
             }
-            let parent = match link.joint {
-                Some(j) => {
-                    let p = robot.links.iter().position(|l| l.children.contains(&i));
-                    let _ = j;
-                    p.map_or(self.worldbody, |p| bodies[p])
-                }
-                None => self.worldbody,
-            };
+            let parent = link.parent.map_or(self.worldbody, |p| bodies[p]);
             let body = self.child(parent, "body", link.node);
             self.set(body, "name", link.name);
             if self.options.keep_links.iter().any(|k| k == link.name) {
