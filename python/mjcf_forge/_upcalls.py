@@ -14,6 +14,7 @@ looks each up here by name, and nowhere else.
 from __future__ import annotations
 
 import functools
+import sys
 from typing import Any, Optional
 
 from ._errors import MjcfFileNotFoundError
@@ -55,13 +56,18 @@ def compile_inertia(xml: str, model_dir: Any) -> tuple:
 
 @functools.lru_cache(maxsize=None)
 def mujoco_version() -> Optional[str]:
-    """The installed ``mujoco``'s version (``mujoco.__version__``), or ``None`` when it
-    cannot be imported: the URDF importer a load follows (``Document.load`` of a URDF
-    file, ``Document.from_urdf`` without ``importer=``). Asked only when a URDF is read,
-    so that reading MJCF never imports ``mujoco``; once per process."""
+    """The installed ``mujoco``'s version, or ``None`` when none is installed: the URDF
+    importer a load follows (``Document.load`` of a URDF file, ``Document.from_urdf``
+    without ``importer=``, a scene's URDF models). Read from the package's metadata, so
+    that asking never imports ``mujoco`` (which must come after ``MUJOCO_GL`` is set, for
+    ``Scene.preview``); an imported ``mujoco`` answers for itself."""
+    module = sys.modules.get("mujoco")
+    version = getattr(module, "__version__", None) if module is not None else None
+    if isinstance(version, str):
+        return version
     try:
-        import mujoco
-    except Exception:  # noqa: BLE001 - not installed, or installed but broken: not importable
+        from importlib import metadata
+
+        return metadata.version("mujoco")
+    except Exception:  # noqa: BLE001 - not installed
         return None
-    version = getattr(mujoco, "__version__", None)
-    return version if isinstance(version, str) else None
