@@ -68,10 +68,11 @@ impl<'a> Robot<'a> {
                 errors.push(invalid(doc, n, "URDF link without 'name'".into()));
                 continue;
             };
-            if by_name.insert(name, links.len()).is_some() {
+            if by_name.contains_key(name) {
                 errors.push(invalid(doc, n, format!("repeated URDF link name '{name}'")));
                 continue;
             }
+            by_name.insert(name, links.len());
             links.push(Link {
                 node: n,
                 name,
