@@ -61,6 +61,25 @@ def try_compile(path: str) -> tuple[str, str | None]:
     return path, None
 
 
+def compile_and_list(candidates: list[str], models_txt: str, rejected_txt: str) -> tuple[list[str], list[str]]:
+    """Compiles every candidate (paths relative to the repository root) in a process pool,
+    from the repository root (a `<model file>` is read from the working directory), and
+    writes the two lists under .cache/corpus/: those that compile, and the others with
+    MuJoCo's first error line. Returns (compiled, rejected). scripts/list_urdf.py uses it
+    too."""
+    os.chdir(ROOT)
+    results: dict[str, str | None] = {}
+    workers = max(1, min(len(candidates), os.cpu_count() or 1))
+    with cf.ProcessPoolExecutor(max_workers=workers, initializer=_quiet_worker) as pool:
+        for path, err in pool.map(try_compile, candidates, chunksize=1):
+            results[path] = err
+    ok = [p for p in candidates if results[p] is None]
+    bad = [p for p in candidates if results[p] is not None]
+    (CORPUS / models_txt).write_text("".join(p + "\n" for p in ok))
+    (CORPUS / rejected_txt).write_text("".join(f"{p}\t{results[p]}\n" for p in bad))
+    return ok, bad
+
+
 def main() -> int:
     suffix = ""
     if len(sys.argv) == 3 and sys.argv[1] == "--suffix":
@@ -101,20 +120,9 @@ def main() -> int:
                     not_mujoco += 1
     candidates.sort()
 
-    # From the repository root: a `<model file>` is read from the working directory.
-    os.chdir(ROOT)
-    results: dict[str, str | None] = {}
-    workers = max(1, min(len(candidates), os.cpu_count() or 1))
-    with cf.ProcessPoolExecutor(max_workers=workers, initializer=_quiet_worker) as pool:
-        for path, err in pool.map(try_compile, candidates, chunksize=1):
-            results[path] = err
-
-    ok = [p for p in candidates if results[p] is None]
-    bad = [p for p in candidates if results[p] is not None]
     models_txt = f"models{suffix}.txt"
     rejected_txt = f"rejected{suffix}.txt"
-    (CORPUS / models_txt).write_text("".join(p + "\n" for p in ok))
-    (CORPUS / rejected_txt).write_text("".join(f"{p}\t{results[p]}\n" for p in bad))
+    ok, bad = compile_and_list(candidates, models_txt, rejected_txt)
 
     for corpus in corpora:
         rel = str(corpus.relative_to(ROOT)) + os.sep

