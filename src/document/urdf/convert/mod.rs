@@ -62,10 +62,28 @@ pub(crate) fn convert(raw: &Document, options: &UrdfOptions) -> Result<Document,
     }
 }
 
-/// One mesh asset the importer made: its name and scale.
-struct MeshEntry {
-    name: String,
-    scale: [f64; 3],
+/// The importer's mesh names: a mesh is its file's stem; the same stem at another scale
+/// gets the count of the stem's earlier scales appended; the same stem at the same scale
+/// is the same asset.
+#[derive(Default)]
+struct MeshNames(AHashMap<String, Vec<[f64; 3]>>);
+
+impl MeshNames {
+    /// The asset name of `stem` at `scale`, and whether the asset is new.
+    fn name(&mut self, stem: &str, scale: [f64; 3]) -> (String, bool) {
+        let scales = self.0.entry(stem.to_string()).or_default();
+        match scales.iter().position(|s| *s == scale) {
+            Some(0) => (stem.to_string(), false),
+            Some(i) => (format!("{stem}{i}"), false),
+            None => {
+                scales.push(scale);
+                match scales.len() - 1 {
+                    0 => (stem.to_string(), true),
+                    i => (format!("{stem}{i}"), true),
+                }
+            }
+        }
+    }
 }
 
 struct Writer<'r> {
@@ -79,7 +97,7 @@ struct Writer<'r> {
     /// URDF material name -> its colour text (the first definition with a colour).
     materials: AHashMap<&'r str, &'r str>,
     /// Mesh assets by file stem, as the importer keys them.
-    meshes: AHashMap<String, Vec<MeshEntry>>,
+    meshes: MeshNames,
     /// Kept visuals' mesh assets: (file, scale text) -> name.
     visual_meshes: AHashMap<(String, String), String>,
     /// Every mesh asset name given so far.
@@ -140,7 +158,7 @@ impl<'r> Writer<'r> {
             strippath: false,
             meshdir: None,
             materials: AHashMap::new(),
-            meshes: AHashMap::new(),
+            meshes: MeshNames::default(),
             visual_meshes: AHashMap::new(),
             mesh_names: AHashSet::new(),
             geom_names: AHashSet::new(),
@@ -694,19 +712,10 @@ impl<'r> Writer<'r> {
             self.visual_meshes.insert(key, name.clone());
             return Some(name);
         }
-        let entries = self.meshes.entry(stem.clone()).or_default();
-        if let Some(e) = entries.iter().find(|e| e.scale == scale) {
-            return Some(e.name.clone());
+        let (name, new) = self.meshes.name(&stem, scale);
+        if !new {
+            return Some(name);
         }
-        let name = if entries.is_empty() {
-            stem
-        } else {
-            format!("{stem}{}", entries.len())
-        };
-        entries.push(MeshEntry {
-            name: name.clone(),
-            scale,
-        });
         let n = self.mesh_element(m, &name, &path, scale_text);
         self.asset_meshes.push(n);
         Some(name)

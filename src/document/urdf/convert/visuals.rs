@@ -64,7 +64,7 @@ impl<'r> Writer<'r> {
     /// in file order), so that no kept visual's mesh takes one.
     pub(super) fn collision_mesh_names(&mut self, robot: &Robot<'r>) -> AHashSet<String> {
         let raw = self.raw;
-        let mut scales: ahash::AHashMap<String, Vec<[f64; 3]>> = ahash::AHashMap::new();
+        let mut meshes = super::MeshNames::default();
         let mut names = AHashSet::new();
         for link in &robot.links {
             for g in raw
@@ -90,15 +90,7 @@ impl<'r> Writer<'r> {
                         (v.len() == 3).then(|| [v[0], v[1], v[2]])
                     })
                     .unwrap_or([1.0; 3]);
-                let known = scales.entry(stem.clone()).or_default();
-                if !known.contains(&scale) {
-                    names.insert(if known.is_empty() {
-                        stem.clone()
-                    } else {
-                        format!("{stem}{}", known.len())
-                    });
-                    known.push(scale);
-                }
+                names.insert(meshes.name(&stem, scale).0);
             }
         }
         names
