@@ -20,6 +20,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ._errors import error
+from ._last_xml import compile_xml
 from ._mjcf_forge import (
     MODEL_FIELDS,
     SIGNATURE_ARRAYS,
@@ -222,7 +223,7 @@ class ModelCache:
         """Compiles the variant's structure (the superset, or the variant itself) and keeps
         it; the model returned is already the variant's."""
         xml = self.superset.xml if self.superset is not None else variant.xml
-        model = self._mujoco.MjModel.from_xml_string(xml)
+        model = compile_xml(self._mujoco, xml)
         self.compiles += 1
         key = self.superset.structure_key if self.superset is not None else variant.structure_key
         self._signatures[key] = _signature(model)

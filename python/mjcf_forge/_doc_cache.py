@@ -22,6 +22,7 @@ import numpy as np
 
 from ._cache import copy_value, evict
 from ._errors import error
+from ._last_xml import compile_xml
 from ._mjcf_forge import Document, MjcfError
 from ._plan import Plan
 
@@ -333,7 +334,7 @@ class DocumentCache:
         try:
             xml = doc.to_xml(pretty=True)
             try:
-                model = self._mujoco.MjModel.from_xml_string(xml)
+                model = compile_xml(self._mujoco, xml)
             except ValueError as e:
                 raise error(doc._mujoco_error(xml, str(e))) from None
             structure = _Structure(self._mujoco, key, model, doc, fixed)

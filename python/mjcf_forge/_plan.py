@@ -19,6 +19,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ._errors import error
+from ._last_xml import compile_xml
 from . import _mujoco
 from ._mjcf_forge import MODEL_FIELDS, PATCH_OBJECTS, ModelArrays, PatchLanding, Statistics
 
@@ -182,7 +183,7 @@ class Plan:
         entry = self.body_models.get(xml)
         if entry is None:
             try:
-                mini = self.mujoco.MjModel.from_xml_string(xml)
+                mini = compile_xml(self.mujoco, xml)
             except ValueError as e:
                 raise error(f"body '{self.model.body(body).name}': its geoms alone: {e}") from None
             if len(self.body_models) >= 64:

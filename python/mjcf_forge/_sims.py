@@ -41,6 +41,7 @@ import numpy as np
 
 from . import _settings
 from ._doc_cache import VISUAL
+from ._last_xml import owe
 
 _KEPT = threading.local()
 # Simulations a forked child inherited kept: never used (their OpenGL contexts belong to
@@ -129,10 +130,16 @@ def keep_simulations(sim_class: Any) -> None:
         if cache is None or offered is None or type(offered[0]) is not cls:
             if offered is not None:
                 release(*offered)
-            return compile_sim(cls, xml) if cache is None else cls(cache.model(xml))
+            if cache is None:
+                return compile_sim(cls, xml)
+            model = cache.model(xml)
+            # Stock loaded ``xml`` here: MuJoCo's last loaded XML model is owed it.
+            owe(xml)
+            return cls(model)
         kept = offered[0]
         held = kept.model._model
         model = cache.model(xml, into=held)
+        owe(xml)
         if model is not held:
             release(*offered)
             return cls(model)

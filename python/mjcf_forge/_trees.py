@@ -31,6 +31,7 @@ import numpy as np
 
 from ._mjcf_forge import GEOM_FACTORS, MODEL_FIELDS, ModelArrays, target_array
 from . import _mujoco
+from ._last_xml import compile_xml
 from ._plan import OBJ
 
 # Patch targets (MjModel arrays) that mj_setConst reads: a tree written into through
@@ -93,7 +94,7 @@ class _Tree:
             after = -(before + count) % 4
         else:
             after = nv - start - count
-        sk = self.skeleton = mujoco.MjModel.from_xml_string(self._xml(model, bodies, before, after))
+        sk = self.skeleton = compile_xml(mujoco, self._xml(model, bodies, before, after))
         b0 = 1 + (before > 0)
         if (
             sk.nbody != len(bodies) + b0 + (after > 0)
@@ -427,7 +428,8 @@ _UNIT = np.array([1.0, 0.0, 0.0, 0.0])
 def _recomputes_sameframe(mujoco: Any) -> bool:
     """Whether this MuJoCo's mj_setConst sets the bodies', geoms' and sites' same-frame
     flags again from their frames (4.0 does; 3.17 keeps the compiler's)."""
-    model = mujoco.MjModel.from_xml_string(
+    model = compile_xml(
+        mujoco,
         '<mujoco><worldbody><body><freejoint/><geom size=".1" pos=".1 0 0"/></body>'
         "</worldbody></mujoco>"
     )

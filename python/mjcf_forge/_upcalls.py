@@ -18,6 +18,7 @@ import sys
 from typing import Any, Optional
 
 from ._errors import MjcfFileNotFoundError
+from ._last_xml import compile_xml
 from ._mjcf_utils import without_materials
 from ._preview import preview
 from ._progress import progress_of
@@ -43,7 +44,7 @@ def compile_inertia(xml: str, model_dir: Any) -> tuple:
 
     xml = without_materials(xml)
     cache = model_cache()
-    model = cache.model(xml) if cache is not None else mujoco.MjModel.from_xml_string(xml)
+    model = cache.model(xml) if cache is not None else compile_xml(mujoco, xml)
     names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, i) or "" for i in range(model.nbody)]
     return (
         names,

@@ -36,6 +36,7 @@ import xml.dom.minidom
 from typing import Any, Optional
 
 from ._mjcf_forge import Document, LoadCache, MjcfError
+from . import _last_xml
 from . import _stock
 from . import etree as ET
 from ._errors import XMLError, reraised as _reraised, xml_error
@@ -273,7 +274,10 @@ class MujocoXML(object):
         if mode == "mujoco":
             cache = model_cache()
             if cache is not None:
-                return cache.model(self.document)
+                model = cache.model(self.document)
+                # Stock loads the text here: MuJoCo's last loaded XML model is owed it.
+                _last_xml.owe(self.document.copy().to_xml)
+                return model
             import mujoco
 
             return mujoco.MjModel.from_xml_string(self.document.to_xml())

@@ -55,6 +55,7 @@ import xml.etree.ElementTree as _XET
 from typing import Any, Optional
 
 from . import base as _base
+from . import _last_xml
 from . import _sims
 from . import etree as _etree
 
@@ -106,7 +107,7 @@ class _LazyModel:
             else:
                 import mujoco
 
-                value = mujoco.MjModel.from_xml_string(value.document.to_xml())
+                value = _last_xml.compile_xml(mujoco, value.document.to_xml())
             robot.__dict__["_mjcf_forge_model"] = value
         return value
 
@@ -121,7 +122,11 @@ def _lazy_robot_model(robot_class: Any) -> None:
         if mujoco_model is not None:
             self.mujoco_model = mujoco_model
         else:
-            self.mujoco_model = _Pending(self.document.copy())
+            pending = _Pending(self.document.copy())
+            self.mujoco_model = pending
+            # Stock compiles the robot here with mujoco.MjModel.from_xml_string: MuJoCo's
+            # last loaded XML model is owed it (written only if read before the next load).
+            _last_xml.owe(pending.document.to_xml)
 
     set_mujoco_model.__doc__ = (
         "Sets ``mujoco_model``: the model given, or else this robot compiled alone, "
@@ -130,18 +135,26 @@ def _lazy_robot_model(robot_class: Any) -> None:
     robot_class.set_mujoco_model = set_mujoco_model
 
 
-class _Loader(importlib.abc.Loader):
-    """A robosuite module's own loader, then :func:`_adapt`."""
+def _adapt_mujoco(module: Any) -> None:
+    """What :func:`use` changes in ``mujoco`` once it has run: its loaders and
+    ``mj_saveLastXML`` wrapped (:mod:`mjcf_forge._last_xml`), so that what MuJoCo's last
+    loaded XML model holds is known from the first load on."""
+    _last_xml.install(module)
 
-    def __init__(self, loader: Any):
+
+class _Loader(importlib.abc.Loader):
+    """A module's own loader, then ``adapt`` (:func:`_adapt` for robosuite's)."""
+
+    def __init__(self, loader: Any, adapt: Any):
         self._loader = loader
+        self._adapt = adapt
 
     def create_module(self, spec: Any) -> Any:
         return self._loader.create_module(spec)
 
     def exec_module(self, module: Any) -> None:
         self._loader.exec_module(module)
-        _adapt(module)
+        self._adapt(module)
 
     def __getattr__(self, name: str) -> Any:
         # get_source, get_resource_reader, is_package...: the module's own loader's.
@@ -149,10 +162,15 @@ class _Loader(importlib.abc.Loader):
 
 
 class _Finder(importlib.abc.MetaPathFinder):
-    """Finds robosuite's modules as the other finders do, with :class:`_Loader`."""
+    """Finds robosuite's modules and ``mujoco`` as the other finders do, with
+    :class:`_Loader`."""
 
     def find_spec(self, fullname: str, path: Any = None, target: Any = None) -> Optional[Any]:
-        if fullname.partition(".")[0] != _PACKAGE:
+        if fullname == "mujoco":
+            adapt = _adapt_mujoco
+        elif fullname.partition(".")[0] == _PACKAGE:
+            adapt = _adapt
+        else:
             return None
         for finder in sys.meta_path:
             if finder is self or not hasattr(finder, "find_spec"):
@@ -163,7 +181,7 @@ class _Finder(importlib.abc.MetaPathFinder):
         else:
             return None
         if spec.loader is not None and hasattr(spec.loader, "exec_module"):
-            spec.loader = _Loader(spec.loader)
+            spec.loader = _Loader(spec.loader, adapt)
         return spec
 
 
@@ -209,3 +227,5 @@ def use(rules: str = "robosuite") -> None:
         )
     _base.set_rules(rules)
     sys.meta_path.insert(0, _FINDER)
+    if "mujoco" in sys.modules:
+        _adapt_mujoco(sys.modules["mujoco"])
