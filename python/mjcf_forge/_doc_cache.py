@@ -254,9 +254,10 @@ class DocumentCache:
         MJCF text read from ``base_dir``, or a path); see the class.
 
         ``into``: a model this cache gave you that you still hold and no longer need as
-        it is (a simulation about to be made again). When ``source`` has its structure
-        and the cache still keeps it, ``into`` itself is patched and returned; otherwise
-        the call is as without ``into`` (``result is into`` says which).
+        it is (a simulation about to be made again), or a list of such models. When
+        ``source`` has the structure of one of them and the cache still keeps it, that
+        model itself is patched and returned; otherwise the call is as without ``into``
+        (``result is into`` says which).
 
         >>> import mjcf_forge
         >>> cache = mjcf_forge.DocumentCache()
@@ -270,11 +271,14 @@ class DocumentCache:
         values = np.frombuffer(numbers, dtype="<f8")
         me = threading.get_ident()
         if into is not None:
+            intos = into if isinstance(into, (list, tuple)) else (into,)
             with self._lock:
                 structure = self._entries.get(key)
                 working = None
                 if structure is not None:
-                    working = next((w for w in structure.workings() if w.model is into), None)
+                    working = next(
+                        (w for w in structure.workings() if any(w.model is m for m in intos)), None
+                    )
                     if working is not None:
                         self._entries.move_to_end(key)
             if working is not None:

@@ -72,11 +72,43 @@ def model_cache() -> Optional[Any]:
     if _model_cache is _UNSET:
         if os.environ.get(MODEL_CACHE_ENV, "").strip().lower() in ("0", "off", "false", "no"):
             _model_cache = None
+        elif not caches_run_on_this_mujoco():
+            _model_cache = None
         else:
             from ._doc_cache import DocumentCache
 
             _model_cache = DocumentCache(max_models=8)
     return _model_cache
+
+
+#: The oldest MuJoCo the caches (model cache, patches, kept simulations) run on.
+OLDEST_CACHED_MUJOCO = (3, 3)
+
+
+def caches_run_on_this_mujoco() -> bool:
+    """Whether the installed ``mujoco`` is one the caches run on (3.3 and newer). On an
+    older one (robosuite 1.4.0 accepts MuJoCo 2.3; libero-infinity pins it), the
+    process's model cache is off and every model compiles as stock compiles it, which is
+    said once, as a warning; everything else of the package runs as on any MuJoCo."""
+    from ._upcalls import mujoco_version
+
+    version = mujoco_version()
+    try:
+        parts = tuple(int(p) for p in (version or "").split(".")[:2])
+    except ValueError:
+        parts = ()
+    if len(parts) < 2 or parts >= OLDEST_CACHED_MUJOCO:
+        return True
+    import warnings
+
+    warnings.warn(
+        f"mjcf_forge: the model cache needs MuJoCo {'.'.join(map(str, OLDEST_CACHED_MUJOCO))} "
+        f"or newer, and this is {version}: models compile as stock compiles them "
+        "(mujoco.MjModel.from_xml_string), at stock's cost",
+        RuntimeWarning,
+        stacklevel=3,
+    )
+    return False
 
 
 def set_model_cache(cache: Any) -> Optional[Any]:

@@ -4,10 +4,13 @@ A robosuite hard reset frees its ``MjSim`` (``MjSim.free``: the render context a
 OpenGL context, the data, the model, then ``gc.collect()``), builds its task again and
 makes a new ``MjSim`` from the task's XML (``MjSim.from_xml_string``), and later a new
 render context, which uploads every texture, mesh, height field and skin again. With the
-switch, ``MjSim.free`` keeps the freed simulation instead (one per thread, until that
-thread's next ``from_xml_string``; robosuite 1.5, unless its renderer is ``"mujoco"``,
-does not free it but lets go of it as ``_initialize_sim`` makes the next: offered the
-same way), and ``MjSim.from_xml_string`` makes the next simulation out of it when it can:
+switch, ``MjSim.free`` keeps the freed simulation instead (the last
+:data:`KEPT_PER_THREAD` per thread, the oldest released as stock releases it; robosuite
+1.5, unless its renderer is ``"mujoco"``, does not free it but lets go of it as
+``_initialize_sim`` makes the next: offered the same way), and ``MjSim.from_xml_string``
+makes the next simulation out of one of them when it can (two, because robosuite's
+clients make two structures take turns: a task and the XML that
+``DataCollectionWrapper`` or ``CameraMover`` reload from its ``get_xml()``):
 
 - the model cache patches the kept simulation's own model in place, when the new XML has
   its structure (``DocumentCache.model(xml, into=...)``): the model MuJoCo compiles from
@@ -49,11 +52,24 @@ _KEPT = threading.local()
 _INHERITED: list = []
 
 
+#: Simulations kept per thread, one per structure at most: a hard reset's task and the
+#: XML robosuite's clients reload between episodes (DataCollectionWrapper's
+#: reset_from_xml_string of get_xml(), CameraMover's scene with its mocap body) take turns.
+KEPT_PER_THREAD = 2
+
+
+def _kept() -> list:
+    """This thread's kept simulations, most recent first, as ``(sim, freed)``."""
+    kept = getattr(_KEPT, "sims", None)
+    if kept is None:
+        kept = _KEPT.sims = []
+    return kept
+
+
 def _forget_after_fork() -> None:
-    kept = getattr(_KEPT, "sim", None)
-    if kept is not None:
-        _INHERITED.append(kept)
-    _KEPT.sim = _KEPT.renewed = None
+    _INHERITED.extend(getattr(_KEPT, "sims", None) or [])
+    _KEPT.sims = []
+    _KEPT.renewed = None
 
 
 os.register_at_fork(after_in_child=_forget_after_fork)
@@ -75,7 +91,7 @@ def _render_inputs(mujoco: Any, model: Any) -> bytes:
     equal bytes, equal context."""
     parts = [np.float64(model.stat.extent).tobytes()]
     for group in VISUAL:
-        obj = getattr(model.vis, group)
+        obj = getattr(model.vis, group, None)
         for name in sorted(dir(obj)):
             if not name.startswith("_"):
                 value = getattr(obj, name)
@@ -98,6 +114,8 @@ def keep_render_inputs(context_class: Any) -> None:
 
     def _set_mujoco_context_and_buffers(self: Any) -> None:
         make(self)
+        if _settings.model_cache() is None:
+            return  # no simulation is kept: nothing will compare them
         import mujoco
 
         self._mjcf_forge_inputs = _render_inputs(mujoco, self.model._model)
@@ -106,10 +124,31 @@ def keep_render_inputs(context_class: Any) -> None:
     context_class._set_mujoco_context_and_buffers = _set_mujoco_context_and_buffers
 
 
+_RELEASE: list = []  # robosuite's own MjSim.free, once keep_simulations has run
+
+
+def offer(sim: Any, freed: bool) -> None:
+    """Keeps ``sim`` (freed by robosuite, or let go of) for this thread's next
+    ``MjSim.from_xml_string``; the oldest of more than :data:`KEPT_PER_THREAD` is released
+    as stock releases it."""
+    kept = _kept()
+    for i, (other, was_freed) in enumerate(kept):
+        if other is sim:
+            del kept[i]
+            freed = freed or was_freed
+            break
+    kept.insert(0, (sim, freed))
+    while len(kept) > KEPT_PER_THREAD:
+        old, old_freed = kept.pop()
+        if old_freed and _RELEASE:
+            _RELEASE[0](old)
+
+
 def keep_simulations(sim_class: Any) -> None:
     """``MjSim.free`` and ``MjSim.from_xml_string`` as the module says."""
     compile_sim = sim_class.__dict__["from_xml_string"].__func__
     free_sim: Callable[[Any], None] = sim_class.__dict__["free"]
+    _RELEASE[:] = [free_sim]
 
     def release(sim: Any, freed: bool) -> None:
         """What stock does with a simulation not made again: frees the one robosuite
@@ -120,32 +159,30 @@ def keep_simulations(sim_class: Any) -> None:
     def free(self: Any) -> None:
         if _settings.model_cache() is None:
             return free_sim(self)
-        previous, _KEPT.sim = getattr(_KEPT, "sim", None), (self, True)
-        if previous is not None and previous[0] is not self:
-            release(*previous)
+        offer(self, True)
 
     def from_xml_string(cls: Any, xml: str) -> Any:
-        offered, _KEPT.sim = getattr(_KEPT, "sim", None), None
         cache = _settings.model_cache()
-        if cache is None or offered is None or type(offered[0]) is not cls:
-            if offered is not None:
-                release(*offered)
-            if cache is None:
-                return compile_sim(cls, xml)
+        kept = _kept()
+        if cache is None:
+            while kept:
+                release(*kept.pop())
+            return compile_sim(cls, xml)
+        candidates = [sim for sim, _ in kept if type(sim) is cls]
+        if not candidates:
             model = cache.model(xml)
             # Stock loaded ``xml`` here: MuJoCo's last loaded XML model is owed it.
             owe(xml)
             return cls(model)
-        kept = offered[0]
-        held = kept.model._model
-        model = cache.model(xml, into=held)
+        model = cache.model(xml, into=[sim.model._model for sim in candidates])
         owe(xml)
-        if model is not held:
-            release(*offered)
-            return cls(model)
-        _renew(kept)
-        _KEPT.renewed = kept
-        return kept
+        for i, (sim, _) in enumerate(kept):
+            if sim.model._model is model:
+                del kept[i]
+                _renew(sim)
+                _KEPT.renewed = sim
+                return sim
+        return cls(model)
 
     free.__doc__ = free_sim.__doc__
     from_xml_string.__doc__ = compile_sim.__doc__
@@ -170,8 +207,8 @@ def keep_environment(env_class: Any) -> None:
         # A hard reset that does not free the simulation (robosuite 1.5's, unless its
         # renderer is "mujoco") lets go of it as the new one is made: offered too.
         sim = getattr(self, "sim", None)
-        if sim is not None and getattr(_KEPT, "sim", None) is None and _settings.model_cache() is not None:
-            _KEPT.sim = (sim, False)
+        if sim is not None and _settings.model_cache() is not None and all(s is not sim for s, _ in _kept()):
+            offer(sim, False)
         return initialize_sim(self, xml_string)
 
     _initialize_sim.__doc__ = initialize_sim.__doc__

@@ -26,13 +26,18 @@ modules has run:
   the cache has not seen, and otherwise patches that structure's model, a model no
   earlier simulation still holds, with every array written back as compiled first (so
   ``DomainRandomizationWrapper``'s changes do not outlive the reset);
-- ``MjSim.free`` keeps the simulation a hard reset frees, and the next
-  ``from_xml_string`` of its thread makes it the new one when the XML has its structure:
+- ``MjSim.free`` keeps the simulation a hard reset frees (the last two per thread), and a
+  later ``from_xml_string`` of its thread makes it the new one when the XML has its
+  structure:
   its own model patched in place, its data reset, its render context kept with what it
   uploaded (when the patched model gives a new context the same inputs), and
   ``MujocoEnv.reset`` then leaves robosuite's observables their sensors instead of
   making them again (:mod:`mjcf_forge._sims`; docs/compiled.md says why each kept
   thing gives stock's result);
+- MuJoCo's last loaded XML model, which robosuite's ``MjModel.get_xml()`` writes
+  (``mujoco.mj_saveLastXML``: what ``DataCollectionWrapper``, robomimic and MimicGen
+  save with every demonstration), is stock's: each load the cache serves is owed to it,
+  and given to it when it is read (:mod:`mjcf_forge._last_xml`);
 - ``RobotModel.mujoco_model``, the robot compiled alone at every load
   (``set_mujoco_model()``), which robosuite never reads, is compiled on first read, from
   the robot as it was when ``set_mujoco_model()`` was called.

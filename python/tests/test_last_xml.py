@@ -1,0 +1,140 @@
+"""MuJoCo's last loaded XML model (what ``mujoco.mj_saveLastXML`` writes, robosuite's
+``get_xml()``) as stock leaves it, whatever the package compiles or serves from its model
+cache (mjcf_forge._last_xml). Each expectation is MuJoCo's own output for the sequence of
+loads stock makes, written in the same process. Version-dependent (MuJoCo's
+``mj_copyBack``): scripts/test.sh runs it under 3.17.0 and 4.0.0.
+"""
+from __future__ import annotations
+
+import mujoco
+import pytest
+
+from mjcf_forge import DocumentCache, _last_xml, base
+from mjcf_forge._last_xml import LastXmlError, compile_xml
+from helpers import ROOT
+
+ARM = ROOT / "corpora" / "scenes" / "demo" / "arm.xml"
+BOX = '<mujoco><worldbody><body name="box" pos="0 0 1"><freejoint/><geom type="box" size=".1 .2 .3"/></body></worldbody></mujoco>'
+BALL = '<mujoco><worldbody><body name="ball"><joint type="hinge"/><geom size=".2"/></body></worldbody></mujoco>'
+
+
+@pytest.fixture(autouse=True)
+def fresh_slot(monkeypatch):
+    """A slot whose content is unknown, as in a process that loaded before the package."""
+    _last_xml.install(mujoco)
+    monkeypatch.setattr(_last_xml, "_SLOT", _last_xml._Slot())
+    previous = base.set_model_cache(DocumentCache(max_models=8))
+    yield
+    base.set_model_cache(previous)
+
+
+def saved(model, tmp_path) -> str:
+    path = tmp_path / "last.xml"
+    mujoco.mj_saveLastXML(str(path), model)
+    return path.read_text()
+
+
+def stock(xml: str, tmp_path, edit=None) -> str:
+    """What stock writes: ``xml`` loaded by MuJoCo's loader, its model (edited) saved."""
+    model = mujoco.MjModel.from_xml_string(xml)
+    if edit:
+        edit(model)
+    return saved(model, tmp_path)
+
+
+def test_our_compiles_leave_mujocos_last_xml_alone(tmp_path):
+    user = mujoco.MjModel.from_xml_string(BOX)
+    before = saved(user, tmp_path)
+    # The caches' compiles, patches and body models; a compile of ours.
+    cache = DocumentCache(max_models=4)
+    cache.model(BALL)
+    cache.model(BALL.replace('size=".2"', 'size=".3"'))
+    compile_xml(mujoco, BALL)
+    assert _last_xml.state()["held"] == "xml"
+    assert saved(user, tmp_path) == before
+    assert "box" in before and "ball" not in before
+
+
+def test_a_model_the_cache_serves_is_owed_to_the_slot_and_written_as_stock(tmp_path):
+    xml = base.MujocoXML(str(ARM))
+    model = xml.get_model()
+    assert _last_xml.state()["owed"] == "lazy"
+    served = saved(model, tmp_path)
+    # Again: a patch this time, and the slot already holds that load as loaded.
+    again = xml.get_model()
+    assert saved(again, tmp_path) == served
+    assert _last_xml.state()["owed"] is None
+    assert served == stock(xml.get_xml(), tmp_path)
+
+
+def test_a_load_by_anyone_else_is_the_last_load(tmp_path):
+    arm = base.MujocoXML(str(ARM)).get_model()
+    box = mujoco.MjModel.from_xml_string(BOX)
+    assert _last_xml.state()["owed"] is None
+    assert saved(box, tmp_path) == stock(BOX, tmp_path)
+    # The arm's model does not fit the box MuJoCo holds: MuJoCo's own error, as stock.
+    with pytest.raises(mujoco.FatalError, match="incompatible models in CopyBack"):
+        saved(arm, tmp_path)
+
+
+def test_a_write_that_leaves_a_statistic_behind_is_loaded_again_as_stock_does(tmp_path):
+    def heavier(m):
+        m.stat.meaninertia = 7.5
+
+    def wider(m):
+        m.geom_size[0] = [0.4, 0.4, 0.4]
+
+    # Stock: two loads of the box, a write after each; the first write's statistic stays
+    # in MuJoCo's parsed model only until the next load.
+    stock(BOX, tmp_path, heavier)
+    expected = stock(BOX, tmp_path, wider)
+    assert 'meaninertia="7.5"' not in expected
+    _last_xml.owe(BOX)
+    first = mujoco.MjModel.from_xml_string.__wrapped__(BOX)
+    heavier(first)
+    assert 'meaninertia="7.5"' in saved(first, tmp_path)
+    assert _last_xml.state()["fresh"] is False
+    _last_xml.owe(BOX)  # the same text: still owed, the slot is not as loaded
+    assert _last_xml.state()["owed"] == "xml"
+    second = mujoco.MjModel.from_xml_string.__wrapped__(BOX)
+    wider(second)
+    assert saved(second, tmp_path) == expected
+
+
+def test_a_write_with_the_compiled_statistics_keeps_the_slot_as_loaded(tmp_path):
+    _last_xml.owe(BOX)
+    model = compile_xml(mujoco, BOX)
+    model.geom_rgba[0] = [1, 0, 0, 1]
+    first = saved(model, tmp_path)
+    _last_xml.owe(BOX)
+    assert _last_xml.state() == {"held": "xml", "fresh": True, "owed": None, "installed": True}
+    assert saved(model, tmp_path) == first == stock(BOX, tmp_path, lambda m: m.geom_rgba.__setitem__(0, [1, 0, 0, 1]))
+
+
+def test_without_mjspec_the_slot_is_given_back_what_it_held(tmp_path, monkeypatch):
+    monkeypatch.setattr(_last_xml, "_spec_compiles", lambda mujoco: False)
+    user = mujoco.MjModel.from_xml_string(BOX)
+    expected = saved(user, tmp_path)
+    compile_xml(mujoco, BALL)  # through MuJoCo's loader: the slot holds the ball now
+    assert _last_xml.state()["held"] == "ours"
+    assert saved(user, tmp_path) == expected
+
+
+def test_without_mjspec_a_slot_held_before_the_package_knew_raises(tmp_path, monkeypatch):
+    monkeypatch.setattr(_last_xml, "_spec_compiles", lambda mujoco: False)
+    user = mujoco.MjModel.from_xml_string.__wrapped__(BOX)  # unseen by the bookkeeping
+    compile_xml(mujoco, BALL)
+    with pytest.raises(LastXmlError, match=r"^mujoco\.mj_saveLastXML: MuJoCo's last loaded XML model was replaced"):
+        saved(user, tmp_path)
+
+
+def test_the_wrappers_are_mujocos_functions(tmp_path):
+    assert mujoco.MjModel.from_xml_string.__wrapped__ is not None
+    assert mujoco.mj_saveLastXML.__doc__ == mujoco.mj_saveLastXML.__wrapped__.__doc__
+    with pytest.raises(ValueError, match="XML Error"):
+        mujoco.MjModel.from_xml_string("<mujoco><bogus/></mujoco>")
+    path = tmp_path / "box.xml"
+    path.write_text(BOX)
+    model = mujoco.MjModel.from_xml_path(str(path))
+    assert _last_xml.state()["held"] == "path"
+    assert saved(model, tmp_path) == stock(BOX, tmp_path)
