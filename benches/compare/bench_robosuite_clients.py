@@ -19,7 +19,10 @@ PYTHONPATH holding only it); rounds alternate between them, and each round times
   renderer, after a hard reset;
 - ``robomimic``: robomimic's ``dataset_states_to_obs`` for one demo of 20 steps (its
   ``reset``, ``reset_to`` with the model and the first state, then a state reset and an
-  observation per step, agentview and wrist images at 84x84).
+  observation per step, agentview and wrist images at 84x84);
+- ``render``: what of that no reset can save: the demo's 21 observations alone
+  (``_get_observations(force_update=True)``: both cameras rendered, the other sensors
+  read), on the state the environment is in.
 
 Printed: per measure the median and best in ms on each side, and the ratios stock / ours
 of the medians and of the bests (docs/speed.md, "robosuite's clients").
@@ -38,7 +41,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-MEASURES = ("record", "attempt", "camera_mover", "robomimic")
+MEASURES = ("record", "attempt", "camera_mover", "robomimic", "render")
 
 
 def worker(mode: str, name: str) -> None:
@@ -101,6 +104,9 @@ def worker(mode: str, name: str) -> None:
         elif measure == "camera_mover":
             viewer.reset()
             CameraMover(viewer, camera="frontview")
+        elif measure == "render":
+            for _ in range(len(states)):
+                images._get_observations(force_update=True)
         else:
             images.reset()
             reset_to(images, {"model": start, "states": states[0]})

@@ -45,9 +45,11 @@ of MuJoCo's process-wide state and why the switch leaves it as stock does.
 
 from __future__ import annotations
 
+import copy
 import functools
 import sys
 import threading
+import xml.etree.ElementTree as _XET
 from typing import Any, Callable, Optional, Union
 
 __all__ = ["LastXmlError", "compile_xml", "install", "owe", "state"]
@@ -76,6 +78,9 @@ class _Slot:
         self.fresh = False  # no write since the load left a statistic copied in it
         self.stat: Optional[tuple] = None  # the held model's statistics as compiled
         self.owed: Any = None  # the key stock's slot holds, where it differs from held
+        self.owed_stat: Optional[tuple] = None  # statistics of the model served for it
+        self.paid = 0  # loads made to pay what was owed
+        self.rewritten = 0  # writes through the held load instead (see _rewrites_as)
         self.loading = 0  # wrapped loads running now
         self.overlapped = False  # two of them ran at once (reset when none runs)
 
@@ -161,10 +166,10 @@ def install(mujoco: Any) -> None:
             return _load(from_path, _key_of(args, kwargs, "path"), *args, **kwargs)
 
         def mj_saveLastXML(filename: Any, m: Any, *args: Any, **kwargs: Any) -> Any:
-            _pay("mujoco.mj_saveLastXML")
-            result = save(filename, m, *args, **kwargs)
+            written = _pay("mujoco.mj_saveLastXML", m)
+            result = save(filename, written, *args, **kwargs)
             with _SLOT.lock:
-                if _SLOT.fresh and (_SLOT.stat is None or _stat(m) != _SLOT.stat):
+                if _SLOT.fresh and (_SLOT.stat is None or _stat(written) != _SLOT.stat):
                     _SLOT.fresh = False
             return result
 
@@ -200,10 +205,11 @@ def _installed() -> bool:
     return True
 
 
-def owe(source: Source, assets: Any = None) -> None:
+def owe(source: Source, assets: Any = None, served: Any = None) -> None:
     """Records that stock would have loaded ``source`` (MJCF text, or a function that
     writes it, called only if the slot is read) with ``mujoco.MjModel.from_xml_string``
-    now, and that the model cache served that load instead."""
+    now, and that the model cache served that load instead (``served``: the model it
+    gave, MuJoCo's compile of ``source``, when the caller has it)."""
     if not _installed():
         return
     slot = _SLOT
@@ -213,19 +219,23 @@ def owe(source: Source, assets: Any = None) -> None:
             slot.owed = None if (slot.fresh and _same(slot.held, key)) else key
         else:
             slot.owed = ("lazy", source, None if assets is None else dict(assets))
+        slot.owed_stat = _stat(served) if served is not None and slot.owed is not None else None
 
 
 def _same(held: tuple, key: tuple) -> bool:
     return held[0] == "xml" and held[1] == key[1] and held[2] == key[2]
 
 
-def _pay(api: str) -> None:
-    """Gives the slot what stock's holds, before ``api`` reads it."""
+def _pay(api: str, model: Any = None) -> Any:
+    """Gives the slot what stock's holds, before ``api`` reads it; returns the model to
+    write it with: ``model``, or a copy of it whose statistics are the held load's where
+    the held load writes what the owed one would (:func:`_rewrites_as`)."""
     slot = _SLOT
     with slot.lock:
-        owed = slot.owed
+        owed, owed_stat = slot.owed, slot.owed_stat
+        held, fresh, held_stat = slot.held, slot.fresh, slot.stat
     if owed is None:
-        return
+        return model
     if owed is _LOST:
         raise LastXmlError(
             f"{api}: MuJoCo's last loaded XML model was replaced by one of mjcf-forge's "
@@ -243,16 +253,106 @@ def _pay(api: str) -> None:
     with slot.lock:
         if slot.fresh and _same(slot.held, owed):
             slot.owed = None
-            return
+            return model
+    if (
+        model is not None and fresh and owed_stat is not None and held_stat is not None
+        and held[0] == owed[0] == "xml" and held[2] is None and owed[2] is None
+        and _stat(model) == owed_stat and _rewrites_as(held[1], owed[1])
+    ):
+        # Written through the held load, with the held load's statistics: what stock's
+        # load of the owed text writes (the slot stays owed: every write goes this way).
+        written = copy.copy(model)
+        with slot.lock:
+            slot.rewritten += 1
+        s = written.stat
+        s.meaninertia, s.meanmass, s.meansize, s.extent = held_stat[:4]
+        s.center[:] = held_stat[4]
+        return written
     kind, text, assets = owed
     loader = _ORIGINAL["from_xml_string" if kind == "xml" else "from_xml_path"]
     args = (text,) if assets is None else (text, assets)
     try:
         _load(loader, owed, *args)
+        with slot.lock:
+            slot.paid += 1
     except ValueError as e:
         raise LastXmlError(
             f"{api}: the model stock would hold there no longer compiles: {e}"
         ) from None
+    return model
+
+
+# What mj_copyBack overwrites from the model at every write, and the writer writes only
+# from what it overwrote (user_model.cc's CopyBack, xml_native_writer.cc): (element,
+# attribute). test_last_xml.py writes each both ways under every MuJoCo of the suite, and
+# test_robosuite_clients.py Lift's episodes (its cube's size is drawn per reset).
+_COPIED_BACK = frozenset({
+    ("body", "pos"), ("body", "quat"), ("geom", "rgba"), ("geom", "friction"),
+    ("site", "pos"), ("site", "quat"), ("site", "rgba"),
+})
+# A geom's size and frame also feed its body's inertia, where the body has no
+# <inertial>. Up to MuJoCo 3.15 the writer writes an inertial only for one given as such;
+# from 3.16 on it also writes one where the copied-back inertia differs from the held
+# compile's, so there these values are loaded (found by writing test_last_xml.py's scene
+# both ways under each of 3.9.0 to 3.16.0). Sizes only for primitives without `fromto`
+# (a fromto is written as given).
+_FEEDS_INERTIA = frozenset({("geom", "size"), ("geom", "pos"), ("geom", "quat")})
+_INERTIA_WRITTEN_AS_GIVEN_BEFORE = (3, 16)
+_PRIMITIVES = frozenset({"sphere", "capsule", "ellipsoid", "cylinder", "box"})
+
+
+@functools.lru_cache(maxsize=None)
+def copied_back(version: str) -> frozenset:
+    """The (element, attribute) pairs whose values a write through the held load takes
+    from the model under MuJoCo ``version`` (see :func:`_rewrites_as`)."""
+    try:
+        parts = tuple(int(p) for p in version.split(".")[:2])
+    except ValueError:
+        return _COPIED_BACK
+    return _COPIED_BACK | _FEEDS_INERTIA if parts < _INERTIA_WRITTEN_AS_GIVEN_BEFORE else _COPIED_BACK
+_REWRITES: dict = {}  # (held text, owed text) -> answer, the last few pairs
+
+
+def _rewrites_as(held: str, owed: str) -> bool:
+    """Whether MuJoCo writes, from the held load of ``held``, what it writes from a load
+    of ``owed`` (for a model of ``owed`` whose statistics are set to the held load's
+    compile): both texts have the same elements and attributes, and differ only in values
+    ``mj_copyBack`` overwrites from the model and the writer writes from there alone. What
+    else a value feeds at compile time is the compiled statistics (meaninertia, meanmass,
+    meansize, extent, center), which ``mj_copyBack`` copies only where they differ from
+    the held compile's: the written model carries the held compile's."""
+    pair = (held, owed)
+    answer = _REWRITES.get(pair)
+    if answer is None:
+        module = sys.modules.get("mujoco")
+        answer = _same_but_copied_values(held, owed, copied_back(getattr(module, "__version__", "")))
+        if len(_REWRITES) >= 8:
+            _REWRITES.pop(next(iter(_REWRITES)))
+        _REWRITES[pair] = answer
+    return answer
+
+
+def _same_but_copied_values(held: str, owed: str, copied: frozenset) -> bool:
+    try:
+        a, b = _XET.fromstring(held), _XET.fromstring(owed)
+    except _XET.ParseError:
+        return False
+    ea, eb = list(a.iter()), list(b.iter())
+    if len(ea) != len(eb):
+        return False
+    for x, y in zip(ea, eb):
+        if x.tag != y.tag or x.attrib.keys() != y.attrib.keys():
+            return False
+        if x.attrib == y.attrib:
+            continue
+        for name, value in x.attrib.items():
+            if y.attrib[name] == value:
+                continue
+            if (x.tag, name) not in copied:
+                return False
+            if x.tag == "geom" and (x.get("type", "sphere") not in _PRIMITIVES or "fromto" in x.attrib):
+                return False
+    return True
 
 
 def compile_xml(mujoco: Any, xml: str) -> Any:
@@ -298,11 +398,14 @@ def _spec_compiles(mujoco: Any) -> bool:
 
 def state() -> dict:
     """The slot's bookkeeping, for tests and docs: what it holds (``"xml"``, ``"path"``,
-    ``"unknown"``, ``"empty"``, ``"ours"``), whether it is fresh, whether a load is owed."""
+    ``"unknown"``, ``"empty"``, ``"ours"``), whether it is fresh, whether a load is owed,
+    how many loads paid what was owed and how many writes went through the held load."""
     with _SLOT.lock:
         return {
             "held": _SLOT.held[0],
             "fresh": _SLOT.fresh,
             "owed": None if _SLOT.owed is None else _SLOT.owed[0],
             "installed": bool(_ORIGINAL),
+            "paid": _SLOT.paid,
+            "rewritten": _SLOT.rewritten,
         }

@@ -124,13 +124,12 @@ def keep_render_inputs(context_class: Any) -> None:
     context_class._set_mujoco_context_and_buffers = _set_mujoco_context_and_buffers
 
 
-_RELEASE: list = []  # robosuite's own MjSim.free, once keep_simulations has run
-
-
 def offer(sim: Any, freed: bool) -> None:
     """Keeps ``sim`` (freed by robosuite, or let go of) for this thread's next
-    ``MjSim.from_xml_string``; the oldest of more than :data:`KEPT_PER_THREAD` is released
-    as stock releases it."""
+    ``MjSim.from_xml_string``, which first releases, as stock releases them, the oldest
+    beyond :data:`KEPT_PER_THREAD` (there, where stock frees its simulation: before the
+    next is made, so that freeing a render context never unbinds the OpenGL context of a
+    simulation made after it)."""
     kept = _kept()
     for i, (other, was_freed) in enumerate(kept):
         if other is sim:
@@ -138,21 +137,27 @@ def offer(sim: Any, freed: bool) -> None:
             freed = freed or was_freed
             break
     kept.insert(0, (sim, freed))
+
+
+def _trim(release: Callable[[Any, bool], None]) -> list:
+    kept = _kept()
     while len(kept) > KEPT_PER_THREAD:
-        old, old_freed = kept.pop()
-        if old_freed and _RELEASE:
-            _RELEASE[0](old)
+        release(*kept.pop())
+    return kept
 
 
 def keep_simulations(sim_class: Any) -> None:
     """``MjSim.free`` and ``MjSim.from_xml_string`` as the module says."""
     compile_sim = sim_class.__dict__["from_xml_string"].__func__
     free_sim: Callable[[Any], None] = sim_class.__dict__["free"]
-    _RELEASE[:] = [free_sim]
 
     def release(sim: Any, freed: bool) -> None:
         """What stock does with a simulation not made again: frees the one robosuite
-        freed, drops the one it let go of."""
+        freed, drops the one it let go of. Its render context is made current first:
+        MuJoCo's ``mjr_freeContext`` deletes its textures and buffers by id in whatever
+        OpenGL context is current, and ids repeat across contexts (stock frees the one
+        context it has, current; a kept one may not be)."""
+        _make_current(sim)
         if freed:
             free_sim(sim)
 
@@ -163,7 +168,7 @@ def keep_simulations(sim_class: Any) -> None:
 
     def from_xml_string(cls: Any, xml: str) -> Any:
         cache = _settings.model_cache()
-        kept = _kept()
+        kept = _trim(release)
         if cache is None:
             while kept:
                 release(*kept.pop())
@@ -172,10 +177,10 @@ def keep_simulations(sim_class: Any) -> None:
         if not candidates:
             model = cache.model(xml)
             # Stock loaded ``xml`` here: MuJoCo's last loaded XML model is owed it.
-            owe(xml)
+            owe(xml, served=model)
             return cls(model)
         model = cache.model(xml, into=[sim.model._model for sim in candidates])
-        owe(xml)
+        owe(xml, served=model)
         for i, (sim, _) in enumerate(kept):
             if sim.model._model is model:
                 del kept[i]
@@ -248,6 +253,14 @@ def _kept_observables(env: Any) -> Any:
     return type(env)._setup_observables(env)
 
 
+def _make_current(sim: Any) -> None:
+    """Makes ``sim``'s render context's OpenGL context current, if it has one."""
+    context = getattr(sim, "_render_context_offscreen", None)
+    gl = getattr(context, "gl_ctx", None)
+    if gl is not None:
+        gl.make_current()
+
+
 def _renew(sim: Any) -> None:
     """A kept simulation whose model was patched: as robosuite makes a new one."""
     import mujoco
@@ -261,7 +274,9 @@ def _renew(sim: Any) -> None:
     if context is None:
         return
     if getattr(context, "_mjcf_forge_inputs", None) != _render_inputs(mujoco, model):
-        # Another context than this model makes: robosuite makes a new one.
+        # Another context than this model makes: robosuite makes a new one (this one
+        # freed with its own OpenGL context current: see release in keep_simulations).
+        _make_current(sim)
         sim._render_context_offscreen = None
         del context
         return

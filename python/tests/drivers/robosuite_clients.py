@@ -374,6 +374,12 @@ def main() -> None:
         replay(args.out, args.data, names)
     else:
         envs(args.out, names, args.steps)
+    if MODE == "switch":
+        # How the switch gave MuJoCo's last loaded XML model its content: loads paid,
+        # writes through the held load.
+        from mjcf_forge import _last_xml
+
+        (args.out / "last_xml.json").write_text(json.dumps(_last_xml.state()))
 
 
 if __name__ == "__main__":
