@@ -9,7 +9,8 @@
 # Without tasks: every task of libero_spatial, libero_object, libero_goal, libero_10 and
 # libero_90. Each way runs in its own process (two at once); each task's record is
 # .cache/libero-check/{stock,switch}/<suite>-<index>.npz (python/tests/drivers/libero_run.py), and
-# the last line says how many tasks were built, how many have equal models, and how many
+# the last line says how many tasks were built, how many have equal models, how many the
+# same get_xml() text (after the first reset and after each hard reset), and how many
 # equal observations (50 steps with cameras, then a hard reset and 5 steps, unless
 # --model-only). Model arrays are recorded as digests (--digest).
 set -euo pipefail
@@ -58,7 +59,7 @@ fi
 import glob, os, sys
 import numpy as np
 out = sys.argv[1]
-built = models = observed = kept = 0
+built = models = observed = kept = xmls = 0
 # Tasks recorded both ways (a stopped run may have recorded one way only).
 records = sorted(p for p in glob.glob(f"{out}/stock/*.npz")
                  if not p.endswith(".part.npz") and os.path.exists(p.replace("/stock/", "/switch/")))
@@ -77,11 +78,15 @@ for path in records:
                 or a[k].shape != b[k].shape or a[k].tobytes() != b[k].tobytes()]
     bad = same("model/")
     models += not bad
+    wrote = same("xml/")
+    xmls += not wrote and any(k.startswith("xml/") for k in a)
+    bad += wrote
     obs = [k for p in ("obs/", "success", "state", "reset/", "again/") for k in same(p)]
     observed += not obs and any(k.startswith("obs/") for k in a)
     if bad or obs:
         print(name, "differs:", (bad + obs)[:10])
 n = len(records)
 print(f"libero_check: {n} tasks, {built} built both ways, {models} models bit-equal, "
+      f"{xmls} with get_xml() byte-equal, "
       f"{observed} with every observation bit-equal, {kept} hard resets on the switch kept the simulation")
 PY

@@ -80,6 +80,17 @@ def test_a_libero_tasks_model_is_stocks_bit_for_bit(records, task):
 
 
 @pytest.mark.parametrize("task", TASKS)
+def test_a_libero_tasks_saved_xml_is_stocks_byte_for_byte(records, task):
+    # env.sim.model.get_xml() (mujoco.mj_saveLastXML), what a dataset saves with each demo:
+    # after the first reset and after a hard reset that kept the simulation.
+    stock, switch = records["stock"][task], records["switch"][task]
+    keys = sorted(k for k in stock if k.startswith("xml/"))
+    assert keys == ["xml/first", "xml/reset0"]
+    assert differing(stock, switch, "xml/") == []
+    assert "<worldbody>" in str(stock["xml/first"])
+
+
+@pytest.mark.parametrize("task", TASKS)
 def test_a_libero_task_observes_and_succeeds_as_stock(records, task):
     stock, switch = records["stock"][task], records["switch"][task]
     images = [k for k in stock if k.startswith("obs/") and k.endswith("_image")]

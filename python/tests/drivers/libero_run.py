@@ -19,6 +19,9 @@ Per task, ``OUT_DIR/<suite>-<index>.npz`` holds:
   the same actions for 5 steps (``reset/<key>``: the observations ``reset()`` returned,
   ``again/<key>``: those after the 5 steps), and how many of those resets kept the
   simulation object (``kept``);
+- ``xml/first`` and ``xml/reset<i>``: ``env.sim.model.get_xml()`` (robosuite's, which is
+  ``mujoco.mj_saveLastXML``: what a dataset saves with each demo) after the first reset
+  and after each later hard reset;
 - ``error``: the exception's type and message, if LIBERO's code raised.
 
 With ``--digest`` each ``model/`` array is its SHA-256 instead (of its dtype, shape and
@@ -102,6 +105,8 @@ def run(suite: str, index: int) -> dict:
     env.seed(0)
     env.reset()
     out = model_arrays(env.sim.model)
+    # What robosuite's get_xml() gives (mujoco.mj_saveLastXML: what a dataset saves).
+    out["xml/first"] = np.array(env.sim.model.get_xml())
     if args.model_only:
         env.close()
         return out
@@ -119,10 +124,11 @@ def run(suite: str, index: int) -> dict:
     out["success"] = np.array(success)
     out["state"] = env.sim.get_state().flatten()
     again, first, kept = [], [], 0
-    for _ in range(args.resets):
+    for i in range(args.resets):
         sim = env.sim
         first.append(env.reset())
         kept += env.sim is sim
+        out[f"xml/reset{i}"] = np.array(env.sim.model.get_xml())
         obs = env.set_init_state(state0)
         for a in actions[:5]:
             obs, *_ = env.step(a)
