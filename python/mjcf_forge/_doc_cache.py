@@ -23,55 +23,9 @@ import numpy as np
 from ._cache import copy_value, evict
 from ._errors import error
 from ._last_xml import compile_xml
+from ._mujoco import VISUAL, restored_arrays, struct_fields
 from ._mjcf_forge import Document, MjcfError
 from ._plan import Plan
-
-# The sizes that count rows of mesh, texture, height field, skin and bounding-volume data:
-# no patch writes them and they are most of a model's bytes (70 MB of lift5's 70.5), so
-# they are not restored before a patch (see DocumentCache).
-_BULK_SIZES = frozenset(
-    {
-        "nmeshvert", "nmeshnormal", "nmeshtexcoord", "nmeshface", "nmeshgraph", "nmeshpoly",
-        "nmeshpolyvert", "nmeshpolymap", "ntexdata", "nhfielddata", "nbvh", "nbvhstatic",
-        "nbvhdynamic", "noct", "nskinvert", "nskintexvert", "nskinface", "nskinbonevert",
-    }
-)
-# The same arrays by name, for a mujoco without introspection.
-_BULK_PREFIXES = (
-    "mesh_vert", "mesh_normal", "mesh_texcoord", "mesh_face", "mesh_graph", "mesh_poly",
-    "tex_data", "hfield_data", "bvh_", "oct_", "skin_vert", "skin_texcoord", "skin_face",
-    "skin_bonevert",
-)
-# The parts of mjVisual, each a struct of numbers.
-VISUAL = ("global_", "quality", "headlight", "map", "scale", "rgba")
-
-
-def _restored_arrays(mujoco: Any, model: Any) -> list[str]:
-    """The arrays of ``model`` written back before each patch: all but the bulk data."""
-    try:
-        from mujoco.introspect import structs
-
-        fields = structs.STRUCTS["mjModel"].fields
-        names = [
-            f.name
-            for f in fields
-            if getattr(f, "array_extent", None) and str(f.array_extent[0]) not in _BULK_SIZES
-        ]
-    except (ImportError, KeyError, AttributeError):
-        names = [n for n in dir(model) if not n.startswith(("_",) + _BULK_PREFIXES)]
-    return [n for n in names if isinstance(getattr(model, n, None), np.ndarray)]
-
-
-def _struct_fields(obj: Any) -> list[str]:
-    """The number fields of a struct of the bindings (``model.opt``, ``model.vis.map``)."""
-    return [
-        n
-        for n in dir(obj)
-        if not n.startswith("_")
-        and isinstance(getattr(obj, n, None), (int, float, np.ndarray))
-        and not callable(getattr(obj, n))
-    ]
-
 
 class _Snapshot:
     """A structure's values as MuJoCo compiled them, of everything a patch or a caller may
@@ -80,12 +34,12 @@ class _Snapshot:
     what a caller changed in a model it was given does not outlive the next call."""
 
     def __init__(self, mujoco: Any, model: Any) -> None:
-        self.arrays = {n: getattr(model, n).copy() for n in _restored_arrays(mujoco, model)}
+        self.arrays = {n: getattr(model, n).copy() for n in restored_arrays(mujoco, model)}
         self.structs: dict[tuple[str, ...], dict[str, Any]] = {}
         for path in [("opt",)] + [("vis", v) for v in VISUAL]:
             obj = _walk(model, path)
             if obj is not None:
-                self.structs[path] = {n: copy_value(getattr(obj, n)) for n in _struct_fields(obj)}
+                self.structs[path] = {n: copy_value(getattr(obj, n)) for n in struct_fields(obj)}
         self.nbytes = sum(a.nbytes for a in self.arrays.values())
 
 

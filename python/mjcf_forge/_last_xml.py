@@ -52,6 +52,10 @@ import threading
 import xml.etree.ElementTree as _XET
 from typing import Any, Callable, Optional, Union
 
+import numpy as np
+
+from ._mujoco import VISUAL, restored_arrays, struct_fields
+
 __all__ = ["LastXmlError", "compile_xml", "install", "owe", "state"]
 
 
@@ -166,11 +170,12 @@ def install(mujoco: Any) -> None:
             return _load(from_path, _key_of(args, kwargs, "path"), *args, **kwargs)
 
         def mj_saveLastXML(filename: Any, m: Any, *args: Any, **kwargs: Any) -> Any:
-            written = _pay("mujoco.mj_saveLastXML", m)
-            result = save(filename, written, *args, **kwargs)
-            with _SLOT.lock:
-                if _SLOT.fresh and (_SLOT.stat is None or _stat(written) != _SLOT.stat):
-                    _SLOT.fresh = False
+            with _WRITE_LOCK:
+                written = _pay("mujoco.mj_saveLastXML", m)
+                result = save(filename, written, *args, **kwargs)
+                with _SLOT.lock:
+                    if _SLOT.fresh and (_SLOT.stat is None or _stat(written) != _SLOT.stat):
+                        _SLOT.fresh = False
             return result
 
         def mj_freeLastXML(*args: Any, **kwargs: Any) -> Any:
@@ -261,13 +266,11 @@ def _pay(api: str, model: Any = None) -> Any:
     ):
         # Written through the held load, with the held load's statistics: what stock's
         # load of the owed text writes (the slot stays owed: every write goes this way).
-        written = copy.copy(model)
-        with slot.lock:
-            slot.rewritten += 1
-        s = written.stat
-        s.meaninertia, s.meanmass, s.meansize, s.extent = held_stat[:4]
-        s.center[:] = held_stat[4]
-        return written
+        written = _with_statistics(model, held_stat)
+        if written is not None:
+            with slot.lock:
+                slot.rewritten += 1
+            return written
     kind, text, assets = owed
     loader = _ORIGINAL["from_xml_string" if kind == "xml" else "from_xml_path"]
     args = (text,) if assets is None else (text, assets)
@@ -280,6 +283,66 @@ def _pay(api: str, model: Any = None) -> Any:
             f"{api}: the model stock would hold there no longer compiles: {e}"
         ) from None
     return model
+
+
+class _Scratch:
+    """A model of one structure that writes through the held load take their values in:
+    every array but the bulk data (which neither ``mj_copyBack`` nor the writer reads, and
+    which is most of a model's bytes: copying Lift's whole model takes longer than the
+    write), ``opt`` and ``vis`` copied from the model written, the statistics the held
+    load's. Never the caller's model: a simulation may read it on another thread."""
+
+    def __init__(self, mujoco: Any, model: Any) -> None:
+        self.model = copy.copy(model)
+        self.signature = _signature(model)
+        self.arrays = [(getattr(self.model, n), n) for n in restored_arrays(mujoco, model)]
+        self.structs = [("opt",)] + [("vis", g) for g in VISUAL if hasattr(model.vis, g)]
+        self.fields = {path: struct_fields(_walk(model, path)) for path in self.structs}
+
+    def fill(self, model: Any, stat: tuple) -> Any:
+        for view, name in self.arrays:
+            np.copyto(view, getattr(model, name))
+        for path in self.structs:
+            source, target = _walk(model, path), _walk(self.model, path)
+            for name in self.fields[path]:
+                value = getattr(source, name)
+                if isinstance(value, np.ndarray):
+                    getattr(target, name)[...] = value
+                else:
+                    setattr(target, name, value)
+        s = self.model.stat
+        s.meaninertia, s.meanmass, s.meansize, s.extent = stat[:4]
+        s.center[:] = stat[4]
+        return self.model
+
+
+def _walk(obj: Any, path: tuple) -> Any:
+    for name in path:
+        obj = getattr(obj, name)
+    return obj
+
+
+def _signature(model: Any) -> tuple:
+    """What makes two models of one structure: their buffer size, names and signature."""
+    return (int(model.nbuffer), bytes(model.names), int(getattr(model, "signature", 0)))
+
+
+_SCRATCH: list = []  # the last structure's _Scratch
+# Writes through the held load use the one scratch model: one at a time (MuJoCo's own
+# mutex serializes the writes anyway).
+_WRITE_LOCK = threading.RLock()
+
+
+def _with_statistics(model: Any, stat: tuple) -> Optional[Any]:
+    """A model with ``model``'s values and the statistics ``stat`` (see :class:`_Scratch`),
+    or ``None`` where that cannot stand for it (height fields: their data is bulk, and
+    ``mj_copyBack`` copies it back)."""
+    if int(model.nhfield):
+        return None
+    mujoco = sys.modules["mujoco"]
+    if not _SCRATCH or _SCRATCH[0].signature != _signature(model):
+        _SCRATCH[:] = [_Scratch(mujoco, model)]
+    return _SCRATCH[0].fill(model, stat)
 
 
 # What mj_copyBack overwrites from the model at every write, and the writer writes only

@@ -6,7 +6,9 @@
 - its diagonal: the last entry of each row of ``data.M`` (sparse rows: ``M_rowadr``,
   ``M_rownnz``, from 3.9 or so), else ``data.qM`` at ``dof_Madr`` (3.3: the same numbers);
 - fields some versions do not have (``dof_length``, ``body_simple``, ``M_rownnz``):
-  :func:`field` gives ``None`` for them.
+  :func:`field` gives ``None`` for them;
+- which of a model's arrays are bulk data (:func:`restored_arrays`: the rest), the
+  number fields of its structs (:func:`struct_fields`) and the parts of ``mjVisual``.
 """
 
 from __future__ import annotations
@@ -33,3 +35,52 @@ def inertia_diagonal(model: Any, data: Any) -> tuple[np.ndarray, np.ndarray]:
 def field(obj: Any, name: str) -> Any:
     """``obj.name`` (a model's or data's field), or ``None`` where this MuJoCo has none."""
     return getattr(obj, name, None)
+
+
+# The sizes that count rows of mesh, texture, height field, skin and bounding-volume data:
+# no patch writes them and they are most of a model's bytes (70 MB of lift5's 70.5), so
+# they are not restored before a patch (see DocumentCache).
+_BULK_SIZES = frozenset(
+    {
+        "nmeshvert", "nmeshnormal", "nmeshtexcoord", "nmeshface", "nmeshgraph", "nmeshpoly",
+        "nmeshpolyvert", "nmeshpolymap", "ntexdata", "nhfielddata", "nbvh", "nbvhstatic",
+        "nbvhdynamic", "noct", "nskinvert", "nskintexvert", "nskinface", "nskinbonevert",
+    }
+)
+# The same arrays by name, for a mujoco without introspection.
+_BULK_PREFIXES = (
+    "mesh_vert", "mesh_normal", "mesh_texcoord", "mesh_face", "mesh_graph", "mesh_poly",
+    "tex_data", "hfield_data", "bvh_", "oct_", "skin_vert", "skin_texcoord", "skin_face",
+    "skin_bonevert",
+)
+# The parts of mjVisual, each a struct of numbers.
+VISUAL = ("global_", "quality", "headlight", "map", "scale", "rgba")
+
+
+def restored_arrays(mujoco: Any, model: Any) -> list[str]:
+    """The arrays of ``model`` but the bulk data (mesh, texture, height-field, skin and
+    bounding-volume data): what a patch may write and ``mj_copyBack`` reads, but height
+    fields' data."""
+    try:
+        from mujoco.introspect import structs
+
+        fields = structs.STRUCTS["mjModel"].fields
+        names = [
+            f.name
+            for f in fields
+            if getattr(f, "array_extent", None) and str(f.array_extent[0]) not in _BULK_SIZES
+        ]
+    except (ImportError, KeyError, AttributeError):
+        names = [n for n in dir(model) if not n.startswith(("_",) + _BULK_PREFIXES)]
+    return [n for n in names if isinstance(getattr(model, n, None), np.ndarray)]
+
+
+def struct_fields(obj: Any) -> list[str]:
+    """The number fields of a struct of the bindings (``model.opt``, ``model.vis.map``)."""
+    return [
+        n
+        for n in dir(obj)
+        if not n.startswith("_")
+        and isinstance(getattr(obj, n, None), (int, float, np.ndarray))
+        and not callable(getattr(obj, n))
+    ]

@@ -43,7 +43,7 @@ from typing import Any, Callable
 import numpy as np
 
 from . import _settings
-from ._doc_cache import VISUAL
+from ._mujoco import VISUAL
 from ._last_xml import owe
 
 _KEPT = threading.local()
