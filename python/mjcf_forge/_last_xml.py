@@ -82,7 +82,8 @@ class _Slot:
         self.fresh = False  # no write since the load left a statistic copied in it
         self.stat: Optional[tuple] = None  # the held model's statistics as compiled
         self.owed: Any = None  # the key stock's slot holds, where it differs from held
-        self.owed_stat: Optional[tuple] = None  # statistics of the model served for it
+        # The statistics and sizes of the model served for it.
+        self.owed_stat: Optional[tuple] = None
         self.paid = 0  # loads made to pay what was owed
         self.rewritten = 0  # writes through the held load instead (see _rewrites_as)
         self.loading = 0  # wrapped loads running now
@@ -224,7 +225,9 @@ def owe(source: Source, assets: Any = None, served: Any = None) -> None:
             slot.owed = None if (slot.fresh and _same(slot.held, key)) else key
         else:
             slot.owed = ("lazy", source, None if assets is None else dict(assets))
-        slot.owed_stat = _stat(served) if served is not None and slot.owed is not None else None
+        slot.owed_stat = (
+            (_stat(served), _signature(served)) if served is not None and slot.owed is not None else None
+        )
 
 
 def _same(held: tuple, key: tuple) -> bool:
@@ -262,7 +265,8 @@ def _pay(api: str, model: Any = None) -> Any:
     if (
         model is not None and fresh and owed_stat is not None and held_stat is not None
         and held[0] == owed[0] == "xml" and held[2] is None and owed[2] is None
-        and _stat(model) == owed_stat and _rewrites_as(held[1], owed[1])
+        and _stat(model) == owed_stat[0] and _signature(model) == owed_stat[1]
+        and _rewrites_as(held[1], owed[1])
     ):
         # Written through the held load, with the held load's statistics: what stock's
         # load of the owed text writes (the slot stays owed: every write goes this way).
@@ -323,8 +327,20 @@ def _walk(obj: Any, path: tuple) -> Any:
 
 
 def _signature(model: Any) -> tuple:
-    """What makes two models of one structure: their buffer size, names and signature."""
-    return (int(model.nbuffer), bytes(model.names), int(getattr(model, "signature", 0)))
+    """What makes two models of one structure: every size, the names, MuJoCo's signature.
+    (Two compiles can share their names and buffer size and still differ in a size that
+    ``mj_copyBack`` checks: MuJoCo 3.3 then writes the held load unchanged, silently.)"""
+    names = _SIZES.get(type(model))
+    if names is None:
+        names = _SIZES[type(model)] = tuple(
+            n for n in dir(model)
+            if n.startswith("n") and type(getattr(model, n, None)) is int
+        )
+    sizes = tuple(getattr(model, n) for n in names)
+    return (sizes, bytes(model.names), int(getattr(model, "signature", 0)))
+
+
+_SIZES: dict = {}  # a model class -> the names of its integer sizes (nq, nbody, nbuffer...)
 
 
 _SCRATCH: list = []  # the last structure's _Scratch
