@@ -54,7 +54,7 @@ from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
-from ._mujoco import VISUAL, restored_arrays, struct_fields
+from ._mujoco import VISUAL, restored_arrays, struct_fields, version_tuple
 
 __all__ = ["LastXmlError", "compile_xml", "install", "owe", "state"]
 
@@ -82,7 +82,7 @@ class _Slot:
         self.fresh = False  # no write since the load left a statistic copied in it
         self.stat: Optional[tuple] = None  # the held model's statistics as compiled
         self.owed: Any = None  # the key stock's slot holds, where it differs from held
-        # The statistics and sizes of the model served for it.
+        # The statistics and _signature of the model served for it.
         self.owed_stat: Optional[tuple] = None
         self.paid = 0  # loads made to pay what was owed
         self.rewritten = 0  # writes through the held load instead (see _rewrites_as)
@@ -257,7 +257,10 @@ def _pay(api: str, model: Any = None) -> Any:
             slot.held, slot.fresh, slot.stat, slot.owed = _EMPTY, False, None, None
         return
     if owed[0] == "lazy":
-        owed = _xml_key(owed[1](), owed[2])
+        lazy, owed = owed, _xml_key(owed[1](), owed[2])
+        with slot.lock:
+            if slot.owed is lazy:  # written once: later writes compare the text itself
+                slot.owed = owed
     with slot.lock:
         if slot.fresh and _same(slot.held, owed):
             slot.owed = None
@@ -384,11 +387,10 @@ _PRIMITIVES = frozenset({"sphere", "capsule", "ellipsoid", "cylinder", "box"})
 def copied_back(version: str) -> frozenset:
     """The (element, attribute) pairs whose values a write through the held load takes
     from the model under MuJoCo ``version`` (see :func:`_rewrites_as`)."""
-    try:
-        parts = tuple(int(p) for p in version.split(".")[:2])
-    except ValueError:
-        return _COPIED_BACK
-    return _COPIED_BACK | _FEEDS_INERTIA if parts < _INERTIA_WRITTEN_AS_GIVEN_BEFORE else _COPIED_BACK
+    parts = version_tuple(version)
+    if parts is not None and parts < _INERTIA_WRITTEN_AS_GIVEN_BEFORE:
+        return _COPIED_BACK | _FEEDS_INERTIA
+    return _COPIED_BACK
 _REWRITES: dict = {}  # (held text, owed text) -> answer, the last few pairs
 
 

@@ -13,7 +13,7 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Optional
 
 import numpy as np
 
@@ -84,3 +84,13 @@ def struct_fields(obj: Any) -> list[str]:
         and isinstance(getattr(obj, n, None), (int, float, np.ndarray))
         and not callable(getattr(obj, n))
     ]
+
+
+def version_tuple(version: Any) -> Optional[tuple]:
+    """A MuJoCo version's (major, minor), or ``None`` where it is not one
+    (``"3.16.0"`` -> ``(3, 16)``)."""
+    try:
+        parts = tuple(int(p) for p in str(version or "").split(".")[:2])
+    except ValueError:
+        return None
+    return parts if len(parts) == 2 else None

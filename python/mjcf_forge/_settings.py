@@ -90,14 +90,12 @@ def caches_run_on_this_mujoco() -> bool:
     older one (robosuite 1.4.0 accepts MuJoCo 2.3; libero-infinity pins it), the
     process's model cache is off and every model compiles as stock compiles it, which is
     said once, as a warning; everything else of the package runs as on any MuJoCo."""
+    from ._mujoco import version_tuple
     from ._upcalls import mujoco_version
 
     version = mujoco_version()
-    try:
-        parts = tuple(int(p) for p in (version or "").split(".")[:2])
-    except ValueError:
-        parts = ()
-    if len(parts) < 2 or parts >= OLDEST_CACHED_MUJOCO:
+    parts = version_tuple(version)
+    if parts is None or parts >= OLDEST_CACHED_MUJOCO:
         return True
     import warnings
 
