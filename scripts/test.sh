@@ -1,65 +1,163 @@
 #!/usr/bin/env bash
-# Runs every test of mjcf-forge (the README's test command; .ci/run calls it):
-# formatting, clippy, the Rust tests without the `mujoco` feature and once with it per
-# MuJoCo version the feature links (3.17.0 from .cache/venv, as .cargo/config.toml sets
-# MJCF_FORGE_PYTHON, and 4.0.0 from .cache/venv-mj4 through MJCF_FORGE_MUJOCO_DIR; real
-# MuJoCo 3.17.0 and 4.0.0 judge every output in each run), the judge's own tests under both
-# versions, the Python package's tests (setup has built and installed it into .cache/venv).
+# Runs every test of mjcf-forge (the README's test command; .ci/run calls it), each
+# judgement once (docs/contributing.md, "Tests", says which stage holds which test):
+#
+#   bash scripts/test.sh            every tier but the full client runs (scripts/test_full.sh)
+#   bash scripts/test.sh --quick    a developer's inner loop (under 5 minutes once built):
+#                                   fmt, clippy once, the Rust unit tests, one judge per tier
+#
+# 1. formatting and clippy (with and without MuJoCo, and the Python bindings crate);
+# 2. `cargo test` without features: every Rust test and every judge that does not depend
+#    on which MuJoCo the build links (the document, prefix, geometry, URDF and merge judges
+#    judge what we write with both Python MuJoCos, 3.17.0 and 4.0.0, in this one pass);
+# 3. per MuJoCo version the feature `mujoco` links (3.17.0 from .cache/venv, as
+#    .cargo/config.toml sets MJCF_FORGE_PYTHON, and 4.0.0 from .cache/venv-mj4 through
+#    MJCF_FORGE_MUJOCO_DIR), only the tests that depend on it ($LINKED below: the compile
+#    FFI, the caches, the preview, the linked builds' merges and scenes), with the doctests
+#    and the documentation's MuJoCo examples once, under 3.17.0;
+# 4. the judges' own tests under both versions;
+# 5. the Python package's tests under 3.17.0, and those that depend on the installed
+#    MuJoCo again under 4.0.0 (and test_last_xml.py under LIBERO's 3.3.1);
+# 6. the batched simulators (MuJoCo Warp, MJX) in .cache/venv-sim.
+#
+# Sets up first (idempotent) and checks that every venv and corpus the tests read is there.
+# Under CI=true (.ci/run sets it) a test that would skip fails instead. Prints the seconds of
+# each stage, and for the Python stages the peak resident memory of the largest process
+# (GNU time's maximum RSS) and of the whole machine over the stage (MemTotal - MemAvailable,
+# sampled every second, less what was in use when the stage began); a summary at the end.
 # Fuzzing is not part of it (tests/fuzz_regressions.rs replays what it found; campaigns:
-# scripts/fuzz.sh). Sets up first (idempotent).
+# scripts/fuzz.sh).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
+QUICK=0
+case "${1:-}" in
+  "") ;;
+  --quick) QUICK=1 ;;
+  *) echo "usage: bash scripts/test.sh [--quick]" >&2; exit 2 ;;
+esac
 
+# The Rust tests whose outcome depends on the MuJoCo the build links: run once per version.
+LINKED=(mujoco_compile cli_compile model_cache document_cache document_differential
+        cli_preview cli_edges scene_batch merge_judge)
+
+SUMMARY=()
+STAGE=""
+STAGE_START=$SECONDS
+stage() { # NAME: ends the stage running, starts NAME
+  end_stage
+  STAGE="$1"
+  STAGE_START=$SECONDS
+  echo "== $STAGE [${SECONDS}s in]"
+}
+end_stage() {
+  if [[ -n "$STAGE" ]]; then
+    SUMMARY+=("$(printf '%6ss  %s%s' "$((SECONDS - STAGE_START))" "$STAGE" "${MEMORY:-}")")
+  fi
+  STAGE=""
+  MEMORY=""
+}
+used_kb() { awk '/^MemTotal:/ {t = $2} /^MemAvailable:/ {a = $2} END {print t - a}' /proc/meminfo; }
+measured() { # CMD...: runs it, noting its peak memory for the stage's summary line
+  local peak_file rss_file sampler before status=0
+  peak_file="$(mktemp)"
+  rss_file="$(mktemp)"
+  before="$(used_kb)"
+  echo 0 >"$peak_file"
+  ( peak=0; while sleep 1; do u="$(used_kb)"; ((u > peak)) && peak=$u && echo "$peak" >"$peak_file"; done ) &
+  sampler=$!
+  if [[ -x /usr/bin/time ]]; then
+    /usr/bin/time -o "$rss_file" -f '%M' "$@" || status=$?
+  else
+    "$@" || status=$?
+  fi
+  kill "$sampler" 2>/dev/null || true
+  wait "$sampler" 2>/dev/null || true
+  local machine=$(( ($(cat "$peak_file") - before) / 1024 )) largest="?"
+  ((machine < 0)) && machine=0
+  [[ -s "$rss_file" ]] && largest=$(( $(tail -n1 "$rss_file") / 1024 ))
+  MEMORY="${MEMORY:-}  [peak: largest process ${largest} MiB, machine +${machine} MiB]"
+  echo "== peak memory: largest process ${largest} MiB, machine +${machine} MiB over the stage"
+  rm -f "$peak_file" "$rss_file"
+  return "$status"
+}
+trap 'end_stage; echo "== stages (seconds):"; printf "%s\n" "${SUMMARY[@]}"' EXIT
+
+stage "setup"
 bash scripts/setup.sh
-# robosuite 1.5.2 with MuJoCo 3.9.0, where python/tests/test_robosuite_use.py builds
-# robosuite's own classes both ways (idempotent; about 300 MB of wheels the first time).
-bash scripts/setup_robosuite_env.sh
-# LIBERO 0.1.1 with robosuite 1.4.0 and MuJoCo 3.3.1 in .cache/venv-libero, with its assets,
-# for python/tests/test_libero.py (idempotent; about 550 MB of wheels the first time).
-bash scripts/setup_libero_env.sh
-# robosuite 1.4.0 on MuJoCo 2.3.7 in .cache/venv-mj2 (the oldest MuJoCo robosuite 1.4.0
-# accepts), for python/tests/test_robosuite_clients.py (idempotent; about 150 MB the first time).
-bash scripts/setup_mj2_env.sh
-# MuJoCo Warp, MJX and JAX on CPU in .cache/venv-sim, with mjcf_forge built into it, for
-# python/tests/test_batch_sim.py (idempotent; Warp's kernels cached in .cache/warp-kernels).
-bash scripts/setup_sim_env.sh
+if ((QUICK == 0)); then
+  # robosuite 1.5.2 with MuJoCo 3.9.0, where the robosuite tests build robosuite's own
+  # classes and environments both ways (about 300 MB of wheels the first time).
+  bash scripts/setup_robosuite_env.sh
+  # LIBERO 0.1.1 with robosuite 1.4.0 and MuJoCo 3.3.1, with its assets (about 550 MB).
+  bash scripts/setup_libero_env.sh
+  # robosuite 1.4.0 on MuJoCo 2.3.7 (the oldest MuJoCo robosuite 1.4.0 accepts; 150 MB).
+  bash scripts/setup_mj2_env.sh
+  # MuJoCo Warp, MJX and JAX on CPU in .cache/venv-sim, with mjcf_forge built into it
+  # (Warp's kernels cached in .cache/warp-kernels).
+  bash scripts/setup_sim_env.sh
+  bash scripts/check_setup.sh
+fi
 
-echo "== cargo fmt --check [${SECONDS}s in]"
+stage "cargo fmt --check, clippy"
 cargo fmt --all -- --check
-echo "== cargo clippy [${SECONDS}s in]"
 cargo clippy --all-targets -- -D warnings
+if ((QUICK == 1)); then
+  stage "quick: Rust unit tests, one judge per tier (document, model, batch, caches)"
+  cargo test --lib
+  cargo test --test document_judge --test merge_rules --test scene_batch
+  .cache/venv/bin/python -m pytest python/tests/test_package.py python/tests/test_document_cache.py \
+    -q -p no:cacheprovider -k "not wheel and not robosuite"
+  end_stage
+  exit 0
+fi
 cargo clippy --all-targets --features mujoco -- -D warnings
 # The Python bindings crate (the workspace's other member; not built by the commands above).
 PYO3_PYTHON="$PWD/.cache/venv/bin/python" cargo clippy -p mjcf-forge-python --all-targets -- -D warnings
-echo "== cargo test (default features) [${SECONDS}s in]"
+
+stage "cargo test, no features: every test and every judge independent of the linked MuJoCo"
 cargo test --all-targets
-echo "== cargo test --features mujoco, MuJoCo 3.17.0 (with doctests) [${SECONDS}s in]"
-cargo test --features mujoco
+
+linked_tests=()
+for t in "${LINKED[@]}"; do linked_tests+=(--test "$t"); done
+stage "cargo test --features mujoco, MuJoCo 3.17.0: what depends on the linked MuJoCo, doctests"
+cargo test --features mujoco --lib --bins "${linked_tests[@]}"
+# The doctests (this documentation's Rust blocks among them) and docs.rs's blocks that need
+# a build with MuJoCo: once, under 3.17.0.
+cargo test --features mujoco --doc
+cargo test --features mujoco --test docs
 # From 4.0 on the wheel `mujoco` depends on `mujoco-core`, which puts libmujoco.so.4.0.0 and
 # include/ into the same `mujoco` folder; the venv's Python says where that is. Its own
 # target folder, so the two MuJoCo builds do not evict each other's artifacts (CI, which
 # builds each once, sets MJCF_FORGE_MJ4_TARGET=target: the dependencies build once).
-echo "== cargo test --features mujoco, MuJoCo 4.0.0 (with doctests) [${SECONDS}s in]"
+stage "cargo test --features mujoco, MuJoCo 4.0.0: what depends on the linked MuJoCo"
 MJ4_DIR="$(.cache/venv-mj4/bin/python -c 'import mujoco, os; print(os.path.dirname(mujoco.__file__))')"
 MJCF_FORGE_MUJOCO_DIR="$MJ4_DIR" CARGO_TARGET_DIR="${MJCF_FORGE_MJ4_TARGET:-target/mujoco-4}" \
-  cargo test --features mujoco
-echo "== judge self-tests (MuJoCo 3.17.0 and 4.0.0) [${SECONDS}s in]"
+  cargo test --features mujoco --lib --bins "${linked_tests[@]}"
+
+stage "judge self-tests (MuJoCo 3.17.0 and 4.0.0)"
 .cache/venv/bin/python -m pytest tests/judge -q -p no:cacheprovider
 .cache/venv-mj4/bin/python -m pytest tests/judge -q -p no:cacheprovider
-echo "== python package (pytest: API, errors, threads, MuJoCo judge, Gymnasium, Ray) [${SECONDS}s in]"
+
+stage "python package, MuJoCo 3.17.0 (API, errors, threads, MuJoCo judge, Gymnasium, Ray, robosuite, LIBERO)"
 # (test_batch_sim.py needs MuJoCo Warp and JAX: it runs in .cache/venv-sim below.)
 # (test_libero.py runs LIBERO in .cache/venv-libero, MuJoCo 3.3.1, stock and on the switch.)
-.cache/venv/bin/python -m pytest python/tests -q -p no:cacheprovider --ignore=python/tests/test_batch_sim.py --durations=15
-echo "== ModelCache, DocumentCache, URDF and MuJoCo's last loaded XML under MuJoCo 4.0.0 (judged against 4.0.0's compile and import) [${SECONDS}s in]"
-.cache/venv-mj4/bin/python -m pytest python/tests/test_model_cache.py python/tests/test_world_batch.py python/tests/test_document_cache.py python/tests/test_differential.py python/tests/test_urdf.py python/tests/test_last_xml.py -q -p no:cacheprovider
+measured .cache/venv/bin/python -m pytest python/tests -q -p no:cacheprovider \
+  --ignore=python/tests/test_batch_sim.py --durations=15
+
+stage "python package, what depends on the installed MuJoCo: 4.0.0, and LIBERO's 3.3.1"
+measured .cache/venv-mj4/bin/python -m pytest python/tests/test_model_cache.py python/tests/test_world_batch.py \
+  python/tests/test_document_cache.py python/tests/test_differential.py python/tests/test_urdf.py \
+  python/tests/test_last_xml.py -q -p no:cacheprovider
 # MuJoCo's last loaded XML model under LIBERO's MuJoCo 3.3.1 too, where a write through
-# the held load covers a geom's size and frame (mjcf_forge._last_xml.copied_back).
+# the held load covers a geom's size and frame (mjcf_forge._copied_back.copied_back).
 only="$(mktemp -d)"
 ln -s "$(.cache/venv/bin/python -c 'import mjcf_forge, os; print(os.path.dirname(mjcf_forge.__file__))')" "$only/mjcf_forge"
 PYTHONPATH="$only:python/tests" .cache/venv-libero/bin/python -m pytest python/tests/test_last_xml.py -q -p no:cacheprovider
 rm -rf "$only"
 # robosuite's task XMLs (written by the robosuite venv) through a DocumentCache, judged by 4.0.0.
 .cache/venv-mj4/bin/python -m pytest python/tests/test_robosuite_resets.py -k task_xmls -q -p no:cacheprovider
-echo "== batched simulators (MuJoCo Warp, MJX on JAX's CPU backend, CPU MuJoCo) judge WorldBatch [${SECONDS}s in]"
-.cache/venv-sim/bin/python -m pytest python/tests/test_batch_sim.py -q -p no:cacheprovider
+
+stage "batched simulators (MuJoCo Warp, MJX on JAX's CPU backend, CPU MuJoCo) judge WorldBatch"
+measured .cache/venv-sim/bin/python -m pytest python/tests/test_batch_sim.py -q -p no:cacheprovider
+end_stage
 echo "== all tests passed [${SECONDS}s]"

@@ -1,6 +1,9 @@
 //! `mjcf-forge compile` and `inline --validate` (cargo feature `mujoco`): sizes agree with
 //! Python MuJoCo on the whole wheel corpus; compile errors carry MuJoCo's message and the
 //! position of our element.
+//!
+//! Pass: once per MuJoCo the feature `mujoco` links (scripts/test.sh: 3.17.0 and 4.0.0),
+//! since what it checks depends on that MuJoCo (a build without the feature has none of it).
 #![cfg(mjcf_mujoco)]
 
 mod common;

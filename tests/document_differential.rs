@@ -4,6 +4,9 @@
 //! follows from mass properties a unit model combines (geom densities) within 1e-12
 //! relative. Fixed seeds here (a short run in CI); the long campaigns are
 //! `scripts/differential.sh`'s, with their results in docs/limits.md.
+//!
+//! Pass: once per MuJoCo the feature `mujoco` links (scripts/test.sh: 3.17.0 and 4.0.0),
+//! since what it checks depends on that MuJoCo (a build without the feature has none of it).
 
 #![cfg(mjcf_mujoco)]
 

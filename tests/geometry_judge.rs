@@ -8,6 +8,9 @@
 //! corpora/geometry/ (rotated primitives of every type with every orientation form, degree
 //! and radian models, non-default eulerseq, fromto geoms and sites, OBJ/STL/MSH/inline
 //! meshes, nested bodies and frames).
+//!
+//! Pass: once, in the build without features (scripts/test.sh): nothing here depends on the
+//! MuJoCo a build links (the judges run both Python MuJoCos, 3.17.0 and 4.0.0, themselves).
 
 mod common;
 

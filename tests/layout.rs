@@ -1,5 +1,8 @@
 //! The house plan, checked: the library's tiers (one folder each, see `src/lib.rs`) use only
 //! the tiers below them, so no import ever goes upwards and no two tiers depend on each other.
+//!
+//! Pass: once, in the build without features (scripts/test.sh): nothing here depends on the
+//! MuJoCo a build links (the judges run both Python MuJoCos, 3.17.0 and 4.0.0, themselves).
 
 use std::path::{Path, PathBuf};
 

@@ -2,6 +2,9 @@
 //!
 //! Expected sizes, names and arrays of `ARM` were taken from the Python bindings of the
 //! same library (PyPI mujoco==3.17.0, `mujoco.MjModel.from_xml_string`).
+//!
+//! Pass: once per MuJoCo the feature `mujoco` links (scripts/test.sh: 3.17.0 and 4.0.0),
+//! since what it checks depends on that MuJoCo (a build without the feature has none of it).
 #![cfg(mjcf_mujoco)]
 
 use std::path::Path;

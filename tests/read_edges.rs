@@ -1,6 +1,9 @@
 //! Reading edge cases: an include cycle met from a string names the files of the cycle only;
 //! where nested includes and the files named in included files are found (MuJoCo 3.17.0 and
 //! 4.0.0, by experiment).
+//!
+//! Pass: once, in the build without features (scripts/test.sh): nothing here depends on the
+//! MuJoCo a build links (the judges run both Python MuJoCos, 3.17.0 and 4.0.0, themselves).
 
 use std::path::{Path, PathBuf};
 

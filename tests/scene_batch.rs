@@ -9,6 +9,10 @@
 //!   interpenetrating, a moved output folder still compiles, placed objects keep their
 //!   physics (the merge judge), mass scaling keeps inertia consistent and randomized
 //!   angles land in each model's own units.
+//!
+//! Pass: once per MuJoCo the feature `mujoco` links (scripts/test.sh: 3.17.0 and 4.0.0),
+//! since what it checks depends on that MuJoCo; the build without the feature runs the
+//! tests here that need none (they are cheap: not worth a file of their own).
 
 mod common;
 

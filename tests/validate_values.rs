@@ -2,6 +2,9 @@
 //! integers, keywords), each refusal checked by its exact message; values MuJoCo 3.17.0 and
 //! 4.0.0 accept (flexible counts, empty values, `nan`, `inf`) stay accepted: the accepted
 //! model below compiles in both (checked with their Python `MjModel.from_xml_string`).
+//!
+//! Pass: once, in the build without features (scripts/test.sh): nothing here depends on the
+//! MuJoCo a build links (the judges run both Python MuJoCos, 3.17.0 and 4.0.0, themselves).
 
 use mjcf_forge::Document;
 

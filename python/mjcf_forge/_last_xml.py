@@ -49,12 +49,12 @@ import copy
 import functools
 import sys
 import threading
-import xml.etree.ElementTree as _XET
 from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
-from ._mujoco import VISUAL, restored_arrays, struct_fields, version_tuple
+from ._copied_back import copied_back, rewrites_as
+from ._mujoco import VISUAL, restored_arrays, struct_fields
 
 __all__ = ["LastXmlError", "compile_xml", "install", "owe", "state"]
 
@@ -364,33 +364,6 @@ def _with_statistics(model: Any, stat: tuple) -> Optional[Any]:
     return _SCRATCH[0].fill(model, stat)
 
 
-# What mj_copyBack overwrites from the model at every write, and the writer writes only
-# from what it overwrote (user_model.cc's CopyBack, xml_native_writer.cc): (element,
-# attribute). test_last_xml.py writes each both ways under every MuJoCo of the suite, and
-# test_robosuite_clients.py Lift's episodes (its cube's size is drawn per reset).
-_COPIED_BACK = frozenset({
-    ("body", "pos"), ("body", "quat"), ("geom", "rgba"), ("geom", "friction"),
-    ("site", "pos"), ("site", "quat"), ("site", "rgba"),
-})
-# A geom's size and frame also feed its body's inertia, where the body has no
-# <inertial>. Up to MuJoCo 3.15 the writer writes an inertial only for one given as such;
-# from 3.16 on it also writes one where the copied-back inertia differs from the held
-# compile's, so there these values are loaded (found by writing test_last_xml.py's scene
-# both ways under each of 3.9.0 to 3.16.0). Sizes only for primitives without `fromto`
-# (a fromto is written as given).
-_FEEDS_INERTIA = frozenset({("geom", "size"), ("geom", "pos"), ("geom", "quat")})
-_INERTIA_WRITTEN_AS_GIVEN_BEFORE = (3, 16)
-_PRIMITIVES = frozenset({"sphere", "capsule", "ellipsoid", "cylinder", "box"})
-
-
-@functools.lru_cache(maxsize=None)
-def copied_back(version: str) -> frozenset:
-    """The (element, attribute) pairs whose values a write through the held load takes
-    from the model under MuJoCo ``version`` (see :func:`_rewrites_as`)."""
-    parts = version_tuple(version)
-    if parts is not None and parts < _INERTIA_WRITTEN_AS_GIVEN_BEFORE:
-        return _COPIED_BACK | _FEEDS_INERTIA
-    return _COPIED_BACK
 _REWRITES: dict = {}  # (held text, owed text) -> answer, the last few pairs
 
 
@@ -398,42 +371,20 @@ def _rewrites_as(held: str, owed: str) -> bool:
     """Whether MuJoCo writes, from the held load of ``held``, what it writes from a load
     of ``owed`` (for a model of ``owed`` whose statistics are set to the held load's
     compile): both texts have the same elements and attributes, and differ only in values
-    ``mj_copyBack`` overwrites from the model and the writer writes from there alone. What
-    else a value feeds at compile time is the compiled statistics (meaninertia, meanmass,
-    meansize, extent, center), which ``mj_copyBack`` copies only where they differ from
-    the held compile's: the written model carries the held compile's."""
+    ``mj_copyBack`` overwrites from the model and the writer writes from there alone
+    (:mod:`._copied_back`). What else a value feeds at compile time is the compiled
+    statistics (meaninertia, meanmass, meansize, extent, center), which ``mj_copyBack``
+    copies only where they differ from the held compile's: the written model carries the
+    held compile's."""
     pair = (held, owed)
     answer = _REWRITES.get(pair)
     if answer is None:
         module = sys.modules.get("mujoco")
-        answer = _same_but_copied_values(held, owed, copied_back(getattr(module, "__version__", "")))
+        answer = rewrites_as(held, owed, copied_back(getattr(module, "__version__", "")))
         if len(_REWRITES) >= 8:
             _REWRITES.pop(next(iter(_REWRITES)))
         _REWRITES[pair] = answer
     return answer
-
-
-def _same_but_copied_values(held: str, owed: str, copied: frozenset) -> bool:
-    try:
-        a, b = _XET.fromstring(held), _XET.fromstring(owed)
-    except _XET.ParseError:
-        return False
-    ea, eb = list(a.iter()), list(b.iter())
-    if len(ea) != len(eb):
-        return False
-    for x, y in zip(ea, eb):
-        if x.tag != y.tag or x.attrib.keys() != y.attrib.keys():
-            return False
-        if x.attrib == y.attrib:
-            continue
-        for name, value in x.attrib.items():
-            if y.attrib[name] == value:
-                continue
-            if (x.tag, name) not in copied:
-                return False
-            if x.tag == "geom" and (x.get("type", "sphere") not in _PRIMITIVES or "fromto" in x.attrib):
-                return False
-    return True
 
 
 def compile_xml(mujoco: Any, xml: str) -> Any:

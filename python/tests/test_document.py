@@ -26,7 +26,12 @@ GRIPPER = RS_ASSETS / "grippers" / "panda_gripper.xml"
 TABLE = RS_ASSETS / "arenas" / "table_arena.xml"
 
 
-def test_inline_equals_the_command_line_on_every_corpus_model(forge_cli, tmp_path):
+def test_inline_and_write_equal_the_command_line_on_every_corpus_model(forge_cli, tmp_path):
+    # `mjcf-forge inline`'s bytes: the library's pretty text (`Document::write_file`), which
+    # tests/document_judge.rs has MuJoCo judge on every corpus model under 3.17.0 and 4.0.0.
+    # Document.load(p).to_xml(pretty=True) and Document.write give those bytes, so what they
+    # write compiles as the original without being judged again here. A path-like and a str
+    # path both accepted.
     models = corpus_models()
     assert len(models) >= 100
     # `inline --out-dir` names each output after its input and refuses two inputs with one
@@ -38,28 +43,19 @@ def test_inline_equals_the_command_line_on_every_corpus_model(forge_cli, tmp_pat
             batch = {}
             batches.append(batch)
         batch[model.name] = model
+    written = tmp_path / "written.xml"
     for i, batch in enumerate(batches):
         out = tmp_path / str(i)
         subprocess.run(
             [str(forge_cli), "inline", *map(str, batch.values()), "--out-dir", str(out)],
             check=True,
         )
-        for name, model in batch.items():
-            assert (out / name).read_text() == Document.load(model).to_xml(pretty=True), model
-
-
-def test_written_documents_compile_as_the_originals(tmp_path):
-    # Every corpus model through Document.load + write: MuJoCo compiles it to the same
-    # model, array by array (the judge), a path-like and a str path both accepted.
-    models = corpus_models()
-    failures = []
-    for i, model in enumerate(models):
-        out = tmp_path / f"{i}.xml"
-        Document.load(model if i % 2 else str(model)).write(out)
-        diffs = judge.compare(model, out)
-        if diffs:
-            failures.append(f"{model}: {diffs[:3]}")
-    assert not failures, "\n".join(failures)
+        for j, (name, model) in enumerate(batch.items()):
+            expected = (out / name).read_text()
+            doc = Document.load(model if j % 2 else str(model))
+            assert doc.to_xml(pretty=True) == expected, model
+            doc.write(written)
+            assert written.read_text() == expected, model
 
 
 def test_prefixed_documents_compile_with_every_name_prefixed(tmp_path):

@@ -217,3 +217,46 @@ def test_a_model_whose_statistics_were_changed_is_written_through_a_load(tmp_pat
     text = saved(served, tmp_path)
     assert 'meanmass="3.25"' in text and _last_xml.state()["paid"] == paid + 1
     assert text == stock(owed, tmp_path, lambda m: setattr(m.stat, "meanmass", 3.25))
+
+
+def test_the_split_comparison_reads_texts_as_xml_etree_does():
+    """``_copied_back.rewrites_as`` splits texts at their attribute values, not parsing them
+    (a recording asks once per episode): it answers as the parsed comparison does, the one
+    the writes above judge, on real models' texts with one value changed at random
+    (copied back or not, a geom's type among them), an attribute or an element added, and
+    on texts it leaves to the parser (comments, text content)."""
+    import random
+    import re
+
+    from mjcf_forge import Document, _copied_back
+    from helpers import corpus_models
+
+    rng = random.Random(0)
+    copied_sets = (_copied_back.COPIED_BACK, _copied_back.copied_back("3.9.0"))
+    models = [ROOT / "corpora" / "scenes" / "demo" / "arm.xml", *corpus_models()[::10]]
+    checked, split_true = 0, 0
+    for model in models:
+        text = Document.load(model).to_xml()
+        values = list(re.finditer(r'="([^"]*)"', text))
+        variants = []
+        for m in rng.sample(values, min(12, len(values))):
+            variants.append(text[: m.start(1)] + m.group(1) + " 2" + text[m.end(1):])
+        variants += [
+            text.replace("<geom ", '<geom margin="0.001" ', 1),
+            text.replace("</worldbody>", '<site name="added"/></worldbody>', 1),
+            text.replace('type="box"', 'type="ellipsoid"', 1),
+            text.replace("<worldbody>", "<worldbody><!-- a comment -->", 1),
+        ]
+        for other in variants:
+            for copied in copied_sets:
+                split = _copied_back.rewrites_as(text, other, copied)
+                assert split == _copied_back._parsed_differ_only_in(text, other, copied), (model, other[:200])
+                checked += 1
+                split_true += split
+    assert checked > 500 and split_true > 20, (checked, split_true)
+    # What the split leaves to the parser: a comment or text content between values.
+    held = '<mujoco><!-- c --><worldbody><body pos="0 0 1"/></worldbody></mujoco>'
+    assert _copied_back._skeleton(held).tags is None
+    assert _copied_back.rewrites_as(held, held.replace("0 0 1", "0 0 2"), _copied_back.COPIED_BACK)
+    held = '<mujoco><worldbody><body pos="0 0 1"/>x="1"</worldbody></mujoco>'
+    assert _copied_back._skeleton(held).tags is None
