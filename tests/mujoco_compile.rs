@@ -430,3 +430,85 @@ fn linked_mujoco_is_the_selected_version() {
         );
     }
 }
+
+/// MuJoCo's own entry points, called here as a client of the linked library would.
+mod client {
+    use std::ffi::{c_char, c_int, c_void};
+    unsafe extern "C" {
+        pub fn mj_loadXML(
+            f: *const c_char,
+            vfs: *const c_void,
+            e: *mut c_char,
+            n: c_int,
+        ) -> *mut c_void;
+        pub fn mj_saveLastXML(
+            f: *const c_char,
+            m: *const c_void,
+            e: *mut c_char,
+            n: c_int,
+        ) -> c_int;
+        pub fn mj_deleteModel(m: *mut c_void);
+    }
+}
+
+/// What `mj_saveLastXML` writes for the client's model (MuJoCo's last loaded XML model,
+/// process-wide), or None where MuJoCo refuses (the model is not the slot's).
+fn saved_last_xml(model: *const std::ffi::c_void, dir: &Path) -> Option<String> {
+    let path = std::ffi::CString::new(dir.join("last.xml").to_str().unwrap()).unwrap();
+    let mut err = vec![0 as std::ffi::c_char; 1000];
+    // SAFETY: `path` is NUL-terminated, `model` a live model of the client's, `err` holds 1000 bytes.
+    let ok = unsafe { client::mj_saveLastXML(path.as_ptr(), model, err.as_mut_ptr(), 1000) };
+    (ok == 1).then(|| std::fs::read_to_string(dir.join("last.xml")).unwrap())
+}
+
+#[test]
+fn compiles_leave_mujocos_last_loaded_xml_to_the_process() {
+    // A client loads its model (MuJoCo keeps it for mj_saveLastXML); our compiles, of
+    // strings, files and failing models, on threads too, leave that slot as it was.
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("client.xml");
+    std::fs::write(
+        &file,
+        r#"<mujoco model="client"><worldbody><body name="ours_not"><geom size="0.1"/></body></worldbody></mujoco>"#,
+    )
+    .unwrap();
+    let path = std::ffi::CString::new(file.to_str().unwrap()).unwrap();
+    let mut err = vec![0 as std::ffi::c_char; 1000];
+    // SAFETY: as above; the model is freed at the end of the test.
+    let model =
+        unsafe { client::mj_loadXML(path.as_ptr(), std::ptr::null(), err.as_mut_ptr(), 1000) };
+    assert!(!model.is_null());
+    let before = saved_last_xml(model, dir.path()).expect("the client's model is the slot's");
+    assert!(before.contains(r#"model="client""#), "{before}");
+
+    let other = dir.path().join("other.xml");
+    std::fs::write(
+        &other,
+        r#"<mujoco model="other"><worldbody><geom size="1"/></worldbody></mujoco>"#,
+    )
+    .unwrap();
+    compile_str(
+        r#"<mujoco model="ours"><worldbody><geom size="1"/></worldbody></mujoco>"#,
+        here(),
+    )
+    .unwrap();
+    compile_file(&other).unwrap();
+    assert!(
+        compile_str(
+            "<mujoco><worldbody><geom type='mesh' mesh='no'/></worldbody></mujoco>",
+            here()
+        )
+        .is_err()
+    );
+    std::thread::scope(|s| {
+        for _ in 0..4 {
+            s.spawn(|| compile_file(&other).unwrap());
+        }
+    });
+    assert_eq!(
+        saved_last_xml(model, dir.path()).as_deref(),
+        Some(before.as_str())
+    );
+    // SAFETY: made by mj_loadXML above, not used afterwards.
+    unsafe { client::mj_deleteModel(model) };
+}

@@ -1,8 +1,10 @@
 //! Compiling with MuJoCo's XML loader: [`compile_file`], [`compile_str`] and why they fail
 //! ([`CompileError`]).
 //!
-//! Both call `mj_loadXML` themselves, with a 4 KiB error buffer: MuJoCo's messages name the
-//! offending element's line at their end, which a short buffer would cut off.
+//! Both run MuJoCo's loader as `mj_loadXML` runs it, without keeping the parsed model as
+//! the process's last loaded XML (`sys::load_xml`), with a 4 KiB error buffer: MuJoCo's
+//! messages name the offending element's line at their end, which a short buffer would cut
+//! off.
 
 use std::ffi::{CStr, CString, c_char, c_int};
 use std::fmt;
@@ -171,7 +173,7 @@ pub fn compile_document(doc: &Document) -> Result<CompiledModel, Error> {
     compile_str(&xml, doc.model_dir()).map_err(|e| doc.mujoco_error(&xml, &e.message))
 }
 
-/// Runs `mj_loadXML` and wraps the result.
+/// Runs MuJoCo's loader (`sys::load_xml`) and wraps the result.
 fn load_xml(path: &CStr, vfs: Option<&sys::Vfs>) -> Result<CompiledModel, CompileError> {
     let mut buf = vec![0 as c_char; ERROR_BUF_LEN];
     // SAFETY: `path` is NUL-terminated; `vfs` is None or a live VFS that outlives the call;

@@ -1,7 +1,9 @@
 //! The MuJoCo FFI tier: compile MJCF with MuJoCo's own C library (cargo feature `mujoco`).
 //!
-//! [`compile_file`], [`compile_str`] and [`compile_document`] run MuJoCo's XML loader (`mj_loadXML`: parse,
-//! then compile) and return a [`CompiledModel`], a safe owning handle to the resulting
+//! [`compile_file`], [`compile_str`] and [`compile_document`] run MuJoCo's XML loader as
+//! `mj_loadXML` runs it (parse, then compile, the same messages) but leave MuJoCo's last
+//! loaded XML model, the one `mj_saveLastXML` writes, to the process (the shim's
+//! `mjf_load_xml` frees the parsed model instead of keeping it), and return a [`CompiledModel`], a safe owning handle to the resulting
 //! `mjModel`, or a [`CompileError`] carrying MuJoCo's own message and, when MuJoCo names
 //! one, the line of the offending element. [`write_inertials`] and
 //! [`write_all_inertials`] write what MuJoCo compiles back into a document.
@@ -22,9 +24,10 @@
 //!
 //! # Thread safety
 //!
-//! The loader is called without any lock of ours: `mj_loadXML` is safe to call from several
-//! threads at once in MuJoCo 3.x. Its only process-wide state is the "last loaded spec"
-//! kept for `mj_saveLastXML`, which MuJoCo guards with its own mutex; the compiler reports
+//! The loader is called without any lock of ours: MuJoCo's parser and compiler are safe to
+//! call from several threads at once in MuJoCo 3.x. `mj_loadXML`'s only process-wide state,
+//! the "last loaded spec" kept for `mj_saveLastXML`, is not touched here (see above:
+//! `tests/mujoco_compile.rs` checks that a compile of ours leaves it); the compiler reports
 //! engine errors through thread-local handlers (`_mjPRIVATE__set_tls_error_fn`) and a
 //! thread-local jump buffer; the XML reader switches the number locale per thread
 //! (`uselocale`); each call here gets its own VFS. (Source: MuJoCo's `xml_api.cc`,
@@ -32,7 +35,7 @@
 //! creates models from several threads.) `tests/mujoco_compile.rs` checks it with 8
 //! threads compiling different models, with and without mesh files, 50 times each. What
 //! stays global in MuJoCo is what this module never touches: the user error/warning
-//! callbacks (`mju_user_error`, `mju_user_warning`) and `mj_saveLastXML`.
+//! callbacks (`mju_user_error`, `mju_user_warning`) and the last loaded XML model.
 //!
 //! # Example
 //!

@@ -6,6 +6,7 @@
 // through MuJoCo's own X-macro tables (mjxmacro.h: MJMODEL_SIZES, MJMODEL_POINTERS), which
 // MuJoCo keeps in step with mjModel; Rust names the fields it reads and checks the element
 // size it expects.
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -19,6 +20,45 @@ int mjf_nbias(void) { return mjNBIAS; }
 
 // A deep copy into a new model (mj_copyModel allocates it), or NULL.
 mjModel* mjf_copy_model(const mjModel* m) { return mj_copyModel(NULL, m); }
+
+// mj_loadXML without making the parsed model MuJoCo's last loaded XML model (the one
+// mj_saveLastXML writes, process-wide): the same parse, compile and messages as MuJoCo's
+// own (xml_api.cc: the parser's error, else the compiler's, else the warnings joined by
+// newlines, else an empty message), and the spec freed instead of kept.
+static void mjf_copy_message(char* error, int error_sz, const char* message) {
+  if (error && error_sz > 0) {
+    strncpy(error, message ? message : "", error_sz);
+    error[error_sz - 1] = 0;
+  }
+}
+
+mjModel* mjf_load_xml(const char* filename, const mjVFS* vfs, char* error, int error_sz) {
+  mjSpec* spec = mj_parseXML(filename, vfs, error, error_sz);
+  if (!spec) {
+    return NULL;
+  }
+  mjModel* m = mj_compile(spec, vfs);
+  if (!m) {
+    mjf_copy_message(error, error_sz, mjs_getError(spec));
+    mj_deleteSpec(spec);
+    return NULL;
+  }
+  int warnings = mjs_numWarnings(spec);
+  if (error && error_sz > 0) {
+    error[0] = 0;
+    size_t used = 0;
+    for (int i = 0; i < warnings && used + 1 < (size_t)error_sz; i++) {
+      const char* w = mjs_getWarning(spec, i);
+      int n = snprintf(error + used, error_sz - used, "%s%s", i ? "\n" : "", w ? w : "");
+      if (n < 0) {
+        break;
+      }
+      used += (size_t)n;
+    }
+  }
+  mj_deleteSpec(spec);
+  return m;
+}
 
 // A size field of mjModel (MJMODEL_SIZES); -1 when `name` is not one.
 long long mjf_model_size(const mjModel* m, const char* name) {

@@ -24,12 +24,6 @@ struct RawVfs {
 
 unsafe extern "C" {
     fn mj_version() -> c_int;
-    fn mj_loadXML(
-        filename: *const c_char,
-        vfs: *const RawVfs,
-        error: *mut c_char,
-        error_sz: c_int,
-    ) -> *mut MjModel;
     fn mj_deleteModel(m: *mut MjModel);
     fn mj_addBufferVFS(
         vfs: *mut RawVfs,
@@ -47,6 +41,12 @@ unsafe extern "C" {
         name: *const c_char,
         elem_size: *mut usize,
     ) -> *const c_void;
+    fn mjf_load_xml(
+        filename: *const c_char,
+        vfs: *const RawVfs,
+        error: *mut c_char,
+        error_sz: c_int,
+    ) -> *mut MjModel;
     fn mjf_copy_model(m: *const MjModel) -> *mut MjModel;
     fn mjf_vfs_new() -> *mut RawVfs;
     fn mjf_vfs_free(vfs: *mut RawVfs);
@@ -139,6 +139,9 @@ impl Drop for Vfs {
     }
 }
 
+/// `mj_loadXML`, without making the model MuJoCo's last loaded XML model (the shim's
+/// `mjf_load_xml`: what `mj_saveLastXML` writes stays what the process loaded itself).
+///
 /// # Safety
 /// As `mj_loadXML`: `err` holds `err_len` writable bytes.
 pub(super) unsafe fn load_xml(
@@ -149,7 +152,7 @@ pub(super) unsafe fn load_xml(
 ) -> *mut MjModel {
     let vfs = vfs.map_or(std::ptr::null(), |v| v.0.as_ptr().cast_const());
     // SAFETY: see the caller's contract; `vfs` is null or live.
-    unsafe { mj_loadXML(path.as_ptr(), vfs, err, err_len) }
+    unsafe { mjf_load_xml(path.as_ptr(), vfs, err, err_len) }
 }
 
 /// A deep copy of `m` (`mj_copyModel` into a new model), or null when MuJoCo cannot
