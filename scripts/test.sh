@@ -102,11 +102,16 @@ stage "cargo fmt --check, clippy"
 cargo fmt --all -- --check
 cargo clippy --all-targets -- -D warnings
 if ((QUICK == 1)); then
-  stage "quick: Rust unit tests, one judge per tier (document, model, batch, caches)"
+  stage "quick: Rust unit tests, one judge per tier (document, model, batch, caches, switch)"
   cargo test --lib
-  cargo test --test document_judge --test merge_rules --test scene_batch
-  .cache/venv/bin/python -m pytest python/tests/test_package.py python/tests/test_document_cache.py \
-    -q -p no:cacheprovider -k "not wheel and not robosuite"
+  # The document tier's judge (207 wheel models under 3.17.0 and 4.0.0), the model tier's
+  # (prefixing), the batch tier's scene tests.
+  cargo test --test document_judge --test prefix_judge --test scene_batch
+  # The package (stubs, docstrings, its examples), the caches' judge on the wheel models'
+  # edited values and structural edits, MuJoCo's last loaded XML under the switch.
+  .cache/venv/bin/python -m pytest python/tests/test_package.py python/tests/test_last_xml.py \
+    python/tests/test_document_cache.py -k "not test_document_cache or wheel_models or structural" \
+    -q -p no:cacheprovider
   end_stage
   exit 0
 fi

@@ -2,12 +2,13 @@
 """What robosuite's clients pay per episode, stock against mjcf_forge.robosuite.use().
 
     .cache/venv-robosuite-env/bin/python benches/compare/bench_robosuite_clients.py \
-        [--env Lift] [--rounds 8] [--per-round 3]
+        [--env Lift] [--rounds 8] [--per-round 3] [--measures record,attempt,...]
 
-Two worker processes of the robosuite venv (robosuite 1.5.2, MuJoCo 3.9.0) stay alive for
-the whole run, one stock, one with ``use()`` first (this checkout's package, through a
-PYTHONPATH holding only it); rounds alternate between them, and each round times
-``--per-round`` of each of these (Panda, headless):
+Per measure, two worker processes of the robosuite venv (robosuite 1.5.2, MuJoCo 3.9.0),
+one stock, one with ``use()`` first (this checkout's package, through a PYTHONPATH holding
+only it), each holding only the environments of that measure, as a client's script does;
+rounds alternate between them, and each round times ``--per-round`` of the measure
+(Panda, headless). The measures:
 
 - ``record``: one episode's start in robosuite's ``DataCollectionWrapper``: its
   ``reset()`` (a hard reset, ``get_xml()``, ``reset_from_xml_string`` of that XML, the
@@ -44,8 +45,8 @@ ROOT = Path(__file__).resolve().parents[2]
 MEASURES = ("record", "attempt", "camera_mover", "robomimic", "render")
 
 
-def worker(mode: str, name: str) -> None:
-    """Reads "MEASURE N" lines on stdin, answers one JSON list of times (ms) each."""
+def worker(mode: str, name: str, measure: str) -> None:
+    """Reads "N" lines on stdin, answers one JSON list of ``measure``'s times (ms) each."""
     if mode == "forge":
         import mjcf_forge.robosuite
 
@@ -69,22 +70,25 @@ def worker(mode: str, name: str) -> None:
             )
 
     plain = dict(has_offscreen_renderer=False, use_camera_obs=False)
-    tmp = tempfile.mkdtemp()
-    recorder = DataCollectionWrapper(make(**plain), tmp)
-    env = make(**plain)
-    viewer = make(has_offscreen_renderer=True, use_camera_obs=False)
-    images = make(
-        has_offscreen_renderer=True, use_camera_obs=True,
-        camera_names=["agentview", "robot0_eye_in_hand"], camera_heights=84, camera_widths=84,
-    )
-    # A demo to convert: 20 seeded steps recorded as DataCollectionWrapper records them.
-    images.reset()
-    start = images.sim.model.get_xml()
-    states = [images.sim.get_state().flatten()]
-    for action in np.random.default_rng(0).uniform(-1, 1, (20, images.action_dim)):
-        images.step(action)
-        states.append(images.sim.get_state().flatten())
-    last_action = action
+    if measure == "record":
+        recorder = DataCollectionWrapper(make(**plain), tempfile.mkdtemp())
+    elif measure == "attempt":
+        env = make(**plain)
+    elif measure == "camera_mover":
+        viewer = make(has_offscreen_renderer=True, use_camera_obs=False)
+    else:
+        images = make(
+            has_offscreen_renderer=True, use_camera_obs=True,
+            camera_names=["agentview", "robot0_eye_in_hand"], camera_heights=84, camera_widths=84,
+        )
+        # A demo to convert: 20 seeded steps recorded as DataCollectionWrapper records them.
+        images.reset()
+        start = images.sim.model.get_xml()
+        states = [images.sim.get_state().flatten()]
+        for action in np.random.default_rng(0).uniform(-1, 1, (20, images.action_dim)):
+            images.step(action)
+            states.append(images.sim.get_state().flatten())
+        last_action = action
 
     def reset_to(e, state):
         if "model" in state:
@@ -95,7 +99,7 @@ def worker(mode: str, name: str) -> None:
         e.sim.forward()
         return e._get_observations(force_update=True)
 
-    def once(measure: str) -> None:
+    def once() -> None:
         if measure == "record":
             recorder.reset()
         elif measure == "attempt":
@@ -115,15 +119,13 @@ def worker(mode: str, name: str) -> None:
             images.step(last_action)
 
     with contextlib.redirect_stdout(sys.stderr):
-        for measure in MEASURES:
-            once(measure)  # untimed: every structure seen once
+        once()  # untimed: every structure seen once
     for line in sys.stdin:
-        measure, count = line.split()
         times = []
         with contextlib.redirect_stdout(sys.stderr):
-            for _ in range(int(count)):
+            for _ in range(int(line)):
                 t = time.perf_counter()
-                once(measure)
+                once()
                 times.append((time.perf_counter() - t) * 1e3)
         print(json.dumps(times), flush=True)
 
@@ -133,10 +135,12 @@ def main() -> None:
     parser.add_argument("--env", default="Lift")
     parser.add_argument("--rounds", type=int, default=8)
     parser.add_argument("--per-round", type=int, default=3)
+    parser.add_argument("--measures", default=",".join(MEASURES), help="comma-separated, of: " + ", ".join(MEASURES))
     parser.add_argument("--worker", choices=["stock", "forge"])
     args = parser.parse_args()
+    measures = args.measures.split(",")
     if args.worker:
-        return worker(args.worker, args.env)
+        return worker(args.worker, args.env, measures[0])
 
     sys.path.insert(0, str(Path(__file__).parent))
     from bench_robosuite_reset import package
@@ -146,25 +150,27 @@ def main() -> None:
     (only / "mjcf_forge").symlink_to(package())
     env = dict(os.environ, PYTHONPATH=str(only), PYTHONHASHSEED="0")
     env.setdefault("MUJOCO_GL", "egl")
-    workers = {
-        mode: subprocess.Popen(
-            [sys.executable, __file__, "--worker", mode, "--env", args.env],
-            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env,
-        )
-        for mode in ("stock", "forge")
-    }
-    times: dict = {(m, w): [] for m in MEASURES for w in workers}
-    for _ in range(args.rounds):
-        for measure in MEASURES:
+    times: dict = {}
+    for measure in measures:
+        workers = {
+            mode: subprocess.Popen(
+                [sys.executable, __file__, "--worker", mode, "--env", args.env, "--measures", measure],
+                stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env,
+            )
+            for mode in ("stock", "forge")
+        }
+        for mode in workers:
+            times[(measure, mode)] = []
+        for _ in range(args.rounds):
             for mode, proc in workers.items():
-                proc.stdin.write(f"{measure} {args.per_round}\n")
+                proc.stdin.write(f"{args.per_round}\n")
                 proc.stdin.flush()
                 times[(measure, mode)] += json.loads(proc.stdout.readline())
-    for proc in workers.values():
-        proc.stdin.close()
-        proc.wait()
+        for proc in workers.values():
+            proc.stdin.close()
+            proc.wait()
     print(f"{args.env}: {args.rounds} rounds x {args.per_round}, ms (median / best), stock / ours")
-    for measure in MEASURES:
+    for measure in measures:
         s, f = times[(measure, "stock")], times[(measure, "forge")]
         print(
             f"{measure:13s} stock {statistics.median(s):8.1f} / {min(s):8.1f}   "
