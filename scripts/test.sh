@@ -80,23 +80,40 @@ measured() { # CMD...: runs it, noting its peak memory for the stage's summary l
   rm -f "$peak_file" "$rss_file"
   return "$status"
 }
-trap 'end_stage; echo "== stages (seconds):"; printf "%s\n" "${SUMMARY[@]}"' EXIT
+finish() {
+  end_stage
+  if [[ -n "${CLIENT_SETUP:-}" ]]; then kill "$CLIENT_SETUP" 2>/dev/null || true; fi
+  echo "== stages (seconds):"
+  printf '%s\n' "${SUMMARY[@]}"
+}
+trap finish EXIT
 
 stage "setup"
 bash scripts/setup.sh
+CLIENT_SETUP=""
 if ((QUICK == 0)); then
-  # robosuite 1.5.2 with MuJoCo 3.9.0, where the robosuite tests build robosuite's own
-  # classes and environments both ways (about 300 MB of wheels the first time).
-  bash scripts/setup_robosuite_env.sh
-  # LIBERO 0.1.1 with robosuite 1.4.0 and MuJoCo 3.3.1, with its assets (about 550 MB).
-  bash scripts/setup_libero_env.sh
-  # robosuite 1.4.0 on MuJoCo 2.3.7 (the oldest MuJoCo robosuite 1.4.0 accepts; 150 MB).
-  bash scripts/setup_mj2_env.sh
-  # MuJoCo Warp, MJX and JAX on CPU in .cache/venv-sim, with mjcf_forge built into it
-  # (Warp's kernels cached in .cache/warp-kernels).
-  bash scripts/setup_sim_env.sh
-  bash scripts/check_setup.sh
+  # The client venvs download and install beside the Rust stages, which read none of them
+  # (network and unpacking against compiling); the Python stages wait for them. In order:
+  # robosuite 1.5.2 with MuJoCo 3.9.0 (about 300 MB of wheels the first time); LIBERO 0.1.1
+  # with robosuite 1.4.0 and MuJoCo 3.3.1, with its assets (550 MB); robosuite 1.4.0 on
+  # MuJoCo 2.3.7, the oldest MuJoCo robosuite 1.4.0 accepts (150 MB); MuJoCo Warp, MJX and
+  # JAX on CPU with mjcf_forge in .cache/venv-sim (Warp's kernels in .cache/warp-kernels).
+  mkdir -p .cache/logs
+  ( bash scripts/setup_robosuite_env.sh && bash scripts/setup_libero_env.sh \
+      && bash scripts/setup_mj2_env.sh && bash scripts/setup_sim_env.sh ) \
+    >.cache/logs/setup-clients.log 2>&1 &
+  CLIENT_SETUP=$!
 fi
+clients_set_up() { # waits for the client venvs, then checks every venv and corpus
+  local status=0
+  wait "$CLIENT_SETUP" || status=$?
+  cat .cache/logs/setup-clients.log
+  if ((status != 0)); then
+    echo "== the client venvs' setup failed (exit $status): .cache/logs/setup-clients.log" >&2
+    exit "$status"
+  fi
+  bash scripts/check_setup.sh
+}
 
 stage "cargo fmt --check, clippy"
 cargo fmt --all -- --check
@@ -139,6 +156,9 @@ MJ4_DIR="$(.cache/venv-mj4/bin/python -c 'import mujoco, os; print(os.path.dirna
 MJCF_FORGE_MUJOCO_DIR="$MJ4_DIR" CARGO_TARGET_DIR="${MJCF_FORGE_MJ4_TARGET:-target/mujoco-4}" \
   cargo test --features mujoco --lib --bins "${linked_tests[@]}"
 
+stage "the client venvs (set up beside the Rust stages), every venv and corpus checked"
+clients_set_up
+
 stage "judge self-tests (MuJoCo 3.17.0 and 4.0.0)"
 .cache/venv/bin/python -m pytest tests/judge -q -p no:cacheprovider
 .cache/venv-mj4/bin/python -m pytest tests/judge -q -p no:cacheprovider
@@ -147,7 +167,7 @@ stage "python package, MuJoCo 3.17.0 (API, errors, threads, MuJoCo judge, Gymnas
 # (test_batch_sim.py needs MuJoCo Warp and JAX: it runs in .cache/venv-sim below.)
 # (test_libero.py runs LIBERO in .cache/venv-libero, MuJoCo 3.3.1, stock and on the switch.)
 measured .cache/venv/bin/python -m pytest python/tests -q -p no:cacheprovider \
-  --ignore=python/tests/test_batch_sim.py --durations=15
+  --ignore=python/tests/test_batch_sim.py --durations=40
 
 stage "python package, what depends on the installed MuJoCo: 4.0.0, and LIBERO's 3.3.1"
 measured .cache/venv-mj4/bin/python -m pytest python/tests/test_model_cache.py python/tests/test_world_batch.py \
