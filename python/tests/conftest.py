@@ -7,6 +7,7 @@ and installs the package into .cache/venv and downloads the wheel corpora).
 from __future__ import annotations
 
 import os
+import resource
 import subprocess
 import sys
 from pathlib import Path
@@ -72,3 +73,24 @@ def pytest_runtest_makereport(item, call):
             f"skipped under CI=true, where no test may skip ({reason}): run the setup step it "
             "names (scripts/test.sh runs every one)"
         )
+
+
+# Where this process's peak resident memory was reached: each test that raised it, and by
+# how much (printed at the end; scripts/test.sh also prints the whole stage's peak).
+_PEAK_RAISES: list = []
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item, nextitem):
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    yield
+    after = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    if after > before:
+        _PEAK_RAISES.append((after - before, item.nodeid))
+
+
+def pytest_terminal_summary(terminalreporter):
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    terminalreporter.write_line(f"peak resident memory of the pytest process: {peak / 1024:.0f} MiB; raised most by:")
+    for kb, nodeid in sorted(_PEAK_RAISES, reverse=True)[:5]:
+        terminalreporter.write_line(f"  +{kb / 1024:.0f} MiB  {nodeid}")

@@ -6,6 +6,9 @@ float array and statistic. Documents: the scenes' variants taken as documents, r
 value edits of a seeded sample of the wheel corpus (robosuite robots, grippers, objects
 and an arena among them), structural edits (which must compile), a caller changing the
 model it was given, threads, errors.
+
+Runs under 3.17.0 and again under 4.0.0 (scripts/test.sh): the package's MuJoCo calls are
+the installed ``mujoco``'s, so what it checks depends on that version.
 """
 from __future__ import annotations
 

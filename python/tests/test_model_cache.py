@@ -4,6 +4,9 @@ Every patched model is compared with MuJoCo compiling the variant's XML: the jud
 whole-model comparison (every array, size, name and statistic), and then bit for bit on
 every float array and statistic (the patch writes the compiler's own values and redoes its
 arithmetic in its order, so nothing is left to tolerance).
+
+Runs under 3.17.0 and again under 4.0.0 (scripts/test.sh): the package's MuJoCo calls are
+the installed ``mujoco``'s, so what it checks depends on that version.
 """
 from __future__ import annotations
 

@@ -16,6 +16,9 @@ arrays the option must leave alone:
 - ``fuse_static``, ``keep_links``, ``actuators``, ``packages`` and their errors;
 - robosuite's ``MujocoXML``/``MujocoXMLModel`` on a URDF arm, and the arm with an MJCF
   gripper merged onto its last link, judged by the merge judge and stepped.
+
+Runs under 3.17.0 and again under 4.0.0 (scripts/test.sh): the package's MuJoCo calls are
+the installed ``mujoco``'s, so what it checks depends on that version.
 """
 from __future__ import annotations
 

@@ -2,6 +2,9 @@
 ``mj_setConst`` gives (derived tree by tree or on the whole superset, the same bits), and
 each world starts at its own keyframe rows. The batched simulators themselves (MuJoCo
 Warp, MJX) judge it in ``test_batch_sim.py``.
+
+Runs under 3.17.0 and again under 4.0.0 (scripts/test.sh): the package's MuJoCo calls are
+the installed ``mujoco``'s, so what it checks depends on that version.
 """
 from __future__ import annotations
 
