@@ -84,7 +84,7 @@ def rewrites_as(held: str, owed: str, copied: frozenset) -> bool:
             return False
         if tag == "geom":
             attributes = skeleton.elements[skeleton.element_of[i]]
-            if _quoted(attributes.get("type"), "sphere") not in _PRIMITIVES or "fromto" in attributes:
+            if not _a_primitive_as_sized(_quoted(attributes.get("type"), "sphere"), attributes):
                 return False
     return True
 
@@ -136,6 +136,12 @@ def _skeleton(text: str) -> _Skeleton:
     return _Skeleton(text)
 
 
+def _a_primitive_as_sized(geom_type: str, attributes) -> bool:
+    """Whether a geom's differing values may be written from the model: a primitive sized
+    by its `size` (a `fromto` is written as given)."""
+    return geom_type in _PRIMITIVES and "fromto" not in attributes
+
+
 def _quoted(value: str | None, default: str) -> str:
     return default if value is None else value[1:-1]
 
@@ -159,6 +165,6 @@ def _parsed_differ_only_in(held: str, owed: str, copied: frozenset) -> bool:
                 continue
             if (x.tag, name) not in copied:
                 return False
-            if x.tag == "geom" and (x.get("type", "sphere") not in _PRIMITIVES or "fromto" in x.attrib):
+            if x.tag == "geom" and not _a_primitive_as_sized(x.get("type", "sphere"), x.attrib):
                 return False
     return True
