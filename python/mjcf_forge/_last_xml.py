@@ -81,6 +81,8 @@ class _Slot:
         self.held: tuple = _UNKNOWN
         self.fresh = False  # no write since the load left a statistic copied in it
         self.stat: Optional[tuple] = None  # the held model's statistics as compiled
+        # The held compile's _signature: mj_copyBack writes only into a model of its sizes.
+        self.signature: Optional[tuple] = None
         self.owed: Any = None  # the key stock's slot holds, where it differs from held
         # The statistics and _signature of the model served for it.
         self.owed_stat: Optional[tuple] = None
@@ -115,8 +117,9 @@ def _loaded(key: tuple, model: Any, began_alone: bool) -> None:
     slot.loading -= 1
     if began_alone and not slot.overlapped:
         slot.held, slot.fresh, slot.stat = key, True, _stat(model)
+        slot.signature = _signature(model)
     else:
-        slot.held, slot.fresh, slot.stat = _UNKNOWN, False, None
+        slot.held, slot.fresh, slot.stat, slot.signature = _UNKNOWN, False, None, None
     if slot.loading == 0:
         slot.overlapped = False
     slot.owed = None
@@ -241,7 +244,7 @@ def _pay(api: str, model: Any = None) -> Any:
     slot = _SLOT
     with slot.lock:
         owed, owed_stat = slot.owed, slot.owed_stat
-        held, fresh, held_stat = slot.held, slot.fresh, slot.stat
+        held, fresh, held_stat, held_signature = slot.held, slot.fresh, slot.stat, slot.signature
     if owed is None:
         return model
     if owed is _LOST:
@@ -269,7 +272,7 @@ def _pay(api: str, model: Any = None) -> Any:
         model is not None and fresh and owed_stat is not None and held_stat is not None
         and held[0] == owed[0] == "xml" and held[2] is None and owed[2] is None
         and _stat(model) == owed_stat[0] and _signature(model) == owed_stat[1]
-        and _rewrites_as(held[1], owed[1])
+        and owed_stat[1] == held_signature and _rewrites_as(held[1], owed[1])
     ):
         # Written through the held load, with the held load's statistics: what stock's
         # load of the owed text writes (the slot stays owed: every write goes this way).
@@ -331,8 +334,13 @@ def _walk(obj: Any, path: tuple) -> Any:
 
 def _signature(model: Any) -> tuple:
     """What makes two models of one structure: every size, the names, MuJoCo's signature.
-    (Two compiles can share their names and buffer size and still differ in a size that
-    ``mj_copyBack`` checks: MuJoCo 3.3 then writes the held load unchanged, silently.)"""
+    Two texts of one structure can compile to different sizes: a free body of two box
+    geoms whose sizes change the order of its principal inertias gets a rotated inertial
+    frame, is no longer "simple", and MuJoCo 3.3's ``nC`` changes (Lift's cube, about one
+    reset in ten). ``mj_copyBack`` checks such sizes against the held compile's, and where
+    one differs MuJoCo 3.3 writes the held load unchanged, silently: a write goes through
+    the held load only where the held compile, the served model and the written one have
+    one signature."""
     names = _SIZES.get(type(model))
     if names is None:
         names = _SIZES[type(model)] = tuple(

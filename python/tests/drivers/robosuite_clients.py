@@ -52,6 +52,7 @@ import inspect
 import json
 import logging
 import os
+import random
 import sys
 from pathlib import Path
 
@@ -83,8 +84,10 @@ def robots(name: str) -> object:
 
 def make(name: str, **kwargs: object) -> object:
     """``robosuite.make`` with the default robots, seeded (1.5's ``seed``; 1.4 draws from
-    NumPy's global generator)."""
+    NumPy's global generator, and its single-object tasks, ``NutAssemblySingle`` and
+    ``PickPlaceSingle``, pick their object with Python's ``random``)."""
     np.random.seed(0)
+    random.seed(0)
     if SEEDED:
         kwargs.setdefault("seed", 0)
     kwargs.setdefault("robots", robots(name))
