@@ -8,6 +8,7 @@ import pydoc
 from pathlib import Path
 
 import mjcf_forge
+from helpers import ROOT
 
 STUB = Path(mjcf_forge.__file__).with_name("_mjcf_forge.pyi")
 PUBLIC_CLASSES = ["Attrib", "Document", "Element", "MergeReport", "Model", "Scene", "Variant", "VariantIterator"]
@@ -119,3 +120,26 @@ def test_the_compiled_modules_examples_run():
             runner.run(test)
     assert runner.failures == 0, f"{runner.failures} of {examples} examples failed"
     assert examples >= 14, examples
+
+
+def test_the_python_modules_examples_run(monkeypatch):
+    """Every ``>>>`` example in the docstrings of the package's Python modules runs and
+    prints what it says (paths in them are relative to the repository's root)."""
+    import doctest
+    import importlib
+    import pkgutil
+
+    monkeypatch.chdir(ROOT)
+    finder, runner = doctest.DocTestFinder(exclude_empty=True), doctest.DocTestRunner()
+    examples, modules = 0, 0
+    names = ["mjcf_forge"] + [i.name for i in pkgutil.iter_modules(mjcf_forge.__path__, "mjcf_forge.")]
+    for name in names:
+        module = importlib.import_module(name)
+        if not getattr(module, "__file__", "").endswith(".py"):
+            continue
+        modules += 1
+        for test in finder.find(module, name):
+            examples += len(test.examples)
+            runner.run(test)
+    assert runner.failures == 0, f"{runner.failures} of {examples} examples failed"
+    assert modules >= 20 and examples >= 10, (modules, examples)
