@@ -80,6 +80,35 @@ measured() { # CMD...: runs it, noting its peak memory for the stage's summary l
   rm -f "$peak_file" "$rss_file"
   return "$status"
 }
+lanes() { # FN...: runs each function at once in the background, each into its own log;
+  # prints the logs when all are done, the machine's peak over them, and fails if any failed
+  local fn names=("$@") pids=() logs=() status=0 i before peak_file sampler
+  mkdir -p .cache/logs
+  before="$(used_kb)"
+  peak_file="$(mktemp)"
+  echo 0 >"$peak_file"
+  ( peak=0; while sleep 1; do u="$(used_kb)"; ((u > peak)) && peak=$u && echo "$peak" >"$peak_file"; done ) &
+  sampler=$!
+  for fn in "$@"; do
+    logs+=(".cache/logs/lane-$fn.log")
+    # A bash of its own, so that `set -e` holds in it whatever context calls lanes.
+    bash -c "set -euo pipefail; $(declare -f used_kb measured "$fn"); $(declare -p CLIENT_TESTS); $fn" \
+      >".cache/logs/lane-$fn.log" 2>&1 &
+    pids+=($!)
+  done
+  for i in "${!pids[@]}"; do
+    if ! wait "${pids[$i]}"; then status=1; echo "== lane ${names[$i]} failed" >>"${logs[$i]}"; fi
+  done
+  kill "$sampler" 2>/dev/null || true
+  wait "$sampler" 2>/dev/null || true
+  for i in "${!logs[@]}"; do echo "== lane log ${logs[$i]}"; cat "${logs[$i]}"; done
+  local machine=$(( ($(cat "$peak_file") - before) / 1024 ))
+  ((machine < 0)) && machine=0
+  rm -f "$peak_file"
+  MEMORY="  [peak: largest process $(grep -ho 'largest process [0-9?]* MiB' "${logs[@]}" | awk '{print $3}' | sort -n | tail -n1) MiB, machine +${machine} MiB]"
+  echo "== peak memory over the lanes: machine +${machine} MiB"
+  return "$status"
+}
 finish() {
   end_stage
   if [[ -n "${CLIENT_SETUP:-}" ]]; then kill "$CLIENT_SETUP" 2>/dev/null || true; fi
@@ -163,26 +192,42 @@ stage "judge self-tests (MuJoCo 3.17.0 and 4.0.0)"
 .cache/venv/bin/python -m pytest tests/judge -q -p no:cacheprovider
 .cache/venv-mj4/bin/python -m pytest tests/judge -q -p no:cacheprovider
 
-stage "python package, MuJoCo 3.17.0 (API, errors, threads, MuJoCo judge, Gymnasium, Ray, robosuite, LIBERO)"
-# (test_batch_sim.py needs MuJoCo Warp and JAX: it runs in .cache/venv-sim below.)
-# (test_libero.py runs LIBERO in .cache/venv-libero, MuJoCo 3.3.1, stock and on the switch.)
-measured .cache/venv/bin/python -m pytest python/tests -q -p no:cacheprovider \
-  --ignore=python/tests/test_batch_sim.py --durations=40
+# The Python stages run in two lanes at once (each alone leaves one of the two cores idle
+# about half the time): the clients lane drives robosuite, LIBERO and the batched
+# simulators in venvs of their own, through subprocesses (little memory in pytest itself);
+# the package lane runs the package's own tests in-process, under 3.17.0, then 4.0.0 and
+# LIBERO's 3.3.1. Each lane writes its log, printed when both are done.
+CLIENT_TESTS=(test_robosuite_clients.py test_libero.py test_robosuite_cover.py
+              test_robosuite_resets.py test_robosuite_use.py)
+clients_lane() {
+  # robosuite 1.5.2, 1.4.0 (MuJoCo 3.3.1, 2.3.7) and LIBERO, stock against switched.
+  local files=()
+  for f in "${CLIENT_TESTS[@]}"; do files+=("python/tests/$f"); done
+  measured .cache/venv/bin/python -m pytest "${files[@]}" -q -p no:cacheprovider --durations=15
+  echo "== batched simulators (MuJoCo Warp, MJX on JAX's CPU backend, CPU MuJoCo) judge WorldBatch"
+  measured .cache/venv-sim/bin/python -m pytest python/tests/test_batch_sim.py -q -p no:cacheprovider
+}
+package_lane() {
+  # (test_batch_sim.py needs MuJoCo Warp and JAX: the clients lane runs it in .cache/venv-sim.)
+  local ignored=(--ignore=python/tests/test_batch_sim.py)
+  for f in "${CLIENT_TESTS[@]}"; do ignored+=("--ignore=python/tests/$f"); done
+  measured .cache/venv/bin/python -m pytest python/tests -q -p no:cacheprovider "${ignored[@]}" --durations=25
+  echo "== what depends on the installed MuJoCo: 4.0.0, and LIBERO's 3.3.1"
+  measured .cache/venv-mj4/bin/python -m pytest python/tests/test_model_cache.py python/tests/test_world_batch.py \
+    python/tests/test_document_cache.py python/tests/test_differential.py python/tests/test_urdf.py \
+    python/tests/test_last_xml.py -q -p no:cacheprovider
+  # MuJoCo's last loaded XML model under LIBERO's MuJoCo 3.3.1 too, where a write through
+  # the held load covers a geom's size and frame (mjcf_forge._copied_back.copied_back).
+  local only
+  only="$(mktemp -d)"
+  ln -s "$(.cache/venv/bin/python -c 'import mjcf_forge, os; print(os.path.dirname(mjcf_forge.__file__))')" "$only/mjcf_forge"
+  PYTHONPATH="$only:python/tests" .cache/venv-libero/bin/python -m pytest python/tests/test_last_xml.py -q -p no:cacheprovider
+  rm -rf "$only"
+  # robosuite's task XMLs (written by the robosuite venv) through a DocumentCache, judged by 4.0.0.
+  .cache/venv-mj4/bin/python -m pytest python/tests/test_robosuite_resets.py -k task_xmls -q -p no:cacheprovider
+}
 
-stage "python package, what depends on the installed MuJoCo: 4.0.0, and LIBERO's 3.3.1"
-measured .cache/venv-mj4/bin/python -m pytest python/tests/test_model_cache.py python/tests/test_world_batch.py \
-  python/tests/test_document_cache.py python/tests/test_differential.py python/tests/test_urdf.py \
-  python/tests/test_last_xml.py -q -p no:cacheprovider
-# MuJoCo's last loaded XML model under LIBERO's MuJoCo 3.3.1 too, where a write through
-# the held load covers a geom's size and frame (mjcf_forge._copied_back.copied_back).
-only="$(mktemp -d)"
-ln -s "$(.cache/venv/bin/python -c 'import mjcf_forge, os; print(os.path.dirname(mjcf_forge.__file__))')" "$only/mjcf_forge"
-PYTHONPATH="$only:python/tests" .cache/venv-libero/bin/python -m pytest python/tests/test_last_xml.py -q -p no:cacheprovider
-rm -rf "$only"
-# robosuite's task XMLs (written by the robosuite venv) through a DocumentCache, judged by 4.0.0.
-.cache/venv-mj4/bin/python -m pytest python/tests/test_robosuite_resets.py -k task_xmls -q -p no:cacheprovider
-
-stage "batched simulators (MuJoCo Warp, MJX on JAX's CPU backend, CPU MuJoCo) judge WorldBatch"
-measured .cache/venv-sim/bin/python -m pytest python/tests/test_batch_sim.py -q -p no:cacheprovider
+stage "python: the package (3.17.0, 4.0.0, 3.3.1) beside robosuite's and LIBERO's clients and the batched simulators"
+lanes clients_lane package_lane
 end_stage
 echo "== all tests passed [${SECONDS}s]"
