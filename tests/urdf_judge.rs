@@ -1,8 +1,12 @@
 //! URDF read as MuJoCo's importer reads it, judged by MuJoCo: every URDF of the corpus
 //! wheels that a MuJoCo version's importer compiles (`URDF_CORPORA` in scripts/setup.sh) and
 //! every case of corpora/urdf, read with that version's importer rules and written as MJCF,
-//! compiles under that version to the model it compiles from the URDF file itself. Bad
-//! URDF gives every problem at its place.
+//! compiles under that version to the model it compiles from the URDF file itself; and every
+//! corpus URDF as a user prepares it for MuJoCo (scripts/list_urdf.py: its meshes beside a
+//! copy that says `<compiler strippath="true">`), read both as prepared and as shipped
+//! (`package://` resolved), compiles to MuJoCo's import of the prepared copy (CI: every
+//! fourth file; all with MJCF_FORGE_FULL=1, scripts/test_full.sh). Bad URDF gives every
+//! problem at its place.
 //!
 //! Pass: once, in the build without features (scripts/test.sh): nothing here depends on the
 //! MuJoCo a build links (the judges run both Python MuJoCos, 3.17.0 and 4.0.0, themselves).
@@ -16,8 +20,12 @@ use mjcf_forge::{Document, UrdfImporter, UrdfOptions};
 
 /// Each input read for `version`'s importer and written to `dir/<version>/`.
 fn written(inputs: &[PathBuf], version: &str, dir: &Path) -> Vec<Pair> {
-    let out_dir = dir.join(version);
-    std::fs::create_dir_all(&out_dir).unwrap();
+    written_to(inputs, version, &dir.join(version))
+}
+
+/// Each input read for `version`'s importer and written into `out_dir`.
+fn written_to(inputs: &[PathBuf], version: &str, out_dir: &Path) -> Vec<Pair> {
+    std::fs::create_dir_all(out_dir).unwrap();
     let opts = UrdfOptions {
         importer: UrdfImporter::of_version(version),
         ..UrdfOptions::default()
@@ -52,6 +60,20 @@ fn written(inputs: &[PathBuf], version: &str, dir: &Path) -> Vec<Pair> {
     pairs
 }
 
+/// Every prepared copy and its file as shipped, each read for `version`'s importer and
+/// written: two pairs per file, both against MuJoCo's import of the copy.
+fn prepared_pairs(files: &[(PathBuf, PathBuf)], version: &str, dir: &Path) -> Vec<Pair> {
+    let copies: Vec<PathBuf> = files.iter().map(|(c, _)| c.clone()).collect();
+    let shipped: Vec<PathBuf> = files.iter().map(|(_, s)| s.clone()).collect();
+    let mut pairs = written_to(&copies, version, &dir.join(version).join("prepared"));
+    let mut as_shipped = written_to(&shipped, version, &dir.join(version).join("shipped"));
+    for (pair, copy) in as_shipped.iter_mut().zip(&copies) {
+        pair.a = copy.clone();
+    }
+    pairs.append(&mut as_shipped);
+    pairs
+}
+
 fn feature_cases() -> Vec<PathBuf> {
     let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("corpora/urdf"))
         .unwrap()
@@ -75,6 +97,32 @@ fn wheel_urdfs_compile_to_mujocos_own_import() {
     }
     let dir = scratch("urdf_wheels");
     let failed = judge_each(|j| written(&j.wheel_urdfs(), j.version, &dir), &dir);
+    assert!(
+        failed.is_empty(),
+        "judge found differences:\n{}",
+        failed.join("\n")
+    );
+}
+
+#[test]
+fn wheel_urdfs_prepared_for_mujoco_read_as_mujocos_import_of_the_copy() {
+    let full = std::env::var("MJCF_FORGE_FULL").is_ok_and(|v| !v.is_empty() && v != "0");
+    let files = |j: &common::Judge| -> Vec<(PathBuf, PathBuf)> {
+        let all = j.prepared_urdfs();
+        assert!(
+            all.len() >= 100,
+            "MuJoCo {} compiles {} prepared corpus URDFs: run scripts/setup.sh",
+            j.version,
+            all.len()
+        );
+        all.into_iter()
+            .enumerate()
+            .filter(|(i, _)| full || i % 4 == 0)
+            .map(|(_, f)| f)
+            .collect()
+    };
+    let dir = scratch("urdf_prepared");
+    let failed = judge_each(|j| prepared_pairs(&files(j), j.version, &dir), &dir);
     assert!(
         failed.is_empty(),
         "judge found differences:\n{}",
@@ -173,8 +221,8 @@ fn bad_urdf_gives_every_problem_at_its_place() {
     assert_eq!(
         errors_of(parts),
         "DIR/bad.urdf:3:26: 'missing.stl': no such file (DIR/missing.stl)\n\
-         DIR/bad.urdf:4:26: 'package://nowhere_pkg/m.stl': package 'nowhere_pkg' is found nowhere: \
-         give its folder (the `packages` option; --urdf-package nowhere_pkg=DIR on the command line), or list it on ROS_PACKAGE_PATH\n\
+         DIR/bad.urdf:4:26: 'package://nowhere_pkg/m.stl': no such file where MuJoCo looks \
+         (DIR/package://nowhere_pkg/m.stl), and package 'nowhere_pkg' is found nowhere: give its folder (the `packages` option; --urdf-package nowhere_pkg=DIR on the command line), or list it on ROS_PACKAGE_PATH\n\
          DIR/bad.urdf:5:26: 'arm.dae' is a COLLADA mesh, which MuJoCo cannot read (it reads STL, OBJ \
          and MSH): convert it, for example with `assimp export arm.dae arm.obj`, and point the URDF at \
          the converted file\n\

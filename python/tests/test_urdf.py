@@ -568,12 +568,14 @@ def test_packages_resolve_a_package_mesh(package):
 
 def test_an_unresolvable_package_is_an_error_at_its_mesh(package):
     urdf, folder = package
-    at = f"{urdf}:5:17: 'package://my_meshes/meshes/tet.obj': package 'my_meshes' is found nowhere"
+    # Both places looked in: MuJoCo's own rule's, and the package's.
+    at = f"{urdf}:5:17: 'package://my_meshes/meshes/tet.obj': no such file where MuJoCo looks ({urdf.parent}/package://"
     for load in (lambda: Document.from_urdf(urdf), lambda: Document.from_urdf(urdf, packages={"x": folder}),
                  lambda: Document.load(urdf)):
         with pytest.raises(MjcfError) as err:
             load()
         assert len(err.value.errors) == 1 and err.value.errors[0].startswith(at), err.value.errors
+        assert "and package 'my_meshes' is found nowhere" in err.value.errors[0]
     # Left alone, the path is what MuJoCo's importer sees: a file it cannot open.
     doc = Document.from_urdf(urdf, resolve_packages=False)
     assert "package://my_meshes/meshes/tet.obj" in doc.find(".//mesh").get("file")
@@ -584,6 +586,52 @@ def test_an_unresolvable_package_is_an_error_at_its_mesh(package):
 # ------------------------------------------------------------------------------------
 # Errors and other inputs
 # ------------------------------------------------------------------------------------
+
+
+# A URDF prepared for MuJoCo: its own <mujoco><compiler> says where MuJoCo looks for its
+# meshes, and MuJoCo's rule comes before any package resolution. (block, mesh reference,
+# where the tetrahedron is put, relative to the URDF's folder.)
+PREPARED = {
+    "strippath, package:// beside": ('<compiler strippath="true"/>', "package://my_meshes/meshes/tet.obj", "tet.obj"),
+    "strippath, relative elsewhere": ('<compiler strippath="true"/>', "../meshes/tet.obj", "tet.obj"),
+    "strippath, absolute elsewhere": ('<compiler strippath="true"/>', "/nowhere/meshes/tet.obj", "tet.obj"),
+    "strippath, file://": ('<compiler strippath="true"/>', "file:///nowhere/tet.obj", "tet.obj"),
+    "strippath and meshdir": ('<compiler strippath="true" meshdir="assets"/>', "package://my_meshes/meshes/tet.obj", "assets/tet.obj"),
+    "assetdir": ('<compiler assetdir="assets"/>', "tet.obj", "assets/tet.obj"),
+    "meshdir over assetdir": ('<compiler assetdir="other" meshdir="assets"/>', "tet.obj", "assets/tet.obj"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(PREPARED))
+def test_a_urdf_prepared_for_mujoco_reads_as_mujocos_import(package, case):
+    urdf, folder = package  # my_meshes is found nowhere, unless given
+    block, reference, where = PREPARED[case]
+    prepared = urdf.with_name("prepared.urdf")
+    text = TET_URDF.format(file=reference).replace('<robot name="tet">', f'<robot name="tet"><mujoco>{block}</mujoco>')
+    prepared.write_text(text)
+    (urdf.parent / where).parent.mkdir(parents=True, exist_ok=True)
+    # A wedge where MuJoCo's rule sends it, a tetrahedron in the package: MuJoCo's wins.
+    (urdf.parent / where).write_text(TETRAHEDRON.replace("v 0 0 0.1\n", "v 0 0 0.2\n"))
+    theirs = mujocos(prepared)
+    for given in (None, {"my_meshes": folder}):
+        ours = compiled(Document.from_urdf(prepared, packages=given) if given else Document.load(prepared))
+        assert judge.compare_models(theirs, ours) == [], (case, given)
+    assert theirs.mesh_vert[:, 2].max() > 0.3  # the file MuJoCo's rule finds (scaled by 2)
+
+
+def test_where_mujocos_rule_finds_nothing_packages_are_resolved_and_both_places_named(package):
+    urdf, folder = package
+    prepared = urdf.with_name("prepared.urdf")
+    prepared.write_text(TET_URDF.format(file="package://my_meshes/meshes/tet.obj").replace(
+        '<robot name="tet">', '<robot name="tet"><mujoco><compiler strippath="true"/></mujoco>'))
+    # Nothing beside the file: the package's file.
+    m = compiled(Document.from_urdf(prepared, packages={"my_meshes": folder}))
+    assert m.nmesh == 1 and m.mesh_vertnum[0] == 4
+    with pytest.raises(MjcfError) as err:
+        Document.from_urdf(prepared)
+    (message,) = err.value.errors
+    assert f"no such file where MuJoCo looks ({urdf.parent / 'tet.obj'})" in message, message
+    assert "package 'my_meshes' is found nowhere" in message, message
 
 
 def test_from_urdf_refuses_mjcf_and_missing_files(tmp_path, arm):

@@ -51,6 +51,7 @@ pub struct Judge {
     venv: &'static str,
     models_list: &'static str,
     urdf_list: &'static str,
+    prepared_list: &'static str,
 }
 
 /// Every judging MuJoCo: what we write must compile under each to what its input compiles to
@@ -61,12 +62,14 @@ pub const JUDGES: [Judge; 2] = [
         venv: ".cache/venv",
         models_list: "models.txt",
         urdf_list: "urdf-models.txt",
+        prepared_list: "urdf-prepared.txt",
     },
     Judge {
         version: "4.0.0",
         venv: ".cache/venv-mj4",
         models_list: "models-mj4.txt",
         urdf_list: "urdf-models-mj4.txt",
+        prepared_list: "urdf-prepared-mj4.txt",
     },
 ];
 
@@ -91,6 +94,22 @@ impl Judge {
     /// MuJoCo's importer compiles.
     pub fn wheel_urdfs(&self) -> Vec<PathBuf> {
         Self::listed(self.urdf_list)
+    }
+
+    /// The corpus URDFs prepared for MuJoCo (scripts/list_urdf.py: a copy with its meshes
+    /// beside it and `<compiler strippath="true">`) whose copy this MuJoCo's importer
+    /// compiles: (the copy, the file as shipped).
+    pub fn prepared_urdfs(&self) -> Vec<(PathBuf, PathBuf)> {
+        Self::listed(self.prepared_list)
+            .into_iter()
+            .map(|line| {
+                let text = line.to_string_lossy().into_owned();
+                let (copy, shipped) = text
+                    .split_once('\t')
+                    .unwrap_or_else(|| panic!("{}: not COPY<TAB>SHIPPED", self.prepared_list));
+                (root().join(copy), root().join(shipped))
+            })
+            .collect()
     }
 
     fn listed(name: &str) -> Vec<PathBuf> {

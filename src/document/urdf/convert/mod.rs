@@ -93,7 +93,9 @@ struct Writer<'r> {
     errors: Vec<Error>,
     visuals: Visuals,
     strippath: bool,
+    /// The file's own `<compiler meshdir assetdir>`: where MuJoCo looks for its meshes.
     meshdir: Option<String>,
+    assetdir: Option<String>,
     /// URDF material name -> its colour text (the first definition with a colour).
     materials: AHashMap<&'r str, &'r str>,
     /// Mesh assets by file stem, as the importer keys them.
@@ -157,6 +159,7 @@ impl<'r> Writer<'r> {
             visuals: Visuals::Dropped,
             strippath: false,
             meshdir: None,
+            assetdir: None,
             materials: AHashMap::new(),
             meshes: MeshNames::default(),
             visual_meshes: AHashMap::new(),
@@ -378,6 +381,7 @@ impl<'r> Writer<'r> {
         };
         self.strippath = setting("strippath") == Some("true");
         self.meshdir = setting("meshdir").map(str::to_string);
+        self.assetdir = setting("assetdir").map(str::to_string);
         let fuse = if self.options.fuse_static {
             setting("fusestatic").unwrap_or("true")
         } else {
@@ -606,69 +610,67 @@ impl<'r> Writer<'r> {
         Some(g)
     }
 
-    /// The file a URDF reference names, as MJCF will name it: `package://` and `file://`
-    /// resolved, MuJoCo's `strippath` applied, COLLADA and missing files refused.
+    /// The file a URDF reference names, as MJCF will name it. MuJoCo's own rule first: the
+    /// name its compiler opens (the file's `strippath` applied, to any path or URI), in the
+    /// file's mesh folder (`meshdir`, else `assetdir`, from the URDF's folder) unless
+    /// absolute. Only where that finds no file are `package://` and `file://` resolved, so
+    /// resolution never changes a model MuJoCo builds. COLLADA and missing files refused,
+    /// a missing one with every place looked in.
     fn file_reference(&mut self, at: Node, file: &'r str) -> Option<String> {
-        let resolved = if self.options.resolve_packages {
-            self.packages.resolve(file)
+        let own = if self.strippath {
+            strip_path(file)
         } else {
-            Resolved::Plain
+            file
         };
-        let path = match resolved {
-            Resolved::Plain => {
-                let f = if self.strippath {
-                    strip_path(file)
-                } else {
-                    file
-                };
-                f.to_string()
-            }
-            Resolved::File(p) => p.to_string_lossy().into_owned(),
-            Resolved::Unfound(pkg) => {
-                self.error(
-                    at,
-                    format!(
-                        "'{file}': package '{pkg}' is found nowhere: give its folder (the \
-                         `packages` option; --urdf-package {pkg}=DIR on the command line), or \
-                         list it on ROS_PACKAGE_PATH"
-                    ),
-                );
-                return None;
-            }
-        };
-        if file.starts_with("package://") && !self.options.resolve_packages {
-            return Some(path);
+        let uri = file.starts_with("package://") || file.starts_with("file://");
+        if uri && !self.options.resolve_packages {
+            // Left as MuJoCo's importer sees it.
+            return Some(own.to_string());
         }
-        if path.to_ascii_lowercase().ends_with(".dae") {
+        if file.to_ascii_lowercase().ends_with(".dae") {
+            let name = strip_path(file);
             self.error(
                 at,
                 format!(
                     "'{file}' is a COLLADA mesh, which MuJoCo cannot read (it reads STL, OBJ \
                      and MSH): convert it, for example with `assimp export {name} {stem}.obj`, \
                      and point the URDF at the converted file",
-                    name = strip_path(&path),
-                    stem = strip_ext(strip_path(&path)),
+                    stem = strip_ext(name),
                 ),
             );
             return None;
         }
-        let full = {
-            let p = std::path::Path::new(&path);
-            if p.is_absolute() {
-                p.to_path_buf()
-            } else {
-                let dir = match &self.meshdir {
-                    Some(m) => self.raw.model_dir.join(m),
-                    None => self.raw.model_dir.to_path_buf(),
-                };
-                dir.join(p)
-            }
+        let own_full = {
+            let p = std::path::Path::new(own);
+            let dir = match self.meshdir.as_deref().or(self.assetdir.as_deref()) {
+                Some(m) => self.raw.model_dir.join(m),
+                None => self.raw.model_dir.to_path_buf(),
+            };
+            dir.join(p)
         };
-        if !full.is_file() {
-            self.error(at, format!("'{file}': no such file ({})", full.display()));
-            return None;
+        if own_full.is_file() {
+            return Some(own.to_string());
         }
-        Some(path)
+        let looked = own_full.display();
+        let message = match (uri, self.packages.resolve(file)) {
+            (true, Resolved::File(p)) if p.is_file() => {
+                return Some(p.to_string_lossy().into_owned());
+            }
+            (true, Resolved::File(p)) => {
+                format!(
+                    "'{file}': no such file (not {looked}, where MuJoCo looks, nor {})",
+                    p.display()
+                )
+            }
+            (true, Resolved::Unfound(pkg)) => format!(
+                "'{file}': no such file where MuJoCo looks ({looked}), and package '{pkg}' is \
+                 found nowhere: give its folder (the `packages` option; --urdf-package \
+                 {pkg}=DIR on the command line), or list it on ROS_PACKAGE_PATH"
+            ),
+            _ => format!("'{file}': no such file ({looked})"),
+        };
+        self.error(at, message);
+        None
     }
 
     /// The mesh asset for a `<mesh>` geometry, made when new; its name.
