@@ -197,20 +197,21 @@ stage "judge self-tests (MuJoCo 3.17.0 and 4.0.0)"
 # simulators in venvs of their own, through subprocesses (little memory in pytest itself);
 # the package lane runs the package's own tests in-process, under 3.17.0, then 4.0.0 and
 # LIBERO's 3.3.1. Each lane writes its log, printed when both are done.
-CLIENT_TESTS=(test_robosuite_clients.py test_libero.py test_robosuite_cover.py
-              test_robosuite_resets.py test_robosuite_use.py)
+# (Balanced by a fresh clone's run: the clients lane 920 s, the package lane 500 s before
+# it took the batched simulators, 240 s, and robosuite's resets and builds, 70 s.)
+CLIENT_TESTS=(test_robosuite_clients.py test_libero.py test_robosuite_cover.py)
 clients_lane() {
   # robosuite 1.5.2, 1.4.0 (MuJoCo 3.3.1, 2.3.7) and LIBERO, stock against switched.
   local files=()
   for f in "${CLIENT_TESTS[@]}"; do files+=("python/tests/$f"); done
   measured .cache/venv/bin/python -m pytest "${files[@]}" -q -p no:cacheprovider --durations=15
-  echo "== batched simulators (MuJoCo Warp, MJX on JAX's CPU backend, CPU MuJoCo) judge WorldBatch"
-  measured .cache/venv-sim/bin/python -m pytest python/tests/test_batch_sim.py -q -p no:cacheprovider
 }
 package_lane() {
-  # (test_batch_sim.py needs MuJoCo Warp and JAX: the clients lane runs it in .cache/venv-sim.)
+  # (test_batch_sim.py needs MuJoCo Warp and JAX: it runs last, in .cache/venv-sim.)
   local ignored=(--ignore=python/tests/test_batch_sim.py)
   for f in "${CLIENT_TESTS[@]}"; do ignored+=("--ignore=python/tests/$f"); done
+  # (robosuite's resets and builds, test_robosuite_resets.py and test_robosuite_use.py, run
+  # here too: their drivers run in the robosuite venv, one process at a time.)
   measured .cache/venv/bin/python -m pytest python/tests -q -p no:cacheprovider "${ignored[@]}" --durations=25
   echo "== what depends on the installed MuJoCo: 4.0.0, and LIBERO's 3.3.1"
   measured .cache/venv-mj4/bin/python -m pytest python/tests/test_model_cache.py python/tests/test_world_batch.py \
@@ -225,6 +226,8 @@ package_lane() {
   rm -rf "$only"
   # robosuite's task XMLs (written by the robosuite venv) through a DocumentCache, judged by 4.0.0.
   .cache/venv-mj4/bin/python -m pytest python/tests/test_robosuite_resets.py -k task_xmls -q -p no:cacheprovider
+  echo "== batched simulators (MuJoCo Warp, MJX on JAX's CPU backend, CPU MuJoCo) judge WorldBatch"
+  measured .cache/venv-sim/bin/python -m pytest python/tests/test_batch_sim.py -q -p no:cacheprovider
 }
 
 stage "python: the package (3.17.0, 4.0.0, 3.3.1) beside robosuite's and LIBERO's clients and the batched simulators"
