@@ -176,19 +176,25 @@ CHANGES = {
 NOT_COPIED = {"density": "500"}
 
 
-@pytest.mark.parametrize("field", sorted(CHANGES) + sorted(NOT_COPIED))
-def test_a_load_of_another_text_of_the_same_scene_writes_as_stocks_load(tmp_path, field):
-    held = SCENE.format(**VALUES)
-    owed = SCENE.format(**{**VALUES, field: {**CHANGES, **NOT_COPIED}[field]})
-    expected = stock(owed, tmp_path)  # stock: the owed text loaded, its model written
-    # The switch: the held text loaded and written once (as a recording's first episode),
-    # then the owed text served by the cache.
+def held_then_served(held: str, owed: str, tmp_path) -> tuple:
+    """The switch's sequence: ``held`` loaded and written once (as a recording's first
+    episode), then ``owed`` served by the cache. Returns (the held compile, the served
+    model, the slot's state before the served one was owed)."""
     _last_xml.owe(held)
     first = compile_xml(mujoco, held)
     saved(first, tmp_path)
     before = _last_xml.state()
     served = compile_xml(mujoco, owed)
     _last_xml.owe(owed, served=served)
+    return first, served, before
+
+
+@pytest.mark.parametrize("field", sorted(CHANGES) + sorted(NOT_COPIED))
+def test_a_load_of_another_text_of_the_same_scene_writes_as_stocks_load(tmp_path, field):
+    held = SCENE.format(**VALUES)
+    owed = SCENE.format(**{**VALUES, field: {**CHANGES, **NOT_COPIED}[field]})
+    expected = stock(owed, tmp_path)  # stock: the owed text loaded, its model written
+    _, served, before = held_then_served(held, owed, tmp_path)
     assert saved(served, tmp_path) == expected
     assert saved(served, tmp_path) == expected  # a second read of the same model
     after = _last_xml.state()
@@ -276,12 +282,7 @@ def test_a_text_whose_compile_has_other_sizes_than_the_held_one_is_loaded(tmp_pa
     held = TWO_GEOM_BOX.format(size="0.1 0.2 0.3")
     owed = TWO_GEOM_BOX.format(size="0.3 0.1 0.2")
     expected = stock(owed, tmp_path)
-    _last_xml.owe(held)
-    first = compile_xml(mujoco, held)
-    saved(first, tmp_path)
-    before = _last_xml.state()
-    served = compile_xml(mujoco, owed)
-    _last_xml.owe(owed, served=served)
+    first, served, before = held_then_served(held, owed, tmp_path)
     assert saved(served, tmp_path) == expected
     after = _last_xml.state()
     if ("geom", "size") in _last_xml.copied_back(mujoco.__version__):
