@@ -56,6 +56,10 @@ end_stage() {
   STAGE=""
   MEMORY=""
 }
+sample_peak() { # FILE: writes the machine's peak used memory (kB) into FILE, every second
+  local peak=0 u
+  while sleep 1; do u="$(used_kb)"; ((u > peak)) && peak=$u && echo "$peak" >"$1"; done
+}
 used_kb() { awk '/^MemTotal:/ {t = $2} /^MemAvailable:/ {a = $2} END {print t - a}' /proc/meminfo; }
 measured() { # CMD...: runs it, noting its peak memory for the stage's summary line
   local peak_file rss_file sampler before status=0
@@ -63,7 +67,7 @@ measured() { # CMD...: runs it, noting its peak memory for the stage's summary l
   rss_file="$(mktemp)"
   before="$(used_kb)"
   echo 0 >"$peak_file"
-  ( peak=0; while sleep 1; do u="$(used_kb)"; ((u > peak)) && peak=$u && echo "$peak" >"$peak_file"; done ) &
+  sample_peak "$peak_file" &
   sampler=$!
   if [[ -x /usr/bin/time ]]; then
     /usr/bin/time -o "$rss_file" -f '%M' "$@" || status=$?
@@ -87,12 +91,12 @@ lanes() { # FN...: runs each function at once in the background, each into its o
   before="$(used_kb)"
   peak_file="$(mktemp)"
   echo 0 >"$peak_file"
-  ( peak=0; while sleep 1; do u="$(used_kb)"; ((u > peak)) && peak=$u && echo "$peak" >"$peak_file"; done ) &
+  sample_peak "$peak_file" &
   sampler=$!
   for fn in "$@"; do
     logs+=(".cache/logs/lane-$fn.log")
     # A bash of its own, so that `set -e` holds in it whatever context calls lanes.
-    bash -c "set -euo pipefail; $(declare -f used_kb measured "$fn"); $(declare -p CLIENT_TESTS); $fn" \
+    bash -c "set -euo pipefail; $(declare -f used_kb sample_peak measured "$fn"); $(declare -p CLIENT_TESTS); $fn" \
       >".cache/logs/lane-$fn.log" 2>&1 &
     pids+=($!)
   done
