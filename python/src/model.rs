@@ -158,6 +158,9 @@ impl PyModel {
             name_unnamed_geoms,
             exclude_from_prefixing,
         };
+        // A URDF file's load warnings, raised as Document.load raises them (a Document
+        // given raised its own when it was loaded).
+        let read_urdf = matches!(source, Source::Urdf(..));
         let model = run(py, move || {
             let doc = match source {
                 Source::Doc(doc) => *doc,
@@ -166,6 +169,15 @@ impl PyModel {
             };
             Ok(XmlModel::with_prefix(doc, &prefix, options)?)
         })?;
+        for w in model.document().warnings().iter().filter(|_| read_urdf) {
+            let message = std::ffi::CString::new(w.to_string()).unwrap_or_default();
+            PyErr::warn(
+                py,
+                &py.get_type::<pyo3::exceptions::PyUserWarning>(),
+                &message,
+                1,
+            )?;
+        }
         Ok(PyModel::with(model))
     }
 

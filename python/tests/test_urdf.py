@@ -196,6 +196,56 @@ def test_the_corpus_compiles_to_mujocos_import(tmp_path):
     assert not failures, summary
 
 
+def mujoco_warnings(load) -> list[str]:
+    """The warnings MuJoCo gives while ``load()`` runs, in order."""
+    said: list[str] = []
+    mujoco.set_mju_user_warning(said.append)
+    try:
+        load()
+    finally:
+        mujoco.set_mju_user_warning(None)
+    return said
+
+
+def test_the_importers_warnings_reach_the_user_with_mujocos_messages():
+    """Every warning MuJoCo's URDF importer gives (on the corpus and our cases:
+    ``corpora/urdf/warned.urdf`` holds each kind) is raised by ``Document.load`` as a
+    ``UserWarning`` at its place in the file, with MuJoCo's message, in MuJoCo's order;
+    nothing else is. (MuJoCo's warnings while compiling our output are its compiler's,
+    given for the URDF too: they are not the importer's.)"""
+    import warnings
+
+    cases = sorted((ROOT / "corpora" / "urdf").glob("*.urdf"))
+    failures: dict[str, list[str]] = {}
+    warned = 0
+    for urdf in corpus_urdfs() + cases:
+        theirs = mujoco_warnings(lambda: mujoco.MjModel.from_xml_path(str(urdf)))
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            doc = Document.load(urdf)
+        compiler = mujoco_warnings(lambda: compiled(doc))
+        for w in compiler:
+            if w in theirs:
+                theirs.remove(w)
+        ours = [str(c.message) for c in caught if c.category is UserWarning]
+        at = f"{urdf}:"
+        if not all(o.startswith(at) for o in ours):
+            failures[str(urdf)] = [f"a warning not at its place in the file: {ours}"]
+            continue
+        ours = [o.split(": ", 1)[1] for o in ours]
+        warned += bool(ours)
+        if ours != theirs:
+            failures[str(urdf)] = [f"ours {ours}", f"MuJoCo's {theirs}"]
+    assert not failures, failures
+    # The case file warns under both versions (the mimics); 4.0.0 about its bounds too.
+    expected = 4 if MUJOCO3 else 6
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        Document.load(ROOT / "corpora" / "urdf" / "warned.urdf")
+    assert len(caught) == expected, [str(c.message) for c in caught]
+    assert warned >= 1
+
+
 def test_the_importer_followed_is_the_installed_mujocos():
     r2d2 = corpus_urdf(R2D2)
     assert mujoco_version() == mujoco.__version__

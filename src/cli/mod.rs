@@ -316,7 +316,13 @@ impl Loader {
     /// bad URDF flag) as text.
     pub fn load(&self, path: &Path) -> Result<mjcf_forge::Document, String> {
         let urdf = self.urdf.as_ref().map_err(Clone::clone)?;
-        mjcf_forge::Document::load_urdf_with(path, &self.limits, urdf).map_err(|e| e.to_string())
+        let doc = mjcf_forge::Document::load_urdf_with(path, &self.limits, urdf)
+            .map_err(|e| e.to_string())?;
+        // What MuJoCo's URDF importer warns about, on standard error as it prints them.
+        for w in doc.warnings() {
+            eprintln!("{}: warning: {}", w.location, w.message);
+        }
+        Ok(doc)
     }
 }
 

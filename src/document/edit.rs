@@ -65,6 +65,7 @@ impl Document {
             names: Names::default(),
             model_dir,
             limits,
+            warnings: Vec::new(),
         }
     }
 

@@ -58,6 +58,24 @@ impl Document {
         finish(read::read_file(path, limits)?, urdf)
     }
 
+    /// [`Document::load_full`] of a file that must be URDF (or xacro): `None` when it is
+    /// MJCF, for the caller to say where the URDF options were given.
+    pub(crate) fn load_urdf_only(
+        path: &Path,
+        limits: &Limits,
+        urdf: &UrdfOptions,
+    ) -> Result<Option<Document>, Errors> {
+        if let Some(xacro) = urdf::xacro_text(path, limits)? {
+            let dir = path.parent().unwrap_or(Path::new(""));
+            return finish(read::read_str(&xacro, dir, limits)?, urdf).map(Some);
+        }
+        let doc = read::read_file(path, limits)?;
+        if !doc.is_urdf() {
+            return Ok(None);
+        }
+        finish(doc, urdf).map(Some)
+    }
+
     /// Loads MJCF text; `base_dir` plays the part of the main file's folder (includes and
     /// asset files are found from there). Positions are reported in `<string>`.
     ///

@@ -179,9 +179,20 @@ pub struct Document {
     pub(crate) model_dir: Arc<Path>,
     /// The bounds it was loaded with; files read later (meshes, skins) keep to them too.
     pub(crate) limits: Limits,
+    /// What its load warned about (a URDF's inputs that MuJoCo's importer warns about).
+    pub(crate) warnings: Vec<crate::error::Warning>,
 }
 
 impl Document {
+    /// What the load of this document warned about, in the order of the input: the
+    /// inputs of a URDF file that MuJoCo's own importer warns about, with its messages
+    /// (see [`crate::Warning`]). Empty for MJCF, and for a document built or edited in
+    /// memory; the command line prints them, the Python package raises each as a
+    /// `UserWarning`.
+    pub fn warnings(&self) -> &[crate::error::Warning] {
+        &self.warnings
+    }
+
     /// The bounds this document was loaded with (files it reads later keep to them).
     pub fn limits(&self) -> &Limits {
         &self.limits

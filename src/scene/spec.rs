@@ -52,6 +52,46 @@ pub(crate) struct FixtureSpec {
     /// Name unnamed geoms of group 0/1 `g{n}_col`/`g{n}_vis` (robosuite's habit).
     #[serde(default)]
     pub(crate) name_unnamed_geoms: bool,
+    /// How the model is read when it is URDF; an error for an MJCF model.
+    pub(crate) urdf: Option<Spanned<UrdfSpec>>,
+}
+
+/// How a URDF model of a scene is read (`mjcf_forge::UrdfOptions`, the command line's
+/// `--urdf-*` flags): MuJoCo's importer without it.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct UrdfSpec {
+    /// Keep each `<visual>` as a geom of group 1 (no mass, no contacts).
+    #[serde(default)]
+    pub(crate) visuals: bool,
+    /// Fuse static links into their parents, as MuJoCo's importer does.
+    #[serde(default = "yes")]
+    pub(crate) fuse_static: bool,
+    /// Links kept as bodies even when static links are fused.
+    #[serde(default)]
+    pub(crate) keep_links: Vec<String>,
+    /// Package folders by name, relative to the scene file's folder.
+    #[serde(default)]
+    pub(crate) packages: std::collections::BTreeMap<String, String>,
+    /// One actuator per hinge and slide joint.
+    pub(crate) actuators: Option<ActuatorSpec>,
+}
+
+/// The actuators of a URDF model: `{ type = "position", kp = 100, kv = 10 }`,
+/// `{ type = "velocity", kv = 5 }` or `{ type = "motor" }`, as the Python package's
+/// `Document.from_urdf(actuators=...)` takes them.
+#[derive(Debug, Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase", deny_unknown_fields)]
+pub(crate) enum ActuatorSpec {
+    Position {
+        kp: f64,
+        #[serde(default)]
+        kv: f64,
+    },
+    Velocity {
+        kv: f64,
+    },
+    Motor,
 }
 
 /// A group of objects drawn from a pool.
@@ -79,6 +119,8 @@ pub(crate) struct GroupSpec {
     /// densities or masses, and MuJoCo is at hand (see [`super::load`]).
     #[serde(default)]
     pub(crate) write_inertials: Option<bool>,
+    /// How the pool's URDF models are read (as for fixtures); an error when none is URDF.
+    pub(crate) urdf: Option<Spanned<UrdfSpec>>,
 }
 
 fn yes() -> bool {

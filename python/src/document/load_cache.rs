@@ -62,7 +62,7 @@ impl PyLoadCache {
                 None => self.cache.load(&path)?,
             })
         })
-        .map(PyDocument::new)
+        .and_then(|d| super::loaded(py, d))
     }
 
     /// How many loads were served from kept documents.

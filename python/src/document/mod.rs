@@ -31,7 +31,7 @@ use std::sync::Arc;
 use ahash::AHashSet;
 use mjcf_forge::split::{PatchValue, SplitOptions, split_document_with};
 use mjcf_forge::{Document, MergePart, Node, Section};
-use pyo3::exceptions::{PyFutureWarning, PyTypeError};
+use pyo3::exceptions::{PyFutureWarning, PyTypeError, PyUserWarning};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyString, PyTuple};
 
@@ -141,7 +141,7 @@ impl PyDocument {
                 None => Document::load(&path)?,
             })
         })
-        .map(PyDocument::new)
+        .and_then(|d| loaded(py, d))
     }
 
     /// Reads MJCF text. ``base_dir`` plays the part of the main file's folder: includes and
@@ -164,7 +164,7 @@ impl PyDocument {
                 None => Document::from_str(&xml, &base_dir)?,
             })
         })
-        .map(PyDocument::new)
+        .and_then(|d| loaded(py, d))
     }
 
     /// Loads a URDF robot (``str`` or path-like; a ``.xacro`` file is expanded with the
@@ -252,7 +252,7 @@ impl PyDocument {
             urdf::check_urdf_file(&path)?;
             Ok(Document::load_urdf(&path, &options)?)
         })
-        .map(PyDocument::new)
+        .and_then(|d| loaded(py, d))
     }
 
     /// URDF text read as :meth:`from_urdf` reads a file, with the same options;
@@ -326,7 +326,7 @@ impl PyDocument {
             urdf::check_urdf_text(&xml)?;
             Ok(Document::from_urdf_str(&xml, &base_dir, &options)?)
         })
-        .map(PyDocument::new)
+        .and_then(|d| loaded(py, d))
     }
 
     /// The document as XML text: compact (no white space between elements) by default,
@@ -869,6 +869,16 @@ impl PyDocument {
             doc.node_count()
         )
     }
+}
+
+/// A loaded document, each of its load's warnings (what MuJoCo's URDF importer warns
+/// about, at its place) raised as a ``UserWarning`` first.
+pub(crate) fn loaded(py: Python<'_>, doc: Document) -> PyResult<PyDocument> {
+    for w in doc.warnings() {
+        let message = std::ffi::CString::new(w.to_string()).unwrap_or_default();
+        PyErr::warn(py, &py.get_type::<PyUserWarning>(), &message, 1)?;
+    }
+    Ok(PyDocument::new(doc))
 }
 
 /// A path of ``ElementTree.find`` and friends, from the tree: an absolute path is taken

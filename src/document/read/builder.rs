@@ -74,6 +74,7 @@ impl Builder {
                 names: Names::default(),
                 model_dir: model_dir.clone(),
                 limits: *limits,
+                warnings: Vec::new(),
             },
             files: vec![SourceFile {
                 path: name.clone(),

@@ -100,6 +100,11 @@ pub(super) fn load(
     }
     let mut pool = Vec::new();
     let mut weights = Vec::new();
+    let urdf = g
+        .urdf
+        .as_ref()
+        .map(|t| super::urdf_options(t.as_ref(), dir));
+    let mut any_urdf = false;
     for entry in g.pool.as_ref() {
         let w = entry.as_ref().weight();
         if !(w.is_finite() && w >= 0.0) {
@@ -108,7 +113,19 @@ pub(super) fn load(
         weights.push(w);
         let file = entry.as_ref().model().to_string();
         let at = Spanned::new(entry.span(), file.clone());
-        let (mut doc, path) = match models.load(dir, &file) {
+        // With the group's `urdf` table, its URDF models are read with those options.
+        let loaded = match &urdf {
+            Some(options) => match models.load_urdf(dir, &file, options) {
+                Ok(Some(x)) => {
+                    any_urdf = true;
+                    Ok(x)
+                }
+                Ok(None) => models.load(dir, &file),
+                Err(e) => Err(e),
+            },
+            None => models.load(dir, &file),
+        };
+        let (mut doc, path) = match loaded {
             Ok(x) => x,
             Err(e) => {
                 errors.extend(src.model_errors(&at, e).0);
@@ -183,6 +200,12 @@ pub(super) fn load(
             }
         };
         pool.push(PoolModel { file, doc, bounds });
+    }
+    if let Some(table) = g.urdf.as_ref().filter(|_| !any_urdf && errors.is_empty()) {
+        errors.push(src.error(
+            table,
+            format!("urdf options are given for group '{name}', whose pool holds no URDF file"),
+        ));
     }
     if !weights.is_empty() && weights.iter().all(|&w| w == 0.0) {
         errors.push(src.error(&g.pool, "at least one weight must be positive"));

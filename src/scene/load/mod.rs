@@ -10,7 +10,9 @@ use toml::Spanned;
 
 use crate::document::Document;
 use crate::document::inertia::InertiaCompiler;
+use crate::document::limits::Limits;
 use crate::document::tree::{Node, Tree};
+use crate::document::urdf::{UrdfActuators, UrdfOptions};
 use crate::error::{Error, ErrorKind, Errors, Location};
 use crate::model::geometry::{Angles, Pose};
 use crate::model::merge::MergeOptions;
@@ -35,6 +37,17 @@ pub(crate) trait ModelSource: Sync {
     /// Loads `file` (as the scene names it) relative to `dir`; also returns its absolute
     /// path when it is a file on disk.
     fn load(&self, dir: &Path, file: &str) -> Result<(Document, Option<PathBuf>), Errors>;
+
+    /// Loads `file` as [`ModelSource::load`] does, a URDF model with `options`; `None`
+    /// when the model is not URDF.
+    fn load_urdf(
+        &self,
+        _dir: &Path,
+        _file: &str,
+        _options: &UrdfOptions,
+    ) -> Result<Option<(Document, Option<PathBuf>)>, Errors> {
+        Ok(None)
+    }
 }
 
 /// Model files on disk.
@@ -46,6 +59,70 @@ impl ModelSource for Files {
         let doc = Document::load(&path)?;
         let abs = std::path::absolute(&path).unwrap_or(path);
         Ok((doc, Some(abs)))
+    }
+
+    fn load_urdf(
+        &self,
+        dir: &Path,
+        file: &str,
+        options: &UrdfOptions,
+    ) -> Result<Option<(Document, Option<PathBuf>)>, Errors> {
+        let path = dir.join(file);
+        let Some(doc) = Document::load_urdf_only(&path, &Limits::default(), options)? else {
+            return Ok(None);
+        };
+        let abs = std::path::absolute(&path).unwrap_or(path);
+        Ok(Some((doc, Some(abs))))
+    }
+}
+
+/// The options a scene's `urdf` table asks for (its package folders relative to `dir`).
+pub(super) fn urdf_options(spec: &spec::UrdfSpec, dir: &Path) -> UrdfOptions {
+    UrdfOptions {
+        visuals: spec.visuals,
+        fuse_static: spec.fuse_static,
+        keep_links: spec.keep_links.clone(),
+        packages: spec
+            .packages
+            .iter()
+            .map(|(name, folder)| (name.clone(), dir.join(folder)))
+            .collect(),
+        actuators: spec.actuators.as_ref().map(|a| match *a {
+            spec::ActuatorSpec::Position { kp, kv } => UrdfActuators::Position { kp, kv },
+            spec::ActuatorSpec::Velocity { kv } => UrdfActuators::Velocity { kv },
+            spec::ActuatorSpec::Motor => UrdfActuators::Motor,
+        }),
+        ..UrdfOptions::default()
+    }
+}
+
+/// A model of the scene, read with its `urdf` table's options where it has one: an
+/// error at that table when the model is not URDF (`what` names it).
+pub(super) fn load_model(
+    models: &dyn ModelSource,
+    src: &Source<'_>,
+    dir: &Path,
+    file: &Spanned<String>,
+    urdf: Option<&Spanned<spec::UrdfSpec>>,
+) -> Result<(Document, Option<PathBuf>), Errors> {
+    let Some(table) = urdf else {
+        return models
+            .load(dir, file.as_ref())
+            .map_err(|e| src.model_errors(file, e));
+    };
+    let options = urdf_options(table.as_ref(), dir);
+    match models.load_urdf(dir, file.as_ref(), &options) {
+        Ok(Some(x)) => Ok(x),
+        Ok(None) => Err(src
+            .error(
+                table,
+                format!(
+                    "urdf options are given for '{}', which is not a URDF file",
+                    file.as_ref()
+                ),
+            )
+            .into()),
+        Err(e) => Err(src.model_errors(file, e)),
     }
 }
 
@@ -211,10 +288,10 @@ fn build(
     parts.push((0, base_end, Arc::from("base"), Arc::from("")));
     let mut prefixes: Vec<&str> = Vec::new();
     for f in &spec.fixture {
-        let (doc, path) = match models.load(&dir, f.model.as_ref()) {
+        let (doc, path) = match load_model(models, src, &dir, &f.model, f.urdf.as_ref()) {
             Ok(x) => x,
             Err(e) => {
-                errors.extend(src.model_errors(&f.model, e).0);
+                errors.extend(e.0);
                 continue;
             }
         };

@@ -5,8 +5,8 @@ use super::{Writer, num};
 use crate::document::tree::Node;
 
 impl Writer<'_> {
-    /// `UrdfOptions::actuators`: one actuator per hinge and slide joint, but those a
-    /// `<mimic>` drives through its equality. A position actuator's control range is the
+    /// `UrdfOptions::actuators`: one actuator per joint of `joints` (the hinges and
+    /// slides but those a `<mimic>` drives through its equality). A position actuator's control range is the
     /// joint's range as the importer reads it (none for a continuous joint under 4.0.0).
     pub(super) fn actuators(&mut self, kind: &UrdfActuators, joints: &[Node]) {
         let raw = self.raw;
@@ -16,9 +16,6 @@ impl Writer<'_> {
             let Some(name) = raw.attr(j, "name") else {
                 continue;
             };
-            if self.sub(j, "mimic").is_some() {
-                continue;
-            }
             let unlimited = raw.attr(j, "type") == Some("continuous")
                 && self.options.importer == UrdfImporter::MuJoCo4;
             let limit = self.sub(j, "limit");

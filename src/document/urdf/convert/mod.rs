@@ -23,14 +23,16 @@
 use ahash::{AHashMap, AHashSet};
 
 mod actuators;
+mod joints;
 mod visuals;
 
+use super::UrdfOptions;
 use super::packages::{Packages, Resolved};
 use super::robot::Robot;
-use super::{UrdfImporter, UrdfOptions};
 use crate::document::Document;
 use crate::document::tree::{Node, Tree};
-use crate::error::{Error, ErrorKind, Errors};
+use crate::error::{Error, ErrorKind, Errors, Warning};
+use joints::JointKind;
 
 /// How `<visual>` elements are read.
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -56,6 +58,7 @@ pub(crate) fn convert(raw: &Document, options: &UrdfOptions) -> Result<Document,
     let mut w = Writer::new(raw, options);
     w.write(&robot);
     if w.errors.is_empty() {
+        w.doc.warnings = std::mem::take(&mut w.warnings);
         Ok(w.doc)
     } else {
         Err(Errors(w.errors))
@@ -91,6 +94,8 @@ struct Writer<'r> {
     options: &'r UrdfOptions,
     doc: Document,
     errors: Vec<Error>,
+    /// What MuJoCo's importer warns about, with its messages.
+    warnings: Vec<Warning>,
     visuals: Visuals,
     strippath: bool,
     /// The file's own `<compiler meshdir assetdir>`: where MuJoCo looks for its meshes.
@@ -156,6 +161,7 @@ impl<'r> Writer<'r> {
             options,
             doc,
             errors: Vec::new(),
+            warnings: Vec::new(),
             visuals: Visuals::Dropped,
             strippath: false,
             meshdir: None,
@@ -182,6 +188,12 @@ impl<'r> Writer<'r> {
     fn error(&mut self, at: Node, msg: String) {
         self.errors
             .push(self.raw.error_at(at, ErrorKind::Invalid(msg)));
+    }
+
+    /// A warning MuJoCo's importer gives, with its message, at `at`.
+    fn warn(&mut self, at: Node, message: String) {
+        let location = self.raw.location(at);
+        self.warnings.push(Warning { location, message });
     }
 
     /// A new element `tag` of the output, placed at `from`'s source position.
@@ -299,6 +311,8 @@ impl<'r> Writer<'r> {
         // Joints, in file order.
         let mut equalities = Vec::new();
         let mut actuated = Vec::new();
+        // The importer warns about the <mimic>s it ignores after reading every joint.
+        let mut ignored = Vec::new();
         for &j in &robot.joints {
             let Some(child) = self
                 .sub(j, "child")
@@ -308,13 +322,33 @@ impl<'r> Writer<'r> {
                 continue;
             };
             if let Some(kind) = self.joint(j, bodies[child]) {
-                if let Some(m) = self.sub(j, "mimic").filter(|_| kind.mimics()) {
-                    equalities.push((j, m));
-                }
-                if kind.mimics() {
+                let mimic = self.sub(j, "mimic").filter(|_| kind != JointKind::Fixed);
+                let read = match mimic {
+                    Some(m) if kind.mimics() && self.leader_moves(m, robot) => {
+                        equalities.push((j, m));
+                        true
+                    }
+                    Some(m) => {
+                        let name = raw.attr(j, "name").unwrap_or_default();
+                        ignored.push((
+                            m,
+                            format!(
+                                "<mimic> on joint '{name}' ignored; mimic requires revolute, \
+                                 continuous, or prismatic joints"
+                            ),
+                        ));
+                        false
+                    }
+                    None => false,
+                };
+                // A joint its <mimic> drives gets no actuator of its own.
+                if kind.mimics() && !read {
                     actuated.push(j);
                 }
             }
+        }
+        for (m, message) in ignored {
+            self.warn(m, message);
         }
         if !equalities.is_empty() {
             let eq = self.child(self.root, "equality", root);
@@ -732,167 +766,5 @@ impl<'r> Writer<'r> {
         }
         self.mesh_names.insert(name.to_string());
         n
-    }
-
-    /// A `<joint>`'s origin on its child body, and the MJCF joint(s) it makes.
-    fn joint(&mut self, j: Node, body: Node) -> Option<JointKind> {
-        let raw = self.raw;
-        let ty = self.required(j, "type")?;
-        let name = self.required(j, "name")?;
-        let continuous = ty == "continuous";
-        let kind = match ty {
-            "revolute" | "continuous" => JointKind::Hinge,
-            "prismatic" => JointKind::Slide,
-            "fixed" => JointKind::Fixed,
-            "floating" => JointKind::Free,
-            "spherical" => JointKind::Ball,
-            "planar" => JointKind::Planar,
-            other => {
-                self.error(
-                    j,
-                    format!(
-                        "invalid joint type '{other}' in URDF joint '{name}' (revolute, \
-                         continuous, prismatic, fixed, floating, planar or spherical)"
-                    ),
-                );
-                return None;
-            }
-        };
-        if body != self.worldbody {
-            self.origin(j, body);
-        }
-        let axis = match self.sub(j, "axis") {
-            Some(a) => self.required(a, "xyz")?,
-            None => "1 0 0",
-        };
-        let out = match kind {
-            JointKind::Fixed => return Some(kind),
-            _ => self.child(body, "joint", j),
-        };
-        // A planar joint is the importer's three: slides along the x and y of the frame
-        // whose z is the axis (`mjuu_z2quat`), and a hinge about the axis; the limit
-        // reaches the first only, the dynamics all three.
-        let mut all = vec![out];
-        if kind == JointKind::Planar {
-            let v = self.numbers(j, "axis", axis, 3)?;
-            let m =
-                crate::document::rotation::quat_to_mat(&crate::document::rotation::z_to_quat(&[
-                    v[0], v[1], v[2],
-                ]));
-            self.set(out, "name", &format!("{name}_TX"));
-            self.set(out, "type", "slide");
-            self.set(
-                out,
-                "axis",
-                &format!("{} {} {}", num(m[0]), num(m[3]), num(m[6])),
-            );
-            for (suffix, ty, ax) in [
-                (
-                    "_TY",
-                    "slide",
-                    format!("{} {} {}", num(m[1]), num(m[4]), num(m[7])),
-                ),
-                ("_RZ", "hinge", axis.to_string()),
-            ] {
-                let more = self.child(body, "joint", j);
-                self.set(more, "name", &format!("{name}{suffix}"));
-                self.set(more, "type", ty);
-                self.set(more, "axis", &ax);
-                all.push(more);
-            }
-        } else {
-            self.set(out, "name", name);
-        }
-        match kind {
-            JointKind::Slide => self.set(out, "type", "slide"),
-            JointKind::Free => self.set(out, "type", "free"),
-            JointKind::Ball => self.set(out, "type", "ball"),
-            _ => {}
-        }
-        if !matches!(kind, JointKind::Free | JointKind::Planar) {
-            self.set(out, "axis", axis);
-        }
-        if let Some(d) = self.sub(j, "dynamics") {
-            for &n in &all {
-                if let Some(v) = raw.attr(d, "damping") {
-                    self.set(n, "damping", v);
-                }
-                if let Some(v) = raw.attr(d, "friction") {
-                    self.set(n, "frictionloss", v);
-                }
-            }
-        }
-        if continuous && self.options.importer == UrdfImporter::MuJoCo4 {
-            // 4.0.0 reads no range for a continuous joint.
-            self.set(out, "limited", "false");
-        }
-        if let Some(limit) = self.sub(j, "limit") {
-            let (mut lower, mut upper) = (raw.attr(limit, "lower"), raw.attr(limit, "upper"));
-            if continuous && self.options.importer == UrdfImporter::MuJoCo4 {
-                (lower, upper) = (None, None);
-            }
-            let mut value = |t: Option<&str>, attr| match t {
-                Some(t) => self.numbers(limit, attr, t, 1).map(|v| v[0]),
-                None => Some(0.0),
-            };
-            let (lo, hi) = (value(lower, "lower")?, value(upper, "upper")?);
-            if lower.is_some() || upper.is_some() {
-                let range = format!(
-                    "{} {}",
-                    lower.map_or("0", str::trim),
-                    upper.map_or("0", str::trim)
-                );
-                self.set(out, "range", &range);
-            }
-            if lower.is_some() != upper.is_some() || lo > hi {
-                self.set(out, "limited", "false");
-            }
-            if let Some(e) = raw.attr(limit, "effort") {
-                let e = self.numbers(limit, "effort", e, 1)?[0].abs();
-                if e > 0.0 {
-                    self.set(out, "actuatorfrcrange", &format!("{} {}", num(-e), num(e)));
-                }
-            }
-        }
-        Some(kind)
-    }
-
-    /// A `<mimic>` as the importer writes it: a joint equality, the follower first, with
-    /// `polycoef="offset multiplier 0 0 0"`.
-    fn mimic(&mut self, eq: Node, j: Node, m: Node) {
-        let raw = self.raw;
-        let (Some(name), Some(leader)) = (raw.attr(j, "name"), self.required(m, "joint")) else {
-            return;
-        };
-        let e = self.child(eq, "joint", m);
-        self.set(e, "joint1", name);
-        self.set(e, "joint2", leader);
-        let (mult, off) = (raw.attr(m, "multiplier"), raw.attr(m, "offset"));
-        if mult.is_some() || off.is_some() {
-            let coef = format!(
-                "{} {} 0 0 0",
-                off.map_or("0", str::trim),
-                mult.map_or("1", str::trim)
-            );
-            self.set(e, "polycoef", &coef);
-        }
-    }
-}
-
-/// What a URDF joint becomes.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum JointKind {
-    Hinge,
-    Slide,
-    Fixed,
-    Free,
-    Ball,
-    Planar,
-}
-
-impl JointKind {
-    /// Whether a `<mimic>` on it is read (MuJoCo warns about and drops the others).
-    fn mimics(self) -> bool {
-        matches!(self, JointKind::Hinge | JointKind::Slide)
     }
 }
