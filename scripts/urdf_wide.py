@@ -38,7 +38,10 @@ def judged(path: str) -> dict:
 
     from mjcf_forge import Document, MjcfError
 
-    mujoco.set_mju_user_warning(lambda _msg: None)
+    import warnings
+
+    said: list[str] = []
+    mujoco.set_mju_user_warning(said.append)
     urdf = Path(path)
     corpus = CORPUS / urdf.relative_to(CORPUS).parts[0]
     out: dict = {"file": str(urdf.relative_to(CORPUS))}
@@ -58,9 +61,28 @@ def judged(path: str) -> dict:
             return "ours does not compile: " + str(e).strip().splitlines()[0][:200]
         return judge.compare_models(reference, model)[:3] or "equal"
 
+    said.clear()
     reference, out["mujoco_shipped"] = theirs(urdf)
     if reference is not None:
         out["shipped"] = ours(urdf, reference)
+        # MuJoCo's importer warnings (its compiler's, given for our output too, aside)
+        # against the UserWarnings of our load, messages in order.
+        importer = list(said)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                doc = Document.load(urdf)
+                said.clear()
+                mujoco.MjModel.from_xml_string(doc.to_xml())
+                for w in said:
+                    if w in importer:
+                        importer.remove(w)
+            except Exception:  # judged above
+                pass
+        mine = [str(c.message).split(": ", 1)[-1] for c in caught if c.category is UserWarning]
+        out["warned"] = len(mine)
+        if mine != importer:
+            out["warnings"] = f"ours {mine}, MuJoCo's {importer}"
     copy, why = list_urdf.prepare(urdf, corpus)
     if copy is None:
         out["prepared"] = "not prepared: " + why
@@ -106,6 +128,14 @@ def main() -> int:
             if r[key] != "equal":
                 status = 1
                 print(f"  {r['file']}: {r[key]}")
+    warned = [r for r in results if r.get("warned")]
+    print(f"urdf_wide: MuJoCo {version}: importer warnings: {len(warned)} files warned, "
+          f"{sum(r['warned'] for r in warned)} warnings, every one as MuJoCo's"
+          if not any("warnings" in r for r in results) else "urdf_wide: warnings differ:")
+    for r in results:
+        if "warnings" in r:
+            status = 1
+            print(f"  {r['file']}: {r['warnings']}")
     reasons = Counter(r["prepared"].split(":")[0] + ": " + r["prepared"].split(":")[1].split("'")[0].strip()
                       for r in results if r.get("prepared") != "ok")
     for reason, n in reasons.most_common():

@@ -392,9 +392,11 @@ print(seen["body"], seen["jnt"], seen["geom"], seen["actuator"])
     let file = dir.join("bad.toml");
     let copy = |text: &str| {
         std::fs::write(&file, text).unwrap();
-        for f in ["arm.urdf"] {
-            std::fs::copy(root().join("corpora/scenes/urdf").join(f), dir.join(f)).unwrap();
-        }
+        std::fs::copy(
+            root().join("corpora/scenes/urdf/arm.urdf"),
+            dir.join("arm.urdf"),
+        )
+        .unwrap();
         let base = root().join("corpora/scenes/demo");
         let text = text.replace("../demo/", &format!("{}/", base.display()));
         std::fs::write(&file, text).unwrap();

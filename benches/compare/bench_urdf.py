@@ -12,7 +12,10 @@ alternating:
 * MuJoCo, importer alone: ``MjSpec.from_file(path).to_xml()`` (no compile: the fairer and
   harder comparison).
 
-Run: ``PYTHONPATH=python .cache/venv/bin/python benches/compare/bench_urdf.py [ROUNDS]``.
+With ``--wide``, over the wider corpus of robot packages instead (scripts/urdf_wide.sh):
+every file MuJoCo reads as shipped, as listed in ``.cache/urdf-wide/result-<version>.json``.
+
+Run: ``PYTHONPATH=python .cache/venv/bin/python benches/compare/bench_urdf.py [ROUNDS] [--wide]``.
 Prints each side's best and median round and the ratios (MuJoCo's time over ours: above 1
 means we are faster).
 """
@@ -33,10 +36,27 @@ import mjcf_forge
 ROOT = Path(__file__).resolve().parents[2]
 
 
+def wide_files() -> list[str]:
+    """The wider corpus's files MuJoCo reads as shipped (and ours reads equal)."""
+    import json
+
+    wide = ROOT / ".cache" / "urdf-wide"
+    results = json.loads((wide / f"result-{mujoco.__version__}.json").read_text())
+    return [str(wide / "corpus" / r["file"]) for r in results if r.get("shipped") == "equal"]
+
+
 def main() -> None:
-    rounds = int(sys.argv[1]) if len(sys.argv) > 1 else 7
-    listed = (ROOT / ".cache/corpus/urdf-models.txt").read_text().split()
-    files = [str(ROOT / f) for f in listed]
+    args = [a for a in sys.argv[1:] if a != "--wide"]
+    rounds = int(args[0]) if args else 7
+    if "--wide" in sys.argv:
+        files = wide_files()
+    else:
+        listed = (ROOT / ".cache/corpus/urdf-models.txt").read_text().split()
+        files = [str(ROOT / f) for f in listed]
+    mujoco.set_mju_user_warning(lambda _msg: None)
+    import warnings
+
+    warnings.simplefilter("ignore", UserWarning)
     out = os.path.join(tempfile.mkdtemp(), "saved.xml")
 
     def ours() -> None:
