@@ -9,8 +9,10 @@
 # - LIBERO's 130 tasks stock against the switch (scripts/libero_check.sh);
 # - robosuite's clients in full (scripts/clients_full.sh --robosuite-only: 10 demos of 50
 #   steps in five environments, every environment, in the three robosuite venvs);
-# - every corpus URDF prepared for MuJoCo (tests/urdf_judge.rs with MJCF_FORGE_FULL=1;
-#   CI judges every fourth), and the 17 further URDF wheels (scripts/urdf_wide.sh).
+# - every wheel model in the document, prefix, merge and geometry judges (CI judges every
+#   second: tests/common/mod.rs, `sampled`) and every corpus URDF prepared for MuJoCo
+#   (tests/urdf_judge.rs; CI judges every fourth), with MJCF_FORGE_FULL=1; the 21 further
+#   URDF wheels (scripts/urdf_wide.sh).
 # Sets up first (idempotent), as scripts/test.sh does.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -25,6 +27,8 @@ echo "== LIBERO's 130 tasks, stock against the switch"
 bash scripts/libero_check.sh
 echo "== robosuite's clients in full, stock against the switch"
 bash scripts/clients_full.sh --robosuite-only
-echo "== every corpus URDF prepared for MuJoCo, and the further URDF wheels"
-MJCF_FORGE_FULL=1 cargo test --test urdf_judge wheel_urdfs_prepared
+echo "== every wheel model (CI judges every second), every corpus URDF prepared for MuJoCo"
+MJCF_FORGE_FULL=1 cargo test --test document_judge --test prefix_judge --test merge_judge \
+  --test geometry_judge --test urdf_judge
+echo "== the further URDF wheels"
 bash scripts/urdf_wide.sh

@@ -46,9 +46,27 @@ def judged(path: str) -> dict:
     corpus = CORPUS / urdf.relative_to(CORPUS).parts[0]
     out: dict = {"file": str(urdf.relative_to(CORPUS))}
 
+    def printing(load):
+        """``load()``, with the ``WARNING: ...`` lines MuJoCo's URDF importer prints to
+        standard output itself (a repeated geom name) added to ``said``."""
+        import tempfile
+
+        sys.stdout.flush()
+        saved = os.dup(1)
+        with tempfile.TemporaryFile() as printed:
+            os.dup2(printed.fileno(), 1)
+            try:
+                return load()
+            finally:
+                os.dup2(saved, 1)
+                os.close(saved)
+                printed.seek(0)
+                lines = printed.read().decode(errors="replace").splitlines()
+                said[:0] = [x.removeprefix("WARNING: ") for x in lines if x.startswith("WARNING: ")]
+
     def theirs(f: Path):
         try:
-            return mujoco.MjModel.from_xml_path(str(f)), None
+            return printing(lambda: mujoco.MjModel.from_xml_path(str(f))), None
         except Exception as e:  # MuJoCo raises ValueError
             return None, str(e).strip().splitlines()[0][:200]
 
@@ -73,7 +91,7 @@ def judged(path: str) -> dict:
             try:
                 doc = Document.load(urdf)
                 said.clear()
-                mujoco.MjModel.from_xml_string(doc.to_xml())
+                printing(lambda: mujoco.MjModel.from_xml_string(doc.to_xml()))
                 for w in said:
                     if w in importer:
                         importer.remove(w)

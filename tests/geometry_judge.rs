@@ -303,7 +303,8 @@ struct Judged {
 fn judged() -> &'static Judged {
     static JUDGED: OnceLock<Judged> = OnceLock::new();
     JUDGED.get_or_init(|| {
-        let mut models: Vec<Model> = wheel_models()
+        // Every second wheel model (all in scripts/test_full.sh): common::sampled.
+        let mut models: Vec<Model> = common::sampled(wheel_models())
             .iter()
             .filter_map(|p| load(p, false))
             .collect();

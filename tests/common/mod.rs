@@ -186,6 +186,26 @@ pub fn wheel_models() -> Vec<PathBuf> {
     models
 }
 
+/// Whether this is the full run (`MJCF_FORGE_FULL=1`, scripts/test_full.sh): the judges
+/// of the wheel corpus then judge every model; otherwise (scripts/test.sh, CI) every
+/// second one ([`sampled`]).
+pub fn full_run() -> bool {
+    std::env::var("MJCF_FORGE_FULL").is_ok_and(|v| !v.is_empty() && v != "0")
+}
+
+/// What a judge of the wheel corpus judges in this run: all of `items` in the full run,
+/// else every second one (the first, the third...: in path order, so every wheel and
+/// every kind of model is still judged). scripts/test_full.sh judges the rest.
+pub fn sampled<T>(items: Vec<T>) -> Vec<T> {
+    let full = full_run();
+    items
+        .into_iter()
+        .enumerate()
+        .filter(|(i, _)| full || i % 2 == 0)
+        .map(|(_, x)| x)
+        .collect()
+}
+
 /// The wheel models that every judging version compiles on its own (a test that judges one
 /// output under every version at once, as the merge judge does, needs a reference in each).
 pub fn wheel_models_in_every_version() -> Vec<PathBuf> {

@@ -473,7 +473,7 @@ impl<'r> Writer<'r> {
                                 if let Some(n) = raw.attr(e, "name") {
                                     geom_name = n;
                                 }
-                                self.name_geom(g, geom_name);
+                                self.name_geom(g, geom_name, e);
                             }
                         }
                         Visuals::Kept => self.kept_visual(e, body),
@@ -487,7 +487,7 @@ impl<'r> Writer<'r> {
                         if let Some(n) = raw.attr(e, "name") {
                             geom_name = n;
                         }
-                        self.name_geom(g, geom_name);
+                        self.name_geom(g, geom_name, e);
                     }
                 }
                 _ => {}
@@ -495,10 +495,21 @@ impl<'r> Writer<'r> {
         }
     }
 
-    /// The importer's naming: a name not given yet is kept, any other left off.
-    fn name_geom(&mut self, geom: Node, name: &str) {
-        if self.geom_names.insert(name.to_string()) && !name.is_empty() {
-            self.set(geom, "name", name);
+    /// The importer's naming: a name not given yet is kept, any other left off, with the
+    /// importer's warning (`at`: the URDF element).
+    fn name_geom(&mut self, geom: Node, name: &str, at: Node) {
+        if self.geom_names.insert(name.to_string()) {
+            if !name.is_empty() {
+                self.set(geom, "name", name);
+            }
+        } else if !name.is_empty() {
+            self.warn(
+                at,
+                format!(
+                    "Geom with duplicate name '{name}' encountered in URDF, creating an \
+                     unnamed geom."
+                ),
+            );
         }
     }
 
