@@ -48,17 +48,19 @@ def judged(path: str) -> dict:
 
     def printing(load):
         """``load()``, with the ``WARNING: ...`` lines MuJoCo's URDF importer prints to
-        standard output itself (a repeated geom name) added to ``said``."""
+        standard error itself (a repeated geom name) put before ``said``."""
+        import ctypes
         import tempfile
 
-        sys.stdout.flush()
-        saved = os.dup(1)
+        sys.stderr.flush()
+        saved = os.dup(2)
         with tempfile.TemporaryFile() as printed:
-            os.dup2(printed.fileno(), 1)
+            os.dup2(printed.fileno(), 2)
             try:
                 return load()
             finally:
-                os.dup2(saved, 1)
+                ctypes.CDLL(None).fflush(None)  # MuJoCo's printf, buffered
+                os.dup2(saved, 2)
                 os.close(saved)
                 printed.seek(0)
                 lines = printed.read().decode(errors="replace").splitlines()

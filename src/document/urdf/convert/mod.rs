@@ -26,9 +26,9 @@ mod actuators;
 mod joints;
 mod visuals;
 
-use super::UrdfOptions;
 use super::packages::{Packages, Resolved};
 use super::robot::Robot;
+use super::{UrdfImporter, UrdfOptions};
 use crate::document::Document;
 use crate::document::tree::{Node, Tree};
 use crate::error::{Error, ErrorKind, Errors, Warning};
@@ -496,13 +496,15 @@ impl<'r> Writer<'r> {
     }
 
     /// The importer's naming: a name not given yet is kept, any other left off, with the
-    /// importer's warning (`at`: the URDF element).
+    /// importer's warning (`at`: the URDF element). 3.17.0 warns about a name the element
+    /// keeps from the one before it too, 4.0.0 only about the element's own.
     fn name_geom(&mut self, geom: Node, name: &str, at: Node) {
+        let own = self.raw.attr(at, "name").is_some();
         if self.geom_names.insert(name.to_string()) {
             if !name.is_empty() {
                 self.set(geom, "name", name);
             }
-        } else if !name.is_empty() {
+        } else if !name.is_empty() && (own || self.options.importer == UrdfImporter::MuJoCo3) {
             self.warn(
                 at,
                 format!(
