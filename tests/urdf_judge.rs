@@ -409,6 +409,24 @@ print(seen["body"], seen["jnt"], seen["geom"], seen["actuator"])
             && err.contains("gripper.xml', which is not a URDF file"),
         "{err}"
     );
+    // A scene passes its URDF models' load warnings on (python/tests/test_urdf.py judges
+    // the messages against MuJoCo's).
+    let warned = root().join("corpora/urdf/warned.urdf");
+    let with_warnings = format!(
+        "base = \"{}\"\n[[fixture]]\nmodel = \"{}\"\nprefix = \"w_\"\n",
+        root().join("corpora/scenes/demo/arena.xml").display(),
+        warned.display()
+    );
+    let scene = Scene::from_toml_str(&with_warnings, &dir).unwrap();
+    let alone = Document::load(&warned).unwrap();
+    assert!(alone.warnings().len() >= 7, "{:?}", alone.warnings());
+    assert_eq!(scene.warnings(), alone.warnings());
+    assert!(
+        Scene::load(root().join("corpora/scenes/urdf/urdf_arm.toml"))
+            .unwrap()
+            .warnings()
+            .is_empty()
+    );
     let err = copy(&text.replace("visuals = true", "visual = true"));
     assert!(
         err.contains("bad.toml:14:1: unknown field `visual`"),

@@ -302,6 +302,30 @@ def test_a_sample_of_robot_packages_we_did_not_pick_reads_as_mujocos_import(tmp_
     assert sum(f.name.endswith(".xacro.urdf") for f in files) == 2
 
 
+def test_a_scene_and_a_model_raise_their_urdfs_warnings():
+    """``Scene.from_toml`` and ``Model`` raise what their URDF models' loads warn about, as
+    ``Document.load`` does; a ``Model`` of a loaded ``Document`` raises nothing again."""
+    import warnings
+
+    from mjcf_forge import Scene
+
+    warned = ROOT / "corpora" / "urdf" / "warned.urdf"
+
+    def caught(make) -> list[str]:
+        with warnings.catch_warnings(record=True) as c:
+            warnings.simplefilter("always")
+            make()
+        return [str(w.message) for w in c if w.category is UserWarning]
+
+    alone = caught(lambda: Document.load(warned))
+    assert len(alone) == (7 if MUJOCO3 else 8), alone
+    text = f'base = "{ROOT / "corpora/scenes/demo/arena.xml"}"\n[[fixture]]\nmodel = "{warned}"\nprefix = "w_"\n'
+    assert caught(lambda: Scene.from_toml(text)) == alone
+    assert caught(lambda: Model(warned, prefix="w_")) == alone
+    doc = Document.load(warned)
+    assert caught(lambda: Model(doc, prefix="w_")) == []
+
+
 def test_the_importer_followed_is_the_installed_mujocos():
     r2d2 = corpus_urdf(R2D2)
     assert mujoco_version() == mujoco.__version__

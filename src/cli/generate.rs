@@ -268,6 +268,12 @@ fn generate(args: &Args, (k, n): (u64, u64)) -> Result<Summary, String> {
         None => Scene::demo(),
     }
     .map_err(|e| e.to_string())?;
+    // What MuJoCo's URDF importer warns about in the scene's models, once per run.
+    if k == 0 {
+        for w in scene.warnings() {
+            eprintln!("{}: warning: {}", w.location, w.message);
+        }
+    }
     if let Some(seed) = args.seed {
         scene = scene.with_seed(seed);
     }

@@ -113,6 +113,9 @@ fn draw(args: &Args, indices: &[u64]) -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
+    for w in scene.warnings() {
+        eprintln!("{}: warning: {}", w.location, w.message);
+    }
     if let Some(seed) = args.seed {
         scene = scene.with_seed(seed);
     }

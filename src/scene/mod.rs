@@ -106,6 +106,8 @@ pub struct Scene {
     structure: OnceLock<(crate::split::Rules, [u8; 32])>,
     /// Variants are written with `<compiler discardvisual="true">`.
     discard_visual: bool,
+    /// What the loads of its models warned about, in the scene's order.
+    warnings: Vec<crate::error::Warning>,
 }
 
 /// One element a randomizer sets, with what the manifest says of it.
@@ -214,6 +216,14 @@ impl Scene {
     /// The scene file (or label) this scene was read from.
     pub fn file(&self) -> &Path {
         &self.file
+    }
+
+    /// What the loads of the scene's models warned about (each URDF model's inputs that
+    /// MuJoCo's importer warns about, see [`Document::warnings`]), base first, then the
+    /// fixtures and the groups' pools in the scene file's order. The command line prints
+    /// them; the Python package raises each as a `UserWarning`.
+    pub fn warnings(&self) -> &[crate::error::Warning] {
+        &self.warnings
     }
 
     /// The template every variant starts from: the base with the fixtures merged in.

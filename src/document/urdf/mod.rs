@@ -27,8 +27,8 @@ use crate::error::Errors;
 pub(crate) use convert::convert;
 
 /// How a URDF file is read. The default is MuJoCo's importer, with `package://` paths
-/// resolved (MuJoCo cannot open such a path at all, so resolving one changes no model
-/// MuJoCo builds).
+/// resolved where MuJoCo's own rule (the file's `<compiler strippath meshdir>`) finds no
+/// file: MuJoCo cannot open such a path, so resolving it changes no model MuJoCo builds.
 ///
 /// ```
 /// use mjcf_forge::{Document, UrdfOptions};

@@ -13,7 +13,7 @@ use crate::document::inertia::InertiaCompiler;
 use crate::document::limits::Limits;
 use crate::document::tree::{Node, Tree};
 use crate::document::urdf::{UrdfActuators, UrdfOptions};
-use crate::error::{Error, ErrorKind, Errors, Location};
+use crate::error::{Error, ErrorKind, Errors, Location, Warning};
 use crate::model::geometry::{Angles, Pose};
 use crate::model::merge::MergeOptions;
 use crate::model::{XmlModel, XmlModelOptions};
@@ -287,6 +287,8 @@ fn build(
     let base_end = slot_end(&template);
     parts.push((0, base_end, Arc::from("base"), Arc::from("")));
     let mut prefixes: Vec<&str> = Vec::new();
+    // What the models' loads warned about (a URDF's inputs MuJoCo's importer warns about).
+    let mut warnings: Vec<Warning> = template.warnings().to_vec();
     for f in &spec.fixture {
         let (doc, path) = match load_model(models, src, &dir, &f.model, f.urdf.as_ref()) {
             Ok(x) => x,
@@ -296,6 +298,7 @@ fn build(
             }
         };
         files.extend(path);
+        warnings.extend_from_slice(doc.warnings());
         if prefixes.contains(&f.prefix.as_ref().as_str()) {
             errors.push(src.error(
                 &f.prefix,
@@ -396,7 +399,12 @@ fn build(
         match group::load(
             src, &dir, g, &groups, &template, &angles, models, compile, write, &mut files,
         ) {
-            Ok(x) => groups.push(x),
+            Ok(x) => {
+                for m in &x.pool {
+                    warnings.extend_from_slice(m.doc.warnings());
+                }
+                groups.push(x)
+            }
             Err(e) => errors.extend(e.0),
         }
     }
@@ -446,6 +454,7 @@ fn build(
         groups,
         randomizers,
         model_files: files,
+        warnings,
     };
     // Every pool model made once for slot 0: checks that it makes an instance and what
     // each randomizer selects in it.
