@@ -15,7 +15,8 @@ alternating:
 With ``--wide``, over the wider corpus of robot packages instead (scripts/urdf_wide.sh):
 every file MuJoCo reads as shipped, as listed in ``.cache/urdf-wide/result-<version>.json``.
 
-Run: ``PYTHONPATH=python .cache/venv/bin/python benches/compare/bench_urdf.py [ROUNDS] [--wide]``.
+Run: ``.cache/venv/bin/python benches/compare/bench_urdf.py [ROUNDS] [--wide]`` (the package
+installed in the venv by scripts/setup.sh).
 Prints each side's best and median round and the ratios (MuJoCo's time over ours: above 1
 means we are faster).
 """
