@@ -210,7 +210,7 @@ impl Error {
 /// let doc = Document::from_urdf_str(urdf, ".", &opts)?;
 /// assert_eq!(
 ///     doc.warnings()[0].to_string(),
-///     "<string>:3:60: joint 'j' has equal lower and upper limits, limit ignored"
+///     "<string>:3:70: joint 'j' has equal lower and upper limits, limit ignored"
 /// );
 /// # Ok::<(), mjcf_forge::Errors>(())
 /// ```

@@ -106,6 +106,21 @@ impl From<Failure> for PyErr {
     }
 }
 
+/// Raises each of a load's warnings (what MuJoCo's URDF importer warns about, at its
+/// place: `file:line:col: message`) as a ``UserWarning``.
+pub(crate) fn raise_warnings(py: Python<'_>, warnings: &[mjcf_forge::Warning]) -> PyResult<()> {
+    for w in warnings {
+        let message = std::ffi::CString::new(w.to_string()).unwrap_or_default();
+        PyErr::warn(
+            py,
+            &py.get_type::<pyo3::exceptions::PyUserWarning>(),
+            &message,
+            1,
+        )?;
+    }
+    Ok(())
+}
+
 /// An `MjcfError` whose message is `lines` joined by newlines and whose `errors` is `lines`.
 pub(crate) fn mjcf_error(lines: Vec<String>) -> PyErr {
     Python::attach(|py| {

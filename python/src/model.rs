@@ -169,14 +169,8 @@ impl PyModel {
             };
             Ok(XmlModel::with_prefix(doc, &prefix, options)?)
         })?;
-        for w in model.document().warnings().iter().filter(|_| read_urdf) {
-            let message = std::ffi::CString::new(w.to_string()).unwrap_or_default();
-            PyErr::warn(
-                py,
-                &py.get_type::<pyo3::exceptions::PyUserWarning>(),
-                &message,
-                1,
-            )?;
+        if read_urdf {
+            crate::errors::raise_warnings(py, model.document().warnings())?;
         }
         Ok(PyModel::with(model))
     }

@@ -31,7 +31,7 @@ use std::sync::Arc;
 use ahash::AHashSet;
 use mjcf_forge::split::{PatchValue, SplitOptions, split_document_with};
 use mjcf_forge::{Document, MergePart, Node, Section};
-use pyo3::exceptions::{PyFutureWarning, PyTypeError, PyUserWarning};
+use pyo3::exceptions::{PyFutureWarning, PyTypeError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyString, PyTuple};
 
@@ -874,10 +874,7 @@ impl PyDocument {
 /// A loaded document, each of its load's warnings (what MuJoCo's URDF importer warns
 /// about, at its place) raised as a ``UserWarning`` first.
 pub(crate) fn loaded(py: Python<'_>, doc: Document) -> PyResult<PyDocument> {
-    for w in doc.warnings() {
-        let message = std::ffi::CString::new(w.to_string()).unwrap_or_default();
-        PyErr::warn(py, &py.get_type::<PyUserWarning>(), &message, 1)?;
-    }
+    crate::errors::raise_warnings(py, doc.warnings())?;
     Ok(PyDocument::new(doc))
 }
 

@@ -79,21 +79,6 @@ fn python_mujoco(py: Python<'_>) -> PyResult<Py<PyAny>> {
     Ok(upcalls::get(py, "compile_inertia")?.unbind())
 }
 
-/// Raises each warning of the scene's model loads (what MuJoCo's URDF importer warns about
-/// in them) as a ``UserWarning``, as ``Document.load`` does.
-fn warned(py: Python<'_>, scene: &Scene) -> PyResult<()> {
-    for w in scene.warnings() {
-        let message = std::ffi::CString::new(w.to_string()).unwrap_or_default();
-        PyErr::warn(
-            py,
-            &py.get_type::<pyo3::exceptions::PyUserWarning>(),
-            &message,
-            1,
-        )?;
-    }
-    Ok(())
-}
-
 #[pymethods]
 impl PyScene {
     /// Loads a TOML scene file (paths in it are relative to it); without ``path``, the
@@ -113,7 +98,7 @@ impl PyScene {
                 None => Scene::demo()?,
             })
         })?;
-        warned(py, &scene)?;
+        crate::errors::raise_warnings(py, scene.warnings())?;
         Ok(PyScene::new(scene, source))
     }
 
@@ -136,7 +121,7 @@ impl PyScene {
             let mut compile = |d: &Document| python_inertia(&mujoco, d);
             Ok(Scene::from_toml_str_with(&text, &base_dir, &mut compile)?)
         })?;
-        warned(py, &scene)?;
+        crate::errors::raise_warnings(py, scene.warnings())?;
         Ok(PyScene::new(scene, Source::Toml(text, absolute(base_dir))))
     }
 
@@ -166,7 +151,7 @@ impl PyScene {
             let mut compile = |d: &Document| python_inertia(&mujoco, d);
             Ok(Scene::from_json_str_with(&json, &base_dir, &mut compile)?)
         })?;
-        warned(py, &scene)?;
+        crate::errors::raise_warnings(py, scene.warnings())?;
         Ok(PyScene::new(scene, Source::Json(json, absolute(base_dir))))
     }
 
