@@ -56,10 +56,16 @@ def records(tmp_path_factory):
         out, err = proc.communicate(timeout=1800)
         assert proc.returncode == 0, err[-3000:]
         assert out.split() == [w for t in TASKS for w in (t, "ok")], (mode, out, err[-3000:])
-    return {
-        mode: {t: dict(np.load(tmp / mode / (t.replace(":", "-") + ".npz"))) for t in TASKS}
+    # Read lazily, an array at a time: the records hold each task's whole model (LIBERO's
+    # textures alone are 190 MB a task), 2.1 GB for the ten.
+    loaded = {
+        mode: {t: np.load(tmp / mode / (t.replace(":", "-") + ".npz")) for t in TASKS}
         for mode in procs
     }
+    yield loaded
+    for by_task in loaded.values():
+        for record in by_task.values():
+            record.close()
 
 
 def differing(a: dict, b: dict, prefix: str) -> list:

@@ -131,11 +131,12 @@ def covered(tmp_path_factory):
     return run_all(tmp_path_factory.mktemp("robosuite_cover"))
 
 
-@functools.lru_cache(maxsize=64)
+@functools.lru_cache(maxsize=8)
 def compiled(xml: str):
     """The model MuJoCo compiles, or its error message without line numbers (ours is one
-    line of text, robosuite's indented). The most recent 64 kept (the cases share their
-    parts): all of robosuite's would be gigabytes, enough to bring a CI machine down."""
+    line of text, robosuite's indented). The most recent 8 kept (a test compares each
+    case's two models, and the next test may ask for them again): all of robosuite's would
+    be gigabytes, and 64 of them were 2.4 GB of the CI machine's memory."""
     try:
         return mujoco.MjModel.from_xml_string(xml)
     except ValueError as e:
