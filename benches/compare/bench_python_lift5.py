@@ -31,7 +31,7 @@ mjcf_forge, per variant: ``scene.variant(i).xml`` on a scene loaded once (untime
 robosuite's imports are), one variant at a time on the calling thread: the Rust work with
 the GIL released, the Variant object, and the ``str`` of its XML.
 
-Crossing cost: the same variants made by ``Scene._rust_seconds`` (the identical Rust calls
+Crossing cost: the same variants made by ``_testing.rust_seconds`` (the identical Rust calls
 in a Rust loop, no Python object made) subtracted from the Python loop's time.
 
 Rounds alternate the sides (robosuite's block, then mjcf_forge and the Rust loop in
@@ -86,6 +86,7 @@ def main() -> int:
         build = make_robosuite_builder(seed=1)
         sample_xml = build(0)  # untimed: imports, caches
     import mjcf_forge
+    from mjcf_forge._mjcf_forge import _testing
 
     scene = mjcf_forge.Scene.load(LIFT5)
     forge_xml = scene.variant(0).xml  # untimed: per-slot instances made on first use
@@ -107,7 +108,7 @@ def main() -> int:
         for b in range(r * args.forge, (r + 1) * args.forge, block):
             idx = list(range(b, b + block))
             rounds["mjcf_forge"].append(per_variant(forge, idx))
-            rounds["rust_loop"].append(scene._rust_seconds(idx) / len(idx))
+            rounds["rust_loop"].append(_testing.rust_seconds(scene, idx) / len(idx))
 
     best = {k: min(v) for k, v in rounds.items()}
     median = {k: statistics.median(v) for k, v in rounds.items()}

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """How fast lift5 variants reach Python: ``scene.variants(range, threads=T)`` (made on Rust
 threads, handed over in order) against ``scene.variant(i)`` one at a time on the Python
-thread, and the Rust work alone (``Scene._rust_seconds``: the same variants made in a Rust
+thread, and the Rust work alone (``_testing.rust_seconds``: the same variants made in a Rust
 loop, no Python object). Every variant's ``.xml`` is read, as a caller writing or
 compiling it would.
 
@@ -17,6 +17,7 @@ import time
 from pathlib import Path
 
 import mjcf_forge
+from mjcf_forge._mjcf_forge import _testing
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -35,7 +36,7 @@ def main():
     scene = mjcf_forge.Scene.load(ROOT / "benches/scenes/lift5.toml")
     n = args.n
     # Every slot's object instances are made on first use: make them before timing.
-    scene._rust_seconds(list(range(2_000)))
+    _testing.rust_seconds(scene, list(range(2_000)))
 
     def stream(threads, base):
         def run():
@@ -53,7 +54,7 @@ def main():
 
     def rust_only(base):
         def run():
-            scene._rust_seconds(list(range(base, base + n)))
+            _testing.rust_seconds(scene, list(range(base, base + n)))
 
         return run
 

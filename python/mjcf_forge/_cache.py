@@ -26,6 +26,7 @@ from ._mjcf_forge import (
     SIGNATURE_ARRAYS,
     SIGNATURE_SKIPPED_SIZES,
     STATIC_PREFIXES,
+    STATISTIC_NAMES,
     MjcfError,
     Scene,
 )
@@ -398,7 +399,7 @@ class ModelCache:
             and not n.startswith(STATIC_PREFIXES)
         ]
         rows: dict[str, list[np.ndarray]] = {n: [] for n in names}
-        stats = {f"stat.{s}": [] for s in ("meaninertia", "meanmass", "meansize", "extent", "center")}
+        stats = {f"stat.{s}": [] for s in STATISTIC_NAMES}
         try:
             for v in variants:
                 self.apply(v, model)
@@ -417,3 +418,26 @@ class ModelCache:
             if not (stacked == stacked[0]).all():
                 out[n] = stacked
         return out
+
+
+# The batch tier's access to a superset cache (batch.py, _warp.py): functions of this
+# module, so that no other module reads a cache's private state.
+def mujoco_of(cache: ModelCache) -> Any:
+    """The ``mujoco`` module ``cache`` compiles and patches with."""
+    return cache._mujoco
+
+
+def body_ids_of(cache: ModelCache, model: Any, names: Any) -> list[int]:
+    """The ids of the bodies ``names`` in ``model``, of ``cache``'s superset structure."""
+    return cache._body_ids_of(model, names)
+
+
+def apply_world(cache: ModelCache, model: Any, world: tuple, patch0: list) -> Any:
+    """``model`` patched in place for one world of ``Superset.worlds`` (``world``: its
+    index, numbers, strings and parked roots; ``patch0``: a patch of its layout)."""
+    return cache._apply_world(model, world, patch0)
+
+
+def plan_of(cache: ModelCache, model: Any) -> Plan:
+    """The patch plan ``cache`` keeps for ``model`` (one it patched)."""
+    return cache._plans[id(model)]

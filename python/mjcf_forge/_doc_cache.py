@@ -221,8 +221,10 @@ class DocumentCache:
         (True, [0.0, 0.0, 1.0, 1.0])
         """
         doc = _document(source, base_dir)
-        key, numbers, materials, fixed, bodies = doc._split()
-        values = np.frombuffer(numbers, dtype="<f8")
+        parts = doc._split()
+        key, fixed, bodies = parts.structure_key, parts.fixed_statistics, parts.bodies
+        materials = parts.materials
+        values = np.frombuffer(parts.numbers, dtype="<f8")
         me = threading.get_ident()
         if into is not None:
             intos = into if isinstance(into, (list, tuple)) else (into,)

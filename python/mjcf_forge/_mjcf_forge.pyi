@@ -21,6 +21,10 @@ SIGNATURE_SKIPPED_SIZES: tuple[str, ...]
 MODEL_FIELDS: tuple[str, ...]
 GEOM_FACTORS: str
 MASS_DERIVED: tuple[str, ...]
+#: The compiler's statistics as ``model.stat`` names them (``center`` has three values).
+STATISTIC_NAMES: tuple[str, ...]
+#: MuJoCo's joint types by their compiled number (``mjtJoint``, ``model.jnt_type``).
+JOINT_TYPES: tuple[str, ...]
 
 def target_array(object: str, field: str) -> Optional[str]: ...
 def joint_widths(jnt_type: int) -> tuple[int, int]: ...
@@ -182,6 +186,7 @@ class Element:
     def __bool__(self) -> bool: ...
     def __copy__(self) -> Element: ...
     def __deepcopy__(self, memo: Any) -> Element: ...
+    def _etree_xml(self) -> Optional[str]: ...
 
 class LoadCache:
     """Loaded documents served again, copied, while their file is unchanged."""
@@ -278,8 +283,24 @@ class Document:
     def structure_key(self) -> str: ...
     @property
     def patch(self) -> tuple[tuple[str, str | int, str, tuple[float, ...] | str], ...]: ...
-    def _split(self) -> tuple[str, bytes, list[str], list[str]]: ...
+    def _split(self) -> DocumentSplit: ...
     def _mujoco_error(self, xml: str, message: str) -> str: ...
+    def _sort_elements(
+        self, name_geoms: bool = True
+    ) -> tuple[dict[str, list[Element]], dict[str, list[Optional[str]]]]: ...
+    def _set_all(
+        self, elements: Sequence[Element], key: str, value: Any, remove: Optional[str] = None
+    ) -> None: ...
+    def _sections(self, tags: Sequence[str]) -> list[Element]: ...
+
+class DocumentSplit:
+    """A document's split as the document cache takes it (``Document._split()``)."""
+
+    structure_key: str
+    numbers: bytes
+    materials: list[str]
+    fixed_statistics: list[str]
+    bodies: list[str]
 
 class Model:
     """One instance of a model with its own name prefix (robosuite's MujocoXMLModel)."""
@@ -363,6 +384,15 @@ class Model:
 class Variant:
     """One variant of a Scene: index, MJCF text, and what was drawn."""
 
+    @staticmethod
+    def _restore(
+        index: int,
+        xml: str,
+        params_json: str,
+        objects: int,
+        model_dir: os.PathLike[str] | str,
+        patched: tuple[str, Sequence[tuple[str, str | int, str, Any]]],
+    ) -> Variant: ...
     @property
     def index(self) -> int: ...
     @property

@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from ._mjcf_forge import GEOM_FACTORS, MODEL_FIELDS, ModelArrays, target_array
+from ._mjcf_forge import GEOM_FACTORS, JOINT_TYPES, MODEL_FIELDS, ModelArrays, joint_widths, target_array
 from . import _mujoco
 from ._last_xml import compile_xml
 from ._plan import OBJ
@@ -54,7 +54,6 @@ _BODY_IN = ("body_pos", "body_quat", "body_ipos", "body_iquat", "body_mass", "bo
             "body_sameframe", "body_simple")
 _JOINT_IN = ("jnt_pos", "jnt_axis")
 _DOF_IN = ("dof_armature", "dof_simplenum")
-_JOINT_TYPES = {0: "free", 1: "ball", 2: "slide", 3: "hinge"}
 
 
 def _num(values: Any) -> str:
@@ -83,7 +82,7 @@ class _Tree:
             raise ValueError("not a contiguous moving tree")
         first = int(model.jnt_qposadr[joints[0]])
         last = int(model.jnt_qposadr[joints[-1]])
-        width = {0: 7, 1: 4, 2: 1, 3: 1}[int(model.jnt_type[joints[-1]])]
+        width = joint_widths(int(model.jnt_type[joints[-1]]))[1]
         self.bodies = slice(int(bodies[0]), int(bodies[-1]) + 1)
         self.joints = slice(int(joints[0]), int(joints[-1]) + 1)
         self.dofs = slice(int(dofs[0]), int(dofs[-1]) + 1)
@@ -145,7 +144,7 @@ class _Tree:
         ``after`` slide joints."""
         parts: dict[int, list[str]] = {int(b): [] for b in bodies}
         for j in np.flatnonzero(np.isin(model.jnt_bodyid, bodies)):
-            kind = _JOINT_TYPES[int(model.jnt_type[j])]
+            kind = JOINT_TYPES[int(model.jnt_type[j])]
             parts[int(model.jnt_bodyid[j])].append(
                 f'<joint type="{kind}" pos="{_num(model.jnt_pos[j])}" axis="{_num(model.jnt_axis[j])}"/>'
             )

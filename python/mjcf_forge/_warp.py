@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from ._cache import mujoco_of
 from ._errors import error
 
 # Fields MuJoCo Warp holds for all worlds but reads only when sleeping is enabled (a
@@ -82,7 +83,7 @@ class WarpWorlds:
             shape = getattr(spec, "shape", ())
             batched = bool(shape) and shape[0] == "*"
             if not batched:
-                sleep = self.model.opt.enableflags & self.cache._mujoco.mjtEnableBit.mjENBL_SLEEP
+                sleep = self.model.opt.enableflags & mujoco_of(self.cache).mjtEnableBit.mjENBL_SLEEP
                 if name in _WARP_SLEEP_ONLY and not sleep:
                     continue
                 rows = self.arrays.get(name)
@@ -102,7 +103,7 @@ class WarpWorlds:
                 # A parked mesh geom is absent from its world (mjlab's switch for padded
                 # slots): no collision work for it, whatever its pose.
                 rows = np.tile(self.model.geom_dataid, (self.nworld, 1))
-                mesh = self.model.geom_type == self.cache._mujoco.mjtGeom.mjGEOM_MESH
+                mesh = self.model.geom_type == mujoco_of(self.cache).mjtGeom.mjGEOM_MESH
                 rows[self.parked_geoms & mesh[None, :]] = -1
             else:
                 rows = self.arrays[name]
@@ -124,7 +125,7 @@ class WarpWorlds:
         (6: a weld), limited joint or tendon and dof or tendon with friction loss. An
         estimate, not a bound: a world past it sets its bit of Warp's ``d.overflow``
         (contacts beyond are dropped); give ``nconmax``/``njmax`` then."""
-        mujoco = self.cache._mujoco
+        mujoco = mujoco_of(self.cache)
         m = self.model
         free = m.jnt_bodyid[m.jnt_type == mujoco.mjtJoint.mjJNT_FREE]
         placed = 0

@@ -33,9 +33,9 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ._cache import ModelCache
+from ._cache import ModelCache, apply_world, body_ids_of, mujoco_of, plan_of
 from ._errors import error
-from ._mjcf_forge import STATIC_PREFIXES, target_array
+from ._mjcf_forge import STATIC_PREFIXES, STATISTIC_NAMES, target_array
 from ._mjx import MjxWorlds
 from ._progress import progress_of
 from ._warp import WarpWorlds
@@ -72,7 +72,7 @@ _FROM_GEOMS = ("body_margin", "body_contype", "body_conaffinity")
 # A model's keyframe arrays (each world's rows: WorldBatch.keys).
 _KEYS = ("key_qpos", "key_qvel", "key_act", "key_ctrl", "key_mpos", "key_mquat", "key_time")
 # The compiler's statistics, per world (``stat.<name>`` in :attr:`WorldBatch.arrays`).
-_STATS = ("meaninertia", "meanmass", "meansize", "extent", "center")
+_STATS = STATISTIC_NAMES
 class _Index(NamedTuple):
     """What a superset ModelCache reads of a variant: its index."""
 
@@ -202,7 +202,7 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         ]
         before = {n: getattr(model, n).tobytes() for n in fields}
         model.body_gravcomp[missing] = 1.0
-        mujoco = self.cache._mujoco
+        mujoco = mujoco_of(self.cache)
         mujoco.mj_setConst(model, mujoco.MjData(model))
         changed = [n for n in fields if getattr(model, n).tobytes() != before[n]]
         if changed:
@@ -228,7 +228,8 @@ class WorldBatch(WarpWorlds, MjxWorlds):
             return None
         model = self.model
         if isinstance(key, str):
-            i = self.cache._mujoco.mj_name2id(model, self.cache._mujoco.mjtObj.mjOBJ_KEY, key)
+            mujoco = mujoco_of(self.cache)
+            i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, key)
             if i < 0:
                 names = [model.key(k).name for k in range(model.nkey)]
                 raise error(f"the scene has no keyframe '{key}' (its keyframes: {names})")
@@ -297,9 +298,9 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         pose is an error."""
         index, numbers, strings, parked_names, patch0 = world
         cache = self.cache
-        parked_roots = cache._body_ids_of(self._scratch, parked_names)
+        parked_roots = body_ids_of(cache, self._scratch, parked_names)
         before = cache.by_tree
-        model = cache._apply_world(self._scratch, (index, numbers, strings, parked_names), patch0)
+        model = apply_world(cache, self._scratch, (index, numbers, strings, parked_names), patch0)
         by_tree = cache.by_tree != before
         self.derived_by_tree += by_tree
         out = {n: getattr(model, n).copy() for n in self._candidates}
@@ -320,7 +321,7 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         if model.nkey:
             for n in _KEYS:
                 out[n] = getattr(model, n).copy()
-        mujoco = self.cache._mujoco
+        mujoco = mujoco_of(self.cache)
         parked = np.isin(self._root_of_geom, parked_roots)
         out["parked_geoms"] = parked
         # The initial pose's contacts: positions and collision only. The statistics left
@@ -347,7 +348,7 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         return out
 
     def _plan_of_scratch(self) -> Any:
-        return self.cache._plans[id(self._scratch)]
+        return plan_of(self.cache, self._scratch)
 
     def assign(self, worlds: Sequence[int], variants: Sequence[Any]) -> np.ndarray:
         """World ``worlds[k]`` holds variant ``variants[k]`` from now on: its rows of

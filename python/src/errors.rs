@@ -142,7 +142,7 @@ fn file_not_found(py: Python<'_>, lines: Vec<String>, path: &Path) -> Result<PyE
     let class = crate::upcalls::get(py, "MjcfFileNotFoundError")?;
     let value = class.call1((lines.join("\n"),))?;
     value.setattr("errors", PyList::new(py, &lines)?)?;
-    value.setattr("errno", py.import("errno")?.getattr("ENOENT")?)?;
+    value.setattr("errno", crate::upcalls::python(py, "errno", "ENOENT")?)?;
     value.setattr("filename", path.as_os_str())?;
     Ok(PyErr::from_value(value))
 }

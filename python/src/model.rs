@@ -80,7 +80,7 @@ fn instance_id(idn: &Bound<'_, PyAny>) -> PyResult<String> {
         return Ok(s.to_cow()?.into_owned());
     }
     if !idn.is_instance_of::<pyo3::types::PyBool>()
-        && let Ok(i) = idn.py().import("operator")?.getattr("index")?.call1((idn,))
+        && let Ok(i) = crate::upcalls::python(idn.py(), "operator", "index")?.call1((idn,))
     {
         return Ok(i.str()?.to_cow()?.into_owned());
     }
@@ -91,9 +91,7 @@ fn instance_id(idn: &Bound<'_, PyAny>) -> PyResult<String> {
 }
 
 fn numpy_array<'py>(py: Python<'py>, values: &[f64]) -> PyResult<Bound<'py, PyAny>> {
-    py.import("numpy")?
-        .getattr("array")?
-        .call1((values.to_vec(),))
+    crate::upcalls::python(py, "numpy", "array")?.call1((values.to_vec(),))
 }
 
 #[pymethods]

@@ -10,6 +10,10 @@
 //! mujoco_version()                  the user's mujoco's version (the URDF importer)
 //! ```
 //!
+//! Every other import the extension makes (the standard library's `json`, `errno`,
+//! `operator`, `xml.etree.ElementPath`, `collections.abc`, NumPy, the user's `mujoco`) goes
+//! through [`python`] and [`python_module`].
+//!
 //! The package's modules never import the compiled module's internals the other way
 //! round: what Python needs of Rust is the public `_mjcf_forge` types.
 
@@ -26,6 +30,18 @@ fn module(py: Python<'_>) -> PyResult<&Bound<'_, PyModule>> {
     UPCALLS
         .get_or_try_init(py, || py.import(MODULE).map(Bound::unbind))
         .map(|m| m.bind(py))
+}
+
+/// `module.name` of another Python module (the standard library, NumPy, the user's
+/// `mujoco`): every import the extension makes is here, this one or [`module`]'s.
+pub fn python<'py>(py: Python<'py>, module: &str, name: &str) -> PyResult<Bound<'py, PyAny>> {
+    py.import(module)?.getattr(name)
+}
+
+/// The Python module `name` (imported on each call; Python's module cache makes a second
+/// import a lookup).
+pub fn python_module<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyModule>> {
+    py.import(name)
 }
 
 /// The upcall `name` (a function or class of `mjcf_forge._upcalls`).

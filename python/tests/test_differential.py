@@ -1,5 +1,5 @@
 """The Python DocumentCache against MuJoCo on random documents (the extension's
-``_random_mjcf``, the same generator as tests/document_differential.rs): every answer equals
+``_testing.random_mjcf``, the same generator as tests/document_differential.rs): every answer equals
 MuJoCo compiling the same text, bit for bit, or both refuse it; and the caller's ways of
 holding what it gets: models kept while later ones are patched, models the caller changes,
 models given back with ``into``, threads sharing one cache. Fixed seeds (a short run in CI);
@@ -15,7 +15,7 @@ import numpy as np
 import judge
 import mjcf_forge
 from helpers import MASS_DERIVED, beyond, not_bit_identical, superset_check
-from mjcf_forge._mjcf_forge import _random_mjcf, _random_mjcf_files, _random_scene
+from mjcf_forge._mjcf_forge import _testing
 from mjcf_forge.batch import WorldBatch
 
 # MJCF_FORGE_DIFFERENTIAL=SEEDS,VARIANTS for a longer run (scripts/differential.sh).
@@ -62,7 +62,7 @@ def test_random_documents_are_answered_as_mujoco_compiles_them():
     answered = refused = 0
     for seed in range(SEEDS):
         for variant in range(VARIANTS):
-            text = _random_mjcf(seed, variant)
+            text = _testing.random_mjcf(seed, variant)
             answer = ask(cache, text)
             problem = verdict(text, answer)
             if problem:
@@ -89,7 +89,7 @@ def test_models_changed_or_given_back_by_the_caller_leave_later_answers_exact():
     for seed in range(100, 100 + SEEDS // 2):
         model = None
         for variant in range(VARIANTS):
-            text = _random_mjcf(seed, variant)
+            text = _testing.random_mjcf(seed, variant)
             # Every other call gives the last model back to be patched in place.
             answer = ask(cache, text, into=model) if model is not None and variant % 2 else ask(cache, text)
             problem = verdict(text, answer)
@@ -113,7 +113,7 @@ def test_threads_sharing_one_cache_each_get_exact_answers():
     def work(first: int) -> None:
         for seed in range(first, first + 6):
             for variant in range(VARIANTS):
-                text = _random_mjcf(seed, variant)
+                text = _testing.random_mjcf(seed, variant)
                 problem = verdict(text, ask(cache, text))
                 if problem:
                     findings.append(f"{seed}/{variant}: {problem}")
@@ -128,7 +128,7 @@ def test_threads_sharing_one_cache_each_get_exact_answers():
 
 
 def test_random_scenes_through_the_model_cache_and_the_superset(tmp_path):
-    # Random scenes (the extension's _random_scene): each variant patched by the plain
+    # Random scenes (the extension's _testing.random_scene): each variant patched by the plain
     # ModelCache equals MuJoCo compiling its XML, bit for bit (what follows from mass
     # properties combined through a unit model within 1e-12 relative); through the superset, every
     # named element has the variant's values, the same contacts at the initial pose, parked
@@ -140,7 +140,7 @@ def test_random_scenes_through_the_model_cache_and_the_superset(tmp_path):
     # scene the superset cannot hold is refused with an error, never answered wrongly.
     findings, answered, refused, supersets = [], 0, 0, 0
     for seed in range(SEEDS // 2):
-        toml, files = _random_scene(seed)
+        toml, files = _testing.random_scene(seed)
         folder = tmp_path / str(seed)
         folder.mkdir()
         for name, text in files:
@@ -189,12 +189,12 @@ def test_random_documents_with_includes_are_answered_as_mujoco_compiles_them(tmp
     cache = mjcf_forge.DocumentCache()
     findings, included = [], 0
     for seed in range(SEEDS * 2):
-        if len(_random_mjcf_files(seed, 0)) < 2:
+        if len(_testing.random_mjcf_files(seed, 0)) < 2:
             continue
         folder = tmp_path / str(seed)
         folder.mkdir()
         for variant in range(VARIANTS):
-            for name, text in _random_mjcf_files(seed, variant):
+            for name, text in _testing.random_mjcf_files(seed, variant):
                 (folder / name).write_text(text)
             path = folder / "model.xml"
             try:

@@ -51,6 +51,45 @@ def test_stubs_name_exactly_the_public_methods_and_properties():
     assert "errors" in stubs["MjcfError"]
 
 
+def test_stubs_type_the_internal_entry_points_too():
+    """What the package's own modules call on the extension is typed in the stub as it is:
+    every module-level name, every class's methods and fields (underscored ones included),
+    and the named result of ``Document._split()``."""
+    from mjcf_forge import _mjcf_forge
+
+    tree = ast.parse(STUB.read_text())
+    top = set()
+    for node in tree.body:
+        if isinstance(node, (ast.ClassDef, ast.FunctionDef)):
+            top.add(node.name)
+        elif isinstance(node, ast.AnnAssign):
+            top.add(node.target.id)
+    runtime = set(vars(_mjcf_forge))
+    assert top - runtime == set(), top - runtime
+    stubs = stub_members()
+    for node in tree.body:
+        if not isinstance(node, ast.ClassDef):
+            continue
+        cls = getattr(_mjcf_forge, node.name)
+        private = {m for m in vars(cls) if m.startswith("_") and not m.startswith("__")}
+        assert private <= stubs[node.name], (node.name, private - stubs[node.name])
+        methods = {n.name for n in node.body if isinstance(n, ast.FunctionDef)}
+        assert {m for m in methods if not hasattr(cls, m)} == set(), node.name
+    split = mjcf_forge.Document.from_string(
+        "<mujoco><worldbody><geom size='.1' rgba='1 0 0 1'/></worldbody></mujoco>"
+    )._split()
+    assert isinstance(split, _mjcf_forge.DocumentSplit)
+    for field in stubs["DocumentSplit"]:
+        assert hasattr(split, field), field
+    assert isinstance(split.numbers, bytes) and len(split.numbers) % 8 == 0
+    import mujoco
+
+    # The tables against MuJoCo's own: mjtJoint's numbers, mjStatistic's fields.
+    assert _mjcf_forge.JOINT_TYPES == tuple(mujoco.mjtJoint(i).name[6:].lower() for i in range(4))
+    stat = mujoco.MjModel.from_xml_string("<mujoco/>").stat
+    assert set(_mjcf_forge.STATISTIC_NAMES) == {n for n in dir(stat) if not n.startswith("_")}
+
+
 def test_every_public_member_has_a_docstring():
     missing = []
     for name in PUBLIC_CLASSES:
@@ -90,11 +129,11 @@ def test_one_exception_type_derives_from_value_error():
 def test_a_rust_panic_reaches_python_as_mjcf_error():
     import pytest
 
-    from mjcf_forge import _mjcf_forge
+    from mjcf_forge._mjcf_forge import _testing
 
     for detached in (True, False):
         with pytest.raises(mjcf_forge.MjcfError) as err:
-            _mjcf_forge._panic_for_tests(detached=detached)
+            _testing.panic(detached=detached)
         assert err.value.errors == [
             "internal error in mjcf-forge (please report it): deliberate panic for the tests"
         ]

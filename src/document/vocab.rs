@@ -407,8 +407,8 @@ const KW_INTERP: &[&str] = &["zoh", "linear", "cubic"];
 const KW_JACOBIAN: &[&str] = &["dense", "sparse", "auto"];
 /// The keywords of `enum<jkind>`.
 const KW_JKIND: &[&str] = &["main"];
-/// The keywords of `enum<jointtype>`.
-const KW_JOINTTYPE: &[&str] = &["free", "ball", "slide", "hinge"];
+/// The keywords of `enum<jointtype>`, in `mjtJoint`'s order (the compiled `jnt_type`).
+pub(crate) const KW_JOINTTYPE: &[&str] = &["free", "ball", "slide", "hinge"];
 /// The keywords of `enum<lrmode>`.
 const KW_LRMODE: &[&str] = &["none", "muscle", "muscleuser", "all"];
 /// The keywords of `enum<mark>`.

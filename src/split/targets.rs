@@ -112,6 +112,14 @@ pub const DOF_FIELDS: [&str; 3] = ["damping", "armature", "frictionloss"];
 /// rows of every keyframe).
 pub const QPOS_FIELDS: [&str; 3] = ["qpos0", "qpos_spring", "key_qpos"];
 
+/// MuJoCo's joint types by their compiled number (`mjtJoint`, `jnt_type`): the schema's
+/// `enum<jointtype>` keywords, in that order.
+///
+/// ```
+/// assert_eq!(mjcf_forge::split::JOINT_TYPES[3], "hinge");
+/// ```
+pub const JOINT_TYPES: &[&str] = crate::document::vocab::KW_JOINTTYPE;
+
 /// How many degrees of freedom and `qpos` coordinates a joint of MuJoCo type `jnt_type`
 /// has (free, ball, slide, hinge).
 ///

@@ -29,13 +29,14 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use ahash::AHashSet;
-use mjcf_forge::split::{PatchValue, SplitOptions, split_document_with};
+use mjcf_forge::split::{SplitOptions, split_document_with};
 use mjcf_forge::{Document, MergePart, Node, Section};
 use pyo3::exceptions::{PyFutureWarning, PyTypeError};
 use pyo3::prelude::*;
-use pyo3::types::{PyBytes, PyDict, PyString, PyTuple};
+use pyo3::types::{PyDict, PyString, PyTuple};
 
 use crate::errors::{Failure, run};
+pub(crate) use patch::PyDocumentSplit;
 use patch::patch_list;
 
 pub(crate) use attrib::PyAttrib;
@@ -556,44 +557,16 @@ impl PyDocument {
         PyTuple::new(py, patch_list(py, &split.entries)?)
     }
 
-    /// The split as the model cache takes it: ``(structure_key, numbers, materials,
-    /// fixed_statistics, bodies)``: every number of :attr:`patch` end to end as float64
-    /// bytes, the material names of its ``matid`` entries in order, the statistics the
-    /// document's ``<statistic>`` sets, and the body models of its ``geoms`` entries.
-    #[allow(clippy::type_complexity)]
-    fn _split<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(
-        String,
-        Bound<'py, PyBytes>,
-        Vec<String>,
-        Vec<&'static str>,
-        Vec<String>,
-    )> {
-        let (key, numbers, materials, fixed, bodies) = run(py, || {
-            let split = split(&self.doc.read_detached());
-            let mut numbers: Vec<u8> = Vec::new();
-            let mut materials = Vec::new();
-            let mut bodies = Vec::new();
-            for e in split.entries {
-                match e.value {
-                    PatchValue::Numbers(v) => {
-                        numbers.extend(v.iter().flat_map(|x| x.to_le_bytes()));
-                    }
-                    PatchValue::Id { name, .. } => materials.push(name),
-                    PatchValue::BodyModel(model) => bodies.push(model),
-                }
-            }
-            Ok((
-                split.structure_key,
-                numbers,
-                materials,
-                split.fixed_statistics,
-                bodies,
-            ))
-        })?;
-        Ok((key, PyBytes::new(py, &numbers), materials, fixed, bodies))
+    /// The split as the document cache takes it (a :class:`DocumentSplit`): the structure
+    /// key and the patch's values by kind.
+    fn _split(&self, py: Python<'_>) -> PyResult<PyDocumentSplit> {
+        let split = run(py, || Ok(split(&self.doc.read_detached())))?;
+        Ok(PyDocumentSplit::new(
+            py,
+            split.structure_key,
+            split.entries,
+            split.fixed_statistics,
+        ))
     }
 
     /// MuJoCo's error ``message`` about ``xml`` (this document as :meth:`to_xml` wrote

@@ -4,7 +4,7 @@
 use mjcf_forge::split::{PatchEntry, PatchValue};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::{PyList, PyTuple};
+use pyo3::types::{PyBytes, PyList, PyTuple};
 
 /// A patch entry as Python holds it: `(object, name or id, field, value)`.
 pub(crate) type PatchTuple<'py> = (String, Bound<'py, PyAny>, String, Bound<'py, PyAny>);
@@ -95,4 +95,53 @@ pub(crate) fn patch_entry(
         field,
         value,
     })
+}
+
+/// A document's split as the document cache takes it (`Document._split()`): its structure
+/// key and its patch's values by kind, in the patch's order.
+#[pyclass(
+    name = "DocumentSplit",
+    module = "mjcf_forge._mjcf_forge",
+    frozen,
+    get_all
+)]
+pub(crate) struct PyDocumentSplit {
+    /// The structure key (`Document.structure_key`).
+    pub structure_key: String,
+    /// Every number of the patch end to end, as little-endian float64 bytes.
+    pub numbers: Py<PyBytes>,
+    /// The material names of its `matid` entries, in order.
+    pub materials: Vec<String>,
+    /// The statistics the document's `<statistic>` sets (`STATISTIC_NAMES`' names).
+    pub fixed_statistics: Vec<&'static str>,
+    /// The body models of its `geoms` entries, in order.
+    pub bodies: Vec<String>,
+}
+
+impl PyDocumentSplit {
+    /// The split of a document's patch `entries` under `structure_key`.
+    pub(crate) fn new(
+        py: Python<'_>,
+        structure_key: String,
+        entries: Vec<PatchEntry>,
+        fixed_statistics: Vec<&'static str>,
+    ) -> Self {
+        let mut numbers: Vec<u8> = Vec::new();
+        let mut materials = Vec::new();
+        let mut bodies = Vec::new();
+        for e in entries {
+            match e.value {
+                PatchValue::Numbers(v) => numbers.extend(v.iter().flat_map(|x| x.to_le_bytes())),
+                PatchValue::Id { name, .. } => materials.push(name),
+                PatchValue::BodyModel(model) => bodies.push(model),
+            }
+        }
+        PyDocumentSplit {
+            structure_key,
+            numbers: PyBytes::new(py, &numbers).unbind(),
+            materials,
+            fixed_statistics,
+            bodies,
+        }
+    }
 }

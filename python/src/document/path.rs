@@ -166,7 +166,9 @@ fn fast<'py>(
 fn element_path(py: Python<'_>) -> PyResult<&Bound<'_, PyModule>> {
     static MODULE: PyOnceLock<Py<PyModule>> = PyOnceLock::new();
     MODULE
-        .get_or_try_init(py, || py.import("xml.etree.ElementPath").map(Bound::unbind))
+        .get_or_try_init(py, || {
+            crate::upcalls::python_module(py, "xml.etree.ElementPath").map(Bound::unbind)
+        })
         .map(|m| m.bind(py))
 }
 

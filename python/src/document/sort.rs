@@ -31,12 +31,10 @@ fn group(py: Python<'_>, value: Option<&str>) -> PyResult<Option<i64>> {
     if !digits.is_empty() && digits.len() < 18 && digits.bytes().all(|b| b.is_ascii_digit()) {
         return Ok(t.parse().ok());
     }
-    let stripped = py
-        .import("builtins")?
-        .getattr("str")?
+    let stripped = crate::upcalls::python(py, "builtins", "str")?
         .call1((value,))?
         .call_method0("strip")?;
-    match py.import("builtins")?.getattr("int")?.call1((stripped,)) {
+    match crate::upcalls::python(py, "builtins", "int")?.call1((stripped,)) {
         Ok(v) => Ok(v.extract::<i64>().ok().or(Some(i64::MAX))),
         Err(e) if e.is_instance_of::<pyo3::exceptions::PyValueError>(py) => Ok(None),
         Err(e) => Err(e),

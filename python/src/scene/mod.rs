@@ -65,6 +65,19 @@ enum Source {
 }
 
 impl PyScene {
+    /// Seconds spent in Rust making `indices` one at a time on this thread, making no
+    /// Python object (`_testing.rust_seconds`).
+    pub(crate) fn rust_seconds(&self, py: Python<'_>, indices: &[u64]) -> PyResult<f64> {
+        run(py, || {
+            let start = std::time::Instant::now();
+            for &i in indices {
+                // Dropped at once, as a Python caller drops a variant it has read.
+                std::hint::black_box(make(&self.scene, i)?);
+            }
+            Ok(start.elapsed().as_secs_f64())
+        })
+    }
+
     fn new(scene: Scene, source: Source) -> PyScene {
         PyScene {
             scene: Arc::new(scene),
@@ -137,9 +150,7 @@ impl PyScene {
         base_dir: Option<PathBuf>,
     ) -> PyResult<PyScene> {
         let base_dir = base_dir.unwrap_or_else(|| PathBuf::from("."));
-        let json: String = py
-            .import("json")?
-            .getattr("dumps")?
+        let json: String = upcalls::python(py, "json", "dumps")?
             .call1((description,))
             .map_err(|e| {
                 PyValueError::new_err(format!("the scene description is not JSON data: {e}"))
@@ -296,21 +307,6 @@ impl PyScene {
         )?)
     }
 
-    /// Seconds spent in Rust making ``indices`` one at a time on this thread (variant, XML
-    /// and parameters, exactly what :meth:`variant` makes) without making any Python
-    /// object: the baseline against which the benchmarks measure the cost of crossing
-    /// into Python per variant. Not part of the API.
-    fn _rust_seconds(&self, py: Python<'_>, indices: Vec<u64>) -> PyResult<f64> {
-        run(py, || {
-            let start = std::time::Instant::now();
-            for &i in &indices {
-                // Dropped at once, as a Python caller drops a variant it has read.
-                std::hint::black_box(make(&self.scene, i)?);
-            }
-            Ok(start.elapsed().as_secs_f64())
-        })
-    }
-
     /// Pickling (Ray, multiprocessing) ships the description, not the models: the copy
     /// loads the same file, text or dict again (so the other side needs the model files
     /// at the same paths, as a cluster with shared storage has them).
@@ -321,7 +317,7 @@ impl PyScene {
             Source::File(path) => (cls.getattr("load")?, (path,).into_pyobject(py)?),
             Source::Toml(text, dir) => (cls.getattr("from_toml")?, (text, dir).into_pyobject(py)?),
             Source::Json(json, dir) => {
-                let dict = py.import("json")?.getattr("loads")?.call1((json,))?;
+                let dict = upcalls::python(py, "json", "loads")?.call1((json,))?;
                 (cls.getattr("from_dict")?, (dict, dir).into_pyobject(py)?)
             }
         };

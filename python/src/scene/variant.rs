@@ -12,6 +12,7 @@ use pyo3::types::{PyList, PyTuple};
 use crate::document::PyDocument;
 use crate::document::patch::{PatchTuple, patch_entry, patch_list};
 use crate::errors::{Failure, catch, run};
+use crate::upcalls;
 
 /// What a worker makes for one index: the variant's text forms, so that the Python side
 /// only wraps them. The XML comes from the library's fastest path (`variant_xml`: the
@@ -194,10 +195,7 @@ impl PyVariant {
     /// those of the XML text, read back exactly.
     #[getter]
     fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let params = py
-            .import("json")?
-            .getattr("loads")?
-            .call1((self.params_json.as_str(),))?;
+        let params = upcalls::python(py, "json", "loads")?.call1((self.params_json.as_str(),))?;
         numeric_params(&params)?;
         Ok(params)
     }
@@ -249,7 +247,7 @@ impl PyVariant {
     /// Compiles the variant with MuJoCo (``mujoco.MjModel.from_xml_string``); needs the
     /// ``mujoco`` package. Asset files are found by their absolute paths.
     fn compile<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let mujoco = py.import("mujoco").map_err(|e| {
+        let mujoco = upcalls::python_module(py, "mujoco").map_err(|e| {
             PyImportError::new_err(format!(
                 "Variant.compile() needs the mujoco package (pip install mujoco): {e}"
             ))

@@ -6,7 +6,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use super::arrays::Array;
-use mjcf_forge::split::{StatArrays, mean_inertia, statistics};
+use mjcf_forge::split::{STATISTIC_NAMES, StatArrays, mean_inertia, statistics};
 
 /// The arrays of one model and its scratch data the statistics read, found once.
 ///
@@ -185,10 +185,7 @@ impl PyStatistics {
     fn compute(&self, py: Python<'_>) -> PyResult<()> {
         let stat = self.stat.bind(py);
         let mut previous = [0.0; 7];
-        for (k, name) in ["meaninertia", "meanmass", "meansize", "extent"]
-            .iter()
-            .enumerate()
-        {
+        for (k, name) in STATISTIC_NAMES[..4].iter().enumerate() {
             previous[k] = stat.getattr(*name)?.extract()?;
         }
         // SAFETY: the GIL is held and nothing else runs; `center` is no input.
@@ -199,10 +196,7 @@ impl PyStatistics {
             None => None,
         };
         let out = self.with_arrays(|arrays| statistics(arrays, &previous, lengths));
-        for (k, name) in ["meaninertia", "meanmass", "meansize", "extent"]
-            .iter()
-            .enumerate()
-        {
+        for (k, name) in STATISTIC_NAMES[..4].iter().enumerate() {
             stat.setattr(*name, out[k])?;
         }
         // SAFETY: as above.

@@ -28,6 +28,8 @@ pub(super) fn add(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MODEL_FIELDS", PyTuple::new(py, split::MODEL_FIELDS)?)?;
     m.add("GEOM_FACTORS", split::GEOM_FACTORS)?;
     m.add("MASS_DERIVED", PyTuple::new(py, split::MASS_DERIVED)?)?;
+    m.add("STATISTIC_NAMES", PyTuple::new(py, split::STATISTIC_NAMES)?)?;
+    m.add("JOINT_TYPES", PyTuple::new(py, split::JOINT_TYPES)?)?;
     m.add_function(wrap_pyfunction!(target_array, m)?)?;
     m.add_function(wrap_pyfunction!(joint_widths, m)?)?;
     Ok(())
