@@ -373,11 +373,13 @@ class ModelCache:
 
     def batch(self, variants: Any, progress: Any = None) -> dict[str, np.ndarray]:
         """Per-world arrays for batched simulation (``superset=True``): for every field of
-        the superset model that differs between the given variants, one row per variant
-        (``{"geom_rgba": (n, ngeom, 4), "qpos0": (n, nq), "stat.meaninertia": (n,), ...}``),
-        each row what the patched superset model holds for that variant: the form MJX and
-        MuJoCo Warp take for per-world model fields. Fields every variant shares are left
-        out (they are the superset model's).
+        the superset model that differs between the given variants, and always for
+        ``qpos0`` and the statistics, one row per variant (``{"geom_rgba": (n, ngeom, 4),
+        "qpos0": (n, nq), "stat.meaninertia": (n,), ...}``), each row what the patched
+        superset model holds for that variant: the form MJX and MuJoCo Warp take for
+        per-world model fields. The other fields every variant shares (they are the
+        superset model's). The rule of the Rust ``ModelCache::worlds``
+        (docs/compiled.md, "Per-world arrays").
 
         ``progress``: ``True`` (a ``tqdm`` bar, or a line on standard error every second
         without ``tqdm``), a ``tqdm``-like object with ``update(n)``, or a callable ``f(n)``,
@@ -413,10 +415,11 @@ class ModelCache:
             if bar is not None:
                 bar.close()
         out = {}
-        for n, r in list(rows.items()) + list(stats.items()):
+        for n, r in rows.items():
             stacked = np.stack(r)
-            if not (stacked == stacked[0]).all():
+            if n == "qpos0" or not (stacked == stacked[0]).all():
                 out[n] = stacked
+        out.update((s, np.stack(r)) for s, r in stats.items())
         return out
 
 

@@ -490,6 +490,13 @@ def test_superset_every_variant_is_a_patch_of_one_model():
         assert rows.shape[0] == 5
         if not field.startswith("stat."):
             assert np.array_equal(rows[3], getattr(model, field)), field
+        else:
+            assert np.array_equal(rows[3], np.asarray(getattr(model.stat, field[5:]))), field
+    # The rule of ModelCache::worlds (docs/compiled.md): qpos0 and the statistics always,
+    # the rest where the worlds differ; two worlds of one variant differ in nothing.
+    same = cache.batch([variants[1], variants[1]])
+    stats = {f"stat.{s}" for s in ("meaninertia", "meanmass", "meansize", "extent", "center")}
+    assert set(same) == {"qpos0"} | stats
 
 
 @pytest.mark.skipif(not RS_ASSETS.is_dir(), reason="setup not run")
