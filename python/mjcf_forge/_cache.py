@@ -22,6 +22,7 @@ import numpy as np
 from ._errors import error
 from ._last_xml import compile_xml
 from ._mjcf_forge import (
+    LAYOUTS_KEPT,
     MODEL_FIELDS,
     SIGNATURE_ARRAYS,
     SIGNATURE_SKIPPED_SIZES,
@@ -278,7 +279,7 @@ class ModelCache:
         def derive(model: Any, data: Any, layout: list) -> bool:
             entry = derivations.get(id(layout))
             if entry is None or entry[0] is not layout:
-                if len(derivations) >= 64:
+                if len(derivations) >= LAYOUTS_KEPT:
                     derivations.clear()
                 entry = derivations[id(layout)] = (layout, TreeDerivation.build(self._mujoco, model, layout))
             derivation = entry[1]

@@ -25,6 +25,10 @@ MASS_DERIVED: tuple[str, ...]
 STATISTIC_NAMES: tuple[str, ...]
 #: MuJoCo's joint types by their compiled number (``mjtJoint``, ``model.jnt_type``).
 JOINT_TYPES: tuple[str, ...]
+#: The bounds of what a cache keeps: a plan's compiled body models, and the superset
+#: layouts whose patch and tree derivation it keeps.
+BODY_MODELS_KEPT: int
+LAYOUTS_KEPT: int
 
 def target_array(object: str, field: str) -> Optional[str]: ...
 def joint_widths(jnt_type: int) -> tuple[int, int]: ...

@@ -21,7 +21,7 @@ import numpy as np
 from ._errors import error
 from ._last_xml import compile_xml
 from . import _mujoco
-from ._mjcf_forge import MODEL_FIELDS, PATCH_OBJECTS, ModelArrays, PatchLanding, Statistics
+from ._mjcf_forge import BODY_MODELS_KEPT, MODEL_FIELDS, PATCH_OBJECTS, ModelArrays, PatchLanding, Statistics
 
 # The split tier's tables (``mjcf_forge::split::targets``, through the extension): each
 # patched object's array prefix, mjtObj name and count; the joints' dof and qpos fields.
@@ -179,14 +179,14 @@ class Plan:
 
     def compiled(self, body: int, xml: str) -> Any:
         """The arrays of ``xml``, a model of ``body``'s geoms, compiled by this MuJoCo once
-        (the last 64 kept)."""
+        (the last ``BODY_MODELS_KEPT`` kept)."""
         entry = self.body_models.get(xml)
         if entry is None:
             try:
                 mini = compile_xml(self.mujoco, xml)
             except ValueError as e:
                 raise error(f"body '{self.model.body(body).name}': its geoms alone: {e}") from None
-            if len(self.body_models) >= 64:
+            if len(self.body_models) >= BODY_MODELS_KEPT:
                 del self.body_models[next(iter(self.body_models))]
             entry = self.body_models[xml] = (mini, ModelArrays(mini))
         return entry[1]

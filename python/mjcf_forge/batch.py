@@ -35,7 +35,7 @@ import numpy as np
 
 from ._cache import ModelCache, apply_world, body_ids_of, mujoco_of, plan_of
 from ._errors import error
-from ._mjcf_forge import STATIC_PREFIXES, STATISTIC_NAMES, target_array
+from ._mjcf_forge import LAYOUTS_KEPT, STATIC_PREFIXES, STATISTIC_NAMES, target_array
 from ._mjx import MjxWorlds
 from ._progress import progress_of
 from ._warp import WarpWorlds
@@ -285,7 +285,7 @@ class WorldBatch(WarpWorlds, MjxWorlds):
             for layout, index in first.items():
                 key = layouts[layout]
                 if key not in self._layouts:
-                    if len(self._layouts) >= 64:
+                    if len(self._layouts) >= LAYOUTS_KEPT:
                         self._layouts.clear()
                     self._layouts[key] = self.superset.patch(index)
                 patches[layout] = self._layouts[key]

@@ -20,7 +20,7 @@ pub(super) struct BodyModels {
 }
 
 /// How many body models a plan keeps.
-const KEPT: usize = 64;
+const KEPT: usize = crate::split::BODY_MODELS_KEPT;
 
 impl BodyModels {
     /// The body models of `model`'s plan, none compiled yet; its massless bodies' frames

@@ -65,9 +65,9 @@ pub use statistics::{
     mean_inertia, statistics,
 };
 pub use targets::{
-    DOF_FIELDS, GEOM_FACTORS, JOINT_TYPES, MASS_DERIVED, MODEL_FIELDS, PATCH_OBJECTS, PatchObject,
-    QPOS_FIELDS, SIGNATURE_ARRAYS, SIGNATURE_SKIPPED_SIZES, STATIC_PREFIXES, joint_widths,
-    target_array,
+    BODY_MODELS_KEPT, DOF_FIELDS, GEOM_FACTORS, JOINT_TYPES, LAYOUTS_KEPT, MASS_DERIVED,
+    MODEL_FIELDS, PATCH_OBJECTS, PatchObject, QPOS_FIELDS, SIGNATURE_ARRAYS,
+    SIGNATURE_SKIPPED_SIZES, STATIC_PREFIXES, joint_widths, target_array,
 };
 pub use volumes::{Volume, VolumeNode, bounding_volumes};
 

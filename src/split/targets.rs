@@ -112,6 +112,14 @@ pub const DOF_FIELDS: [&str; 3] = ["damping", "armature", "frictionloss"];
 /// rows of every keyframe).
 pub const QPOS_FIELDS: [&str; 3] = ["qpos0", "qpos_spring", "key_qpos"];
 
+/// How many compiled body models (a body's geoms compiled alone, `geoms` entries) a
+/// structure's patch plan keeps, the oldest dropped first: both faces' bound.
+pub const BODY_MODELS_KEPT: usize = 64;
+
+/// How many superset layouts (which objects a world places) a cache keeps derived things
+/// of (a layout's patch, its tree-by-tree derivation), all dropped when one more comes.
+pub const LAYOUTS_KEPT: usize = 64;
+
 /// MuJoCo's joint types by their compiled number (`mjtJoint`, `jnt_type`): the schema's
 /// `enum<jointtype>` keywords, in that order.
 ///

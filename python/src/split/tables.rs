@@ -30,6 +30,8 @@ pub(super) fn add(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MASS_DERIVED", PyTuple::new(py, split::MASS_DERIVED)?)?;
     m.add("STATISTIC_NAMES", PyTuple::new(py, split::STATISTIC_NAMES)?)?;
     m.add("JOINT_TYPES", PyTuple::new(py, split::JOINT_TYPES)?)?;
+    m.add("BODY_MODELS_KEPT", split::BODY_MODELS_KEPT)?;
+    m.add("LAYOUTS_KEPT", split::LAYOUTS_KEPT)?;
     m.add_function(wrap_pyfunction!(target_array, m)?)?;
     m.add_function(wrap_pyfunction!(joint_widths, m)?)?;
     Ok(())
