@@ -150,9 +150,11 @@ def test_the_compiled_modules_examples_run():
 
     finder, runner = doctest.DocTestFinder(exclude_empty=True), doctest.DocTestRunner()
     examples = 0
-    for name in dir(_mjcf_forge):
-        obj = getattr(_mjcf_forge, name)
-        if name.startswith("__") or not (inspect.isclass(obj) or callable(obj)):
+    # The module's own names and its submodule _testing's (the tests' entry points).
+    members = [(name, getattr(_mjcf_forge, name)) for name in dir(_mjcf_forge)]
+    members += [(f"_testing.{n}", getattr(_mjcf_forge._testing, n)) for n in dir(_mjcf_forge._testing)]
+    for name, obj in members:
+        if name.split(".")[-1].startswith("__") or not (inspect.isclass(obj) or callable(obj)):
             continue
         for test in finder.find(obj, name, globs={}):
             examples += len(test.examples)
