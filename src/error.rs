@@ -112,6 +112,26 @@ pub enum ErrorKind {
         /// The operating system's words.
         reason: String,
     },
+    /// MuJoCo refused to compile a scene's variant (`ModelCache`).
+    Compile {
+        /// The variant's index.
+        variant: u64,
+        /// MuJoCo's words.
+        message: String,
+    },
+    /// A model handed to `ModelCache::apply` is not of the variant's structure.
+    OtherStructure {
+        /// The variant's index.
+        variant: u64,
+        /// The variant's structure key.
+        key: String,
+        /// The model's structure key, where the cache patched it before.
+        found: Option<String>,
+    },
+    /// A call that needs a superset cache (`ModelCache::with_superset`) on a plain one.
+    NeedsSuperset,
+    /// A batch of worlds with no variant.
+    NoWorlds,
 }
 
 impl fmt::Display for ErrorKind {
@@ -159,6 +179,33 @@ impl fmt::Display for ErrorKind {
             ErrorKind::Invalid(msg) => f.write_str(msg),
             ErrorKind::Write { path, reason } => {
                 write!(f, "cannot write '{}': {reason}", path.display())
+            }
+            ErrorKind::Compile { variant, message } => {
+                write!(f, "variant {variant}: MuJoCo: {message}")
+            }
+            ErrorKind::OtherStructure {
+                variant,
+                key,
+                found: Some(found),
+            } => write!(
+                f,
+                "the model has structure {found}, variant {variant} has {key}: a patch cannot \
+                 change a structure (ModelCache::model compiles it)"
+            ),
+            ErrorKind::OtherStructure {
+                variant,
+                key,
+                found: None,
+            } => write!(
+                f,
+                "the model does not have the structure of variant {variant} (key {key}): its \
+                 sizes or names differ"
+            ),
+            ErrorKind::NeedsSuperset => {
+                f.write_str("per-world arrays need ModelCache::with_superset")
+            }
+            ErrorKind::NoWorlds => {
+                f.write_str("a batch needs at least one world: no variant was given (0 worlds)")
             }
         }
     }

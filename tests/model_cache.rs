@@ -9,6 +9,7 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
+use mjcf_forge::ErrorKind;
 use mjcf_forge::compiled::ModelCache;
 use mjcf_forge::mujoco::{CompiledModel, compile_str};
 use mjcf_forge::scene::Scene;
@@ -84,10 +85,31 @@ fn apply_patches_a_model_of_ones_own_and_refuses_another_structure() {
         assert_eq!(mine.differences(&compiled(&scene, i)), Vec::<String>::new());
     }
     let err = cache.apply(b[0], &mut mine).unwrap_err();
-    assert!(err.contains("a patch cannot change a structure"), "{err}");
+    assert!(
+        matches!(
+            &err.first().kind,
+            ErrorKind::OtherStructure { found: Some(_), .. }
+        ),
+        "{err:?}"
+    );
+    assert!(
+        err.to_string()
+            .contains("a patch cannot change a structure"),
+        "{err}"
+    );
     let mut fresh = compiled(&scene, a[0]);
     let err = cache.apply(b[0], &mut fresh).unwrap_err();
-    assert!(err.contains("does not have the structure"), "{err}");
+    assert!(
+        matches!(
+            &err.first().kind,
+            ErrorKind::OtherStructure { found: None, .. }
+        ),
+        "{err:?}"
+    );
+    assert!(
+        err.to_string().contains("does not have the structure"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -619,7 +641,11 @@ fn per_world_arrays_hold_each_worlds_superset_model() {
         assert_eq!(f.row_bytes(0), f.row_bytes(3), "{}", f.name);
     }
     // Bad input, before any array: zero worlds; no superset.
-    assert!(cache.worlds(&[]).unwrap_err().contains("0 worlds"));
+    let none = cache.worlds(&[]).unwrap_err();
+    assert_eq!(none.first().kind, ErrorKind::NoWorlds);
+    assert!(none.to_string().contains("0 worlds"));
     let mut plain = ModelCache::new(&scene, 2, None);
-    assert!(plain.worlds(&[0]).unwrap_err().contains("with_superset"));
+    let plain_err = plain.worlds(&[0]).unwrap_err();
+    assert_eq!(plain_err.first().kind, ErrorKind::NeedsSuperset);
+    assert!(plain_err.to_string().contains("with_superset"));
 }

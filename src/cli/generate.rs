@@ -486,7 +486,7 @@ impl<'s> Validators<'s> {
         // A thread's own cache: the lock is never contended (poisoned only by a panic
         // elsewhere, after which the cache is still whole).
         let mut cache = self.0[k].lock().unwrap_or_else(|p| p.into_inner());
-        let model = cache.model(i)?;
+        let model = cache.model(i).map_err(|e| e.to_string())?;
         mjcf_forge::scene::check_model(i, params, model)?;
         Ok(t.elapsed())
     }

@@ -16,6 +16,9 @@ use super::sys::{mjf_patch_array, mjf_patch_array_name, mjf_patch_get_stat, mjf_
 use crate::mujoco::{CompileError, CompiledModel, compile_str};
 use crate::scene::{Scene, Superset, VariantPatch};
 use crate::split::{PatchEntry, fixed_statistics_mask};
+use crate::{ErrorKind, Errors};
+
+use super::{bare, internal};
 
 impl CompiledModel {
     /// Where `other` differs from this model: every array of `mjModel` compared bit for
@@ -185,8 +188,8 @@ impl<'s> ModelCache<'s> {
 
     /// Makes every variant a patch of one model, the scene's superset
     /// ([`Scene::superset`]): `model(i)` is that model patched for variant `i`.
-    pub fn with_superset(mut self) -> Result<Self, String> {
-        let superset = self.scene.superset().map_err(|e| e.to_string())?;
+    pub fn with_superset(mut self) -> Result<Self, Errors> {
+        let superset = self.scene.superset()?;
         let xml = superset.document.to_xml_string();
         self.superset = Some(SupersetState {
             superset,
@@ -202,22 +205,19 @@ impl<'s> ModelCache<'s> {
     }
 
     /// The root bodies of the objects variant `index` parks in the superset.
-    pub(super) fn parked(&self, index: u64) -> Result<Vec<String>, String> {
+    pub(super) fn parked(&self, index: u64) -> Result<Vec<String>, Errors> {
         let Some(s) = &self.superset else {
-            return Err("no superset".to_string());
+            return Err(bare(ErrorKind::NeedsSuperset));
         };
-        self.scene
-            .superset_parked(&s.superset, index)
-            .map_err(|e| e.to_string())
+        self.scene.superset_parked(&s.superset, index)
     }
 
     /// The variant's patch: of its own structure, or of the superset.
-    fn patch_of(&self, index: u64) -> Result<VariantPatch, String> {
+    fn patch_of(&self, index: u64) -> Result<VariantPatch, Errors> {
         match &self.superset {
             Some(s) => self.scene.superset_patch(&s.superset, index),
             None => self.scene.patch(index),
         }
-        .map_err(|e| e.to_string())
     }
 
     /// Models compiled so far (misses).
@@ -248,7 +248,7 @@ impl<'s> ModelCache<'s> {
     /// Variant `index` as MuJoCo compiles it from its XML: the cached model of its
     /// structure patched in place, or on a miss the variant compiled (and kept). The model
     /// stays the cache's: the next call for the same structure patches it again.
-    pub fn model(&mut self, index: u64) -> Result<&CompiledModel, String> {
+    pub fn model(&mut self, index: u64) -> Result<&CompiledModel, Errors> {
         let patch = self.patch_of(index)?;
         let key = patch.structure_key;
         let patch_it = if self.store.touch(&key) {
@@ -261,7 +261,7 @@ impl<'s> ModelCache<'s> {
         if patch_it {
             let store = &mut self.store;
             let Some((_, model)) = store.entries.last_mut() else {
-                return Err("the cache holds no model".to_string());
+                return Err(internal("the cache holds no model".to_string()));
             };
             let target = (index, key.as_str(), patch.entries.as_slice());
             let patched = patch_variant(
@@ -280,17 +280,17 @@ impl<'s> ModelCache<'s> {
                     self.store.remove(&key);
                     self.compile(index, &key)?;
                 }
-                Err(e) => return Err(e),
+                Err(e) => return Err(internal(e)),
             }
         }
         self.store
             .last()
-            .ok_or_else(|| "the cache holds no model".to_string())
+            .ok_or_else(|| internal("the cache holds no model".to_string()))
     }
 
     /// Patches `model`, a model of variant `index`'s structure, in place into variant
     /// `index`'s compiled model. A model of another structure is refused.
-    pub fn apply(&mut self, index: u64, model: &mut CompiledModel) -> Result<(), String> {
+    pub fn apply(&mut self, index: u64, model: &mut CompiledModel) -> Result<(), Errors> {
         let patch = self.patch_of(index)?;
         let key = patch.structure_key;
         let known = self
@@ -301,11 +301,11 @@ impl<'s> ModelCache<'s> {
             .find(|p| p.serial == model.serial());
         match known {
             Some(p) if p.key != key => {
-                return Err(format!(
-                    "the model has structure {}, variant {index} has {key}: a patch cannot \
-                     change a structure (ModelCache::model compiles it)",
-                    p.key
-                ));
+                return Err(bare(ErrorKind::OtherStructure {
+                    variant: index,
+                    key,
+                    found: Some(p.key.clone()),
+                }));
             }
             Some(_) => {}
             None => {
@@ -313,32 +313,37 @@ impl<'s> ModelCache<'s> {
                     self.compile(index, &key)?;
                 }
                 if self.store.state.signatures.get(&key) != Some(&Signature::of(model)) {
-                    return Err(format!(
-                        "the model does not have the structure of variant {index} (key \
-                         {key}): its sizes or names differ"
-                    ));
+                    return Err(bare(ErrorKind::OtherStructure {
+                        variant: index,
+                        key,
+                        found: None,
+                    }));
                 }
             }
         }
         let target = (index, key.as_str(), patch.entries.as_slice());
         let state = &mut self.store.state;
-        patch_variant(self.scene, &mut self.superset, state, target, model)?;
+        patch_variant(self.scene, &mut self.superset, state, target, model).map_err(internal)?;
         self.store.trim();
         Ok(())
     }
 
-    fn compile(&mut self, index: u64, key: &str) -> Result<(), String> {
+    fn compile(&mut self, index: u64, key: &str) -> Result<(), Errors> {
         let xml = match &self.superset {
             Some(s) => s.xml.clone(),
-            None => self.scene.variant_xml(index).map_err(|e| e.to_string())?.0,
+            None => self.scene.variant_xml(index)?.0,
         };
         let dir = self
             .dir
             .as_deref()
             .unwrap_or_else(|| self.scene.template().model_dir());
-        let model = compile_str(&xml, dir)
-            .map_err(|e: CompileError| format!("variant {index}: MuJoCo: {e}"))?;
-        self.store.insert(key, model, self.fixed)
+        let model = compile_str(&xml, dir).map_err(|e: CompileError| {
+            bare(ErrorKind::Compile {
+                variant: index,
+                message: e.to_string(),
+            })
+        })?;
+        self.store.insert(key, model, self.fixed).map_err(internal)
     }
 }
 

@@ -7,9 +7,10 @@
 
 use std::path::Path;
 
+use super::internal;
 use super::store::Store;
 use crate::document::Document;
-use crate::error::{Error, ErrorKind, Errors};
+use crate::error::Errors;
 use crate::mujoco::{CompiledModel, compile_document};
 use crate::split::{SplitOptions, fixed_statistics_mask, split_document_with};
 
@@ -122,11 +123,4 @@ impl DocumentCache {
     pub fn nbytes(&self) -> usize {
         self.store.nbytes()
     }
-}
-
-fn internal(message: String) -> Errors {
-    Errors(vec![Error {
-        location: None,
-        kind: ErrorKind::Invalid(message),
-    }])
 }

@@ -37,5 +37,18 @@ mod sys;
 mod worlds;
 
 pub use cache::ModelCache;
+
+/// An error of this tier's API: one problem of `kind`, at no place in a file.
+fn bare(kind: crate::ErrorKind) -> crate::Errors {
+    crate::Errors(vec![crate::Error {
+        location: None,
+        kind,
+    }])
+}
+
+/// A problem of this tier's own, in words (`ErrorKind::Invalid`).
+fn internal(message: String) -> crate::Errors {
+    bare(crate::ErrorKind::Invalid(message))
+}
 pub use document::DocumentCache;
 pub use worlds::{Dtype, WorldArrays, WorldField, WorldStatistics};

@@ -18,6 +18,9 @@ use super::cache::ModelCache;
 use super::sys::{mjf_patch_array, mjf_patch_array_name, mjf_patch_array_type, mjf_patch_get_stat};
 use crate::mujoco::CompiledModel;
 use crate::split::STATIC_PREFIXES;
+use crate::{ErrorKind, Errors};
+
+use super::{bare, internal};
 
 /// The element type of an `mjModel` array, as MuJoCo declares it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -185,14 +188,12 @@ impl ModelCache<'_> {
     /// let pos = worlds.field("qpos0").unwrap().to_f64().unwrap(); // 4 rows of nq
     /// assert_eq!(pos.len(), 4 * worlds.model.sizes().nq);
     /// ```
-    pub fn worlds(&mut self, indices: &[u64]) -> Result<WorldArrays, String> {
+    pub fn worlds(&mut self, indices: &[u64]) -> Result<WorldArrays, Errors> {
         if !self.has_superset() {
-            return Err("per-world arrays need ModelCache::with_superset".to_string());
+            return Err(bare(ErrorKind::NeedsSuperset));
         }
         let Some(&first) = indices.first() else {
-            return Err(
-                "a batch needs at least one world: no variant was given (0 worlds)".to_string(),
-            );
+            return Err(bare(ErrorKind::NoWorlds));
         };
         let parked = indices
             .iter()
@@ -219,7 +220,7 @@ impl ModelCache<'_> {
             stats.push(statistics(&scratch));
             for (k, (i, name, _, first_bytes)) in base.iter().enumerate() {
                 let Some((_, _, bytes)) = array(&mut scratch, *i) else {
-                    return Err(format!("mjModel.{name} vanished"));
+                    return Err(internal(format!("mjModel.{name} vanished")));
                 };
                 match &mut rows[k] {
                     Some(r) => r.extend_from_slice(bytes),
