@@ -378,8 +378,8 @@ class ModelCache:
         ``qpos0`` and the statistics, one row per variant (``{"geom_rgba": (n, ngeom, 4),
         "qpos0": (n, nq), "stat.meaninertia": (n,), ...}``), each row what the patched
         superset model holds for that variant: the form MJX and MuJoCo Warp take for
-        per-world model fields. The other fields every variant shares (they are the
-        superset model's). The rule of the Rust ``ModelCache::worlds``
+        per-world model fields. Every other field is left out: the superset model's
+        value is every variant's. The rule of the Rust ``ModelCache::worlds``
         (docs/compiled.md, "Per-world arrays").
 
         ``progress``: ``True`` (a ``tqdm`` bar, or a line on standard error every second

@@ -222,8 +222,8 @@ class DocumentCache:
         """
         doc = _document(source, base_dir)
         parts = doc._split()
-        key, fixed, bodies = parts.structure_key, parts.fixed_statistics, parts.bodies
-        materials = parts.materials
+        key, materials, bodies = parts.structure_key, parts.materials, parts.bodies
+        fixed = parts.fixed_statistics
         values = np.frombuffer(parts.numbers, dtype="<f8")
         me = threading.get_ident()
         if into is not None:

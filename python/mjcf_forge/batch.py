@@ -71,8 +71,6 @@ _WRITTEN = (
 _FROM_GEOMS = ("body_margin", "body_contype", "body_conaffinity")
 # A model's keyframe arrays (each world's rows: WorldBatch.keys).
 _KEYS = ("key_qpos", "key_qvel", "key_act", "key_ctrl", "key_mpos", "key_mquat", "key_time")
-# The compiler's statistics, per world (``stat.<name>`` in :attr:`WorldBatch.arrays`).
-_STATS = STATISTIC_NAMES
 class _Index(NamedTuple):
     """What a superset ModelCache reads of a variant: its index."""
 
@@ -167,7 +165,7 @@ class WorldBatch(WarpWorlds, MjxWorlds):
             if bar is not None:
                 bar.close()
         varying = sorted({n for r in rows for n in r if n in self._others})
-        self.per_world = self._candidates + varying + [f"stat.{s}" for s in _STATS]
+        self.per_world = self._candidates + varying + [f"stat.{s}" for s in STATISTIC_NAMES]
         self.arrays = {
             n: np.stack([r[n] if n in r else getattr(model, n) for r in rows]) for n in self.per_world
         }
@@ -316,7 +314,7 @@ class WorldBatch(WarpWorlds, MjxWorlds):
             value = getattr(model, n)
             if value.tobytes() != self._others[n]:
                 out[n] = value.copy()
-        for s in _STATS:
+        for s in STATISTIC_NAMES:
             out[f"stat.{s}"] = np.array(getattr(model.stat, s), dtype=np.float64)
         if model.nkey:
             for n in _KEYS:
