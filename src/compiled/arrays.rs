@@ -1,7 +1,6 @@
 //! A live model's arrays by their `mjModel` names, through `patch.c` (MuJoCo's X-macro
 //! table): what the split tier's shared rules read and write on the C face
-//! ([`crate::split::land`] and [`crate::split::Run::write`] in `store.rs`,
-//! [`crate::split::copy_body_model`] in `body_models.rs`).
+//! (the split tier's patch plan, through `linked.rs`).
 
 use std::ffi::{CString, c_int};
 
@@ -27,7 +26,7 @@ impl Arrays {
     }
 
     /// `name`'s pointer and element count, checked to hold elements of `T`'s size.
-    fn typed<T>(&self, name: &str) -> Result<(*mut T, usize), String> {
+    pub(super) fn typed<T>(&self, name: &str) -> Result<(*mut T, usize), String> {
         let (p, elem, count) = self.find(name)?;
         if elem != std::mem::size_of::<T>() {
             return Err(format!(

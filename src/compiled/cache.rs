@@ -10,12 +10,11 @@
 use std::collections::HashMap;
 use std::ffi::{CString, c_int};
 
-use super::statistics::variant_inertia;
 use super::store::{Signature, State, Store};
 use super::sys::{mjf_patch_array, mjf_patch_array_name, mjf_patch_get_stat, mjf_patch_name2id};
 use crate::mujoco::{CompileError, CompiledModel, compile_str};
 use crate::scene::{Scene, Superset, VariantPatch};
-use crate::split::{PatchEntry, fixed_statistics_mask};
+use crate::split::{PatchEntry, PatchModel, fixed_statistics_mask};
 use crate::{ErrorKind, Errors};
 
 use super::{bare, internal};
@@ -300,11 +299,11 @@ impl<'s> ModelCache<'s> {
             .iter()
             .find(|p| p.serial == model.serial());
         match known {
-            Some(p) if p.key != key => {
+            Some(p) if p.plan.key != key => {
                 return Err(bare(ErrorKind::OtherStructure {
                     variant: index,
                     key,
-                    found: Some(p.key.clone()),
+                    found: Some(p.plan.key.clone()),
                 }));
             }
             Some(_) => {}
@@ -378,13 +377,15 @@ fn patch_variant(
         sup.kept_dofs.insert(roots.clone(), keep);
     }
     let keep = &sup.kept_dofs[&roots];
-    let Some(plan) = state.plans.iter().find(|p| p.serial == model.serial()) else {
+    if keep.is_empty() {
+        return Ok(());
+    }
+    let Some(plan) = state.plan(model) else {
         return Ok(());
     };
-    // SAFETY: live model and its scratch data (left at qpos0 by the statistics); `keep`
-    // holds valid dof indices of this structure.
-    unsafe { variant_inertia(model.as_mut_ptr(), plan.scratch.0.as_ptr(), keep) };
-    Ok(())
+    let mut stat = model.stat();
+    stat[0] = plan.plan.mean_inertia(model, keep)?;
+    model.set_stat(&stat)
 }
 
 /// The dofs of `model` outside the subtrees of the bodies named in `parked`, in order.

@@ -28,9 +28,9 @@
 #![allow(unsafe_code)]
 
 mod arrays;
-mod body_models;
 mod cache;
 mod document;
+mod linked;
 mod statistics;
 mod store;
 mod sys;

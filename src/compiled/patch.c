@@ -95,18 +95,28 @@ struct mjf_stat_arrays {
   long long nbody, njnt, nsite, ngeom, nhfield, nv, ninertia;
 };
 
-// After a patch's values are written: mj_setConst on scratch data `d`, then the
-// kinematics, centres of mass and joint-space inertia at qpos0 (what the compiler's
-// statistics read; mj_setConst of 3.17 and 4.0 leaves those statistics as they were).
-void mjf_patch_set_const(mjModel* m, mjData* d) {
-  mj_setConst(m, d);
+// After a patch's values are written (mjcf_forge::split::PatchPlan::finish): mj_setConst
+// on scratch data `d`; then the kinematics and centres of mass at qpos0, and the
+// joint-space inertia (what the compiler's statistics read; mj_setConst of 3.17 and 4.0
+// leaves those statistics as they were).
+void mjf_patch_set_const(mjModel* m, mjData* d) { mj_setConst(m, d); }
+
+void mjf_patch_kinematics(const mjModel* m, mjData* d) {
   mju_copy(d->qpos, m->qpos0, m->nq);
   mj_kinematics(m, d);
   mj_comPos(m, d);
-  mj_makeM(m, d);
 }
 
-// The arrays of `m` and of `d` (as mjf_patch_set_const left it) the statistics read.
+void mjf_patch_make_m(const mjModel* m, mjData* d) { mj_makeM(m, d); }
+
+// The name of the element of `kind` (as mjf_patch_name2id takes it) with id `id`; NULL when
+// it has none.
+const char* mjf_patch_id2name(const mjModel* m, const char* kind, int id) {
+  if (strcmp(kind, "body") == 0) return mj_id2name(m, mjOBJ_BODY, id);
+  return NULL;
+}
+
+// The arrays of `m` and of `d` (as mjf_patch_kinematics and mjf_patch_make_m left it) the statistics read.
 void mjf_patch_stat_arrays(mjModel* m, const mjData* d, struct mjf_stat_arrays* out) {
   out->xpos = d->xpos;
   out->xipos = d->xipos;

@@ -4,11 +4,9 @@
 
 use std::os::raw::c_longlong;
 
-use super::sys::{
-    RawData, mjf_patch_get_stat, mjf_patch_set_const, mjf_patch_set_stat, mjf_patch_stat_arrays,
-};
+use super::sys::{RawData, mjf_patch_stat_arrays};
 use crate::mujoco::{MjModel, slice_or_empty};
-use crate::split::{StatArrays, Statistics, keep_fixed, mean_inertia, statistics};
+use crate::split::StatArrays;
 
 /// `struct mjf_stat_arrays` of `patch.c`: the arrays of a model and its scratch data the
 /// statistics read, with their counts.
@@ -51,7 +49,7 @@ pub(super) struct RawStatArrays {
 ///
 /// # Safety
 /// `m` and `d` are live, of one structure, and nothing else touches them meanwhile.
-unsafe fn with_arrays<R>(
+pub(super) unsafe fn with_arrays<R>(
     m: *mut MjModel,
     d: *const RawData,
     f: impl FnOnce(&StatArrays<'_>, &mut [f64]) -> R,
@@ -101,48 +99,5 @@ unsafe fn with_arrays<R>(
             std::slice::from_raw_parts_mut(r.dof_length, nv)
         };
         f(&arrays, lengths)
-    }
-}
-
-/// What follows a patch's values: `mj_setConst` on scratch data `d`, the compiler's
-/// statistics and dof lengths, then the statistics the document's `<statistic>` fixes
-/// (`fixed`, a [`crate::split::fixed_statistics_mask`], taking them from `values`).
-///
-/// # Safety
-/// `m` and `d` are live, of one structure, and nothing else touches them meanwhile.
-pub(super) unsafe fn finish(m: *mut MjModel, d: *mut RawData, fixed: u32, values: &Statistics) {
-    let mut previous = [0.0; 7];
-    // SAFETY: as the caller promises; `previous` holds 7 values.
-    unsafe {
-        mjf_patch_set_const(m, d);
-        mjf_patch_get_stat(m, previous.as_mut_ptr());
-    }
-    // SAFETY: as the caller promises.
-    let mut stat = unsafe {
-        with_arrays(m, d, |arrays, lengths| {
-            statistics(arrays, &previous, Some(lengths))
-        })
-    };
-    keep_fixed(&mut stat, fixed, values);
-    // SAFETY: live model; `stat` holds 7 values.
-    unsafe { mjf_patch_set_stat(m, stat.as_ptr()) };
-}
-
-/// Superset: sets `stat.meaninertia` to the mean of the joint-space inertia's diagonal
-/// over the dofs in `keep` (the variant's, in order), from scratch data `d` as
-/// [`finish`] left it; nothing when `keep` is empty.
-///
-/// # Safety
-/// As for [`finish`], which ran on `m` and `d` last; `keep` holds dofs of `m`.
-pub(super) unsafe fn variant_inertia(m: *mut MjModel, d: *const RawData, keep: &[usize]) {
-    if keep.is_empty() {
-        return;
-    }
-    let mut stat = [0.0; 7];
-    // SAFETY: as the caller promises.
-    unsafe {
-        mjf_patch_get_stat(m, stat.as_mut_ptr());
-        stat[0] = with_arrays(m, d, |arrays, _| mean_inertia(arrays, keep.iter().copied()));
-        mjf_patch_set_stat(m, stat.as_ptr());
     }
 }

@@ -1,7 +1,8 @@
 //! The C functions of `patch.c` (compiled by `build.rs` against the linked MuJoCo's
 //! headers, as the FFI's shim is): arrays found by name through MuJoCo's X-macro table,
 //! scratch data, the derived values after a patch. The only `extern` block of this tier;
-//! `store.rs` (plans, scratch data), `body_models.rs` and `worlds.rs` call it.
+//! `linked.rs` (the linked MuJoCo behind the split tier's patch plan), `store.rs`,
+//! `statistics.rs` and `worlds.rs` call it.
 
 use std::ffi::{c_char, c_int, c_void};
 
@@ -30,6 +31,13 @@ unsafe extern "C" {
     pub(super) fn mjf_patch_nbytes(m: *const MjModel, d: *const RawData) -> i64;
     pub(super) fn mjf_patch_get_stat(m: *const MjModel, out: *mut f64);
     pub(super) fn mjf_patch_set_const(m: *mut MjModel, d: *mut RawData);
+    pub(super) fn mjf_patch_kinematics(m: *const MjModel, d: *mut RawData);
+    pub(super) fn mjf_patch_make_m(m: *const MjModel, d: *mut RawData);
+    pub(super) fn mjf_patch_id2name(
+        m: *const MjModel,
+        kind: *const c_char,
+        id: c_int,
+    ) -> *const c_char;
     pub(super) fn mjf_patch_stat_arrays(
         m: *mut MjModel,
         d: *const RawData,

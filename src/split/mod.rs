@@ -28,7 +28,8 @@
 //! `targets.rs` (the `mjModel` array each entry writes, the arrays no patch changes, the
 //! arrays that tell structures apart: the one copy the model caches of both faces read),
 //! `landing.rs` (where each patch entry lands in a compiled model and how its numbers are
-//! written, for both faces), `document.rs` (any document split by reading it), `body_model.rs` (a body's geoms as a
+//! written, for both faces), `plan.rs` (one model patched in place: the patch plan both
+//! faces' caches run, over their own MuJoCo), `document.rs` (any document split by reading it), `body_model.rs` (a body's geoms as a
 //! model of their own, for what MuJoCo derives from their sizes), `body_copy.rs` (that
 //! model's compile copied into a structure's model, for both faces), `geom_masses.rs` (a
 //! body's mass properties from its geoms' densities or masses, at patch cost; with
@@ -45,6 +46,7 @@ mod body_model;
 mod document;
 mod geom_masses;
 mod landing;
+mod plan;
 mod rules;
 mod statistics;
 mod targets;
@@ -59,6 +61,7 @@ pub use geom_masses::{
     write_geom_masses,
 };
 pub use landing::{ArrayMut, Carried, Landing, ModelLayout, Run, land};
+pub use plan::{LayoutEntry, PatchModel, PatchPlan, PatchValues};
 pub use rules::{PATCHABLE, PatchEntry, PatchValue};
 pub use statistics::{
     STATISTIC_NAMES, StatArrays, Statistics, fixed_statistics, fixed_statistics_mask, keep_fixed,

@@ -1,0 +1,236 @@
+//! The linked MuJoCo behind the split tier's patch plan ([`crate::split::PatchPlan`], the
+//! one implementation both faces' caches run): a [`CompiledModel`] as a
+//! [`PatchModel`], its arrays found by name through `patch.c` ([`Arrays`]), its scratch
+//! data, body models compiled by the FFI, and `mj_setConst` and the kinematics called
+//! through `patch.c`.
+
+use std::ffi::CString;
+use std::path::Path;
+use std::ptr::NonNull;
+
+use super::arrays::{Arrays, array_mut};
+use super::statistics::with_arrays;
+use super::sys::{
+    RawData, mjf_patch_delete_data, mjf_patch_get_stat, mjf_patch_id2name, mjf_patch_kinematics,
+    mjf_patch_make_data, mjf_patch_make_m, mjf_patch_name2id, mjf_patch_nbytes, mjf_patch_option,
+    mjf_patch_set_const, mjf_patch_set_stat, mjf_patch_size, mjf_patch_size_name,
+};
+use crate::mujoco::{CompiledModel, compile_str};
+use crate::split::{
+    ArrayMut, ModelArrays, ModelArraysMut, ModelLayout, PatchModel, StatArrays, Statistics,
+};
+
+/// Scratch mjData for `mj_setConst` (which overwrites the qpos of the data it is given).
+pub struct Scratch(NonNull<RawData>);
+
+// SAFETY: exclusively owned heap data without thread affinity.
+unsafe impl Send for Scratch {}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        // SAFETY: made by mj_makeData, owned here alone.
+        unsafe { mjf_patch_delete_data(self.0.as_ptr()) }
+    }
+}
+
+/// An array found once: its start, element size and count.
+pub struct Target {
+    ptr: *mut u8,
+    elem: usize,
+    count: usize,
+    int: bool,
+}
+
+// SAFETY: the pointer points into the model the plan belongs to, which is only written
+// through `&mut` of that model.
+unsafe impl Send for Target {}
+
+/// The model's arrays (the model is live while borrowed; writes go through `&mut`).
+fn arrays(model: &CompiledModel) -> Arrays {
+    Arrays(std::ptr::from_ref(model.raw()).cast_mut())
+}
+
+impl ModelArrays for CompiledModel {
+    fn floats(&self, name: &str) -> Result<&[f64], String> {
+        let (p, n) = arrays(self).typed::<f64>(name)?;
+        // SAFETY: `n` elements of this live model, read while `self` is borrowed.
+        Ok(unsafe { crate::mujoco::slice_or_empty(p.cast_const(), n) })
+    }
+    fn ints(&self, name: &str) -> Result<&[i32], String> {
+        let (p, n) = arrays(self).typed::<i32>(name)?;
+        // SAFETY: as above.
+        Ok(unsafe { crate::mujoco::slice_or_empty(p.cast_const(), n) })
+    }
+    fn bytes(&self, name: &str) -> Result<&[u8], String> {
+        let (p, n) = arrays(self).typed::<u8>(name)?;
+        // SAFETY: as above.
+        Ok(unsafe { crate::mujoco::slice_or_empty(p.cast_const(), n) })
+    }
+}
+
+/// `name`'s `n` elements of `T`, to write.
+fn whole_mut<'a, T>(model: &'a mut CompiledModel, name: &str) -> Result<&'a mut [T], String> {
+    let (p, n) = Arrays(model.as_mut_ptr()).typed::<T>(name)?;
+    // SAFETY: `n` elements of this live model, written through its `&mut` borrow only.
+    Ok(unsafe { super::arrays::whole(p.cast(), n) })
+}
+
+impl ModelArraysMut for CompiledModel {
+    fn floats_mut(&mut self, name: &str) -> Result<&mut [f64], String> {
+        whole_mut(self, name)
+    }
+    fn bytes_mut(&mut self, name: &str) -> Result<&mut [u8], String> {
+        whole_mut(self, name)
+    }
+    fn ints_mut(&mut self, name: &str) -> Result<&mut [i32], String> {
+        whole_mut(self, name)
+    }
+}
+
+impl ModelLayout for CompiledModel {
+    fn int(&self, name: &str, i: usize) -> Result<i64, String> {
+        arrays(self).int(name, i)
+    }
+    fn len(&self, name: &str) -> Result<usize, String> {
+        arrays(self).len(name)
+    }
+}
+
+impl PatchModel for CompiledModel {
+    type Target = Target;
+    type Part = CompiledModel;
+    type Data = Scratch;
+
+    fn target(&mut self, name: &str, int: bool) -> Result<Target, String> {
+        let (ptr, elem, count) = Arrays(self.as_mut_ptr()).find(name)?;
+        Ok(Target {
+            ptr,
+            elem,
+            count,
+            int,
+        })
+    }
+
+    fn target_mut<'a>(&'a mut self, t: &'a Target) -> ArrayMut<'a> {
+        // SAFETY: the target is this live model's array (found by `target`), written only
+        // through the `&mut` borrow of the model the slice lives in.
+        unsafe { array_mut(t.ptr, t.elem, t.count, t.int) }
+    }
+
+    fn size(&self, name: &str) -> Option<usize> {
+        for i in 0.. {
+            // SAFETY: a static NUL-terminated name, or null past the last size.
+            let n = unsafe { mjf_patch_size_name(i) };
+            if n.is_null() {
+                return None;
+            }
+            // SAFETY: as above.
+            if unsafe { std::ffi::CStr::from_ptr(n) }.to_bytes() == name.as_bytes() {
+                // SAFETY: the model is live; `i` names one of its sizes.
+                return usize::try_from(unsafe { mjf_patch_size(self.raw(), i) }).ok();
+            }
+        }
+        None
+    }
+
+    fn id(&self, object: &str, name: &str) -> Option<usize> {
+        let kind = CString::new(object).ok()?;
+        let name = CString::new(name).ok()?;
+        // SAFETY: the model is live; both strings are NUL-terminated.
+        usize::try_from(unsafe { mjf_patch_name2id(self.raw(), kind.as_ptr(), name.as_ptr()) }).ok()
+    }
+
+    fn has_option(&self, field: &str, n: usize) -> bool {
+        let Ok(c) = CString::new(field) else {
+            return false;
+        };
+        let (mut elem, mut count) = (0usize, 0usize);
+        let raw = std::ptr::from_ref(self.raw()).cast_mut();
+        // SAFETY: the model is live; `c` is NUL-terminated; nothing is written.
+        let p = unsafe { mjf_patch_option(raw, c.as_ptr(), &mut elem, &mut count) };
+        !p.is_null() && elem == std::mem::size_of::<f64>() && count == n
+    }
+
+    fn write_option(&mut self, field: &str, values: &[f64]) -> Result<(), String> {
+        let c = CString::new(field).map_err(|x| x.to_string())?;
+        let (mut elem, mut count) = (0usize, 0usize);
+        // SAFETY: the model is live; `c` is NUL-terminated.
+        let p = unsafe { mjf_patch_option(self.as_mut_ptr(), c.as_ptr(), &mut elem, &mut count) };
+        if p.is_null() || elem != std::mem::size_of::<f64>() || count != values.len() {
+            return Err(format!(
+                "this MuJoCo's mjOption has no field {field} of {}",
+                values.len()
+            ));
+        }
+        // SAFETY: `count` doubles of the live model's mjOption, written through `&mut`.
+        unsafe { std::slice::from_raw_parts_mut(p.cast::<f64>(), count) }.copy_from_slice(values);
+        Ok(())
+    }
+
+    fn body_name(&self, body: usize) -> String {
+        let name = i32::try_from(body).ok().and_then(|id| {
+            // SAFETY: the model is live; "body" is NUL-terminated; MuJoCo checks the id.
+            let p = unsafe { mjf_patch_id2name(self.raw(), c"body".as_ptr(), id) };
+            // SAFETY: a NUL-terminated name in the model's names buffer.
+            (!p.is_null()).then(|| unsafe { std::ffi::CStr::from_ptr(p) }.to_string_lossy())
+        });
+        name.map_or_else(|| body.to_string(), |n| n.into_owned())
+    }
+
+    fn compile_part(&self, xml: &str) -> Result<CompiledModel, String> {
+        compile_str(xml, Path::new(".")).map_err(|e| e.to_string())
+    }
+
+    fn make_data(&self) -> Result<Scratch, String> {
+        // SAFETY: the model is live.
+        let d = unsafe { mjf_patch_make_data(self.raw()) };
+        NonNull::new(d)
+            .map(Scratch)
+            .ok_or_else(|| "MuJoCo could not allocate mjData for the model".to_string())
+    }
+
+    fn nbytes(&self, data: &Scratch) -> usize {
+        // SAFETY: model and data are live.
+        usize::try_from(unsafe { mjf_patch_nbytes(self.raw(), data.0.as_ptr()) }).unwrap_or(0)
+    }
+
+    fn set_const(&mut self, data: &mut Scratch) -> Result<(), String> {
+        // SAFETY: the model and its scratch data are live and of one structure.
+        unsafe { mjf_patch_set_const(self.as_mut_ptr(), data.0.as_ptr()) };
+        Ok(())
+    }
+
+    fn kinematics(&mut self, data: &mut Scratch) -> Result<(), String> {
+        // SAFETY: as above.
+        unsafe { mjf_patch_kinematics(self.raw(), data.0.as_ptr()) };
+        Ok(())
+    }
+
+    fn inertia(&mut self, data: &mut Scratch) -> Result<(), String> {
+        // SAFETY: as above.
+        unsafe { mjf_patch_make_m(self.raw(), data.0.as_ptr()) };
+        Ok(())
+    }
+
+    fn with_statistics<R>(
+        &mut self,
+        data: &Scratch,
+        f: impl FnOnce(&StatArrays<'_>, &mut [f64]) -> R,
+    ) -> Result<R, String> {
+        // SAFETY: as above; nothing else touches them while `f` runs.
+        Ok(unsafe { with_arrays(self.as_mut_ptr(), data.0.as_ptr(), f) })
+    }
+
+    fn stat(&self) -> Statistics {
+        let mut stat = [0.0; 7];
+        // SAFETY: the model is live; `stat` holds 7 values.
+        unsafe { mjf_patch_get_stat(self.raw(), stat.as_mut_ptr()) };
+        stat
+    }
+
+    fn set_stat(&mut self, stat: &Statistics) -> Result<(), String> {
+        // SAFETY: the model is live; `stat` holds 7 values.
+        unsafe { mjf_patch_set_stat(self.as_mut_ptr(), stat.as_ptr()) };
+        Ok(())
+    }
+}

@@ -1,0 +1,494 @@
+//! One compiled model patched in place: a [`PatchPlan`], the one implementation both
+//! faces' model caches run. Made once per model, it finds where each entry of a patch
+//! lands ([`land`], with element ids found by the model's own MuJoCo) once per layout,
+//! writes a patch's numbers, material ids, `mjOption` fields, body models and geom masses,
+//! and then what follows from the values: `mj_setConst` (or a caller's derivation that
+//! writes the same), the compiler's statistics at `qpos0` ([`statistics`]) and the
+//! statistics the document fixes ([`keep_fixed`]).
+//!
+//! The MuJoCo is the model's, behind [`PatchModel`]: the linked library's
+//! (`crate::compiled`, through `patch.c`) or the user's `mujoco` (the Python package,
+//! `python/src/split/plan.rs`). Each implements only what its MuJoCo does: find an array,
+//! a name's id, compile a body model, run `mj_setConst` and the kinematics.
+//!
+//! ```
+//! use mjcf_forge::split::{LayoutEntry, Carried};
+//!
+//! // A patch's layout: which field of which element each entry writes, and what it carries.
+//! let entry = LayoutEntry::new("joint", "hinge", None, "damping", Carried::Numbers(1));
+//! assert_eq!(entry.field, "damping");
+//! ```
+
+use super::body_copy::{MasslessFrame, ModelArrays, ModelArraysMut, copy_body_model};
+use super::geom_masses::write_geom_masses;
+use super::landing::{ArrayMut, Carried, Landing, ModelLayout, Run, land};
+use super::massless_frames;
+use super::rules::{PatchEntry, PatchValue};
+use super::statistics::{StatArrays, Statistics, keep_fixed, mean_inertia, statistics};
+use super::targets::{BODY_MODELS_KEPT, PATCH_OBJECTS};
+
+/// A compiled model a [`PatchPlan`] writes into, with what its own MuJoCo does for it.
+pub trait PatchModel: ModelArraysMut + ModelLayout {
+    /// An array the plan writes, found once (where it starts, its type and length).
+    type Target;
+    /// A model compiled from MJCF text by the same MuJoCo: a body model or unit model.
+    type Part: ModelArrays;
+    /// Scratch data of this model (`mj_setConst` overwrites the qpos of the data it is
+    /// given; the statistics read its kinematics at `qpos0`).
+    type Data;
+
+    /// The array `name` (of integers: `int`), to write; an error names an array this
+    /// MuJoCo does not have.
+    fn target(&mut self, name: &str, int: bool) -> Result<Self::Target, String>;
+    /// The whole array `target` (one of this model's), to write.
+    fn target_mut<'a>(&'a mut self, target: &'a Self::Target) -> ArrayMut<'a>;
+    /// The size `name` (`nbody`); `None` where this MuJoCo has none.
+    fn size(&self, name: &str) -> Option<usize>;
+    /// `mj_name2id`: the id of the element of patch object type `object` (a
+    /// [`PATCH_OBJECTS`] entry's, or `material`) named `name`.
+    fn id(&self, object: &str, name: &str) -> Option<usize>;
+    /// Whether this MuJoCo's `mjOption` has a field `field` of `n` numbers.
+    fn has_option(&self, field: &str, n: usize) -> bool;
+    /// Writes `values` into the `mjOption` field `field`.
+    fn write_option(&mut self, field: &str, values: &[f64]) -> Result<(), String>;
+    /// The name of body `body`, for errors.
+    fn body_name(&self, body: usize) -> String;
+    /// `xml` compiled by this model's MuJoCo.
+    fn compile_part(&self, xml: &str) -> Result<Self::Part, String>;
+    /// New scratch data for this model.
+    fn make_data(&self) -> Result<Self::Data, String>;
+    /// Bytes held by this model and `data`.
+    fn nbytes(&self, data: &Self::Data) -> usize;
+    /// `mj_setConst`.
+    fn set_const(&mut self, data: &mut Self::Data) -> Result<(), String>;
+    /// `data.qpos` set to `qpos0`, then `mj_kinematics` and `mj_comPos`.
+    fn kinematics(&mut self, data: &mut Self::Data) -> Result<(), String>;
+    /// The joint-space inertia from the kinematics (`mj_makeM`, or `mj_crb` where MuJoCo
+    /// has no `mj_makeM`).
+    fn inertia(&mut self, data: &mut Self::Data) -> Result<(), String>;
+    /// Calls `f` with the arrays the statistics read (of this model and `data`) and this
+    /// model's `dof_length` (empty where this MuJoCo has none).
+    fn with_statistics<R>(
+        &mut self,
+        data: &Self::Data,
+        f: impl FnOnce(&StatArrays<'_>, &mut [f64]) -> R,
+    ) -> Result<R, String>;
+    /// The model's statistics, in [`STATISTIC_NAMES`](super::STATISTIC_NAMES)' order.
+    fn stat(&self) -> Statistics;
+    /// Sets the model's statistics.
+    fn set_stat(&mut self, stat: &Statistics) -> Result<(), String>;
+}
+
+/// One entry of a patch's layout: the element and field it writes and what it carries
+/// (the value itself is the patch's: [`PatchPlan::write`] takes them laid out by kind).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LayoutEntry {
+    /// The element's type (`body`, `geom`...), or `option`.
+    pub object: String,
+    /// The element's name; empty for an unnamed element, which `id` then identifies.
+    pub name: String,
+    /// The element's id, for an unnamed one.
+    pub id: Option<usize>,
+    /// The field (`rgba`, `geoms`, `geom_factors`...).
+    pub field: String,
+    /// What the entry carries.
+    pub carried: Carried,
+}
+
+impl LayoutEntry {
+    /// An entry of `object` `name` (or id `id`) writing `field`, carrying `carried`.
+    pub fn new(
+        object: &str,
+        name: &str,
+        id: Option<usize>,
+        field: &str,
+        carried: Carried,
+    ) -> LayoutEntry {
+        LayoutEntry {
+            object: object.to_string(),
+            name: name.to_string(),
+            id,
+            field: field.to_string(),
+            carried,
+        }
+    }
+
+    /// The layout entry of a patch entry.
+    pub fn of(e: &PatchEntry) -> LayoutEntry {
+        let carried = match &e.value {
+            PatchValue::Numbers(v) => Carried::Numbers(v.len()),
+            PatchValue::Id { .. } => Carried::Id,
+            PatchValue::BodyModel(_) => Carried::BodyModel,
+        };
+        LayoutEntry::new(e.object, &e.name, e.id, e.field, carried)
+    }
+
+    /// Whether this is the layout entry of `e`.
+    fn is_of(&self, e: &PatchEntry) -> bool {
+        let carried = match &e.value {
+            PatchValue::Numbers(v) => Carried::Numbers(v.len()),
+            PatchValue::Id { .. } => Carried::Id,
+            PatchValue::BodyModel(_) => Carried::BodyModel,
+        };
+        self.object == e.object
+            && self.name == e.name
+            && self.id == e.id
+            && self.field == e.field
+            && self.carried == carried
+    }
+}
+
+/// A patch of a resolved layout, its values laid out by kind in the layout's order.
+#[derive(Clone, Copy, Debug)]
+pub struct PatchValues<'a, S: AsRef<str>> {
+    /// The numbers of every entry that carries numbers, end to end.
+    pub numbers: &'a [f64],
+    /// The names of the materials the `Id` entries choose.
+    pub materials: &'a [S],
+    /// The MJCF texts of the body-model and unit-model entries.
+    pub bodies: &'a [S],
+}
+
+/// A run of numbers (from `first` in the values laid end to end, `count` of them) and the
+/// array it writes.
+struct NumberTarget<T> {
+    run: Run,
+    first: usize,
+    count: usize,
+    target: T,
+}
+
+/// A body-model or unit-model entry: its body, whether it is the body's geoms (else a
+/// unit model, which its `geom_factors` entry reads), the text the layout was resolved
+/// with, and the one last written into the model (`None`: not known).
+struct BodyEntry {
+    body: usize,
+    geoms: bool,
+    xml0: String,
+    written: Option<String>,
+}
+
+/// How to patch one model: its scratch data, where each entry of the last layout lands
+/// and the body models compiled so far.
+pub struct PatchPlan<M: PatchModel> {
+    /// The structure key of the model.
+    pub key: String,
+    /// The scratch data.
+    pub data: M::Data,
+    layout: Vec<LayoutEntry>,
+    resolved: bool,
+    numbers: Vec<NumberTarget<M::Target>>,
+    ids: Vec<(Run, M::Target)>,
+    options: Vec<(String, usize, usize)>,
+    factors: Vec<(usize, usize, usize)>,
+    bodies: Vec<BodyEntry>,
+    /// Body models and unit models compiled so far, by their text, the newest last.
+    parts: Vec<(String, M::Part)>,
+    /// The unit model of each body with one (an index into `parts`' texts).
+    units: Vec<(usize, String)>,
+    massless: Vec<(usize, MasslessFrame)>,
+    /// The statistics the document fixes (bits as [`keep_fixed`] takes them) and their
+    /// values as MuJoCo compiled them.
+    fixed: u32,
+    fixed_values: Statistics,
+    nbytes: usize,
+}
+
+impl<M: PatchModel> PatchPlan<M> {
+    /// The plan of `model` (of structure `key`), its massless bodies' frames as it holds
+    /// them now; `fixed` the statistics the document fixes, at `fixed_values`.
+    pub fn new(model: &M, key: &str, fixed: u32, fixed_values: Statistics) -> Result<Self, String> {
+        let data = model.make_data()?;
+        let nbytes = model.nbytes(&data);
+        Ok(PatchPlan {
+            key: key.to_string(),
+            data,
+            layout: Vec::new(),
+            resolved: false,
+            numbers: Vec::new(),
+            ids: Vec::new(),
+            options: Vec::new(),
+            factors: Vec::new(),
+            bodies: Vec::new(),
+            parts: Vec::new(),
+            units: Vec::new(),
+            massless: massless_frames(model)?,
+            fixed,
+            fixed_values,
+            nbytes,
+        })
+    }
+
+    /// Bytes held: the model and the scratch data.
+    pub fn nbytes(&self) -> usize {
+        self.nbytes
+    }
+
+    /// The layout last resolved.
+    pub fn layout(&self) -> &[LayoutEntry] {
+        &self.layout
+    }
+
+    /// Where every entry of `layout` lands in `model`; the next [`PatchPlan::write`]
+    /// takes a patch of it.
+    pub fn resolve(&mut self, model: &mut M, layout: Vec<LayoutEntry>) -> Result<(), String> {
+        self.resolved = false;
+        let (mut numbers, mut ids, mut options, mut factors, mut bodies) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut first = 0;
+        for e in &layout {
+            let id = element_id(model, e)?;
+            let landing = land(&e.object, id, &e.field, e.carried, &*model)
+                .map_err(|x| format!("{} '{}': {x}", e.object, e.name))?;
+            match landing {
+                Landing::Numbers(run) if run.id => {
+                    let target = model.target(&run.array, run.int)?;
+                    ids.push((run, target));
+                }
+                Landing::Numbers(run) => {
+                    let Carried::Numbers(count) = e.carried else {
+                        return Err(format!("{} '{}': numbers expected", e.object, e.name));
+                    };
+                    let target = model.target(&run.array, run.int)?;
+                    numbers.push(NumberTarget {
+                        run,
+                        first,
+                        count,
+                        target,
+                    });
+                    first += count;
+                }
+                Landing::Option { field, n } => {
+                    if !model.has_option(&field, n) {
+                        return Err(format!("this MuJoCo's mjOption has no field {field}"));
+                    }
+                    options.push((field, first, n));
+                    first += n;
+                }
+                Landing::GeomFactors { body, n } => {
+                    factors.push((body, first, n));
+                    first += n;
+                }
+                Landing::BodyModel { body } => bodies.push(BodyEntry {
+                    body,
+                    geoms: e.field == "geoms",
+                    xml0: String::new(),
+                    written: None,
+                }),
+            }
+        }
+        (
+            self.numbers,
+            self.ids,
+            self.options,
+            self.factors,
+            self.bodies,
+        ) = (numbers, ids, options, factors, bodies);
+        self.layout = layout;
+        self.resolved = true;
+        Ok(())
+    }
+
+    /// Writes `patch` (of any layout: resolved again where it differs from the last) and
+    /// what follows from it ([`PatchPlan::finish`], with `mj_setConst`).
+    pub fn apply(&mut self, model: &mut M, patch: &[PatchEntry]) -> Result<(), String> {
+        let same = self.resolved
+            && self.layout.len() == patch.len()
+            && self.layout.iter().zip(patch).all(|(l, e)| l.is_of(e));
+        let mut numbers = Vec::new();
+        let (mut materials, mut bodies) = (Vec::new(), Vec::new());
+        for e in patch {
+            match &e.value {
+                PatchValue::Numbers(v) => numbers.extend_from_slice(v),
+                PatchValue::Id { name, .. } => materials.push(name.as_str()),
+                PatchValue::BodyModel(xml) => bodies.push(xml.as_str()),
+            }
+        }
+        if !same {
+            self.resolve(model, patch.iter().map(LayoutEntry::of).collect())?;
+            self.set_resolved_bodies(&bodies);
+        }
+        let values = PatchValues {
+            numbers: &numbers,
+            materials: &materials,
+            bodies: &bodies,
+        };
+        self.write(model, values)?;
+        self.finish(model, None)
+    }
+
+    /// Records the body texts of the patch the layout was resolved with (a body model
+    /// the arrays already hold, as compiled and as last written, is not written again).
+    pub fn set_resolved_bodies<S: AsRef<str>>(&mut self, bodies: &[S]) {
+        for (b, xml) in self.bodies.iter_mut().zip(bodies) {
+            b.xml0 = xml.as_ref().to_string();
+            b.written = None;
+        }
+    }
+
+    /// Writes a patch of the resolved layout: its numbers, material ids, options, body
+    /// models and geom masses (nothing of what follows from them: [`PatchPlan::finish`]).
+    pub fn write<S: AsRef<str>>(
+        &mut self,
+        model: &mut M,
+        values: PatchValues<'_, S>,
+    ) -> Result<(), String> {
+        if !self.resolved {
+            return Err("the plan has no layout to write".into());
+        }
+        if values.materials.len() != self.ids.len() || values.bodies.len() != self.bodies.len() {
+            return Err(format!(
+                "{} material names and {} body models for a layout of {} and {}",
+                values.materials.len(),
+                values.bodies.len(),
+                self.ids.len(),
+                self.bodies.len()
+            ));
+        }
+        let numbers = values.numbers;
+        for t in &self.numbers {
+            let v = numbers
+                .get(t.first..t.first + t.count)
+                .ok_or_else(|| format!("{} numbers: too few for this layout", numbers.len()))?;
+            t.run.write(model.target_mut(&t.target), v)?;
+        }
+        for ((run, target), name) in self.ids.iter().zip(values.materials) {
+            let name = name.as_ref();
+            let id = model
+                .id("material", name)
+                .ok_or_else(|| format!("no material named '{name}'"))?;
+            run.write_id(model.target_mut(target), id)?;
+        }
+        for (field, first, n) in &self.options {
+            let v = numbers
+                .get(*first..first + n)
+                .ok_or_else(|| format!("{} numbers: too few for this layout", numbers.len()))?;
+            model.write_option(field, v)?;
+        }
+        for k in 0..self.bodies.len() {
+            let xml = values.bodies[k].as_ref();
+            let (body, geoms) = (self.bodies[k].body, self.bodies[k].geoms);
+            if !geoms {
+                // A unit model: its geom factors' entry reads it.
+                self.compiled(model, body, xml)?;
+                match self.units.iter_mut().find(|(b, _)| *b == body) {
+                    Some(u) => u.1 = xml.to_string(),
+                    None => self.units.push((body, xml.to_string())),
+                }
+                continue;
+            }
+            let b = &self.bodies[k];
+            // As compiled and as last written: the arrays already hold it.
+            if b.xml0 == xml && b.written.as_deref() == Some(xml) {
+                continue;
+            }
+            self.bodies[k].written = None;
+            let at = self.compiled(model, body, xml)?;
+            let kept = self
+                .massless
+                .iter()
+                .find(|(m, _)| *m == body)
+                .map(|(_, f)| f);
+            let name = model.body_name(body);
+            copy_body_model(model, body, &name, kept, &self.parts[at].1)?;
+            self.bodies[k].written = Some(xml.to_string());
+        }
+        for &(body, first, n) in &self.factors {
+            let name = model.body_name(body);
+            let unit = self
+                .units
+                .iter()
+                .find(|(b, _)| *b == body)
+                .and_then(|(_, xml)| self.parts.iter().find(|(x, _)| x == xml))
+                .ok_or_else(|| format!("body '{name}': geom factors without a unit model"))?;
+            let factors = numbers
+                .get(first..first + n)
+                .ok_or_else(|| format!("{} numbers: too few for this layout", numbers.len()))?;
+            write_geom_masses(model, body, &name, &unit.1, factors)?;
+        }
+        Ok(())
+    }
+
+    /// The index of the compile of `xml` (a model of `body`'s geoms) in `parts`, compiled
+    /// by the model's MuJoCo on first sight (the last [`BODY_MODELS_KEPT`] kept).
+    fn compiled(&mut self, model: &M, body: usize, xml: &str) -> Result<usize, String> {
+        if let Some(at) = self.parts.iter().position(|(x, _)| x == xml) {
+            return Ok(at);
+        }
+        let part = model
+            .compile_part(xml)
+            .map_err(|e| format!("body '{}': its geoms alone: {e}", model.body_name(body)))?;
+        if self.parts.len() >= BODY_MODELS_KEPT {
+            self.parts.remove(0);
+        }
+        self.parts.push((xml.to_string(), part));
+        Ok(self.parts.len() - 1)
+    }
+
+    /// What follows the values: `mj_setConst` (or `derive(model, data)`, which writes
+    /// the same and says whether the data then holds the kinematics at `qpos0`), the
+    /// compiler's statistics and dof lengths, then the statistics the document fixes.
+    #[allow(clippy::type_complexity)]
+    pub fn finish(
+        &mut self,
+        model: &mut M,
+        derive: Option<&mut dyn FnMut(&mut M, &mut M::Data) -> Result<bool, String>>,
+    ) -> Result<(), String> {
+        let fresh = match derive {
+            None => {
+                model.set_const(&mut self.data)?;
+                false
+            }
+            Some(derive) => derive(model, &mut self.data)?,
+        };
+        if !fresh {
+            model.kinematics(&mut self.data)?;
+        }
+        model.inertia(&mut self.data)?;
+        let previous = model.stat();
+        let mut stat = model.with_statistics(&self.data, |arrays, lengths| {
+            statistics(arrays, &previous, Some(lengths))
+        })?;
+        keep_fixed(&mut stat, self.fixed, &self.fixed_values);
+        model.set_stat(&stat)
+    }
+
+    /// The mean of the joint-space inertia's diagonal over `dofs` (in order), from the
+    /// scratch data as [`PatchPlan::finish`] left it: a superset world's
+    /// `stat.meaninertia`, the dofs of what its variant places.
+    pub fn mean_inertia(&self, model: &mut M, dofs: &[usize]) -> Result<f64, String> {
+        if dofs.is_empty() {
+            return Err("no dofs to take the mean inertia over".into());
+        }
+        model.with_statistics(&self.data, |arrays, _| {
+            mean_inertia(arrays, dofs.iter().copied())
+        })
+    }
+}
+
+/// The id of `e`'s element in `model` (none for an option): its own, checked against the
+/// model's count, or its name's.
+fn element_id<M: PatchModel>(model: &M, e: &LayoutEntry) -> Result<Option<usize>, String> {
+    if e.object == "option" {
+        return Ok(None);
+    }
+    let missing = || {
+        format!(
+            "the patch names {} '{}', which the compiled model does not have",
+            e.object, e.name
+        )
+    };
+    match e.id {
+        Some(id) => {
+            let count = PATCH_OBJECTS
+                .iter()
+                .find(|o| o.object == e.object)
+                .and_then(|o| model.size(o.count));
+            match count {
+                Some(n) if id < n => Ok(Some(id)),
+                _ => Err(missing()),
+            }
+        }
+        None => model.id(&e.object, &e.name).map(Some).ok_or_else(missing),
+    }
+}
