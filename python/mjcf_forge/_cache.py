@@ -29,9 +29,9 @@ from ._mjcf_forge import (
     STATIC_PREFIXES,
     STATISTIC_NAMES,
     MjcfError,
+    PatchPlan,
     Scene,
 )
-from ._plan import Plan
 from ._progress import progress_of
 from ._trees import TreeDerivation
 
@@ -158,7 +158,7 @@ class ModelCache:
         self._entries: collections.OrderedDict[str, Any] = collections.OrderedDict()
         # How to patch each model seen (cached ones and the caller's), by id; holding the
         # model keeps the id its own. Bounded: the least recently patched go first.
-        self._plans: collections.OrderedDict[int, Plan] = collections.OrderedDict()
+        self._plans: collections.OrderedDict[int, PatchPlan] = collections.OrderedDict()
         # Signatures of structures seen, kept after their models are evicted, and the
         # <statistic> values each fixes.
         self._signatures: dict[str, tuple] = {}
@@ -175,8 +175,8 @@ class ModelCache:
         """Bytes held: every cached model, and every model's scratch ``MjData``."""
         return sum(p.nbytes for p in self._plans.values())
 
-    def _plan(self, model: Any, key: str) -> Plan:
-        plan = Plan(self._mujoco, model, key, self._fixed_values[key], self.superset is not None)
+    def _plan(self, model: Any, key: str) -> PatchPlan:
+        plan = PatchPlan(self._mujoco, model, key, self._fixed_values[key])
         self._plans[id(model)] = plan
         self._trim()
         return plan
@@ -194,7 +194,7 @@ class ModelCache:
         for k in extra[: max(0, len(extra) - self._max_models)]:
             del self._plans[k]
 
-    def _variant_inertia(self, model: Any, plan: "Plan", variant: Any, parked: Any = None) -> None:
+    def _variant_inertia(self, model: Any, plan: PatchPlan, variant: Any, parked: Any = None) -> None:
         """Superset: ``stat.meaninertia`` (which scales the constraint solver's tolerance)
         as the variant's own model has it: the mean of the mass matrix's diagonal over the
         dofs of what the variant places (in the superset's dof order, which is the
@@ -214,7 +214,7 @@ class ModelCache:
             mask[np.concatenate([of[root] for root in roots])] = False
         keep = np.flatnonzero(mask)
         if len(keep):
-            model.stat.meaninertia = plan.mean_inertia(keep)
+            model.stat.meaninertia = plan.mean_inertia(keep.tolist())
 
     def _key_and_patch(self, variant: Any) -> tuple[str, Any]:
         if self.superset is not None:
@@ -267,8 +267,8 @@ class ModelCache:
     # where a patch allows. False: always the whole mj_setConst (the tests compare both).
     _by_tree = True
 
-    def _tree_derive(self, plan: Plan, parked: Any) -> Any:
-        """Superset: ``derive(model, data, layout)`` for :meth:`Plan.apply`, deriving
+    def _tree_derive(self, plan: PatchPlan, parked: Any) -> Any:
+        """Superset: ``derive(model, data, layout)`` for ``PatchPlan.apply``, deriving
         tree by tree (:class:`TreeDerivation`, per plan and patch layout) what
         ``mj_setConst`` would, or None (``mj_setConst``): no superset, or turned off."""
         if self.superset is None or not self._by_tree or parked is None:
@@ -442,6 +442,6 @@ def apply_world(cache: ModelCache, model: Any, world: tuple, patch0: list) -> An
     return cache._apply_world(model, world, patch0)
 
 
-def plan_of(cache: ModelCache, model: Any) -> Plan:
+def plan_of(cache: ModelCache, model: Any) -> PatchPlan:
     """The patch plan ``cache`` keeps for ``model`` (one it patched)."""
     return cache._plans[id(model)]

@@ -24,8 +24,7 @@ from ._cache import copy_value, evict
 from ._errors import error
 from ._last_xml import compile_xml
 from ._mujoco import VISUAL, restored_arrays, struct_fields
-from ._mjcf_forge import Document, MjcfError
-from ._plan import Plan
+from ._mjcf_forge import Document, MjcfError, PatchPlan
 
 class _Snapshot:
     """A structure's values as MuJoCo compiled them, of everything a patch or a caller may
@@ -68,7 +67,7 @@ class _Working:
                     self.structs.append((obj, name, saved))
         # The plan reads the model as compiled (a copy of another model may hold its patch).
         self.restore()
-        self.plan = Plan(mujoco, model, structure.key, structure.fixed, superset=False)
+        self.plan = PatchPlan(mujoco, model, structure.key, structure.fixed)
         self.plan.resolve(list(structure.layout))
         # The references the cache itself holds (this object's views and plan), counted
         # by calibrate() once the model's maker has let go of it.

@@ -50,14 +50,29 @@ class ModelArrays:
     def write_geom_masses(self, body: int, name: str, unit: ModelArrays, factors: Sequence[float]) -> None: ...
     def write_frame_flags(self, bodies: Sequence[int], geoms: Sequence[int], sites: Sequence[int]) -> None: ...
 
-class PatchLanding:
-    """Where each entry of a patch of one layout lands in a model, found once
-    (``mjcf_forge::split::land``), and the writer of that layout's numbers and ids."""
+class PatchPlan:
+    """How one compiled model is patched in place (``mjcf_forge::split::PatchPlan`` over
+    the user's ``mujoco``), made once per model."""
 
-    options: list[tuple[str, int, int]]
-    geom_factors: list[tuple[int, int, int]]
-    def __init__(self, model: Any, patch: Sequence[Any], ids: Sequence[Optional[int]]) -> None: ...
-    def write(self, values: npt.NDArray[np.float64], material_ids: Sequence[int]) -> None: ...
+    model: Any
+    key: str
+    nbytes: int
+    data: Any
+    fields: Optional[list[tuple[str, Union[str, int], str]]]
+    derivations: dict[int, Any]
+    derived_at: int
+    source: Any
+    string_geoms: Any
+    compiled_parts: int
+    body_models: int
+    def __init__(self, mujoco: Any, model: Any, key: str, fixed: Sequence[tuple[str, Any]]) -> None: ...
+    def resolve(self, patch: Sequence[Any]) -> None: ...
+    def apply(self, patch: Sequence[Any], derive: Optional[Callable[[Any, Any, Any], bool]] = None) -> None: ...
+    def write(
+        self, values: npt.NDArray[np.float64], materials: Sequence[str], bodies: Sequence[str] = ...
+    ) -> None: ...
+    def finish(self, derive: Optional[Callable[[Any, Any, Any], bool]] = None) -> None: ...
+    def mean_inertia(self, dofs: Sequence[int]) -> float: ...
 
 _Path = Union[str, os.PathLike[str]]
 #: What Element.set and Element.append take as an attribute value.

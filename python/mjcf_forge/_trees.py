@@ -29,10 +29,12 @@ from typing import Any
 
 import numpy as np
 
-from ._mjcf_forge import GEOM_FACTORS, JOINT_TYPES, MODEL_FIELDS, ModelArrays, joint_widths, target_array
+from ._mjcf_forge import GEOM_FACTORS, JOINT_TYPES, MODEL_FIELDS, PATCH_OBJECTS, ModelArrays, joint_widths, target_array
 from . import _mujoco
 from ._last_xml import compile_xml
-from ._plan import OBJ
+
+# Each patched object's mjtObj name (the split tier's PATCH_OBJECTS, through the extension).
+OBJ = {obj: kind for obj, (_prefix, kind, _count) in PATCH_OBJECTS.items()}
 
 # Patch targets (MjModel arrays) that mj_setConst reads: a tree written into through
 # them is derived again per world.

@@ -8,7 +8,10 @@ looks each up here by name, and nowhere else.
 - ``fromstring``: an element rebuilt from its XML (pickling an ``Element``);
 - ``MjcfFileNotFoundError``: the error raised when every problem is a missing file;
 - :func:`mujoco_version`: the installed ``mujoco``'s version, whose URDF importer a URDF
-  is read as (``Document.load``, ``Document.from_urdf``).
+  is read as (``Document.load``, ``Document.from_urdf``);
+- ``compile_xml``, ``inertia_diagonal``, ``make_inertia``: a ``PatchPlan`` compiling its
+  body models with the user's ``mujoco`` (leaving MuJoCo's last loaded XML model alone)
+  and finding the joint-space inertia as that version keeps it (``_mujoco.py``).
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from typing import Any, Optional
 from ._errors import MjcfFileNotFoundError
 from ._last_xml import compile_xml
 from ._mjcf_utils import without_materials
+from ._mujoco import inertia_diagonal, make_inertia
 from ._preview import preview
 from ._progress import progress_of
 from ._settings import model_cache
@@ -28,7 +32,10 @@ from .etree import fromstring
 __all__ = [
     "MjcfFileNotFoundError",
     "compile_inertia",
+    "compile_xml",
     "fromstring",
+    "inertia_diagonal",
+    "make_inertia",
     "mujoco_version",
     "preview",
     "progress_of",

@@ -60,7 +60,7 @@ _DERIVED = (
     "dof_length",
 )
 # What a world's patch writes besides its own arrays: a body model
-# (_plan.Plan.body_model) and the same-frame flags (_trees).
+# (PatchPlan's body-model entries) and the same-frame flags (_trees).
 _WRITTEN = (
     "geom_size", "geom_rbound", "geom_aabb", "geom_pos", "geom_quat",
     "body_mass", "body_inertia", "body_ipos", "body_iquat",
@@ -306,7 +306,7 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         # tree by tree, only the patch and its body models write.
         if not by_tree:
             others = self._others
-        elif self._plan_of_scratch().bodies:
+        elif self._plan_of_scratch().body_models:
             others = self._written + self._from_geoms
         else:
             others = self._flags + self._from_geoms

@@ -8,6 +8,9 @@
 //! fromstring(xml)                   an Element rebuilt (pickling)
 //! MjcfFileNotFoundError             the error of missing files
 //! mujoco_version()                  the user's mujoco's version (the URDF importer)
+//! compile_xml(mujoco, xml)          a PatchPlan's body model compiled by the user's mujoco
+//! inertia_diagonal(model, data)     where that version keeps the joint-space inertia
+//! make_inertia(mujoco, model, data) that version's mj_makeM (or mj_crb)
 //! ```
 //!
 //! Every other import the extension makes (the standard library's `json`, `errno`,

@@ -24,6 +24,7 @@ import judge
 import mjcf_forge
 from helpers import CORPUS, MODELS_TXT, ROOT, RS_ASSETS
 from helpers import not_bit_identical
+from mjcf_forge._mjcf_forge import PatchPlan
 
 SCENES = [
     ROOT / "corpora" / "scenes" / "patch" / "patch.toml",
@@ -252,10 +253,11 @@ def test_a_layout_the_compile_cannot_take_is_answered_by_compiling(monkeypatch):
     # the split names that the compile does not have), the compile itself is the answer
     # and nothing is kept: every such document compiles, exact (the Rust cache does the
     # same).
-    def refuse(self, patch):
-        raise mjcf_forge.MjcfError("the patch names body 'x', which the compiled model does not have")
+    class Refusing(PatchPlan):
+        def resolve(self, patch):
+            raise mjcf_forge.MjcfError("the patch names body 'x', which the compiled model does not have")
 
-    monkeypatch.setattr(mjcf_forge._plan.Plan, "resolve", refuse)
+    monkeypatch.setattr(mjcf_forge._doc_cache, "PatchPlan", Refusing)
     cache = mjcf_forge.DocumentCache()
     xml = '<mujoco><worldbody><body name="b"><geom size="0.1" rgba="{} 0 0 1"/></body></worldbody></mujoco>'
     for k, red in enumerate(["1", "0.5"]):

@@ -22,6 +22,7 @@ import pytest
 import judge
 import mjcf_forge
 from helpers import MASS_DERIVED, ROOT, RS_ASSETS, beyond, not_bit_identical, superset_check
+from mjcf_forge._cache import plan_of
 from mjcf_forge.batch import WorldBatch
 
 PATCH = ROOT / "corpora" / "scenes" / "patch"
@@ -153,7 +154,7 @@ def test_mass_of_bodies_without_inertial_is_a_patch():
     superset_check(scene, range(4), trajectory_tolerance=1e-9, mass_tolerance=1e-12)
 
 
-def test_masses_of_geom_bodies_are_patches_by_default(monkeypatch):
+def test_masses_of_geom_bodies_are_patches_by_default():
     # mass_auto.toml: mass.toml's scene with `write_inertials` unset. A body mass
     # randomizer applies to the group, so MuJoCo's own <inertial>s are written when the
     # scene loads and every variant is a patch of them: no body model compiled, the
@@ -191,20 +192,22 @@ def test_masses_of_geom_bodies_are_patches_by_default(monkeypatch):
             assert m.body(r["name"]).mass[0] == r["value"], (i, r)
             drawn.add(r["value"])
     assert len(drawn) >= 6, drawn
-    compiled = []
-    monkeypatch.setattr(mjcf_forge._plan.Plan, "body_model", lambda *a: compiled.append(a))
-    cache = mjcf_forge.ModelCache(auto)
+    cache = mjcf_forge.ModelCache(auto, max_models=24)
+    models = {}
     for i in range(24):
         v = auto.variant(i)
-        check_exact(v, cache.model(v))
+        model = cache.model(v)
+        models[id(model)] = model
+        check_exact(v, model)
     assert cache.patches >= 12, cache.patches
     superset_check(auto, range(4), trajectory_tolerance=0.0)
-    assert compiled == []
+    # No body model compiled: every plan's count of them is 0.
+    assert [plan_of(cache, m).compiled_parts for m in models.values()] == [0] * len(models)
     # Set to false, the geoms' densities are scaled (mass.toml), through body models.
     assert all("<inertial" not in densities.variant(i).xml for i in range(4))
 
 
-def test_written_inertials_make_masses_patches_without_compiles(monkeypatch):
+def test_written_inertials_make_masses_patches_without_compiles():
     # write_inertials = true: each object body whose mass MuJoCo infers from its geoms gets
     # MuJoCo's own <inertial> when the scene loads (the file compiled alone), so a mass
     # randomizer scales that <inertial>: no geom density changes, no body model to
@@ -223,14 +226,15 @@ def test_written_inertials_make_masses_patches_without_compiles(monkeypatch):
         assert "<inertial" not in a.xml.split("clutter0_")[1] and "<inertial" in b.xml
         ref, ours = mujoco.MjModel.from_xml_string(a.xml), mujoco.MjModel.from_xml_string(b.xml)
         assert judge.compare_models(ref, ours) == [] and not_bit_identical(ref, ours) == [], i
-    compiled = []
-    monkeypatch.setattr(mjcf_forge._plan.Plan, "body_model", lambda *a: compiled.append(a))
-    cache = mjcf_forge.ModelCache(scene)
+    cache = mjcf_forge.ModelCache(scene, max_models=24)
+    models = {}
     for v in variants:
-        check_exact(v, cache.model(v))
+        model = cache.model(v)
+        models[id(model)] = model
+        check_exact(v, model)
     assert cache.patches >= 12, cache.patches
     superset_check(scene, range(4), trajectory_tolerance=0.0)
-    assert compiled == []
+    assert [plan_of(cache, m).compiled_parts for m in models.values()] == [0] * len(models)
     # Absolute masses too (a body without <inertial> refuses them, saying why).
     absolute = text.replace("scale = true\nlog_uniform = [0.5, 2.0]", "uniform = [0.05, 0.5]")
     masses = mjcf_forge.Scene.from_toml(absolute, base_dir=PATCH)

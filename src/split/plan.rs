@@ -51,7 +51,7 @@ pub trait PatchModel: ModelArraysMut + ModelLayout {
     fn has_option(&self, field: &str, n: usize) -> bool;
     /// Writes `values` into the `mjOption` field `field`.
     fn write_option(&mut self, field: &str, values: &[f64]) -> Result<(), String>;
-    /// The name of body `body`, for errors.
+    /// The name of body `body`, for errors (asked once per layout resolved).
     fn body_name(&self, body: usize) -> String;
     /// `xml` compiled by this model's MuJoCo.
     fn compile_part(&self, xml: &str) -> Result<Self::Part, String>;
@@ -159,10 +159,11 @@ struct NumberTarget<T> {
 }
 
 /// A body-model or unit-model entry: its body, whether it is the body's geoms (else a
-/// unit model, which its `geom_factors` entry reads), the text the layout was resolved
-/// with, and the one last written into the model (`None`: not known).
+/// unit model, which its `geom_factors` entry reads), its name (for errors), the text the
+/// layout was resolved with, and the one last written into the model (`None`: not known).
 struct BodyEntry {
     body: usize,
+    name: String,
     geoms: bool,
     xml0: String,
     written: Option<String>,
@@ -180,7 +181,8 @@ pub struct PatchPlan<M: PatchModel> {
     numbers: Vec<NumberTarget<M::Target>>,
     ids: Vec<(Run, M::Target)>,
     options: Vec<(String, usize, usize)>,
-    factors: Vec<(usize, usize, usize)>,
+    /// The `geom_factors` entries: body, first number, count, the body's name.
+    factors: Vec<(usize, usize, usize, String)>,
     bodies: Vec<BodyEntry>,
     /// Body models and unit models compiled so far, by their text, the newest last.
     parts: Vec<(String, M::Part)>,
@@ -192,6 +194,7 @@ pub struct PatchPlan<M: PatchModel> {
     fixed: u32,
     fixed_values: Statistics,
     nbytes: usize,
+    compiled_parts: u64,
 }
 
 impl<M: PatchModel> PatchPlan<M> {
@@ -216,12 +219,23 @@ impl<M: PatchModel> PatchPlan<M> {
             fixed,
             fixed_values,
             nbytes,
+            compiled_parts: 0,
         })
     }
 
     /// Bytes held: the model and the scratch data.
     pub fn nbytes(&self) -> usize {
         self.nbytes
+    }
+
+    /// How many body models and unit models this plan has compiled.
+    pub fn compiled_parts(&self) -> u64 {
+        self.compiled_parts
+    }
+
+    /// How many body-model and unit-model entries the layout last resolved has.
+    pub fn body_models(&self) -> usize {
+        self.bodies.len()
     }
 
     /// The layout last resolved.
@@ -266,11 +280,12 @@ impl<M: PatchModel> PatchPlan<M> {
                     first += n;
                 }
                 Landing::GeomFactors { body, n } => {
-                    factors.push((body, first, n));
+                    factors.push((body, first, n, model.body_name(body)));
                     first += n;
                 }
                 Landing::BodyModel { body } => bodies.push(BodyEntry {
                     body,
+                    name: model.body_name(body),
                     geoms: e.field == "geoms",
                     xml0: String::new(),
                     written: None,
@@ -370,7 +385,7 @@ impl<M: PatchModel> PatchPlan<M> {
             let (body, geoms) = (self.bodies[k].body, self.bodies[k].geoms);
             if !geoms {
                 // A unit model: its geom factors' entry reads it.
-                self.compiled(model, body, xml)?;
+                self.compiled(model, k, xml)?;
                 match self.units.iter_mut().find(|(b, _)| *b == body) {
                     Some(u) => u.1 = xml.to_string(),
                     None => self.units.push((body, xml.to_string())),
@@ -393,8 +408,8 @@ impl<M: PatchModel> PatchPlan<M> {
             copy_body_model(model, body, &name, kept, &self.parts[at].1)?;
             self.bodies[k].written = Some(xml.to_string());
         }
-        for &(body, first, n) in &self.factors {
-            let name = model.body_name(body);
+        for (body, first, n, name) in &self.factors {
+            let (body, first, n) = (*body, *first, *n);
             let unit = self
                 .units
                 .iter()
@@ -404,20 +419,22 @@ impl<M: PatchModel> PatchPlan<M> {
             let factors = numbers
                 .get(first..first + n)
                 .ok_or_else(|| format!("{} numbers: too few for this layout", numbers.len()))?;
-            write_geom_masses(model, body, &name, &unit.1, factors)?;
+            write_geom_masses(model, body, name, &unit.1, factors)?;
         }
         Ok(())
     }
 
-    /// The index of the compile of `xml` (a model of `body`'s geoms) in `parts`, compiled
-    /// by the model's MuJoCo on first sight (the last [`BODY_MODELS_KEPT`] kept).
-    fn compiled(&mut self, model: &M, body: usize, xml: &str) -> Result<usize, String> {
+    /// The index of the compile of `xml` (a model of the geoms of the body of body entry
+    /// `k`) in `parts`, compiled by the model's MuJoCo on first sight (the last
+    /// [`BODY_MODELS_KEPT`] kept).
+    fn compiled(&mut self, model: &M, k: usize, xml: &str) -> Result<usize, String> {
         if let Some(at) = self.parts.iter().position(|(x, _)| x == xml) {
             return Ok(at);
         }
         let part = model
             .compile_part(xml)
-            .map_err(|e| format!("body '{}': its geoms alone: {e}", model.body_name(body)))?;
+            .map_err(|e| format!("body '{}': its geoms alone: {e}", self.bodies[k].name))?;
+        self.compiled_parts += 1;
         if self.parts.len() >= BODY_MODELS_KEPT {
             self.parts.remove(0);
         }

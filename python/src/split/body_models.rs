@@ -60,9 +60,9 @@ const BYTES: [&str; 3] = ["body_sameframe", "geom_sameframe", "site_sameframe"];
 /// True
 #[pyclass(name = "ModelArrays", module = "mjcf_forge._mjcf_forge", frozen)]
 pub(crate) struct PyModelArrays {
-    floats: AHashMap<&'static str, Array<f64>>,
-    ints: AHashMap<&'static str, Array<i32>>,
-    bytes: AHashMap<&'static str, Array<u8>>,
+    pub(super) floats: AHashMap<&'static str, Array<f64>>,
+    pub(super) ints: AHashMap<&'static str, Array<i32>>,
+    pub(super) bytes: AHashMap<&'static str, Array<u8>>,
     /// The massless bodies' inertial frames as the model held them when this was made.
     massless: Vec<(usize, MasslessFrame)>,
 }
@@ -143,7 +143,7 @@ impl split::ModelArraysMut for Writer<'_> {
 #[pymethods]
 impl PyModelArrays {
     #[new]
-    fn new(model: &Bound<'_, PyAny>) -> PyResult<Self> {
+    pub(super) fn new(model: &Bound<'_, PyAny>) -> PyResult<Self> {
         let mut arrays = PyModelArrays {
             floats: AHashMap::new(),
             ints: AHashMap::new(),

@@ -1,6 +1,7 @@
 //! The split tier's face in Python: its tables (`tables.rs`, the one copy of each the
 //! package's caches read) and the rules the caches run over the user's `MjModel` in place
-//! (`patch.rs`, `statistics.rs`, `body_models.rs`, through `arrays.rs`).
+//! (`plan.rs`, the split tier's patch plan over the user's `mujoco`, with `patch.rs`,
+//! `statistics.rs`, `body_models.rs`, through `arrays.rs`).
 
 // NumPy's memory read in place: the bindings' only unsafe code.
 #[allow(unsafe_code)]
@@ -9,6 +10,8 @@ mod arrays;
 mod body_models;
 #[allow(unsafe_code)]
 mod patch;
+#[allow(unsafe_code)]
+mod plan;
 #[allow(unsafe_code)]
 mod statistics;
 mod tables;
@@ -20,6 +23,6 @@ pub(crate) fn add(m: &Bound<'_, PyModule>) -> PyResult<()> {
     tables::add(m)?;
     m.add_class::<statistics::PyStatistics>()?;
     m.add_class::<body_models::PyModelArrays>()?;
-    m.add_class::<patch::PyPatchLanding>()?;
+    m.add_class::<plan::PyPatchPlan>()?;
     Ok(())
 }

@@ -89,6 +89,18 @@ impl PyStatistics {
         }
     }
 
+    /// Calls `f` with the arrays and the model's `dof_length` (empty where this MuJoCo has
+    /// none).
+    pub(super) fn with_lengths<R>(&self, f: impl FnOnce(&StatArrays<'_>, &mut [f64]) -> R) -> R {
+        let lengths: &mut [f64] = match &self.dof_length {
+            // SAFETY: the GIL is held and no Python code runs while `f` does;
+            // `dof_length` is no input of the statistics.
+            Some(a) => unsafe { a.slice_mut() },
+            None => &mut [],
+        };
+        self.with_arrays(|arrays| f(arrays, lengths))
+    }
+
     /// Calls `f` with the arrays.
     fn with_arrays<R>(&self, f: impl FnOnce(&StatArrays<'_>) -> R) -> R {
         // SAFETY: the GIL is held and no Python code runs while `f` does; the arrays this
@@ -124,7 +136,7 @@ impl PyStatistics {
 #[pymethods]
 impl PyStatistics {
     #[new]
-    fn new(
+    pub(super) fn new(
         model: &Bound<'_, PyAny>,
         data: &Bound<'_, PyAny>,
         inertia: &Bound<'_, PyAny>,
