@@ -3,7 +3,7 @@
 //! the body's mass, inertia and inertial frame, its bounding volumes), after checking that
 //! the body model has the body's layout. The model caches of both faces call this with
 //! their own MuJoCo's arrays, found by name ([`ModelArrays`]): the C face through
-//! `patch.c` (`compiled/body_models.rs`), the Python face over the user's `MjModel` in
+//! `patch.c` (`compiled/linked.rs`), the Python face over the user's `MjModel` in
 //! place (`python/src/split/`).
 
 /// A compiled model's arrays by their `mjModel` names.

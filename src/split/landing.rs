@@ -1,8 +1,8 @@
 //! Where a patch entry lands in a compiled model, and how its numbers are written there:
 //! the one rule both faces' model caches follow. Each face finds element ids with its own
 //! MuJoCo (`mj_name2id`) and hands over its arrays: the C face the linked MuJoCo's
-//! (`compiled/store.rs`), the Python face the user's `MjModel` in place
-//! (`python/src/split/patch.rs`).
+//! (`compiled/linked.rs`, for the patch plan), the Python face the user's `MjModel` in place
+//! (`python/src/split/plan.rs`).
 //!
 //! ```
 //! use mjcf_forge::split::{ArrayMut, Carried, Landing, ModelLayout, land};

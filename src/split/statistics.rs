@@ -3,7 +3,7 @@
 //! `mj_setConst` of 3.17 and 4.0 leaves as they were: after a patch, the model caches of
 //! both faces compute them here, from the model's arrays and the kinematics at `qpos0`, with
 //! the compiler's operations in its order (the same bits). The C face hands over the
-//! arrays of the linked MuJoCo (`compiled/store.rs`), the Python face those of the user's
+//! arrays of the linked MuJoCo (`compiled/linked.rs`), the Python face those of the user's
 //! (`python/src/split/statistics.rs`).
 
 /// `mjGEOM_PLANE` and `mjGEOM_HFIELD`: geoms without a bounding radius that still count

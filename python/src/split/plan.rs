@@ -385,9 +385,11 @@ fn read(patch: &Bound<'_, PyAny>) -> PyResult<Read> {
         let entry = entry?;
         let (object, name, field, value): (String, Bound<'_, PyAny>, String, Bound<'_, PyAny>) =
             entry.extract()?;
-        let (name, id) = match name.extract::<usize>() {
-            Ok(id) => (String::new(), Some(id)),
-            Err(_) => (name.extract::<String>()?, None),
+        // A name, or the id of an unnamed element (no failed extraction: an error made
+        // per entry would cost more than the entry).
+        let (name, id) = match name.cast::<PyString>() {
+            Ok(text) => (text.to_cow()?.into_owned(), None),
+            Err(_) => (String::new(), Some(name.extract::<usize>()?)),
         };
         let carried = if let Ok(text) = value.cast::<PyString>() {
             let text = text.to_cow()?.into_owned();
