@@ -147,9 +147,6 @@ class ModelCache:
         self._max_bytes = max_bytes
         #: The scene's :class:`Superset` when every variant is a patch of it, else None.
         self.superset = scene.superset() if superset else None
-        # Superset: the dofs of each candidate's subtree, by its root's name (one
-        # structure: the same in every model of it).
-        self._subtree_dofs: dict[str, np.ndarray] = {}
         # Superset: body ids by name (one structure).
         self._body_ids: dict[str, int] = {}
         #: Superset patches whose derived values came tree by tree (not mj_setConst).
@@ -194,27 +191,12 @@ class ModelCache:
         for k in extra[: max(0, len(extra) - self._max_models)]:
             del self._plans[k]
 
-    def _variant_inertia(self, model: Any, plan: PatchPlan, variant: Any, parked: Any = None) -> None:
+    def _variant_inertia(self, plan: PatchPlan, variant: Any, parked: Any = None) -> None:
         """Superset: ``stat.meaninertia`` (which scales the constraint solver's tolerance)
-        as the variant's own model has it: the mean of the mass matrix's diagonal over the
-        dofs of what the variant places (in the superset's dof order, which is the
-        variant's), parked objects left out (``parked``: their root bodies' names, when
-        known)."""
+        as the variant's own model has it (``PatchPlan.variant_inertia``: parked objects,
+        their root bodies' names, left out)."""
         roots = self.superset.parked(variant.index) if parked is None else parked
-        of = self._subtree_dofs
-        for root in roots:
-            if root not in of:
-                inside = np.zeros(model.nbody, dtype=bool)
-                inside[model.body(root).id] = True
-                for b in range(1, model.nbody):  # parents come before their children
-                    inside[b] |= inside[model.body_parentid[b]]
-                of[root] = np.flatnonzero(inside[model.dof_bodyid])
-        mask = np.ones(model.nv, dtype=bool)
-        if roots:
-            mask[np.concatenate([of[root] for root in roots])] = False
-        keep = np.flatnonzero(mask)
-        if len(keep):
-            model.stat.meaninertia = plan.mean_inertia(keep.tolist())
+        plan.variant_inertia(list(roots))
 
     def _key_and_patch(self, variant: Any) -> tuple[str, Any]:
         if self.superset is not None:
@@ -236,7 +218,7 @@ class ModelCache:
         if self.superset is not None:
             # The superset as compiled parks every object: the variant's patch places its own.
             plan.apply(self.superset.patch(variant.index))
-            self._variant_inertia(model, plan, variant)
+            self._variant_inertia(plan, variant)
             self.patches += 1
         return model
 
@@ -259,7 +241,7 @@ class ModelCache:
             # axes): not a patch of this structure, so the variant is compiled (and kept).
             return self._compile(variant)
         if self.superset is not None:
-            self._variant_inertia(model, plan, variant, parked)
+            self._variant_inertia(plan, variant, parked)
         self.patches += 1
         return model
 
@@ -339,7 +321,7 @@ class ModelCache:
         parked = self.superset.parked(variant.index) if self.superset is not None else None
         plan.apply(patch, self._tree_derive(plan, parked))
         if self.superset is not None:
-            self._variant_inertia(model, plan, variant, parked)
+            self._variant_inertia(plan, variant, parked)
         self.patches += 1
         return model
 
@@ -368,7 +350,7 @@ class ModelCache:
             materials, bodies = [], []
         plan.write(values, materials, bodies)
         plan.finish(self._tree_derive(plan, parked))
-        self._variant_inertia(model, plan, None, parked)
+        self._variant_inertia(plan, None, parked)
         self.patches += 1
         return model
 

@@ -7,14 +7,11 @@
 //! key, least recently used out; plans; the C side) is `store.rs`, which
 //! [`super::DocumentCache`] shares.
 
-use std::collections::HashMap;
-use std::ffi::{CString, c_int};
-
 use super::store::{Signature, State, Store};
-use super::sys::{mjf_patch_array, mjf_patch_array_name, mjf_patch_get_stat, mjf_patch_name2id};
+use super::sys::{mjf_patch_array, mjf_patch_array_name, mjf_patch_get_stat};
 use crate::mujoco::{CompileError, CompiledModel, compile_str};
 use crate::scene::{Scene, Superset, VariantPatch};
-use crate::split::{PatchEntry, PatchModel, fixed_statistics_mask};
+use crate::split::{PatchEntry, fixed_statistics_mask};
 use crate::{ErrorKind, Errors};
 
 use super::{bare, internal};
@@ -190,11 +187,7 @@ impl<'s> ModelCache<'s> {
     pub fn with_superset(mut self) -> Result<Self, Errors> {
         let superset = self.scene.superset()?;
         let xml = superset.document.to_xml_string();
-        self.superset = Some(SupersetState {
-            superset,
-            xml,
-            kept_dofs: HashMap::new(),
-        });
+        self.superset = Some(SupersetState { superset, xml });
         Ok(self)
     }
 
@@ -346,18 +339,14 @@ impl<'s> ModelCache<'s> {
     }
 }
 
-/// A superset cache's own state: the superset, its XML, and per set of parked objects the
-/// dofs of the variant's own model.
+/// A superset cache's own state: the superset and its XML.
 struct SupersetState {
     superset: Superset,
     xml: String,
-    kept_dofs: HashMap<Vec<String>, Vec<usize>>,
 }
 
 /// Writes variant `index`'s patch (`key`, `entries`) into `model`, and for a superset
-/// `stat.meaninertia` (which scales the constraint solver's tolerance) as the variant's own
-/// model has it: the mass matrix's diagonal over the dofs of what the variant places (the
-/// superset's dof order is the variant's), parked objects left out.
+/// `stat.meaninertia` as the variant's own model has it (`PatchPlan::variant_inertia`).
 fn patch_variant(
     scene: &Scene,
     superset: &mut Option<SupersetState>,
@@ -372,60 +361,8 @@ fn patch_variant(
     let roots = scene
         .superset_parked(&sup.superset, index)
         .map_err(|e| e.to_string())?;
-    if !sup.kept_dofs.contains_key(&roots) {
-        let keep = kept_dofs(model, &roots)?;
-        sup.kept_dofs.insert(roots.clone(), keep);
+    match state.plan_mut(model) {
+        Some(plan) => plan.plan.variant_inertia(model, &roots),
+        None => Ok(()),
     }
-    let keep = &sup.kept_dofs[&roots];
-    if keep.is_empty() {
-        return Ok(());
-    }
-    let Some(plan) = state.plan(model) else {
-        return Ok(());
-    };
-    let mut stat = model.stat();
-    stat[0] = plan.plan.mean_inertia(model, keep)?;
-    model.set_stat(&stat)
-}
-
-/// The dofs of `model` outside the subtrees of the bodies named in `parked`, in order.
-fn kept_dofs(model: &mut CompiledModel, parked: &[String]) -> Result<Vec<usize>, String> {
-    let nbody = model.sizes().nbody;
-    let nv = model.sizes().nv;
-    let parent = model.body_parentid().to_vec();
-    let ints = |model: &mut CompiledModel, name: &str| -> Result<Vec<c_int>, String> {
-        let c = CString::new(name).map_err(|e| e.to_string())?;
-        let (mut elem, mut count) = (0usize, 0usize);
-        // SAFETY: live model; NUL-terminated name.
-        let p = unsafe { mjf_patch_array(model.as_mut_ptr(), c.as_ptr(), &mut elem, &mut count) };
-        if elem != 4 || p.is_null() {
-            return Err(format!("this MuJoCo's mjModel has no int array {name}"));
-        }
-        // SAFETY: `count` ints at `p`.
-        Ok(unsafe { std::slice::from_raw_parts(p.cast::<c_int>(), count) }.to_vec())
-    };
-    let dofadr = ints(model, "body_dofadr")?;
-    let dofnum = ints(model, "body_dofnum")?;
-    let mut out_of = vec![false; nbody];
-    for root in parked {
-        let kind = CString::new("body").map_err(|e| e.to_string())?;
-        let name = CString::new(root.as_str()).map_err(|e| e.to_string())?;
-        // SAFETY: live model; NUL-terminated strings.
-        let id = unsafe { mjf_patch_name2id(model.as_mut_ptr(), kind.as_ptr(), name.as_ptr()) };
-        let id = usize::try_from(id).map_err(|_| format!("the superset has no body '{root}'"))?;
-        out_of[id] = true;
-    }
-    // Bodies come after their parents: one pass marks whole subtrees.
-    for b in 1..nbody {
-        if out_of[parent[b] as usize] {
-            out_of[b] = true;
-        }
-    }
-    let mut parked_dof = vec![false; nv];
-    for b in (0..nbody).filter(|&b| out_of[b]) {
-        let first = usize::try_from(dofadr[b]).unwrap_or(0);
-        let n = usize::try_from(dofnum[b]).unwrap_or(0);
-        parked_dof[first..first + n].fill(true);
-    }
-    Ok((0..nv).filter(|&d| !parked_dof[d]).collect())
 }

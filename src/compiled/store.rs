@@ -248,7 +248,7 @@ impl State {
     }
 
     /// The plan of `model`, if it has one.
-    pub(super) fn plan(&self, model: &CompiledModel) -> Option<&Plan> {
-        self.plans.iter().find(|p| p.serial == model.serial())
+    pub(super) fn plan_mut(&mut self, model: &CompiledModel) -> Option<&mut Plan> {
+        self.plans.iter_mut().find(|p| p.serial == model.serial())
     }
 }

@@ -195,6 +195,8 @@ pub struct PatchPlan<M: PatchModel> {
     fixed_values: Statistics,
     nbytes: usize,
     compiled_parts: u64,
+    /// A superset's parked roots seen so far, by name: the dofs of each one's subtree.
+    subtree_dofs: Vec<(String, Vec<usize>)>,
 }
 
 impl<M: PatchModel> PatchPlan<M> {
@@ -220,6 +222,7 @@ impl<M: PatchModel> PatchPlan<M> {
             fixed_values,
             nbytes,
             compiled_parts: 0,
+            subtree_dofs: Vec::new(),
         })
     }
 
@@ -481,6 +484,69 @@ impl<M: PatchModel> PatchPlan<M> {
             mean_inertia(arrays, dofs.iter().copied())
         })
     }
+}
+
+impl<M: PatchModel> PatchPlan<M> {
+    /// Superset: `stat.meaninertia` (which scales the constraint solver's tolerance) as the
+    /// variant's own model has it, after [`PatchPlan::finish`]: the mean of the mass
+    /// matrix's diagonal over the dofs of what the variant places (the superset's dof
+    /// order is the variant's), the subtrees of the bodies named `parked` left out;
+    /// nothing when no dof is left.
+    pub fn variant_inertia<S: AsRef<str>>(
+        &mut self,
+        model: &mut M,
+        parked: &[S],
+    ) -> Result<(), String> {
+        let nv = model.ints("dof_bodyid")?.len();
+        let mut out = vec![false; nv];
+        for root in parked {
+            let root = root.as_ref();
+            let at = match self.subtree_dofs.iter().position(|(r, _)| r == root) {
+                Some(at) => at,
+                None => {
+                    let dofs = subtree_dofs(model, root)?;
+                    self.subtree_dofs.push((root.to_string(), dofs));
+                    self.subtree_dofs.len() - 1
+                }
+            };
+            for &d in &self.subtree_dofs[at].1 {
+                out[d] = true;
+            }
+        }
+        let keep: Vec<usize> = (0..nv).filter(|&d| !out[d]).collect();
+        if keep.is_empty() {
+            return Ok(());
+        }
+        let mut stat = model.stat();
+        stat[0] = self.mean_inertia(model, &keep)?;
+        model.set_stat(&stat)
+    }
+}
+
+/// The dofs of the subtree of the body named `root` in `model`, in order.
+fn subtree_dofs<M: PatchModel>(model: &M, root: &str) -> Result<Vec<usize>, String> {
+    let id = model
+        .id("body", root)
+        .ok_or_else(|| format!("the superset has no body '{root}'"))?;
+    let parent = model.ints("body_parentid")?;
+    let mut inside = vec![false; parent.len()];
+    *inside
+        .get_mut(id)
+        .ok_or_else(|| format!("body '{root}': an id past the model's bodies"))? = true;
+    // Bodies come after their parents: one pass marks the whole subtree.
+    for b in 1..parent.len() {
+        let up = usize::try_from(parent[b])
+            .ok()
+            .and_then(|p| inside.get(p).copied());
+        inside[b] |= up == Some(true);
+    }
+    Ok(model
+        .ints("dof_bodyid")?
+        .iter()
+        .enumerate()
+        .filter(|&(_, &b)| usize::try_from(b).is_ok_and(|b| inside.get(b) == Some(&true)))
+        .map(|(d, _)| d)
+        .collect())
 }
 
 /// The id of `e`'s element in `model` (none for an option): its own, checked against the

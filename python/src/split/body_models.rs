@@ -27,8 +27,10 @@ const FLOATS: [&str; 14] = [
     "site_pos",
     "site_quat",
 ];
-const INTS: [&str; 12] = [
+const INTS: [&str; 14] = [
     "body_geomadr",
+    "body_parentid",
+    "dof_bodyid",
     "body_geomnum",
     "body_bvhadr",
     "body_bvhnum",

@@ -673,6 +673,18 @@ impl PyPatchPlan {
             .map_err(PyValueError::new_err)
     }
 
+    /// Superset: ``model.stat.meaninertia`` as the variant's own model has it, after
+    /// :meth:`finish`: the mean of the mass matrix's diagonal over the dofs of what the
+    /// variant places, the subtrees of the bodies named ``parked`` left out.
+    fn variant_inertia(&self, parked: Vec<String>) -> PyResult<()> {
+        let mut core = hold(&self.core)?;
+        let Core { user, plan } = &mut *core;
+        match plan.variant_inertia(user, &parked) {
+            Ok(()) => Ok(()),
+            Err(e) => Err(core.error(e)),
+        }
+    }
+
     /// How many body-model and unit-model entries the layout last resolved has.
     #[getter]
     fn body_models(&self) -> PyResult<usize> {
