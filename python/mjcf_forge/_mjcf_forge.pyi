@@ -29,6 +29,12 @@ JOINT_TYPES: tuple[str, ...]
 #: layouts whose patch and tree derivation it keeps.
 BODY_MODELS_KEPT: int
 LAYOUTS_KEPT: int
+#: Field facts: what mj_setConst derives from patched values, what a body model's copy
+#: writes (with the same-frame flags), and the bulk data a restore leaves.
+SET_CONST_DERIVED: tuple[str, ...]
+BODY_MODEL_WRITES: tuple[str, ...]
+BULK_SIZES: tuple[str, ...]
+BULK_PREFIXES: tuple[str, ...]
 
 def target_array(object: str, field: str) -> Optional[str]: ...
 def joint_widths(jnt_type: int) -> tuple[int, int]: ...

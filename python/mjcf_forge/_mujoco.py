@@ -17,6 +17,8 @@ from typing import Any, Optional
 
 import numpy as np
 
+from ._mjcf_forge import BULK_PREFIXES, BULK_SIZES
+
 
 def make_inertia(mujoco: Any, model: Any, data: Any) -> None:
     """Fills ``data``'s joint-space inertia (``qM``, and ``M`` where MuJoCo has it) from
@@ -37,22 +39,12 @@ def field(obj: Any, name: str) -> Any:
     return getattr(obj, name, None)
 
 
-# The sizes that count rows of mesh, texture, height field, skin and bounding-volume data:
-# no patch writes them and they are most of a model's bytes (70 MB of lift5's 70.5), so
-# they are not restored before a patch (see DocumentCache).
-_BULK_SIZES = frozenset(
-    {
-        "nmeshvert", "nmeshnormal", "nmeshtexcoord", "nmeshface", "nmeshgraph", "nmeshpoly",
-        "nmeshpolyvert", "nmeshpolymap", "ntexdata", "nhfielddata", "nbvh", "nbvhstatic",
-        "nbvhdynamic", "noct", "nskinvert", "nskintexvert", "nskinface", "nskinbonevert",
-    }
-)
-# The same arrays by name, for a mujoco without introspection.
-_BULK_PREFIXES = (
-    "mesh_vert", "mesh_normal", "mesh_texcoord", "mesh_face", "mesh_graph", "mesh_poly",
-    "tex_data", "hfield_data", "bvh_", "oct_", "skin_vert", "skin_texcoord", "skin_face",
-    "skin_bonevert",
-)
+# The sizes that count rows of mesh, texture, height field, skin and bounding-volume data
+# (BULK_SIZES), and the same arrays by name for a mujoco without introspection
+# (BULK_PREFIXES): the split tier's tables (mjcf_forge::split, through the extension). No
+# patch writes them and they are most of a model's bytes (70 MB of lift5's 70.5), so they
+# are not restored before a patch (see DocumentCache).
+_BULK_SIZES = frozenset(BULK_SIZES)
 # The parts of mjVisual, each a struct of numbers.
 VISUAL = ("global_", "quality", "headlight", "map", "scale", "rgba")
 
@@ -71,7 +63,7 @@ def restored_arrays(mujoco: Any, model: Any) -> list[str]:
             if getattr(f, "array_extent", None) and str(f.array_extent[0]) not in _BULK_SIZES
         ]
     except (ImportError, KeyError, AttributeError):
-        names = [n for n in dir(model) if not n.startswith(("_",) + _BULK_PREFIXES)]
+        names = [n for n in dir(model) if not n.startswith(("_",) + BULK_PREFIXES)]
     return [n for n in names if isinstance(getattr(model, n, None), np.ndarray)]
 
 

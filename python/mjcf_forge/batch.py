@@ -35,42 +35,28 @@ import numpy as np
 
 from ._cache import ModelCache, apply_world, body_ids_of, mujoco_of, plan_of
 from ._errors import error
-from ._mjcf_forge import LAYOUTS_KEPT, STATIC_PREFIXES, STATISTIC_NAMES, target_array
+from ._mjcf_forge import (
+    BODY_MODEL_WRITES,
+    LAYOUTS_KEPT,
+    SET_CONST_DERIVED,
+    STATIC_PREFIXES,
+    STATISTIC_NAMES,
+    target_array,
+)
 from ._mjx import MjxWorlds
 from ._progress import progress_of
 from ._warp import WarpWorlds
 
-# Fields mj_setConst derives from values a patch writes (so they follow the variant even
-# when no patch entry names them).
-_DERIVED = (
-    "body_subtreemass",
-    "body_invweight0",
-    "dof_invweight0",
-    "dof_M0",
-    "tendon_length0",
-    "tendon_invweight0",
-    "actuator_acc0",
-    "actuator_length0",
-    "cam_pos0",
-    "cam_poscom0",
-    "cam_mat0",
-    "light_pos0",
-    "light_poscom0",
-    "light_dir0",
-    "dof_length",
-)
-# What a world's patch writes besides its own arrays: a body model
-# (PatchPlan's body-model entries) and the same-frame flags (_trees).
-_WRITTEN = (
-    "geom_size", "geom_rbound", "geom_aabb", "geom_pos", "geom_quat",
-    "body_mass", "body_inertia", "body_ipos", "body_iquat",
-    "body_sameframe", "geom_sameframe", "site_sameframe",
-)
+# The split tier's field facts (mjcf_forge::split, through the extension): the arrays
+# mj_setConst derives from values a patch writes (SET_CONST_DERIVED: they follow the
+# variant even when no patch entry names them), and what a world's patch writes besides
+# its own arrays (BODY_MODEL_WRITES: a body model's copy and the same-frame flags).
 # What the tree-by-tree derivation writes from the geoms, as mj_setConst does
 # (_cache._bodies_from_geoms): a world's geom margins move its bodies' margins.
 _FROM_GEOMS = ("body_margin", "body_contype", "body_conaffinity")
-# A model's keyframe arrays (each world's rows: WorldBatch.keys).
-_KEYS = ("key_qpos", "key_qvel", "key_act", "key_ctrl", "key_mpos", "key_mquat", "key_time")
+# A model's keyframe arrays (each world's rows: WorldBatch.keys): its arrays of prefix
+# key_.
+_KEY_PREFIX = "key_"
 class _Index(NamedTuple):
     """What a superset ModelCache reads of a variant: its index."""
 
@@ -138,7 +124,7 @@ class WorldBatch(WarpWorlds, MjxWorlds):
             and isinstance(getattr(model, n, None), np.ndarray)
             and not n.startswith(STATIC_PREFIXES)
         ]
-        self._candidates = sorted((self._patched | set(_DERIVED)) & set(self._fields))
+        self._candidates = sorted((self._patched | set(SET_CONST_DERIVED)) & set(self._fields))
         # Every other field as the batch's first world holds it: a world's row of one is
         # kept only when it differs (no superset patch makes one differ; checked anyway).
         self._others = {
@@ -148,7 +134,7 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         self._root_of_geom = model.body_rootid[model.geom_bodyid]
         # A patch of each layout Superset.worlds has given, by layout.
         self._layouts: dict[tuple, Any] = {}
-        self._written = [n for n in _WRITTEN if n in self._others]
+        self._written = [n for n in BODY_MODEL_WRITES if n in self._others]
         self._flags = [n for n in self._written if n.endswith("_sameframe")]
         self._from_geoms = [n for n in _FROM_GEOMS if n in self._others]
         #: Worlds whose derived values came tree by tree (the others: mj_setConst; see
@@ -174,7 +160,7 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         #: an object's free joint are its pose in that world, placed or parked):
         #: ``key_qpos`` ``(nworld, nkey, nq)``, ``key_qvel``, ``key_act``, ``key_ctrl``,
         #: ``key_mpos``, ``key_mquat``, ``key_time``; empty without keyframes.
-        self.keys = {n: np.stack([r[n] for r in rows]) for n in _KEYS if n in rows[0]}
+        self.keys = {n: np.stack([r[n] for r in rows]) for n in self._key_arrays(model) if n in rows[0]}
         self.world_variant = np.array(indices, dtype=np.int64)
         self._warp: Any = None
         self._mjx: Any = None
@@ -290,6 +276,16 @@ class WorldBatch(WarpWorlds, MjxWorlds):
             for index, (layout, numbers, strings, parked) in zip(part, worlds):
                 yield index, numbers, strings, parked, patches[layout]
 
+    def _key_arrays(self, model: Any) -> list[str]:
+        """The model's keyframe arrays (its arrays of prefix ``key_``), found once."""
+        names = self.__dict__.get("_key_names")
+        if names is None:
+            names = self._key_names = [
+                n for n in dir(model)
+                if n.startswith(_KEY_PREFIX) and isinstance(getattr(model, n, None), np.ndarray)
+            ]
+        return names
+
     def _rows(self, world: tuple) -> dict[str, np.ndarray]:
         """Every field of the superset patched for one world (``_worlds``), its
         statistics, its parked geoms; a parked geom that touches anything at the initial
@@ -317,7 +313,7 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         for s in STATISTIC_NAMES:
             out[f"stat.{s}"] = np.array(getattr(model.stat, s), dtype=np.float64)
         if model.nkey:
-            for n in _KEYS:
+            for n in self._key_arrays(model):
                 out[n] = getattr(model, n).copy()
         mujoco = mujoco_of(self.cache)
         parked = np.isin(self._root_of_geom, parked_roots)

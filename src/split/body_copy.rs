@@ -43,6 +43,23 @@ const BODY_FIELDS: [(&str, usize); 4] = [
 ];
 const BVH_FIELDS: [(&str, usize); 1] = [("bvh_aabb", 6)];
 
+/// Every array a body model's copy ([`copy_body_model`]) writes, with the same-frame flags
+/// a patch of frames sets again ([`FRAME_FLAGS`](super::FRAME_FLAGS)): what a world's
+/// patch writes besides the arrays its entries name.
+///
+/// ```
+/// assert!(mjcf_forge::split::body_model_writes().contains(&"geom_aabb"));
+/// ```
+pub fn body_model_writes() -> Vec<&'static str> {
+    GEOM_FIELDS
+        .iter()
+        .chain(&BODY_FIELDS)
+        .chain(&BVH_FIELDS)
+        .map(|&(name, _)| name)
+        .chain(super::FRAME_FLAGS)
+        .collect()
+}
+
 /// The inertial frame of a body its geoms give no mass, as the structure compiled it:
 /// MuJoCo puts it where it puts a massless body's, which is not a function of the geoms
 /// alone (a body model at the origin has another), so it is kept while the body's own

@@ -187,6 +187,9 @@ pub fn frame_flag(pos: &[f64; 3], quat: &[f64; 4], ipos: &[f64; 3], iquat: &[f64
     }
 }
 
+/// The same-frame flags [`write_frame_flags`] sets: of bodies, geoms and sites.
+pub const FRAME_FLAGS: [&str; 3] = ["body_sameframe", "geom_sameframe", "site_sameframe"];
+
 /// Sets the same-frame flags of `bodies`, `geoms` and `sites` from their frames and their
 /// bodies' inertial frames ([`body_frame_flag`], [`frame_flag`]): what MuJoCo 4.0's
 /// `mj_setConst` sets again (3.17.0's keeps the compiler's), for a superset world derived
@@ -223,11 +226,10 @@ pub fn write_frame_flags(
     };
     let geom_flags = element_flags("geom", geoms)?;
     let site_flags = element_flags("site", sites)?;
-    for (name, flags) in [
-        ("body_sameframe", body_flags),
-        ("geom_sameframe", geom_flags),
-        ("site_sameframe", site_flags),
-    ] {
+    for (name, flags) in FRAME_FLAGS
+        .into_iter()
+        .zip([body_flags, geom_flags, site_flags])
+    {
         if flags.is_empty() {
             continue;
         }

@@ -52,12 +52,14 @@ mod statistics;
 mod targets;
 mod volumes;
 
-pub use body_copy::{MasslessFrame, ModelArrays, ModelArraysMut, copy_body_model, massless_frames};
+pub use body_copy::{
+    MasslessFrame, ModelArrays, ModelArraysMut, body_model_writes, copy_body_model, massless_frames,
+};
 pub use document::{
     DocumentPatch, PATCHABLE_OPTIONS, SplitOptions, split_document, split_document_with,
 };
 pub use geom_masses::{
-    BodyMass, GeomMass, body_frame_flag, body_mass, frame_flag, write_frame_flags,
+    BodyMass, FRAME_FLAGS, GeomMass, body_frame_flag, body_mass, frame_flag, write_frame_flags,
     write_geom_masses,
 };
 pub use landing::{ArrayMut, Carried, Landing, ModelLayout, Run, land};
@@ -68,9 +70,10 @@ pub use statistics::{
     mean_inertia, statistics,
 };
 pub use targets::{
-    BODY_MODELS_KEPT, DOF_FIELDS, GEOM_FACTORS, JOINT_TYPES, LAYOUTS_KEPT, MASS_DERIVED,
-    MODEL_FIELDS, PATCH_OBJECTS, PatchObject, QPOS_FIELDS, SIGNATURE_ARRAYS,
-    SIGNATURE_SKIPPED_SIZES, STATIC_PREFIXES, joint_widths, target_array,
+    BODY_MODELS_KEPT, BULK_PREFIXES, BULK_SIZES, DOF_FIELDS, GEOM_FACTORS, JOINT_TYPES,
+    LAYOUTS_KEPT, MASS_DERIVED, MODEL_FIELDS, PATCH_OBJECTS, PatchObject, QPOS_FIELDS,
+    SET_CONST_DERIVED, SIGNATURE_ARRAYS, SIGNATURE_SKIPPED_SIZES, STATIC_PREFIXES, joint_widths,
+    target_array,
 };
 pub use volumes::{Volume, VolumeNode, bounding_volumes};
 

@@ -105,6 +105,69 @@ pub const MASS_DERIVED: [&str; 8] = [
     "stat.meaninertia",
 ];
 
+/// The arrays `mj_setConst` derives from values a patch writes: they follow a variant even
+/// where no patch entry names them (a batch's per-world candidates).
+pub const SET_CONST_DERIVED: [&str; 15] = [
+    "body_subtreemass",
+    "body_invweight0",
+    "dof_invweight0",
+    "dof_M0",
+    "tendon_length0",
+    "tendon_invweight0",
+    "actuator_acc0",
+    "actuator_length0",
+    "cam_pos0",
+    "cam_poscom0",
+    "cam_mat0",
+    "light_pos0",
+    "light_poscom0",
+    "light_dir0",
+    "dof_length",
+];
+
+/// The sizes that count rows of mesh, texture, height-field, skin and bounding-volume data:
+/// no patch writes their arrays, and they are most of a model's bytes, so a cache that
+/// restores a model before a patch leaves them (the Python `DocumentCache`).
+pub const BULK_SIZES: [&str; 18] = [
+    "nmeshvert",
+    "nmeshnormal",
+    "nmeshtexcoord",
+    "nmeshface",
+    "nmeshgraph",
+    "nmeshpoly",
+    "nmeshpolyvert",
+    "nmeshpolymap",
+    "ntexdata",
+    "nhfielddata",
+    "nbvh",
+    "nbvhstatic",
+    "nbvhdynamic",
+    "noct",
+    "nskinvert",
+    "nskintexvert",
+    "nskinface",
+    "nskinbonevert",
+];
+
+/// The same arrays by their name's start, for a MuJoCo whose bindings do not say which size
+/// counts an array's rows.
+pub const BULK_PREFIXES: [&str; 14] = [
+    "mesh_vert",
+    "mesh_normal",
+    "mesh_texcoord",
+    "mesh_face",
+    "mesh_graph",
+    "mesh_poly",
+    "tex_data",
+    "hfield_data",
+    "bvh_",
+    "oct_",
+    "skin_vert",
+    "skin_texcoord",
+    "skin_face",
+    "skin_bonevert",
+];
+
 /// A joint's fields that are per degree of freedom (`dof_<field>`).
 pub const DOF_FIELDS: [&str; 3] = ["damping", "armature", "frictionloss"];
 

@@ -1,11 +1,11 @@
-//! The split tier's tables the package's caches read (`mjcf_forge._plan`, `_cache`,
-//! `batch`): the one copy of each, `mjcf_forge::split::targets`.
+//! The split tier's tables the package's caches read (`mjcf_forge._cache`, `_trees`,
+//! `batch`, `_mujoco`): the one copy of each, `mjcf_forge::split::targets`.
 
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
-/// The split tier's tables the package's caches read (`mjcf_forge._plan`, `_cache`,
-/// `batch`), added to the module: the one copy of each (`mjcf_forge::split::targets`).
+/// The split tier's tables the package's caches read (`mjcf_forge._cache`, `_trees`,
+/// `batch`, `_mujoco`), added to the module: the one copy of each (`mjcf_forge::split::targets`).
 pub(super) fn add(m: &Bound<'_, PyModule>) -> PyResult<()> {
     use mjcf_forge::split;
     let py = m.py();
@@ -32,6 +32,16 @@ pub(super) fn add(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("JOINT_TYPES", PyTuple::new(py, split::JOINT_TYPES)?)?;
     m.add("BODY_MODELS_KEPT", split::BODY_MODELS_KEPT)?;
     m.add("LAYOUTS_KEPT", split::LAYOUTS_KEPT)?;
+    m.add(
+        "SET_CONST_DERIVED",
+        PyTuple::new(py, split::SET_CONST_DERIVED)?,
+    )?;
+    m.add(
+        "BODY_MODEL_WRITES",
+        PyTuple::new(py, split::body_model_writes())?,
+    )?;
+    m.add("BULK_SIZES", PyTuple::new(py, split::BULK_SIZES)?)?;
+    m.add("BULK_PREFIXES", PyTuple::new(py, split::BULK_PREFIXES)?)?;
     m.add_function(wrap_pyfunction!(target_array, m)?)?;
     m.add_function(wrap_pyfunction!(joint_widths, m)?)?;
     Ok(())
