@@ -12,10 +12,9 @@ of a millisecond instead of the compile's tens of milliseconds.
 
 from __future__ import annotations
 
-import collections
 import copy
 import os
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -29,6 +28,7 @@ from ._mjcf_forge import (
     STATIC_PREFIXES,
     STATISTIC_NAMES,
     MjcfError,
+    ModelStore,
     PatchPlan,
     Scene,
 )
@@ -50,23 +50,6 @@ def _signature(model: Any) -> tuple:
         getattr(model, a).tobytes() for a in SIGNATURE_ARRAYS if hasattr(model, a)
     )
     return sizes, bytes(model.names), arrays
-
-
-def evict(
-    entries: "collections.OrderedDict[str, Any]",
-    max_models: int,
-    max_bytes: int | None,
-    nbytes: Callable[[], int],
-    dropped: Callable[[str, Any], None],
-) -> None:
-    """The bound both caches keep: the least recently used entries out (``dropped`` is
-    told of each) while there are more than ``max_models`` or ``nbytes()`` is above
-    ``max_bytes``; the most recent one always stays."""
-    while len(entries) > 1 and (
-        len(entries) > max_models or (max_bytes is not None and nbytes() > max_bytes)
-    ):
-        key, gone = entries.popitem(last=False)
-        dropped(key, gone)
 
 
 def copy_value(value: Any) -> Any:
@@ -143,19 +126,16 @@ class ModelCache:
         self._mujoco = mujoco
         self._scene = scene
         self._fixed = list(scene.fixed_statistics)
-        self._max_models = max_models
-        self._max_bytes = max_bytes
         #: The scene's :class:`Superset` when every variant is a patch of it, else None.
         self.superset = scene.superset() if superset else None
         # Superset: body ids by name (one structure).
         self._body_ids: dict[str, int] = {}
         #: Superset patches whose derived values came tree by tree (not mj_setConst).
         self.by_tree = 0
-        # Cached models by structure key, least recently used first.
-        self._entries: collections.OrderedDict[str, Any] = collections.OrderedDict()
-        # How to patch each model seen (cached ones and the caller's), by id; holding the
-        # model keeps the id its own. Bounded: the least recently patched go first.
-        self._plans: collections.OrderedDict[int, PatchPlan] = collections.OrderedDict()
+        # Cached models by structure key and how to patch each model seen (cached ones
+        # and the caller's), least recently used first: the split tier's bound
+        # (ModelStore), the Rust caches' too.
+        self._store = ModelStore(max_models, max_bytes)
         # Signatures of structures seen, kept after their models are evicted, and the
         # <statistic> values each fixes.
         self._signatures: dict[str, tuple] = {}
@@ -165,31 +145,18 @@ class ModelCache:
         self.patches = 0
 
     def __len__(self) -> int:
-        return len(self._entries)
+        return len(self._store)
 
     @property
     def nbytes(self) -> int:
         """Bytes held: every cached model, and every model's scratch ``MjData``."""
-        return sum(p.nbytes for p in self._plans.values())
+        return self._store.nbytes
 
     def _plan(self, model: Any, key: str) -> PatchPlan:
         plan = PatchPlan(self._mujoco, model, key, self._fixed_values[key])
-        self._plans[id(model)] = plan
-        self._trim()
+        self._store.add_plan(model, plan)
+        self._store.trim()
         return plan
-
-    def _trim(self) -> None:
-        cached = {id(m) for m in self._entries.values()}
-
-        def dropped(_key: str, gone: Any) -> None:
-            self._plans.pop(id(gone), None)
-            cached.discard(id(gone))
-
-        evict(self._entries, self._max_models, self._max_bytes, lambda: self.nbytes, dropped)
-        # Plans of the caller's models: as many as cached models are allowed.
-        extra = [k for k in self._plans if k not in cached]
-        for k in extra[: max(0, len(extra) - self._max_models)]:
-            del self._plans[k]
 
     def _variant_inertia(self, plan: PatchPlan, variant: Any, parked: Any = None) -> None:
         """Superset: ``stat.meaninertia`` (which scales the constraint solver's tolerance)
@@ -212,8 +179,7 @@ class ModelCache:
         key = self.superset.structure_key if self.superset is not None else variant.structure_key
         self._signatures[key] = _signature(model)
         self._fixed_values[key] = [(s, copy_value(getattr(model.stat, s))) for s in self._fixed]
-        self._entries[key] = model
-        self._entries.move_to_end(key)
+        self._store.insert(key, model)
         plan = self._plan(model, key)
         if self.superset is not None:
             # The superset as compiled parks every object: the variant's patch places its own.
@@ -226,11 +192,10 @@ class ModelCache:
         """A compiled model equal to MuJoCo's compile of ``variant.xml`` (see the class);
         with ``superset=True``, the superset model patched for the variant."""
         key, patch = self._key_and_patch(variant)
-        model = self._entries.get(key)
+        model = self._store.get(key)
         if model is None:
             return self._compile(variant)
-        self._entries.move_to_end(key)
-        plan = self._plans.get(id(model)) or self._plan(model, key)
+        plan = self._store.plan(model) or self._plan(model, key)
         parked = self.superset.parked(variant.index) if self.superset is not None else None
         try:
             plan.apply(patch, self._tree_derive(plan, parked))
@@ -301,8 +266,8 @@ class ModelCache:
         """Patches ``model`` (of ``variant``'s structure) in place into ``variant``'s
         compiled model; returns it. Raises :class:`MjcfError` when its structure differs."""
         key, patch = self._key_and_patch(variant)
-        plan = self._plans.get(id(model))
-        if plan is None or plan.model is not model:
+        plan = self._store.plan(model)
+        if plan is None:
             if key not in self._signatures:
                 # The structure's first sight: its compile (kept) says what it is.
                 self._compile(variant)
@@ -317,7 +282,6 @@ class ModelCache:
                 f"the model has structure {plan.key}, variant {variant.index} has {key}: "
                 "a patch cannot change a structure (cache.model(variant) compiles it)"
             )
-        self._plans.move_to_end(id(model))
         parked = self.superset.parked(variant.index) if self.superset is not None else None
         plan.apply(patch, self._tree_derive(plan, parked))
         if self.superset is not None:
@@ -331,12 +295,11 @@ class ModelCache:
         layout, resolved once), as :meth:`apply` patches it."""
         index, numbers, strings, parked = world
         key = self.superset.structure_key
-        plan = self._plans.get(id(model))
-        if plan is None or plan.model is not model:
+        plan = self._store.plan(model)
+        if plan is None:
             if key not in self._signatures:
                 self._compile(_Variant(index))
             plan = self._plan(model, key)
-        self._plans.move_to_end(id(model))
         if plan.source is not patch0:
             plan.resolve(patch0)
             plan.source = patch0
@@ -426,4 +389,7 @@ def apply_world(cache: ModelCache, model: Any, world: tuple, patch0: list) -> An
 
 def plan_of(cache: ModelCache, model: Any) -> PatchPlan:
     """The patch plan ``cache`` keeps for ``model`` (one it patched)."""
-    return cache._plans[id(model)]
+    plan = cache._store.plan(model)
+    if plan is None:
+        raise KeyError("the cache keeps no plan of this model")
+    return plan

@@ -11,7 +11,6 @@ model MuJoCo compiles from the document, every array and size, at patch cost.
 
 from __future__ import annotations
 
-import collections
 import copy
 import os
 import sys
@@ -20,11 +19,11 @@ from typing import Any
 
 import numpy as np
 
-from ._cache import copy_value, evict
+from ._cache import copy_value
 from ._errors import error
 from ._last_xml import compile_xml
 from ._mujoco import VISUAL, restored_arrays, struct_fields
-from ._mjcf_forge import Document, MjcfError, PatchPlan
+from ._mjcf_forge import Document, MjcfError, ModelStore, PatchPlan
 
 class _Snapshot:
     """A structure's values as MuJoCo compiled them, of everything a patch or a caller may
@@ -179,11 +178,10 @@ class DocumentCache:
         if max_models < 1:
             raise ValueError("max_models must be at least 1")
         self._mujoco = mujoco
-        self._max_models = max_models
-        self._max_bytes = max_bytes
         self._lock = threading.Lock()
-        # Compiled structures by key, least recently used first.
-        self._entries: collections.OrderedDict[str, _Structure] = collections.OrderedDict()
+        # Compiled structures by key, least recently used first, each counting its own
+        # bytes: the split tier's bound (ModelStore), the Rust caches' too.
+        self._store = ModelStore(max_models, max_bytes, sized=True)
         # Structures being compiled, each with the event its waiters wait on.
         self._compiling: dict[str, threading.Event] = {}
         #: Models compiled (misses) and patches applied (hits) so far.
@@ -191,16 +189,13 @@ class DocumentCache:
         self.patches = 0
 
     def __len__(self) -> int:
-        return len(self._entries)
+        return len(self._store)
 
     @property
     def nbytes(self) -> int:
         """Bytes held: every model, its scratch ``MjData`` and its structure's snapshot."""
         with self._lock:
-            return self._nbytes()
-
-    def _nbytes(self) -> int:
-        return sum(s.nbytes for s in self._entries.values())
+            return self._store.nbytes
 
     def model(self, source: Any, base_dir: Any = None, *, into: Any = None) -> Any:
         """The ``mujoco.MjModel`` MuJoCo compiles from ``source`` (a :class:`Document`,
@@ -228,21 +223,18 @@ class DocumentCache:
         if into is not None:
             intos = into if isinstance(into, (list, tuple)) else (into,)
             with self._lock:
-                structure = self._entries.get(key)
+                structure = self._store.get(key)
                 working = None
                 if structure is not None:
                     working = next(
                         (w for w in structure.workings() if any(w.model is m for m in intos)), None
                     )
-                    if working is not None:
-                        self._entries.move_to_end(key)
             if working is not None:
                 return self._patched(working, doc, key, fixed, values, materials, bodies)
         while True:
             with self._lock:
-                structure = self._entries.get(key)
+                structure = self._store.get(key)
                 if structure is not None:
-                    self._entries.move_to_end(key)
                     working = structure.free(me)
                     if working is None:
                         other = next(iter(structure.workings()), None)
@@ -284,7 +276,7 @@ class DocumentCache:
         working.calibrate()
         with self._lock:
             structure.keep(me, working)
-            self._trim()
+            self._store.trim()
         return working
 
     def _compile(self, doc: Any, key: str, fixed: list, replace: bool = False) -> Any:
@@ -311,17 +303,13 @@ class DocumentCache:
             structure.keep(threading.get_ident(), working)
             with self._lock:
                 self.compiles += 1
-                self._entries[key] = structure
-                self._entries.move_to_end(key)
-                self._trim()
+                self._store.insert(key, structure)
+                self._store.trim()
             return working.model
         finally:
             if not replace:
                 with self._lock:
                     self._compiling.pop(key).set()
-
-    def _trim(self) -> None:
-        evict(self._entries, self._max_models, self._max_bytes, self._nbytes, lambda k, s: None)
 
 
 def _document(source: Any, base_dir: Any) -> Any:

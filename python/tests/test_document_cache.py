@@ -360,7 +360,7 @@ def test_a_model_someone_holds_is_never_patched_again():
     assert held[2].tolist() == mujoco.MjModel.from_xml_string(docs[2].to_xml()).body_mass.tolist()
     assert cache.compiles == 1 and cache.patches == 6
     # The structure keeps a few models per thread: holders beyond that keep theirs alone.
-    pool = next(iter(cache._entries.values())).models[threading.get_ident()]
+    pool = cache._store.models()[0].models[threading.get_ident()]
     assert len(pool) <= 4
     # Once let go of, a model is patched again rather than copied.
     del held, data

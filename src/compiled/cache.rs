@@ -7,7 +7,7 @@
 //! key, least recently used out; plans; the C side) is `store.rs`, which
 //! [`super::DocumentCache`] shares.
 
-use super::store::{Signature, State, Store};
+use super::store::{Signature, Store};
 use super::sys::{mjf_patch_array, mjf_patch_array_name, mjf_patch_get_stat};
 use crate::mujoco::{CompileError, CompiledModel, compile_str};
 use crate::scene::{Scene, Superset, VariantPatch};
@@ -214,22 +214,22 @@ impl<'s> ModelCache<'s> {
 
     /// Models compiled so far (misses).
     pub fn compiles(&self) -> u64 {
-        self.store.state.compiles
+        self.store.compiles
     }
 
     /// Patches applied so far.
     pub fn patches(&self) -> u64 {
-        self.store.state.patches
+        self.store.patches
     }
 
     /// How many compiled models the cache holds.
     pub fn len(&self) -> usize {
-        self.store.entries.len()
+        self.store.len()
     }
 
     /// Whether the cache holds none.
     pub fn is_empty(&self) -> bool {
-        self.store.entries.is_empty()
+        self.store.len() == 0
     }
 
     /// Bytes held: the cached models and every plan's scratch data.
@@ -251,20 +251,10 @@ impl<'s> ModelCache<'s> {
             self.superset.is_some()
         };
         if patch_it {
-            let store = &mut self.store;
-            let Some((_, model)) = store.entries.last_mut() else {
-                return Err(internal("the cache holds no model".to_string()));
-            };
             let target = (index, key.as_str(), patch.entries.as_slice());
-            let patched = patch_variant(
-                self.scene,
-                &mut self.superset,
-                &mut store.state,
-                target,
-                model,
-            );
+            let patched = patch_variant(self.scene, &self.superset, &mut self.store, target, None);
             match patched {
-                Ok(()) => store.trim(),
+                Ok(()) => self.store.trim(),
                 // A body's geoms that compile to another layout (sizes that turn its
                 // principal axes): not a patch of this structure, so the variant is
                 // compiled (and kept). The superset has no other structure to offer.
@@ -285,26 +275,20 @@ impl<'s> ModelCache<'s> {
     pub fn apply(&mut self, index: u64, model: &mut CompiledModel) -> Result<(), Errors> {
         let patch = self.patch_of(index)?;
         let key = patch.structure_key;
-        let known = self
-            .store
-            .state
-            .plans
-            .iter()
-            .find(|p| p.serial == model.serial());
-        match known {
-            Some(p) if p.plan.key != key => {
+        match self.store.plan_key(model) {
+            Some(found) if found != key => {
                 return Err(bare(ErrorKind::OtherStructure {
                     variant: index,
+                    found: Some(found.to_string()),
                     key,
-                    found: Some(p.plan.key.clone()),
                 }));
             }
             Some(_) => {}
             None => {
-                if !self.store.state.signatures.contains_key(&key) {
+                if !self.store.signatures.contains_key(&key) {
                     self.compile(index, &key)?;
                 }
-                if self.store.state.signatures.get(&key) != Some(&Signature::of(model)) {
+                if self.store.signatures.get(&key) != Some(&Signature::of(model)) {
                     return Err(bare(ErrorKind::OtherStructure {
                         variant: index,
                         key,
@@ -314,8 +298,14 @@ impl<'s> ModelCache<'s> {
             }
         }
         let target = (index, key.as_str(), patch.entries.as_slice());
-        let state = &mut self.store.state;
-        patch_variant(self.scene, &mut self.superset, state, target, model).map_err(internal)?;
+        patch_variant(
+            self.scene,
+            &self.superset,
+            &mut self.store,
+            target,
+            Some(model),
+        )
+        .map_err(internal)?;
         self.store.trim();
         Ok(())
     }
@@ -349,20 +339,26 @@ struct SupersetState {
 /// `stat.meaninertia` as the variant's own model has it (`PatchPlan::variant_inertia`).
 fn patch_variant(
     scene: &Scene,
-    superset: &mut Option<SupersetState>,
-    state: &mut State,
+    superset: &Option<SupersetState>,
+    store: &mut Store,
     (index, key, entries): (u64, &str, &[PatchEntry]),
-    model: &mut CompiledModel,
+    model: Option<&mut CompiledModel>,
 ) -> Result<(), String> {
-    state.patch_model(model, key, entries)?;
-    let Some(sup) = superset else {
-        return Ok(());
+    let roots = match superset {
+        Some(sup) => Some(
+            scene
+                .superset_parked(&sup.superset, index)
+                .map_err(|e| e.to_string())?,
+        ),
+        None => None,
     };
-    let roots = scene
-        .superset_parked(&sup.superset, index)
-        .map_err(|e| e.to_string())?;
-    match state.plan_mut(model) {
-        Some(plan) => plan.plan.variant_inertia(model, &roots),
-        None => Ok(()),
-    }
+    store.with_plan(model, key, |plan, model| {
+        plan.apply(model, entries)?;
+        match &roots {
+            Some(roots) => plan.variant_inertia(model, roots),
+            None => Ok(()),
+        }
+    })?;
+    store.patches += 1;
+    Ok(())
 }

@@ -101,22 +101,22 @@ impl DocumentCache {
 
     /// Models compiled so far (misses).
     pub fn compiles(&self) -> u64 {
-        self.store.state.compiles
+        self.store.compiles
     }
 
     /// Patches applied so far (hits).
     pub fn patches(&self) -> u64 {
-        self.store.state.patches
+        self.store.patches
     }
 
     /// How many compiled models the cache holds.
     pub fn len(&self) -> usize {
-        self.store.entries.len()
+        self.store.len()
     }
 
     /// Whether the cache holds none.
     pub fn is_empty(&self) -> bool {
-        self.store.entries.is_empty()
+        self.store.len() == 0
     }
 
     /// Bytes held: the cached models and their scratch data.

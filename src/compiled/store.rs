@@ -1,8 +1,9 @@
-//! The mechanism both model caches share: compiled models kept by structure key, least
-//! recently used out past a count and a byte bound, and how one model is patched in place
-//! (its plan: scratch data for `mj_setConst`, and where each entry of the structure's patch
-//! lands, resolved once). [`super::ModelCache`] (a scene's variants) and
-//! [`super::DocumentCache`] (any document) sit on it.
+//! The mechanism both model caches of the C face share: compiled models and their plans in
+//! the split tier's `ModelStore` (by structure key, least recently used out past a count
+//! and a byte bound: the rule the Python face's caches keep too), each patched by the split
+//! tier's `PatchPlan`, with each structure's signature and fixed statistics.
+//! [`super::ModelCache`] (a scene's variants) and [`super::DocumentCache`] (any document)
+//! sit on it.
 //!
 //! The C side (`patch.c`) is compiled against the linked MuJoCo's headers, as the FFI's
 //! shim is; arrays are found by name through MuJoCo's X-macro table, so no Rust copy of
@@ -14,13 +15,17 @@ use std::collections::HashMap;
 use super::arrays::Arrays;
 use super::sys::{mjf_patch_names, mjf_patch_size, mjf_patch_size_name};
 use crate::mujoco::CompiledModel;
-use crate::split::{PatchEntry, PatchModel, PatchPlan, SIGNATURE_ARRAYS, SIGNATURE_SKIPPED_SIZES};
+use crate::split::{
+    Held, ModelStore, PatchEntry, PatchModel, PatchPlan, SIGNATURE_ARRAYS, SIGNATURE_SKIPPED_SIZES,
+};
 
-/// How to patch one model: the split tier's [`PatchPlan`] over the linked MuJoCo, by the
-/// model's serial.
-pub(super) struct Plan {
-    pub(super) serial: u64,
-    pub(super) plan: PatchPlan<CompiledModel>,
+/// How to patch one model: the split tier's [`PatchPlan`] over the linked MuJoCo.
+pub(super) struct Plan(pub(super) PatchPlan<CompiledModel>);
+
+impl Held for Plan {
+    fn nbytes(&self) -> usize {
+        self.0.nbytes()
+    }
 }
 
 /// What a structure is, to refuse a model of another: every size of its model but
@@ -81,11 +86,26 @@ impl Signature {
     }
 }
 
-/// Compiled models by structure key, least recently used first, and the state that
-/// patches them.
+/// Compiled models by structure key and plans by model serial, in the split tier's
+/// [`ModelStore`] (its bound), with what the caches know of each structure.
 pub(super) struct Store {
-    pub(super) entries: Vec<(String, CompiledModel)>,
-    pub(super) state: State,
+    kept: ModelStore<CompiledModel, Plan>,
+    pub(super) signatures: HashMap<String, Signature>,
+    /// Per structure, the statistics its `<statistic>` fixes (bits as `keep_fixed` takes
+    /// them) and the values MuJoCo compiled.
+    stats: HashMap<String, (u32, [f64; 7])>,
+    pub(super) compiles: u64,
+    pub(super) patches: u64,
+}
+
+/// A model's serial: its id in the store.
+fn serial(m: &CompiledModel) -> u64 {
+    m.serial()
+}
+
+/// What a model holds beyond its plan's count (the plan counts the model).
+fn no_bytes(_: &CompiledModel) -> usize {
+    0
 }
 
 impl Store {
@@ -93,162 +113,110 @@ impl Store {
     /// `max_bytes` of models and scratch data.
     pub(super) fn new(max_models: usize, max_bytes: Option<usize>) -> Store {
         Store {
-            entries: Vec::new(),
-            state: State {
-                max_models: max_models.max(1),
-                max_bytes,
-                plans: Vec::new(),
-                signatures: HashMap::new(),
-                stats: HashMap::new(),
-                compiles: 0,
-                patches: 0,
-            },
+            kept: ModelStore::new(max_models, max_bytes),
+            signatures: HashMap::new(),
+            stats: HashMap::new(),
+            compiles: 0,
+            patches: 0,
         }
+    }
+
+    /// How many models are cached.
+    pub(super) fn len(&self) -> usize {
+        self.kept.len()
     }
 
     /// Whether a model of structure `key` is cached; if so it becomes the most recent.
     pub(super) fn touch(&mut self, key: &str) -> bool {
-        match self.entries.iter().position(|(k, _)| k == key) {
-            Some(at) => {
-                let entry = self.entries.remove(at);
-                self.entries.push(entry);
-                true
-            }
-            None => false,
-        }
+        self.kept.touch(key).is_some()
     }
 
     /// Keeps `model`, just compiled for structure `key`, as the most recent model: its
-    /// signature, its statistics (`fixed`: the bits of those its `<statistic>` sets, as
-    /// `mjf_patch_finish` takes them) and its plan, whose bytes count from now on.
+    /// signature, its statistics (`fixed`: the bits of those its `<statistic>` sets) and
+    /// its plan, whose bytes count from now on.
     pub(super) fn insert(
         &mut self,
         key: &str,
         model: CompiledModel,
         fixed: u32,
     ) -> Result<(), String> {
-        let state = &mut self.state;
-        state.compiles += 1;
-        state.stats.insert(key.to_string(), (fixed, model.stat()));
-        state
-            .signatures
+        self.compiles += 1;
+        let stat = model.stat();
+        self.stats.insert(key.to_string(), (fixed, stat));
+        self.signatures
             .insert(key.to_string(), Signature::of(&model));
-        state.plan_of(&model, key)?;
-        self.entries.push((key.to_string(), model));
-        self.state.trim(&mut self.entries);
+        let plan = PatchPlan::new(&model, key, fixed, stat)?;
+        self.kept.add_plan(model.serial(), Plan(plan));
+        self.kept.insert(key, model);
+        self.trim();
         Ok(())
     }
 
     /// Drops the model of structure `key`, if cached, with its plan.
     pub(super) fn remove(&mut self, key: &str) {
-        if let Some(at) = self.entries.iter().position(|(k, _)| k == key) {
-            let (_, gone) = self.entries.remove(at);
-            self.state.plans.retain(|p| p.serial != gone.serial());
-        }
+        self.kept.remove(key, serial);
     }
 
     /// The most recent model.
     pub(super) fn last(&self) -> Option<&CompiledModel> {
-        self.entries.last().map(|(_, m)| m)
+        self.kept.last()
+    }
+
+    /// The structure key of the plan of `model`, if it has one.
+    pub(super) fn plan_key(&self, model: &CompiledModel) -> Option<&str> {
+        self.kept
+            .peek_plan(model.serial())
+            .map(|p| p.0.key.as_str())
+    }
+
+    /// Calls `f` with the plan of `model` (of structure `key`; `None`: the most recent
+    /// cached model) and the model, the plan made on first sight; the plan becomes the
+    /// most recent.
+    pub(super) fn with_plan<R>(
+        &mut self,
+        outside: Option<&mut CompiledModel>,
+        key: &str,
+        f: impl FnOnce(&mut PatchPlan<CompiledModel>, &mut CompiledModel) -> Result<R, String>,
+    ) -> Result<R, String> {
+        let id = match &outside {
+            Some(m) => m.serial(),
+            None => self.kept.last().map(serial).ok_or("no model to patch")?,
+        };
+        if self.kept.peek_plan(id).is_none() {
+            let (fixed, stat) = self.stats.get(key).copied().unwrap_or_default();
+            let model = match &outside {
+                Some(m) => &**m,
+                None => self.kept.last().ok_or("no model to patch")?,
+            };
+            let plan = PatchPlan::new(model, key, fixed, stat)?;
+            self.kept.add_plan(id, Plan(plan));
+        }
+        match outside {
+            Some(model) => {
+                let plan = self.kept.plan(id).ok_or("the plan is gone")?;
+                f(&mut plan.0, model)
+            }
+            None => {
+                let (model, plan) = self.kept.last_and_plan(id).ok_or("the plan is gone")?;
+                f(&mut plan.0, model)
+            }
+        }
     }
 
     /// Patches the most recent model (of structure `key`) with `entries`.
     pub(super) fn patch_last(&mut self, key: &str, entries: &[PatchEntry]) -> Result<(), String> {
-        let Some((_, model)) = self.entries.last_mut() else {
-            return Err("no model to patch".to_string());
-        };
-        self.state.patch_model(model, key, entries)
-    }
-
-    /// Drops the least recently used models beyond the bounds.
-    pub(super) fn trim(&mut self) {
-        self.state.trim(&mut self.entries);
-    }
-
-    /// Bytes held: the cached models and every plan's scratch data.
-    pub(super) fn nbytes(&self) -> usize {
-        self.state.nbytes()
-    }
-}
-
-/// Everything but the cached models (so that a cached model and the plans can be borrowed
-/// at once).
-pub(super) struct State {
-    max_models: usize,
-    max_bytes: Option<usize>,
-    /// Plans by model serial (cached models' and callers'), least recently used first.
-    pub(super) plans: Vec<Plan>,
-    pub(super) signatures: HashMap<String, Signature>,
-    /// Per structure, the statistics its `<statistic>` fixes (bits as `mjf_patch_finish`
-    /// takes them) and the values MuJoCo compiled.
-    stats: HashMap<String, (u32, [f64; 7])>,
-    pub(super) compiles: u64,
-    pub(super) patches: u64,
-}
-
-impl State {
-    pub(super) fn nbytes(&self) -> usize {
-        self.plans.iter().map(|p| p.plan.nbytes()).sum()
-    }
-
-    /// Drops the least recently used models (and plans) beyond the bounds.
-    pub(super) fn trim(&mut self, entries: &mut Vec<(String, CompiledModel)>) {
-        while entries.len() > 1
-            && (entries.len() > self.max_models
-                || self.max_bytes.is_some_and(|b| self.nbytes() > b))
-        {
-            let (_, gone) = entries.remove(0);
-            self.plans.retain(|p| p.serial != gone.serial());
-        }
-        // Plans of callers' models: as many as cached models are allowed.
-        let cached: Vec<u64> = entries.iter().map(|(_, m)| m.serial()).collect();
-        let mut extra = self
-            .plans
-            .iter()
-            .filter(|p| !cached.contains(&p.serial))
-            .count();
-        self.plans.retain(|p| {
-            if extra > self.max_models && !cached.contains(&p.serial) {
-                extra -= 1;
-                false
-            } else {
-                true
-            }
-        });
-    }
-
-    /// The index of `model`'s plan, made on first sight.
-    fn plan_of(&mut self, model: &CompiledModel, key: &str) -> Result<usize, String> {
-        if let Some(at) = self.plans.iter().position(|p| p.serial == model.serial()) {
-            return Ok(at);
-        }
-        let (fixed, stat) = self.stats.get(key).copied().unwrap_or_default();
-        self.plans.push(Plan {
-            serial: model.serial(),
-            plan: PatchPlan::new(model, key, fixed, stat)?,
-        });
-        Ok(self.plans.len() - 1)
-    }
-
-    /// Writes `entries` into `model` (of structure `key`) and what follows from them;
-    /// its plan becomes the most recent.
-    pub(super) fn patch_model(
-        &mut self,
-        model: &mut CompiledModel,
-        key: &str,
-        entries: &[PatchEntry],
-    ) -> Result<(), String> {
-        let at = self.plan_of(model, key)?;
-        let mut plan = self.plans.remove(at);
-        let result = plan.plan.apply(model, entries);
-        self.plans.push(plan);
-        result?;
+        self.with_plan(None, key, |plan, model| plan.apply(model, entries))?;
         self.patches += 1;
         Ok(())
     }
 
-    /// The plan of `model`, if it has one.
-    pub(super) fn plan_mut(&mut self, model: &CompiledModel) -> Option<&mut Plan> {
-        self.plans.iter_mut().find(|p| p.serial == model.serial())
+    /// Drops the least recently used models beyond the bounds.
+    pub(super) fn trim(&mut self) {
+        self.kept.trim(serial, no_bytes);
+    }
+
+    /// Bytes held: the cached models and every plan's scratch data.
+    pub(super) fn nbytes(&self) -> usize {
+        self.kept.nbytes(no_bytes)
     }
 }

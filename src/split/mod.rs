@@ -29,7 +29,8 @@
 //! arrays that tell structures apart: the one copy the model caches of both faces read),
 //! `landing.rs` (where each patch entry lands in a compiled model and how its numbers are
 //! written, for both faces), `plan.rs` (one model patched in place: the patch plan both
-//! faces' caches run, over their own MuJoCo), `document.rs` (any document split by reading it), `body_model.rs` (a body's geoms as a
+//! faces' caches run, over their own MuJoCo), `store.rs` (the models and plans a cache
+//! keeps, and the bound on them), `document.rs` (any document split by reading it), `body_model.rs` (a body's geoms as a
 //! model of their own, for what MuJoCo derives from their sizes), `body_copy.rs` (that
 //! model's compile copied into a structure's model, for both faces), `geom_masses.rs` (a
 //! body's mass properties from its geoms' densities or masses, at patch cost; with
@@ -49,6 +50,7 @@ mod landing;
 mod plan;
 mod rules;
 mod statistics;
+mod store;
 mod targets;
 mod volumes;
 
@@ -69,6 +71,7 @@ pub use statistics::{
     STATISTIC_NAMES, StatArrays, Statistics, fixed_statistics, fixed_statistics_mask, keep_fixed,
     mean_inertia, statistics,
 };
+pub use store::{Held, ModelStore};
 pub use targets::{
     BODY_MODELS_KEPT, BULK_PREFIXES, BULK_SIZES, DOF_FIELDS, GEOM_FACTORS, JOINT_TYPES,
     LAYOUTS_KEPT, MASS_DERIVED, MODEL_FIELDS, PATCH_OBJECTS, PatchObject, QPOS_FIELDS,

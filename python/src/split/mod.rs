@@ -1,6 +1,7 @@
 //! The split tier's face in Python: its tables (`tables.rs`, the one copy of each the
 //! package's caches read) and the rules the caches run over the user's `MjModel` in place
-//! (`plan.rs`, the split tier's patch plan over the user's `mujoco`, with `patch.rs`,
+//! (`plan.rs`, the split tier's patch plan over the user's `mujoco`, and `store.rs`, its
+//! bound on what a cache keeps; with `patch.rs`,
 //! `statistics.rs`, `body_models.rs`, through `arrays.rs`).
 
 // NumPy's memory read in place: the bindings' only unsafe code.
@@ -14,6 +15,7 @@ mod patch;
 mod plan;
 #[allow(unsafe_code)]
 mod statistics;
+mod store;
 mod tables;
 
 use pyo3::prelude::*;
@@ -24,5 +26,6 @@ pub(crate) fn add(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<statistics::PyStatistics>()?;
     m.add_class::<body_models::PyModelArrays>()?;
     m.add_class::<plan::PyPatchPlan>()?;
+    m.add_class::<store::PyModelStore>()?;
     Ok(())
 }

@@ -440,6 +440,11 @@ fn hold<T>(lock: &Mutex<T>) -> PyResult<MutexGuard<'_, T>> {
 }
 
 impl PyPatchPlan {
+    /// Bytes held: the model and the scratch data.
+    pub(super) fn nbytes(&self) -> usize {
+        self.nbytes
+    }
+
     fn resolve_read(
         &self,
         py: Python<'_>,
