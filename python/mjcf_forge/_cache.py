@@ -23,33 +23,16 @@ from ._last_xml import compile_xml
 from ._mjcf_forge import (
     LAYOUTS_KEPT,
     MODEL_FIELDS,
-    SIGNATURE_ARRAYS,
-    SIGNATURE_SKIPPED_SIZES,
     STATIC_PREFIXES,
     STATISTIC_NAMES,
     MjcfError,
     ModelStore,
     PatchPlan,
     Scene,
+    structure_signature,
 )
 from ._progress import progress_of
 from ._trees import TreeDerivation
-
-
-def _signature(model: Any) -> tuple:
-    """What decides a model's structure (``mjcf_forge::split``'s signature, from this
-    MuJoCo): every size but those a patch changes, the names, the integer arrays."""
-    sizes = tuple(
-        getattr(model, a)
-        for a in sorted(dir(model))
-        if a.startswith("n")
-        and a not in SIGNATURE_SKIPPED_SIZES
-        and isinstance(getattr(model, a, None), int)
-    )
-    arrays = tuple(
-        getattr(model, a).tobytes() for a in SIGNATURE_ARRAYS if hasattr(model, a)
-    )
-    return sizes, bytes(model.names), arrays
 
 
 def copy_value(value: Any) -> Any:
@@ -138,7 +121,7 @@ class ModelCache:
         self._store = ModelStore(max_models, max_bytes)
         # Signatures of structures seen, kept after their models are evicted, and the
         # <statistic> values each fixes.
-        self._signatures: dict[str, tuple] = {}
+        self._signatures: dict[str, bytes] = {}
         self._fixed_values: dict[str, list] = {}
         #: Models compiled (misses) and patches applied so far.
         self.compiles = 0
@@ -177,7 +160,7 @@ class ModelCache:
         model = compile_xml(self._mujoco, xml)
         self.compiles += 1
         key = self.superset.structure_key if self.superset is not None else variant.structure_key
-        self._signatures[key] = _signature(model)
+        self._signatures[key] = structure_signature(model)
         self._fixed_values[key] = [(s, copy_value(getattr(model.stat, s))) for s in self._fixed]
         self._store.insert(key, model)
         plan = self._plan(model, key)
@@ -271,7 +254,7 @@ class ModelCache:
             if key not in self._signatures:
                 # The structure's first sight: its compile (kept) says what it is.
                 self._compile(variant)
-            if _signature(model) != self._signatures[key]:
+            if structure_signature(model) != self._signatures[key]:
                 raise error(
                     f"the model does not have the structure of variant {variant.index} "
                     f"(key {key}): its sizes, names or element types differ"

@@ -16,8 +16,6 @@ PATCH_OBJECTS: dict[str, tuple[str, str, str]]
 DOF_FIELDS: tuple[str, ...]
 QPOS_FIELDS: tuple[str, ...]
 STATIC_PREFIXES: tuple[str, ...]
-SIGNATURE_ARRAYS: tuple[str, ...]
-SIGNATURE_SKIPPED_SIZES: tuple[str, ...]
 MODEL_FIELDS: tuple[str, ...]
 GEOM_FACTORS: str
 MASS_DERIVED: tuple[str, ...]
@@ -38,6 +36,7 @@ BULK_PREFIXES: tuple[str, ...]
 
 def target_array(object: str, field: str) -> Optional[str]: ...
 def joint_widths(jnt_type: int) -> tuple[int, int]: ...
+def structure_signature(model: Any) -> bytes: ...
 
 class Statistics:
     """The compiler's statistics of a model, computed over its arrays in place

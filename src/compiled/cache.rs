@@ -7,11 +7,11 @@
 //! key, least recently used out; plans; the C side) is `store.rs`, which
 //! [`super::DocumentCache`] shares.
 
-use super::store::{Signature, Store};
+use super::store::Store;
 use super::sys::{mjf_patch_array, mjf_patch_array_name, mjf_patch_get_stat};
 use crate::mujoco::{CompileError, CompiledModel, compile_str};
 use crate::scene::{Scene, Superset, VariantPatch};
-use crate::split::{PatchEntry, fixed_statistics_mask};
+use crate::split::{PatchEntry, Signature, fixed_statistics_mask};
 use crate::{ErrorKind, Errors};
 
 use super::{bare, internal};

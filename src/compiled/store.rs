@@ -16,7 +16,7 @@ use super::arrays::Arrays;
 use super::sys::{mjf_patch_names, mjf_patch_size, mjf_patch_size_name};
 use crate::mujoco::CompiledModel;
 use crate::split::{
-    Held, ModelStore, PatchEntry, PatchModel, PatchPlan, SIGNATURE_ARRAYS, SIGNATURE_SKIPPED_SIZES,
+    Held, ModelStore, PatchEntry, PatchModel, PatchPlan, Signature, SignatureSource,
 };
 
 /// How to patch one model: the split tier's [`PatchPlan`] over the linked MuJoCo.
@@ -28,33 +28,10 @@ impl Held for Plan {
     }
 }
 
-/// What a structure is, to refuse a model of another: every size of its model but
-/// [`SIGNATURE_SKIPPED_SIZES`](crate::split::SIGNATURE_SKIPPED_SIZES), its names buffer and
-/// the integer arrays [`SIGNATURE_ARRAYS`](crate::split::SIGNATURE_ARRAYS) (the Python
-/// caches take the same, from their own MuJoCo).
-#[derive(PartialEq)]
-pub(super) struct Signature {
-    sizes: Vec<i64>,
-    names: Vec<u8>,
-    arrays: Vec<Vec<u8>>,
-}
-
-impl Signature {
-    pub(super) fn of(m: &CompiledModel) -> Signature {
-        let raw = std::ptr::from_ref(m.raw()).cast_mut();
-        let arrays = SIGNATURE_ARRAYS
-            .iter()
-            .map(|name| {
-                let Ok((p, elem, count)) = Arrays(raw).find(name) else {
-                    return Vec::new();
-                };
-                if p.is_null() {
-                    return Vec::new();
-                }
-                // SAFETY: MuJoCo's array holds `count` elements of `elem` bytes.
-                unsafe { std::slice::from_raw_parts(p.cast::<u8>(), elem * count) }.to_vec()
-            })
-            .collect();
+/// The linked MuJoCo's model as the split tier's [`Signature`] reads it.
+impl SignatureSource for CompiledModel {
+    fn sizes(&self) -> Vec<(String, i64)> {
+        let raw = self.raw();
         let mut sizes = Vec::new();
         for i in 0.. {
             // SAFETY: a static NUL-terminated name, or null past the last size.
@@ -64,25 +41,33 @@ impl Signature {
             }
             // SAFETY: as above.
             let name = unsafe { std::ffi::CStr::from_ptr(name) }.to_string_lossy();
-            if !SIGNATURE_SKIPPED_SIZES.contains(&name.as_ref()) {
-                // SAFETY: the model is live; `i` names one of its sizes.
-                sizes.push(unsafe { mjf_patch_size(raw, i) });
-            }
+            // SAFETY: the model is live; `i` names one of its sizes.
+            sizes.push((name.into_owned(), unsafe { mjf_patch_size(raw, i) }));
         }
+        sizes
+    }
+
+    fn names_buffer(&self) -> Vec<u8> {
         let mut len = 0i64;
         // SAFETY: the model is live; its names buffer holds `len` bytes.
-        let p = unsafe { mjf_patch_names(raw, &mut len) };
-        let names = if p.is_null() || len <= 0 {
-            Vec::new()
-        } else {
-            // SAFETY: as above.
-            unsafe { std::slice::from_raw_parts(p.cast::<u8>(), len as usize) }.to_vec()
-        };
-        Signature {
-            sizes,
-            names,
-            arrays,
+        let p = unsafe { mjf_patch_names(self.raw(), &mut len) };
+        if p.is_null() || len <= 0 {
+            return Vec::new();
         }
+        // SAFETY: as above.
+        unsafe { std::slice::from_raw_parts(p.cast::<u8>(), len as usize) }.to_vec()
+    }
+
+    fn array_bytes(&self, name: &str) -> Vec<u8> {
+        let raw = std::ptr::from_ref(self.raw()).cast_mut();
+        let Ok((p, elem, count)) = Arrays(raw).find(name) else {
+            return Vec::new();
+        };
+        if p.is_null() {
+            return Vec::new();
+        }
+        // SAFETY: MuJoCo's array holds `count` elements of `elem` bytes.
+        unsafe { std::slice::from_raw_parts(p.cast::<u8>(), elem * count) }.to_vec()
     }
 }
 

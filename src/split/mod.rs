@@ -30,7 +30,8 @@
 //! `landing.rs` (where each patch entry lands in a compiled model and how its numbers are
 //! written, for both faces), `plan.rs` (one model patched in place: the patch plan both
 //! faces' caches run, over their own MuJoCo), `store.rs` (the models and plans a cache
-//! keeps, and the bound on them), `document.rs` (any document split by reading it), `body_model.rs` (a body's geoms as a
+//! keeps, and the bound on them), `signature.rs` (what tells one structure's compiled model
+//! from another's), `document.rs` (any document split by reading it), `body_model.rs` (a body's geoms as a
 //! model of their own, for what MuJoCo derives from their sizes), `body_copy.rs` (that
 //! model's compile copied into a structure's model, for both faces), `geom_masses.rs` (a
 //! body's mass properties from its geoms' densities or masses, at patch cost; with
@@ -49,6 +50,7 @@ mod geom_masses;
 mod landing;
 mod plan;
 mod rules;
+mod signature;
 mod statistics;
 mod store;
 mod targets;
@@ -67,6 +69,7 @@ pub use geom_masses::{
 pub use landing::{ArrayMut, Carried, Landing, ModelLayout, Run, land};
 pub use plan::{LayoutEntry, PatchModel, PatchPlan, PatchValues};
 pub use rules::{PATCHABLE, PatchEntry, PatchValue};
+pub use signature::{Signature, SignatureSource};
 pub use statistics::{
     STATISTIC_NAMES, StatArrays, Statistics, fixed_statistics, fixed_statistics_mask, keep_fixed,
     mean_inertia, statistics,

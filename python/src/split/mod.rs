@@ -13,6 +13,7 @@ mod body_models;
 mod patch;
 #[allow(unsafe_code)]
 mod plan;
+mod signature;
 #[allow(unsafe_code)]
 mod statistics;
 mod store;
@@ -27,5 +28,6 @@ pub(crate) fn add(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<body_models::PyModelArrays>()?;
     m.add_class::<plan::PyPatchPlan>()?;
     m.add_class::<store::PyModelStore>()?;
+    m.add_function(wrap_pyfunction!(signature::structure_signature, m)?)?;
     Ok(())
 }

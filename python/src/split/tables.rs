@@ -17,14 +17,6 @@ pub(super) fn add(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DOF_FIELDS", PyTuple::new(py, split::DOF_FIELDS)?)?;
     m.add("QPOS_FIELDS", PyTuple::new(py, split::QPOS_FIELDS)?)?;
     m.add("STATIC_PREFIXES", PyTuple::new(py, split::STATIC_PREFIXES)?)?;
-    m.add(
-        "SIGNATURE_ARRAYS",
-        PyTuple::new(py, split::SIGNATURE_ARRAYS)?,
-    )?;
-    m.add(
-        "SIGNATURE_SKIPPED_SIZES",
-        PyTuple::new(py, split::SIGNATURE_SKIPPED_SIZES)?,
-    )?;
     m.add("MODEL_FIELDS", PyTuple::new(py, split::MODEL_FIELDS)?)?;
     m.add("GEOM_FACTORS", split::GEOM_FACTORS)?;
     m.add("MASS_DERIVED", PyTuple::new(py, split::MASS_DERIVED)?)?;
