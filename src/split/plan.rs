@@ -115,26 +115,25 @@ impl LayoutEntry {
 
     /// The layout entry of a patch entry.
     pub fn of(e: &PatchEntry) -> LayoutEntry {
-        let carried = match &e.value {
-            PatchValue::Numbers(v) => Carried::Numbers(v.len()),
-            PatchValue::Id { .. } => Carried::Id,
-            PatchValue::BodyModel(_) => Carried::BodyModel,
-        };
-        LayoutEntry::new(e.object, &e.name, e.id, e.field, carried)
+        LayoutEntry::new(e.object, &e.name, e.id, e.field, carried(&e.value))
     }
 
     /// Whether this is the layout entry of `e`.
     fn is_of(&self, e: &PatchEntry) -> bool {
-        let carried = match &e.value {
-            PatchValue::Numbers(v) => Carried::Numbers(v.len()),
-            PatchValue::Id { .. } => Carried::Id,
-            PatchValue::BodyModel(_) => Carried::BodyModel,
-        };
         self.object == e.object
             && self.name == e.name
             && self.id == e.id
             && self.field == e.field
-            && self.carried == carried
+            && self.carried == carried(&e.value)
+    }
+}
+
+/// What `value` carries, as far as where it lands goes.
+fn carried(value: &PatchValue) -> Carried {
+    match value {
+        PatchValue::Numbers(v) => Carried::Numbers(v.len()),
+        PatchValue::Id { .. } => Carried::Id,
+        PatchValue::BodyModel(_) => Carried::BodyModel,
     }
 }
 

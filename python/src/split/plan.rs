@@ -80,31 +80,30 @@ impl split::ModelArrays for UserModel {
     }
 }
 
+/// The array `name` of `arrays`, to write (called only through `&mut UserModel`, which
+/// owns `arrays`: the borrow that makes the slice the only view).
+#[allow(clippy::mut_from_ref)]
+fn writable<'a, T: super::arrays::Element>(
+    arrays: &'a ahash::AHashMap<&'static str, Array<T>>,
+    name: &str,
+) -> Result<&'a mut [T], String> {
+    // SAFETY: the only view of this array while the model is borrowed mutably (each array
+    // is one entry; the GIL is held and no Python code runs meanwhile).
+    arrays
+        .get(name)
+        .map(|a| unsafe { a.slice_mut() })
+        .ok_or_else(|| missing(name))
+}
+
 impl split::ModelArraysMut for UserModel {
     fn floats_mut(&mut self, name: &str) -> Result<&mut [f64], String> {
-        // SAFETY: the only view of this array while `self` is borrowed mutably (the GIL
-        // is held and no Python code runs meanwhile).
-        self.arrays
-            .floats
-            .get(name)
-            .map(|a| unsafe { a.slice_mut() })
-            .ok_or_else(|| missing(name))
+        writable(&self.arrays.floats, name)
     }
     fn bytes_mut(&mut self, name: &str) -> Result<&mut [u8], String> {
-        // SAFETY: as above.
-        self.arrays
-            .bytes
-            .get(name)
-            .map(|a| unsafe { a.slice_mut() })
-            .ok_or_else(|| missing(name))
+        writable(&self.arrays.bytes, name)
     }
     fn ints_mut(&mut self, name: &str) -> Result<&mut [i32], String> {
-        // SAFETY: as above.
-        self.arrays
-            .ints
-            .get(name)
-            .map(|a| unsafe { a.slice_mut() })
-            .ok_or_else(|| missing(name))
+        writable(&self.arrays.ints, name)
     }
 }
 
