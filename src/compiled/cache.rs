@@ -3,18 +3,18 @@
 //! ([`crate::scene::Scene::patch`]) into its arrays, then running MuJoCo's `mj_setConst`
 //! and the statistics the compiler derives from the model at `qpos0` (which `mj_setConst`
 //! of 3.17 and 4.0 leaves): exactly the model MuJoCo compiles from the variant's XML
-//! (`tests/model_cache.rs` compares every array bit for bit). The mechanism (models kept by
-//! key, least recently used out; plans; the C side) is `store.rs`, which
-//! [`super::DocumentCache`] shares.
+//! (`tests/model_cache.rs` compares every array bit for bit). The rules (misses, patches,
+//! a caller's model checked, the bound) are the split tier's cache core, run over the
+//! linked MuJoCo by `store.rs`, which [`super::DocumentCache`] shares.
 
-use super::store::Store;
+use super::store::{Core, Linked, cache_error};
 use super::sys::{mjf_patch_array, mjf_patch_array_name, mjf_patch_get_stat};
 use crate::mujoco::{CompileError, CompiledModel, compile_str};
 use crate::scene::{Scene, Superset, VariantPatch};
-use crate::split::{PatchEntry, Signature, fixed_statistics_mask};
+use crate::split::{Request, fixed_statistics_mask};
 use crate::{ErrorKind, Errors};
 
-use super::{bare, internal};
+use super::bare;
 
 impl CompiledModel {
     /// Where `other` differs from this model: every array of `mjModel` compared bit for
@@ -157,9 +157,10 @@ pub struct ModelCache<'s> {
     dir: Option<std::path::PathBuf>,
     /// With [`ModelCache::with_superset`]: the scene's superset.
     superset: Option<SupersetState>,
-    /// The statistics the scene's `<statistic>` fixes, as bits (see `Store::insert`).
+    /// The statistics the scene's `<statistic>` fixes, as bits.
     fixed: u32,
-    store: Store,
+    core: Core,
+    max: (usize, Option<usize>),
 }
 
 impl<'s> ModelCache<'s> {
@@ -171,7 +172,8 @@ impl<'s> ModelCache<'s> {
             dir: None,
             superset: None,
             fixed: fixed_statistics_mask(scene.fixed_statistics()),
-            store: Store::new(max_models, max_bytes),
+            core: Core::new(max_models, max_bytes, false),
+            max: (max_models, max_bytes),
         }
     }
 
@@ -188,6 +190,7 @@ impl<'s> ModelCache<'s> {
         let superset = self.scene.superset()?;
         let xml = superset.document.to_xml_string();
         self.superset = Some(SupersetState { superset, xml });
+        self.core = Core::new(self.max.0, self.max.1, true);
         Ok(self)
     }
 
@@ -204,128 +207,96 @@ impl<'s> ModelCache<'s> {
         self.scene.superset_parked(&s.superset, index)
     }
 
-    /// The variant's patch: of its own structure, or of the superset.
-    fn patch_of(&self, index: u64) -> Result<VariantPatch, Errors> {
+    /// The variant's patch (of its own structure, or of the superset) and, for a
+    /// superset, the roots it parks.
+    fn patch_of(&self, index: u64) -> Result<(VariantPatch, Option<Vec<String>>), Errors> {
         match &self.superset {
-            Some(s) => self.scene.superset_patch(&s.superset, index),
-            None => self.scene.patch(index),
+            Some(s) => Ok((
+                self.scene.superset_patch(&s.superset, index)?,
+                Some(self.scene.superset_parked(&s.superset, index)?),
+            )),
+            None => Ok((self.scene.patch(index)?, None)),
         }
     }
 
     /// Models compiled so far (misses).
     pub fn compiles(&self) -> u64 {
-        self.store.compiles
+        self.core.compiles()
     }
 
     /// Patches applied so far.
     pub fn patches(&self) -> u64 {
-        self.store.patches
+        self.core.patches()
     }
 
     /// How many compiled models the cache holds.
     pub fn len(&self) -> usize {
-        self.store.len()
+        self.core.len()
     }
 
     /// Whether the cache holds none.
     pub fn is_empty(&self) -> bool {
-        self.store.len() == 0
+        self.core.is_empty()
     }
 
     /// Bytes held: the cached models and every plan's scratch data.
     pub fn nbytes(&self) -> usize {
-        self.store.nbytes()
+        self.core.nbytes()
     }
 
     /// Variant `index` as MuJoCo compiles it from its XML: the cached model of its
     /// structure patched in place, or on a miss the variant compiled (and kept). The model
     /// stays the cache's: the next call for the same structure patches it again.
     pub fn model(&mut self, index: u64) -> Result<&CompiledModel, Errors> {
-        let patch = self.patch_of(index)?;
-        let key = patch.structure_key;
-        let patch_it = if self.store.touch(&key) {
-            true
-        } else {
-            self.compile(index, &key)?;
-            // The superset as compiled parks every object: place the variant's.
-            self.superset.is_some()
-        };
-        if patch_it {
-            let target = (index, key.as_str(), patch.entries.as_slice());
-            let patched = patch_variant(self.scene, &self.superset, &mut self.store, target, None);
-            match patched {
-                Ok(()) => self.store.trim(),
-                // A body's geoms that compile to another layout (sizes that turn its
-                // principal axes): not a patch of this structure, so the variant is
-                // compiled (and kept). The superset has no other structure to offer.
-                Err(_) if self.superset.is_none() => {
-                    self.store.remove(&key);
-                    self.compile(index, &key)?;
-                }
-                Err(e) => return Err(internal(e)),
-            }
-        }
-        self.store
-            .last()
-            .ok_or_else(|| internal("the cache holds no model".to_string()))
+        let (patch, parked) = self.patch_of(index)?;
+        let request = self.request(&patch, parked.as_deref());
+        let compile = compiler(self.scene, &self.superset, self.dir.as_deref(), index);
+        self.core
+            .model(&mut Linked, &request, compile)
+            .map_err(|e| cache_error(e, index, &patch.structure_key))
     }
 
     /// Patches `model`, a model of variant `index`'s structure, in place into variant
     /// `index`'s compiled model. A model of another structure is refused.
     pub fn apply(&mut self, index: u64, model: &mut CompiledModel) -> Result<(), Errors> {
-        let patch = self.patch_of(index)?;
-        let key = patch.structure_key;
-        match self.store.plan_key(model) {
-            Some(found) if found != key => {
-                return Err(bare(ErrorKind::OtherStructure {
-                    variant: index,
-                    found: Some(found.to_string()),
-                    key,
-                }));
-            }
-            Some(_) => {}
-            None => {
-                if !self.store.signatures.contains_key(&key) {
-                    self.compile(index, &key)?;
-                }
-                if self.store.signatures.get(&key) != Some(&Signature::of(model)) {
-                    return Err(bare(ErrorKind::OtherStructure {
-                        variant: index,
-                        key,
-                        found: None,
-                    }));
-                }
-            }
-        }
-        let target = (index, key.as_str(), patch.entries.as_slice());
-        patch_variant(
-            self.scene,
-            &self.superset,
-            &mut self.store,
-            target,
-            Some(model),
-        )
-        .map_err(internal)?;
-        self.store.trim();
-        Ok(())
+        let (patch, parked) = self.patch_of(index)?;
+        let request = self.request(&patch, parked.as_deref());
+        let compile = compiler(self.scene, &self.superset, self.dir.as_deref(), index);
+        self.core
+            .apply(&mut Linked, &request, model, compile)
+            .map_err(|e| cache_error(e, index, &patch.structure_key))
     }
 
-    fn compile(&mut self, index: u64, key: &str) -> Result<(), Errors> {
-        let xml = match &self.superset {
+    fn request<'a>(&self, patch: &'a VariantPatch, parked: Option<&'a [String]>) -> Request<'a> {
+        Request {
+            key: &patch.structure_key,
+            entries: &patch.entries,
+            parked,
+            fixed: self.fixed,
+        }
+    }
+}
+
+/// The compile of variant `index`'s structure: the superset, or the variant's XML, with
+/// relative file names resolved against `dir` (else the template's folder).
+fn compiler<'a>(
+    scene: &'a Scene,
+    superset: &'a Option<SupersetState>,
+    dir: Option<&'a std::path::Path>,
+    index: u64,
+) -> impl FnMut() -> Result<CompiledModel, Errors> + 'a {
+    move || {
+        let xml = match superset {
             Some(s) => s.xml.clone(),
-            None => self.scene.variant_xml(index)?.0,
+            None => scene.variant_xml(index)?.0,
         };
-        let dir = self
-            .dir
-            .as_deref()
-            .unwrap_or_else(|| self.scene.template().model_dir());
-        let model = compile_str(&xml, dir).map_err(|e: CompileError| {
+        let dir = dir.unwrap_or_else(|| scene.template().model_dir());
+        compile_str(&xml, dir).map_err(|e: CompileError| {
             bare(ErrorKind::Compile {
                 variant: index,
                 message: e.to_string(),
             })
-        })?;
-        self.store.insert(key, model, self.fixed).map_err(internal)
+        })
     }
 }
 
@@ -333,32 +304,4 @@ impl<'s> ModelCache<'s> {
 struct SupersetState {
     superset: Superset,
     xml: String,
-}
-
-/// Writes variant `index`'s patch (`key`, `entries`) into `model`, and for a superset
-/// `stat.meaninertia` as the variant's own model has it (`PatchPlan::variant_inertia`).
-fn patch_variant(
-    scene: &Scene,
-    superset: &Option<SupersetState>,
-    store: &mut Store,
-    (index, key, entries): (u64, &str, &[PatchEntry]),
-    model: Option<&mut CompiledModel>,
-) -> Result<(), String> {
-    let roots = match superset {
-        Some(sup) => Some(
-            scene
-                .superset_parked(&sup.superset, index)
-                .map_err(|e| e.to_string())?,
-        ),
-        None => None,
-    };
-    store.with_plan(model, key, |plan, model| {
-        plan.apply(model, entries)?;
-        match &roots {
-            Some(roots) => plan.variant_inertia(model, roots),
-            None => Ok(()),
-        }
-    })?;
-    store.patches += 1;
-    Ok(())
 }

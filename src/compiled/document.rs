@@ -7,12 +7,11 @@
 
 use std::path::Path;
 
-use super::internal;
-use super::store::Store;
+use super::store::{Core, Linked, cache_error};
 use crate::document::Document;
 use crate::error::Errors;
 use crate::mujoco::{CompiledModel, compile_document};
-use crate::split::{SplitOptions, fixed_statistics_mask, split_document_with};
+use crate::split::{Request, SplitOptions, fixed_statistics_mask, split_document_with};
 
 /// Compiled models of documents, one per structure, patched per document; bounded in
 /// count and bytes (models and their scratch data), least recently used out.
@@ -48,7 +47,7 @@ use crate::split::{SplitOptions, fixed_statistics_mask, split_document_with};
 /// # Ok::<(), mjcf_forge::Errors>(())
 /// ```
 pub struct DocumentCache {
-    store: Store,
+    core: Core,
 }
 
 impl DocumentCache {
@@ -56,7 +55,7 @@ impl DocumentCache {
     /// given, about `max_bytes` of models and scratch data.
     pub fn new(max_models: usize, max_bytes: Option<usize>) -> DocumentCache {
         DocumentCache {
-            store: Store::new(max_models, max_bytes),
+            core: Core::new(max_models, max_bytes, false),
         }
     }
 
@@ -66,19 +65,19 @@ impl DocumentCache {
     /// ([`Document::mujoco_error`]); the cache is then as it was.
     pub fn model(&mut self, doc: &Document) -> Result<&CompiledModel, Errors> {
         let split = split_document_with(doc, SplitOptions { body_models: true });
-        let key = split.structure_key.as_str();
+        let request = Request {
+            key: &split.structure_key,
+            entries: &split.entries,
+            parked: None,
+            fixed: fixed_statistics_mask(split.fixed_statistics.iter().copied()),
+        };
         // When a value does not fit the cached model (a material that does not exist),
-        // MuJoCo's own verdict follows. The cached model is whole again after its next
-        // patch, which writes every entry of the structure.
-        if self.store.touch(key) && self.store.patch_last(key, &split.entries).is_ok() {
-            self.store.trim();
-            return self.last();
-        }
-        let model = compile_document(doc).map_err(|e| Errors(vec![e]))?;
-        self.store.remove(key);
-        let fixed = fixed_statistics_mask(split.fixed_statistics.iter().copied());
-        self.store.insert(key, model, fixed).map_err(internal)?;
-        self.last()
+        // MuJoCo's own verdict follows (the core compiles). The cached model is whole again
+        // after its next patch, which writes every entry of the structure.
+        let compile = || compile_document(doc).map_err(|e| Errors(vec![e]));
+        self.core
+            .model(&mut Linked, &request, compile)
+            .map_err(|e| cache_error(e, 0, &split.structure_key))
     }
 
     /// The MJCF text `xml` as MuJoCo compiles it, relative file names resolved against
@@ -93,34 +92,28 @@ impl DocumentCache {
         self.model(&doc)
     }
 
-    fn last(&self) -> Result<&CompiledModel, Errors> {
-        self.store
-            .last()
-            .ok_or_else(|| internal("the cache holds no model".to_string()))
-    }
-
     /// Models compiled so far (misses).
     pub fn compiles(&self) -> u64 {
-        self.store.compiles
+        self.core.compiles()
     }
 
     /// Patches applied so far (hits).
     pub fn patches(&self) -> u64 {
-        self.store.patches
+        self.core.patches()
     }
 
     /// How many compiled models the cache holds.
     pub fn len(&self) -> usize {
-        self.store.len()
+        self.core.len()
     }
 
     /// Whether the cache holds none.
     pub fn is_empty(&self) -> bool {
-        self.store.len() == 0
+        self.core.is_empty()
     }
 
     /// Bytes held: the cached models and their scratch data.
     pub fn nbytes(&self) -> usize {
-        self.store.nbytes()
+        self.core.nbytes()
     }
 }

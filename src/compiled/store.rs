@@ -1,7 +1,7 @@
-//! The mechanism both model caches of the C face share: compiled models and their plans in
-//! the split tier's `ModelStore` (by structure key, least recently used out past a count
-//! and a byte bound: the rule the Python face's caches keep too), each patched by the split
-//! tier's `PatchPlan`, with each structure's signature and fixed statistics.
+//! What both model caches of the C face run: the split tier's cache core ([`CacheCore`]:
+//! models by structure key, least recently used out past a count and a byte bound; misses,
+//! patches and a caller's model checked: the rules the Python face's `ModelCache` runs
+//! too) over the linked MuJoCo, each model patched by the split tier's `PatchPlan`.
 //! [`super::ModelCache`] (a scene's variants) and [`super::DocumentCache`] (any document)
 //! sit on it.
 //!
@@ -10,14 +10,15 @@
 //! `mjModel`'s layout is needed. Models come from the FFI ([`crate::mujoco`]), which hands
 //! over the raw model, its serial number and the writable pointer through `pub(crate)` items.
 
-use std::collections::HashMap;
-
 use super::arrays::Arrays;
 use super::sys::{mjf_patch_names, mjf_patch_size, mjf_patch_size_name};
+use super::{bare, internal};
 use crate::mujoco::CompiledModel;
 use crate::split::{
-    Held, ModelStore, PatchEntry, PatchModel, PatchPlan, Signature, SignatureSource,
+    CacheBackend, CacheCore, CacheError, Held, PatchFailure, PatchModel, PatchPlan, Request,
+    Signature, SignatureSource, Statistics,
 };
+use crate::{ErrorKind, Errors};
 
 /// How to patch one model: the split tier's [`PatchPlan`] over the linked MuJoCo.
 pub(super) struct Plan(pub(super) PatchPlan<CompiledModel>);
@@ -71,137 +72,71 @@ impl SignatureSource for CompiledModel {
     }
 }
 
-/// Compiled models by structure key and plans by model serial, in the split tier's
-/// [`ModelStore`] (its bound), with what the caches know of each structure.
-pub(super) struct Store {
-    kept: ModelStore<CompiledModel, Plan>,
-    pub(super) signatures: HashMap<String, Signature>,
-    /// Per structure, the statistics its `<statistic>` fixes (bits as `keep_fixed` takes
-    /// them) and the values MuJoCo compiled.
-    stats: HashMap<String, (u32, [f64; 7])>,
-    pub(super) compiles: u64,
-    pub(super) patches: u64,
-}
+/// The linked MuJoCo as the split tier's cache core runs it ([`CacheBackend`]): compiled
+/// models by serial, their [`PatchPlan`]s, each patch's failure the structure's (a patch
+/// that does not land compiles the variant, as the core's rule says).
+pub(super) struct Linked;
 
-/// A model's serial: its id in the store.
-fn serial(m: &CompiledModel) -> u64 {
-    m.serial()
-}
+/// The cache core over the linked MuJoCo, as both caches of this face keep it.
+pub(super) type Core = CacheCore<Linked>;
 
-/// What a model holds beyond its plan's count (the plan counts the model).
-fn no_bytes(_: &CompiledModel) -> usize {
-    0
-}
+impl CacheBackend for Linked {
+    type Model = CompiledModel;
+    type Plan = Plan;
+    type Error = Errors;
 
-impl Store {
-    /// A store of at most `max_models` models (at least one) and, when given, about
-    /// `max_bytes` of models and scratch data.
-    pub(super) fn new(max_models: usize, max_bytes: Option<usize>) -> Store {
-        Store {
-            kept: ModelStore::new(max_models, max_bytes),
-            signatures: HashMap::new(),
-            stats: HashMap::new(),
-            compiles: 0,
-            patches: 0,
-        }
+    fn id(model: &CompiledModel) -> u64 {
+        model.serial()
     }
 
-    /// How many models are cached.
-    pub(super) fn len(&self) -> usize {
-        self.kept.len()
+    fn signature(&self, model: &CompiledModel) -> Option<Signature> {
+        Some(Signature::of(model))
     }
 
-    /// Whether a model of structure `key` is cached; if so it becomes the most recent.
-    pub(super) fn touch(&mut self, key: &str) -> bool {
-        self.kept.touch(key).is_some()
+    fn stat(&self, model: &CompiledModel) -> Statistics {
+        model.stat()
     }
 
-    /// Keeps `model`, just compiled for structure `key`, as the most recent model: its
-    /// signature, its statistics (`fixed`: the bits of those its `<statistic>` sets) and
-    /// its plan, whose bytes count from now on.
-    pub(super) fn insert(
+    fn plan(
         &mut self,
+        model: &CompiledModel,
         key: &str,
-        model: CompiledModel,
         fixed: u32,
-    ) -> Result<(), String> {
-        self.compiles += 1;
-        let stat = model.stat();
-        self.stats.insert(key.to_string(), (fixed, stat));
-        self.signatures
-            .insert(key.to_string(), Signature::of(&model));
-        let plan = PatchPlan::new(&model, key, fixed, stat)?;
-        self.kept.add_plan(model.serial(), Plan(plan));
-        self.kept.insert(key, model);
-        self.trim();
-        Ok(())
+        values: Statistics,
+    ) -> Result<Plan, Errors> {
+        PatchPlan::new(model, key, fixed, values)
+            .map(Plan)
+            .map_err(internal)
     }
 
-    /// Drops the model of structure `key`, if cached, with its plan.
-    pub(super) fn remove(&mut self, key: &str) {
-        self.kept.remove(key, serial);
-    }
-
-    /// The most recent model.
-    pub(super) fn last(&self) -> Option<&CompiledModel> {
-        self.kept.last()
-    }
-
-    /// The structure key of the plan of `model`, if it has one.
-    pub(super) fn plan_key(&self, model: &CompiledModel) -> Option<&str> {
-        self.kept
-            .peek_plan(model.serial())
-            .map(|p| p.0.key.as_str())
-    }
-
-    /// Calls `f` with the plan of `model` (of structure `key`; `None`: the most recent
-    /// cached model) and the model, the plan made on first sight; the plan becomes the
-    /// most recent.
-    pub(super) fn with_plan<R>(
+    fn patch(
         &mut self,
-        outside: Option<&mut CompiledModel>,
-        key: &str,
-        f: impl FnOnce(&mut PatchPlan<CompiledModel>, &mut CompiledModel) -> Result<R, String>,
-    ) -> Result<R, String> {
-        let id = match &outside {
-            Some(m) => m.serial(),
-            None => self.kept.last().map(serial).ok_or("no model to patch")?,
-        };
-        if self.kept.peek_plan(id).is_none() {
-            let (fixed, stat) = self.stats.get(key).copied().unwrap_or_default();
-            let model = match &outside {
-                Some(m) => &**m,
-                None => self.kept.last().ok_or("no model to patch")?,
-            };
-            let plan = PatchPlan::new(model, key, fixed, stat)?;
-            self.kept.add_plan(id, Plan(plan));
-        }
-        match outside {
-            Some(model) => {
-                let plan = self.kept.plan(id).ok_or("the plan is gone")?;
-                f(&mut plan.0, model)
-            }
-            None => {
-                let (model, plan) = self.kept.last_and_plan(id).ok_or("the plan is gone")?;
-                f(&mut plan.0, model)
-            }
-        }
+        plan: &mut Plan,
+        model: &mut CompiledModel,
+        request: &Request<'_>,
+        _patches: u64,
+    ) -> Result<(), PatchFailure<Errors>> {
+        let r = plan
+            .0
+            .apply(model, request.entries)
+            .and_then(|()| match request.parked {
+                Some(parked) => plan.0.variant_inertia(model, parked),
+                None => Ok(()),
+            });
+        r.map_err(PatchFailure::NotThisStructure)
     }
+}
 
-    /// Patches the most recent model (of structure `key`) with `entries`.
-    pub(super) fn patch_last(&mut self, key: &str, entries: &[PatchEntry]) -> Result<(), String> {
-        self.with_plan(None, key, |plan, model| plan.apply(model, entries))?;
-        self.patches += 1;
-        Ok(())
-    }
-
-    /// Drops the least recently used models beyond the bounds.
-    pub(super) fn trim(&mut self) {
-        self.kept.trim(serial, no_bytes);
-    }
-
-    /// Bytes held: the cached models and every plan's scratch data.
-    pub(super) fn nbytes(&self) -> usize {
-        self.kept.nbytes(no_bytes)
+/// The core's error as this face's: an [`ErrorKind::OtherStructure`] names the variant
+/// (`variant`, `key`); the others are the backend's or the plan's words.
+pub(super) fn cache_error(e: CacheError<Errors>, variant: u64, key: &str) -> Errors {
+    match e {
+        CacheError::Backend(e) => e,
+        CacheError::OtherStructure { found } => bare(ErrorKind::OtherStructure {
+            variant,
+            key: key.to_string(),
+            found,
+        }),
+        CacheError::NotThisStructure(m) => internal(m),
     }
 }

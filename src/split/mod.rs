@@ -30,7 +30,8 @@
 //! `landing.rs` (where each patch entry lands in a compiled model and how its numbers are
 //! written, for both faces), `plan.rs` (one model patched in place: the patch plan both
 //! faces' caches run, over their own MuJoCo), `store.rs` (the models and plans a cache
-//! keeps, and the bound on them), `signature.rs` (what tells one structure's compiled model
+//! keeps, and the bound on them), `cache.rs` (the model cache both faces run over their
+//! MuJoCo: misses, patches, a caller's model checked), `signature.rs` (what tells one structure's compiled model
 //! from another's), `document.rs` (any document split by reading it), `body_model.rs` (a body's geoms as a
 //! model of their own, for what MuJoCo derives from their sizes), `body_copy.rs` (that
 //! model's compile copied into a structure's model, for both faces), `geom_masses.rs` (a
@@ -40,11 +41,12 @@
 //! compiler's statistics at `qpos0`, computed over a model's arrays for both faces). The scene tier reads its
 //! drawn variants through the same rules (`scene/patch.rs`).
 //!
-//! May use: the document tier and `crate::error`. Knows nothing of scenes, MuJoCo or the
-//! caches that use it.
+//! May use: the document tier and `crate::error`. Knows nothing of scenes or of MuJoCo
+//! itself: the faces' caches bring theirs (`CacheBackend`, `PatchModel`).
 
 mod body_copy;
 mod body_model;
+mod cache;
 mod document;
 mod geom_masses;
 mod landing;
@@ -59,6 +61,7 @@ mod volumes;
 pub use body_copy::{
     MasslessFrame, ModelArrays, ModelArraysMut, body_model_writes, copy_body_model, massless_frames,
 };
+pub use cache::{CacheBackend, CacheCore, CacheError, PatchFailure, Request};
 pub use document::{
     DocumentPatch, PATCHABLE_OPTIONS, SplitOptions, split_document, split_document_with,
 };
