@@ -14,22 +14,19 @@ from __future__ import annotations
 
 import copy
 import os
+import weakref
 from typing import Any
 
 import numpy as np
 
-from ._errors import error
-from ._last_xml import compile_xml
 from ._mjcf_forge import (
     LAYOUTS_KEPT,
     MODEL_FIELDS,
     STATIC_PREFIXES,
     STATISTIC_NAMES,
-    MjcfError,
-    ModelStore,
+    CacheCore,
     PatchPlan,
     Scene,
-    structure_signature,
 )
 from ._progress import progress_of
 from ._trees import TreeDerivation
@@ -37,13 +34,6 @@ from ._trees import TreeDerivation
 
 def copy_value(value: Any) -> Any:
     return value.copy() if hasattr(value, "copy") else value
-
-
-class _Variant:
-    """What a superset ModelCache reads of a variant: its index."""
-
-    def __init__(self, index: int) -> None:
-        self.index = index
 
 
 def _bodies_from_geoms(model: Any) -> None:
@@ -108,99 +98,63 @@ class ModelCache:
             raise ValueError("max_models must be at least 1")
         self._mujoco = mujoco
         self._scene = scene
-        self._fixed = list(scene.fixed_statistics)
         #: The scene's :class:`Superset` when every variant is a patch of it, else None.
         self.superset = scene.superset() if superset else None
         # Superset: body ids by name (one structure).
         self._body_ids: dict[str, int] = {}
         #: Superset patches whose derived values came tree by tree (not mj_setConst).
         self.by_tree = 0
-        # Cached models by structure key and how to patch each model seen (cached ones
-        # and the caller's), least recently used first: the split tier's bound
-        # (ModelStore), the Rust caches' too.
-        self._store = ModelStore(max_models, max_bytes)
-        # Signatures of structures seen, kept after their models are evicted, and the
-        # <statistic> values each fixes.
-        self._signatures: dict[str, bytes] = {}
-        self._fixed_values: dict[str, list] = {}
-        #: Models compiled (misses) and patches applied so far.
-        self.compiles = 0
-        self.patches = 0
+        # The rules (misses, patches, a caller's model checked, the bound) are the split
+        # tier's cache core, the C face's too; this class is its face. The derivation it
+        # calls back holds the cache weakly (no cycle through the core).
+        ref = weakref.ref(self)
+
+        def derive(plan: PatchPlan, parked: list, patches: int) -> Any:
+            cache = ref()
+            return None if cache is None else cache._tree_derive(plan, parked, patches)
+
+        self._core = CacheCore(
+            mujoco, max_models, max_bytes, list(scene.fixed_statistics), self.superset,
+            derive if superset else None,
+        )
 
     def __len__(self) -> int:
-        return len(self._store)
+        return len(self._core)
 
     @property
     def nbytes(self) -> int:
         """Bytes held: every cached model, and every model's scratch ``MjData``."""
-        return self._store.nbytes
+        return self._core.nbytes
 
-    def _plan(self, model: Any, key: str) -> PatchPlan:
-        plan = PatchPlan(self._mujoco, model, key, self._fixed_values[key])
-        self._store.add_plan(model, plan)
-        self._store.trim()
-        return plan
+    @property
+    def compiles(self) -> int:
+        """Models compiled (misses) so far."""
+        return self._core.compiles
 
-    def _variant_inertia(self, plan: PatchPlan, variant: Any, parked: Any = None) -> None:
-        """Superset: ``stat.meaninertia`` (which scales the constraint solver's tolerance)
-        as the variant's own model has it (``PatchPlan.variant_inertia``: parked objects,
-        their root bodies' names, left out)."""
-        roots = self.superset.parked(variant.index) if parked is None else parked
-        plan.variant_inertia(list(roots))
-
-    def _key_and_patch(self, variant: Any) -> tuple[str, Any]:
-        if self.superset is not None:
-            return self.superset.structure_key, self.superset.patch(variant.index)
-        return variant.structure_key, variant.patch
-
-    def _compile(self, variant: Any) -> Any:
-        """Compiles the variant's structure (the superset, or the variant itself) and keeps
-        it; the model returned is already the variant's."""
-        xml = self.superset.xml if self.superset is not None else variant.xml
-        model = compile_xml(self._mujoco, xml)
-        self.compiles += 1
-        key = self.superset.structure_key if self.superset is not None else variant.structure_key
-        self._signatures[key] = structure_signature(model)
-        self._fixed_values[key] = [(s, copy_value(getattr(model.stat, s))) for s in self._fixed]
-        self._store.insert(key, model)
-        plan = self._plan(model, key)
-        if self.superset is not None:
-            # The superset as compiled parks every object: the variant's patch places its own.
-            plan.apply(self.superset.patch(variant.index))
-            self._variant_inertia(plan, variant)
-            self.patches += 1
-        return model
+    @property
+    def patches(self) -> int:
+        """Patches applied so far."""
+        return self._core.patches
 
     def model(self, variant: Any) -> Any:
         """A compiled model equal to MuJoCo's compile of ``variant.xml`` (see the class);
         with ``superset=True``, the superset model patched for the variant."""
-        key, patch = self._key_and_patch(variant)
-        model = self._store.get(key)
-        if model is None:
-            return self._compile(variant)
-        plan = self._store.plan(model) or self._plan(model, key)
-        parked = self.superset.parked(variant.index) if self.superset is not None else None
-        try:
-            plan.apply(patch, self._tree_derive(plan, parked))
-        except MjcfError:
-            if self.superset is not None:
-                raise
-            # A body's geoms that compile to another layout (sizes that turn its principal
-            # axes): not a patch of this structure, so the variant is compiled (and kept).
-            return self._compile(variant)
-        if self.superset is not None:
-            self._variant_inertia(plan, variant, parked)
-        self.patches += 1
-        return model
+        return self._core.model(variant)
+
+    def apply(self, variant: Any, model: Any) -> Any:
+        """Patches ``model`` (of ``variant``'s structure) in place into ``variant``'s
+        compiled model; returns it. Raises :class:`MjcfError` when its structure differs."""
+        return self._core.apply(variant, model)
 
     # Superset: derive what mj_setConst does tree by tree (see _trees; the same bits)
     # where a patch allows. False: always the whole mj_setConst (the tests compare both).
     _by_tree = True
 
-    def _tree_derive(self, plan: PatchPlan, parked: Any) -> Any:
-        """Superset: ``derive(model, data, layout)`` for ``PatchPlan.apply``, deriving
+    def _tree_derive(self, plan: PatchPlan, parked: Any, patches: int) -> Any:
+        """Superset: ``derive(model, data, layout)`` for ``PatchPlan.finish``, deriving
         tree by tree (:class:`TreeDerivation`, per plan and patch layout) what
-        ``mj_setConst`` would, or None (``mj_setConst``): no superset, or turned off."""
+        ``mj_setConst`` would, or None (``mj_setConst``): no superset, or turned off.
+        ``patches``: the cache's count of patches before this one."""
         if self.superset is None or not self._by_tree or parked is None:
             return None
         derivations = plan.derivations
@@ -222,11 +176,11 @@ class ModelCache:
             if derivation is None or compensated != bool(model.ngravcomp):
                 self._mujoco.mj_setConst(model, data)
                 return False
-            if plan.derived_at != self.patches:
+            if plan.derived_at != patches:
                 derivation.forget()  # patched another way since this plan's last derivation
             self.by_tree += 1
-            # The caller counts this patch next (self.patches + 1): nothing between.
-            plan.derived_at = self.patches + 1
+            # The caller counts this patch next (patches + 1): nothing between.
+            plan.derived_at = patches + 1
             fresh = derivation(model, data, roots)
             _bodies_from_geoms(model)
             return fresh
@@ -245,44 +199,12 @@ class ModelCache:
             out.append(i)
         return out
 
-    def apply(self, variant: Any, model: Any) -> Any:
-        """Patches ``model`` (of ``variant``'s structure) in place into ``variant``'s
-        compiled model; returns it. Raises :class:`MjcfError` when its structure differs."""
-        key, patch = self._key_and_patch(variant)
-        plan = self._store.plan(model)
-        if plan is None:
-            if key not in self._signatures:
-                # The structure's first sight: its compile (kept) says what it is.
-                self._compile(variant)
-            if structure_signature(model) != self._signatures[key]:
-                raise error(
-                    f"the model does not have the structure of variant {variant.index} "
-                    f"(key {key}): its sizes, names or element types differ"
-                )
-            plan = self._plan(model, key)
-        elif plan.key != key:
-            raise error(
-                f"the model has structure {plan.key}, variant {variant.index} has {key}: "
-                "a patch cannot change a structure (cache.model(variant) compiles it)"
-            )
-        parked = self.superset.parked(variant.index) if self.superset is not None else None
-        plan.apply(patch, self._tree_derive(plan, parked))
-        if self.superset is not None:
-            self._variant_inertia(plan, variant, parked)
-        self.patches += 1
-        return model
-
     def _apply_world(self, model: Any, world: tuple, patch0: list) -> Any:
         """Superset: ``model`` patched for one world as :meth:`Superset.worlds` gives it
         (``world``: its index, numbers, strings and parked roots; ``patch0``: a patch of its
         layout, resolved once), as :meth:`apply` patches it."""
-        index, numbers, strings, parked = world
-        key = self.superset.structure_key
-        plan = self._store.plan(model)
-        if plan is None:
-            if key not in self._signatures:
-                self._compile(_Variant(index))
-            plan = self._plan(model, key)
+        _index, numbers, strings, parked = world
+        plan = self._core.plan_for(model)
         if plan.source is not patch0:
             plan.resolve(patch0)
             plan.source = patch0
@@ -295,9 +217,9 @@ class ModelCache:
         else:
             materials, bodies = [], []
         plan.write(values, materials, bodies)
-        plan.finish(self._tree_derive(plan, parked))
-        self._variant_inertia(plan, None, parked)
-        self.patches += 1
+        plan.finish(self._tree_derive(plan, parked, self._core.patches))
+        plan.variant_inertia(list(parked))
+        self._core.count_patch()
         return model
 
     def batch(self, variants: Any, progress: Any = None) -> dict[str, np.ndarray]:
@@ -372,7 +294,7 @@ def apply_world(cache: ModelCache, model: Any, world: tuple, patch0: list) -> An
 
 def plan_of(cache: ModelCache, model: Any) -> PatchPlan:
     """The patch plan ``cache`` keeps for ``model`` (one it patched)."""
-    plan = cache._store.plan(model)
+    plan = cache._core.plan(model)
     if plan is None:
         raise KeyError("the cache keeps no plan of this model")
     return plan

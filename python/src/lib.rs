@@ -10,13 +10,15 @@
 //! `MjModel` arrays in place), `scene/` (the batch tier: scenes, variants, the stream, the
 //! superset); `errors.rs` is the edge where Rust errors and panics become `MjcfError`;
 //! `upcalls.rs` the one way up into the package's Python code; `testing.rs` the tests' and
-//! benches' entry points, in a submodule of their own. The compiled tier's face,
-//! `ModelCache`, is Python (`mjcf_forge/_cache.py`), over the user's own `mujoco` package.
+//! benches' entry points, in a submodule of their own. `cache.rs` is the compiled tier's
+//! face: the split tier's model cache over the user's own `mujoco` package
+//! (`mjcf_forge/_cache.py`'s `ModelCache` is its Python face).
 //!
 //! No `unsafe` but in `split/`, which reads and writes NumPy arrays of the user's MuJoCo
 //! in place (`split/arrays.rs`).
 #![deny(unsafe_code)]
 
+mod cache;
 mod document;
 mod errors;
 mod model;
@@ -55,6 +57,7 @@ fn _mjcf_forge(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::PyVariantIter>()?;
     m.add_class::<scene::PySuperset>()?;
     split::add(m)?;
+    m.add_class::<cache::PyCacheCore>()?;
     testing::add(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

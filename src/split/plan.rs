@@ -309,9 +309,25 @@ impl<M: PatchModel> PatchPlan<M> {
     /// Writes `patch` (of any layout: resolved again where it differs from the last) and
     /// what follows from it ([`PatchPlan::finish`], with `mj_setConst`).
     pub fn apply(&mut self, model: &mut M, patch: &[PatchEntry]) -> Result<(), String> {
-        let same = self.resolved
+        self.apply_with(model, patch, None)
+    }
+
+    /// Whether `patch` is of the layout last resolved (its next write lands as resolved).
+    pub fn is_layout_of(&self, patch: &[PatchEntry]) -> bool {
+        self.resolved
             && self.layout.len() == patch.len()
-            && self.layout.iter().zip(patch).all(|(l, e)| l.is_of(e));
+            && self.layout.iter().zip(patch).all(|(l, e)| l.is_of(e))
+    }
+
+    /// [`PatchPlan::apply`] with [`PatchPlan::finish`]'s `derive` in place of `mj_setConst`.
+    #[allow(clippy::type_complexity)]
+    pub fn apply_with(
+        &mut self,
+        model: &mut M,
+        patch: &[PatchEntry],
+        derive: Option<&mut dyn FnMut(&mut M, &mut M::Data) -> Result<bool, String>>,
+    ) -> Result<(), String> {
+        let same = self.is_layout_of(patch);
         let mut numbers = Vec::new();
         let (mut materials, mut bodies) = (Vec::new(), Vec::new());
         for e in patch {
@@ -331,7 +347,7 @@ impl<M: PatchModel> PatchPlan<M> {
             bodies: &bodies,
         };
         self.write(model, values)?;
-        self.finish(model, None)
+        self.finish(model, derive)
     }
 
     /// Records the body texts of the patch the layout was resolved with (a body model

@@ -148,6 +148,20 @@ impl PyVariant {
         Ok(self.patch.get_or_init(|| p))
     }
 
+    /// The structure key and patch (made on first call with the GIL released).
+    pub(crate) fn drawn(&self, py: Python<'_>) -> PyResult<&VariantPatch> {
+        if let Some(p) = self.patch.get() {
+            return Ok(p);
+        }
+        run(py, || self.drawn_patch().map(drop))?;
+        self.drawn_patch().map_err(PyErr::from)
+    }
+
+    /// The variant as compact MJCF text.
+    pub(crate) fn text(&self) -> &str {
+        &self.xml
+    }
+
     /// The document, built on first call (GIL released by the caller).
     fn doc(&self) -> Result<&Document, Failure> {
         if let Some(doc) = self.document.get() {
@@ -174,7 +188,7 @@ impl PyVariant {
 impl PyVariant {
     /// The variant's index.
     #[getter]
-    fn index(&self) -> u64 {
+    pub(crate) fn index(&self) -> u64 {
         self.index
     }
 

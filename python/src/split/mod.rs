@@ -21,6 +21,9 @@ mod tables;
 
 use pyo3::prelude::*;
 
+pub(crate) use plan::PyPatchPlan;
+pub(crate) use signature::signature_of;
+
 /// Adds the tier's tables, functions and classes to the module.
 pub(crate) fn add(m: &Bound<'_, PyModule>) -> PyResult<()> {
     tables::add(m)?;

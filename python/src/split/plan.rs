@@ -20,8 +20,8 @@ use super::statistics::PyStatistics;
 use crate::errors::mjcf_error;
 use crate::upcalls;
 use mjcf_forge::split::{
-    self, ArrayMut, Carried, LayoutEntry, PatchModel, PatchValues, STATISTIC_NAMES, StatArrays,
-    Statistics,
+    self, ArrayMut, Carried, LayoutEntry, PatchEntry, PatchFailure, PatchModel, PatchValues,
+    STATISTIC_NAMES, StatArrays, Statistics,
 };
 
 /// A user's model as the patch plan writes it: the model, its `mujoco`, the arrays a body
@@ -440,8 +440,128 @@ fn hold<T>(lock: &Mutex<T>) -> PyResult<MutexGuard<'_, T>> {
 
 impl PyPatchPlan {
     /// Bytes held: the model and the scratch data.
-    pub(super) fn nbytes(&self) -> usize {
+    pub(crate) fn nbytes(&self) -> usize {
         self.nbytes
+    }
+
+    /// The model this plan patches.
+    pub(crate) fn model(&self) -> &Py<PyAny> {
+        &self.model
+    }
+
+    /// The plan of `model` (of structure `key`); `fixed` the statistics the document
+    /// fixes (bits), at `values`.
+    pub(crate) fn create(
+        py: Python<'_>,
+        mujoco: Bound<'_, PyAny>,
+        model: Bound<'_, PyAny>,
+        key: String,
+        fixed: u32,
+        values: Statistics,
+    ) -> PyResult<Self> {
+        let stat = model.getattr("stat")?;
+        let user = UserModel {
+            arrays: PyModelArrays::new(&model)?,
+            center: Array::of(&stat.getattr("center")?, "stat.center", true)?,
+            opt: model.getattr("opt")?.unbind(),
+            stat: stat.unbind(),
+            mujoco: mujoco.unbind(),
+            model: model.clone().unbind(),
+            pending: None,
+        };
+        let plan =
+            split::PatchPlan::new(&user, &key, fixed, values).map_err(PyValueError::new_err)?;
+        let data = plan.data.data.clone_ref(py);
+        Ok(PyPatchPlan {
+            nbytes: plan.nbytes(),
+            core: Mutex::new(Core { user, plan }),
+            fields: Mutex::new(None),
+            model: model.unbind(),
+            key,
+            data,
+            derivations: PyDict::new(py).unbind(),
+            derived_at: AtomicI64::new(-1),
+            source: Mutex::new(py.None()),
+            string_geoms: Mutex::new(PyList::empty(py).into_any().unbind()),
+        })
+    }
+
+    /// Writes `entries` (a patch of any layout: resolved again where it is not the last
+    /// one's) and what follows (`derive`, as `finish` takes it), then for a superset
+    /// (`parked`) the variant's `stat.meaninertia`: the cache core's patch.
+    pub(crate) fn patch(
+        &self,
+        py: Python<'_>,
+        entries: &[PatchEntry],
+        derive: Option<Bound<'_, PyAny>>,
+        parked: Option<&[String]>,
+    ) -> Result<(), PatchFailure<PyErr>> {
+        let mut core = hold(&self.core).map_err(PatchFailure::Backend)?;
+        if !core.plan.is_layout_of(entries) {
+            self.new_fields(py, entries)
+                .map_err(PatchFailure::Backend)?;
+        }
+        let r = match derive.filter(|d| !d.is_none()) {
+            None => {
+                let Core { user, plan } = &mut *core;
+                plan.apply_with(user, entries, None)
+            }
+            Some(derive) => match self.derive_call(py, derive) {
+                Ok(mut call) => {
+                    let Core { user, plan } = &mut *core;
+                    plan.apply_with(user, entries, Some(&mut call))
+                }
+                Err(e) => return Err(PatchFailure::Backend(e)),
+            },
+        };
+        let r = r.and_then(|()| match parked {
+            Some(parked) => {
+                let Core { user, plan } = &mut *core;
+                plan.variant_inertia(user, parked)
+            }
+            None => Ok(()),
+        });
+        r.map_err(|e| match core.user.pending.take() {
+            Some(raised) => PatchFailure::Backend(raised),
+            None => PatchFailure::NotThisStructure(e),
+        })
+    }
+
+    /// `entries`' layout as ``(object, name or id, field)`` tuples: the fields a
+    /// derivation reads (a new list object per layout).
+    fn new_fields(&self, py: Python<'_>, entries: &[PatchEntry]) -> PyResult<()> {
+        let fields = PyList::empty(py);
+        for e in entries {
+            let name = match e.id {
+                Some(id) => id.into_pyobject(py)?.into_any(),
+                None => PyString::new(py, &e.name).into_any(),
+            };
+            fields.append((e.object, name, e.field))?;
+        }
+        *hold(&self.fields)? = Some(fields.unbind());
+        *hold(&self.source)? = py.None();
+        Ok(())
+    }
+
+    /// `derive(model, data, fields)` as the split tier's plan calls a derivation (its
+    /// Python error kept, raised in place of the plan's).
+    fn derive_call<'py>(
+        &self,
+        py: Python<'py>,
+        derive: Bound<'py, PyAny>,
+    ) -> PyResult<impl FnMut(&mut UserModel, &mut UserData) -> Result<bool, String> + 'py> {
+        let fields = hold(&self.fields)?
+            .as_ref()
+            .map_or_else(|| py.None(), |f| f.clone_ref(py).into_any());
+        let data = self.data.clone_ref(py);
+        Ok(
+            move |m: &mut UserModel, _d: &mut UserData| -> Result<bool, String> {
+                let r = derive
+                    .call1((m.model.bind(py), data.bind(py), fields.bind(py)))
+                    .and_then(|v| v.is_truthy());
+                m.keep(r)
+            },
+        )
     }
 
     fn resolve_read(
@@ -477,20 +597,11 @@ impl PyPatchPlan {
         core: &mut Core,
         derive: Option<Bound<'_, PyAny>>,
     ) -> PyResult<()> {
-        let Core { user, plan } = core;
         let r = match derive.filter(|d| !d.is_none()) {
-            None => plan.finish(user, None),
+            None => core.plan.finish(&mut core.user, None),
             Some(derive) => {
-                let fields = hold(&self.fields)?
-                    .as_ref()
-                    .map_or_else(|| py.None(), |f| f.clone_ref(py).into_any());
-                let data = self.data.clone_ref(py);
-                let mut call = |m: &mut UserModel, _d: &mut UserData| -> Result<bool, String> {
-                    let r = derive
-                        .call1((m.model.bind(py), data.bind(py), fields.bind(py)))
-                        .and_then(|v| v.is_truthy());
-                    m.keep(r)
-                };
+                let mut call = self.derive_call(py, derive)?;
+                let Core { user, plan } = core;
                 plan.finish(user, Some(&mut call))
             }
         };
@@ -508,16 +619,6 @@ impl PyPatchPlan {
         key: String,
         fixed: Vec<(String, Bound<'_, PyAny>)>,
     ) -> PyResult<Self> {
-        let stat = model.getattr("stat")?;
-        let user = UserModel {
-            arrays: PyModelArrays::new(&model)?,
-            center: Array::of(&stat.getattr("center")?, "stat.center", true)?,
-            opt: model.getattr("opt")?.unbind(),
-            stat: stat.unbind(),
-            mujoco: mujoco.unbind(),
-            model: model.clone().unbind(),
-            pending: None,
-        };
         let mut values = [0.0; 7];
         for (name, value) in &fixed {
             match STATISTIC_NAMES.iter().position(|s| s == name) {
@@ -533,21 +634,7 @@ impl PyPatchPlan {
             }
         }
         let mask = split::fixed_statistics_mask(fixed.iter().map(|(n, _)| n.as_str()));
-        let plan =
-            split::PatchPlan::new(&user, &key, mask, values).map_err(PyValueError::new_err)?;
-        let data = plan.data.data.clone_ref(py);
-        Ok(PyPatchPlan {
-            nbytes: plan.nbytes(),
-            core: Mutex::new(Core { user, plan }),
-            fields: Mutex::new(None),
-            model: model.unbind(),
-            key,
-            data,
-            derivations: PyDict::new(py).unbind(),
-            derived_at: AtomicI64::new(-1),
-            source: Mutex::new(py.None()),
-            string_geoms: Mutex::new(PyList::empty(py).into_any().unbind()),
-        })
+        PyPatchPlan::create(py, mujoco, model, key, mask, values)
     }
 
     /// The layout last resolved, as ``(object, name, field)`` tuples: one list object per

@@ -73,5 +73,10 @@ impl SignatureSource for UserModel<'_, '_> {
 /// True
 #[pyfunction]
 pub(super) fn structure_signature<'py>(model: &Bound<'py, PyAny>) -> Bound<'py, PyBytes> {
-    PyBytes::new(model.py(), &Signature::of(&UserModel(model)).to_bytes())
+    PyBytes::new(model.py(), &signature_of(model).to_bytes())
+}
+
+/// The signature of the user's `model`.
+pub(crate) fn signature_of(model: &Bound<'_, PyAny>) -> Signature {
+    Signature::of(&UserModel(model))
 }

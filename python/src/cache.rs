@@ -1,0 +1,390 @@
+//! `CacheCore`: the split tier's model cache ([`mjcf_forge::split::CacheCore`], the rules
+//! the C face's `ModelCache` runs too) over the user's `mujoco`: its `MjModel`s kept,
+//! each patched by its `PatchPlan` (`split/plan.rs`), compiled by the package's
+//! `compile_xml` (through `upcalls.rs`). The package's `ModelCache` is its face: a
+//! variant's path through `ModelCache.model` crosses into Rust once, and back up only for
+//! a compile or a superset's tree-by-tree derivation.
+
+use std::borrow::Cow;
+use std::sync::{Mutex, MutexGuard, TryLockError};
+
+use pyo3::exceptions::PyRuntimeError;
+use pyo3::prelude::*;
+use pyo3::types::PyList;
+
+use crate::document::patch::patch_entry;
+use crate::errors::mjcf_error;
+use crate::scene::{PySuperset, PyVariant};
+use crate::split::{PyPatchPlan, signature_of};
+use crate::upcalls;
+use mjcf_forge::ErrorKind;
+use mjcf_forge::split::{
+    self, CacheBackend, CacheError, Held, PatchEntry, PatchFailure, Request, STATISTIC_NAMES,
+    Signature, Statistics,
+};
+
+/// The user's `mujoco` as the cache core runs it, and the caller's derivation: `derive(plan,
+/// parked, patches)` gives what `PatchPlan.finish` takes in place of `mj_setConst` (or
+/// `None`) for a superset's patch.
+struct UserBackend {
+    mujoco: Py<PyAny>,
+    derive: Option<Py<PyAny>>,
+}
+
+/// A model's plan, kept by the core (the plan holds its model, so its id stays its own).
+struct Kept(Py<PyPatchPlan>);
+
+impl Held for Kept {
+    fn nbytes(&self) -> usize {
+        self.0.get().nbytes()
+    }
+}
+
+impl CacheBackend for UserBackend {
+    type Model = Py<PyAny>;
+    type Plan = Kept;
+    type Error = PyErr;
+
+    fn id(model: &Py<PyAny>) -> u64 {
+        model.as_ptr() as usize as u64
+    }
+
+    fn signature(&self, model: &Py<PyAny>) -> Option<Signature> {
+        Some(Python::attach(|py| signature_of(model.bind(py))))
+    }
+
+    fn stat(&self, model: &Py<PyAny>) -> Statistics {
+        let mut out = [0.0; 7];
+        Python::attach(|py| {
+            let Ok(stat) = model.bind(py).getattr("stat") else {
+                return;
+            };
+            for (k, name) in STATISTIC_NAMES[..4].iter().enumerate() {
+                out[k] = stat.getattr(*name).and_then(|v| v.extract()).unwrap_or(0.0);
+            }
+            let center: Vec<f64> = stat
+                .getattr("center")
+                .and_then(|c| c.extract())
+                .unwrap_or_default();
+            if center.len() == 3 {
+                out[4..].copy_from_slice(&center);
+            }
+        });
+        out
+    }
+
+    fn plan(
+        &mut self,
+        model: &Py<PyAny>,
+        key: &str,
+        fixed: u32,
+        values: Statistics,
+    ) -> PyResult<Kept> {
+        Python::attach(|py| {
+            let plan = PyPatchPlan::create(
+                py,
+                self.mujoco.bind(py).clone(),
+                model.bind(py).clone(),
+                key.to_string(),
+                fixed,
+                values,
+            )?;
+            Ok(Kept(Py::new(py, plan)?))
+        })
+    }
+
+    fn patch(
+        &mut self,
+        plan: &mut Kept,
+        _model: &mut Py<PyAny>,
+        request: &Request<'_>,
+        patches: u64,
+    ) -> Result<(), PatchFailure<PyErr>> {
+        Python::attach(|py| {
+            let derive = match (&self.derive, request.parked) {
+                (Some(derive), Some(parked)) => Some(
+                    derive
+                        .bind(py)
+                        .call1((plan.0.bind(py), parked.to_vec(), patches))
+                        .map_err(PatchFailure::Backend)?,
+                ),
+                _ => None,
+            };
+            plan.0
+                .get()
+                .patch(py, request.entries, derive, request.parked)
+        })
+    }
+}
+
+/// The core and its backend, one call at a time.
+struct Inner {
+    core: split::CacheCore<UserBackend>,
+    backend: UserBackend,
+}
+
+/// The model cache's rules over the user's ``mujoco`` (``mjcf_forge::split::CacheCore``):
+/// one compiled ``MjModel`` per structure, patched per variant by its ``PatchPlan``,
+/// bounded (``max_models``, ``max_bytes``), least recently used out. ``fixed``: the
+/// statistics the scene's ``<statistic>`` fixes; ``superset``: every variant a patch of
+/// it; ``derive(plan, parked, patches)``: a superset patch's derivation in place of
+/// ``mj_setConst`` (or ``None``). The package's :class:`mjcf_forge.ModelCache` is its face.
+///
+/// >>> import mujoco, mjcf_forge
+/// >>> from mjcf_forge._mjcf_forge import CacheCore
+/// >>> scene = mjcf_forge.Scene.demo()
+/// >>> core = CacheCore(mujoco, 2, None, list(scene.fixed_statistics))
+/// >>> model = core.model(scene.variant(0))
+/// >>> core.model(scene.variant(0)) is model, core.compiles, core.patches
+/// (True, 1, 1)
+#[pyclass(name = "CacheCore", module = "mjcf_forge._mjcf_forge", frozen)]
+pub(crate) struct PyCacheCore {
+    inner: Mutex<Inner>,
+    superset: Option<Py<PySuperset>>,
+    fixed: u32,
+}
+
+impl PyCacheCore {
+    fn inner(&self) -> PyResult<MutexGuard<'_, Inner>> {
+        match self.inner.try_lock() {
+            Ok(guard) => Ok(guard),
+            Err(TryLockError::Poisoned(p)) => Ok(p.into_inner()),
+            Err(TryLockError::WouldBlock) => Err(PyRuntimeError::new_err(
+                "this model cache is in use by another call",
+            )),
+        }
+    }
+
+    /// What `variant` asks: its index, patch and (superset) parked roots, and the XML of
+    /// its structure's compile.
+    fn asked<'a>(&'a self, py: Python<'_>, variant: &'a Bound<'_, PyAny>) -> PyResult<Asked<'a>> {
+        if let Some(sup) = &self.superset {
+            let sup = sup.get();
+            let index: u64 = variant.getattr("index")?.extract()?;
+            let (patch, parked) = py
+                .detach(|| {
+                    let patch = sup.scene.superset_patch(&sup.superset, index)?;
+                    let parked = sup.scene.superset_parked(&sup.superset, index)?;
+                    Ok::<_, mjcf_forge::Errors>((patch, parked))
+                })
+                .map_err(|e| mjcf_error(e.0.iter().map(ToString::to_string).collect()))?;
+            return Ok(Asked {
+                index,
+                key: Cow::Owned(patch.structure_key),
+                entries: Cow::Owned(patch.entries),
+                parked: Some(parked),
+                xml: Cow::Borrowed(&sup.xml),
+            });
+        }
+        if let Ok(v) = variant.cast::<PyVariant>() {
+            let v = v.get();
+            let patch = v.drawn(py)?;
+            return Ok(Asked {
+                index: v.index(),
+                key: Cow::Borrowed(&patch.structure_key),
+                entries: Cow::Borrowed(&patch.entries),
+                parked: None,
+                xml: Cow::Borrowed(v.text()),
+            });
+        }
+        // Code that stands for a variant: its key, patch tuples and XML.
+        let mut entries = Vec::new();
+        for e in variant.getattr("patch")?.try_iter()? {
+            let (object, name, field, value): (String, Bound<'_, PyAny>, String, Bound<'_, PyAny>) =
+                e?.extract()?;
+            entries.push(patch_entry(object, &name, field, &value)?);
+        }
+        Ok(Asked {
+            index: variant.getattr("index")?.extract()?,
+            key: Cow::Owned(variant.getattr("structure_key")?.extract()?),
+            entries: Cow::Owned(entries),
+            parked: None,
+            xml: Cow::Owned(variant.getattr("xml")?.extract()?),
+        })
+    }
+}
+
+/// What a variant asks of the cache (see `PyCacheCore::asked`).
+struct Asked<'a> {
+    index: u64,
+    key: Cow<'a, str>,
+    entries: Cow<'a, [PatchEntry]>,
+    parked: Option<Vec<String>>,
+    xml: Cow<'a, str>,
+}
+
+impl Asked<'_> {
+    fn request(&self, fixed: u32) -> Request<'_> {
+        Request {
+            key: &self.key,
+            entries: &self.entries,
+            parked: self.parked.as_deref(),
+            fixed,
+        }
+    }
+
+    /// The compile of the variant's structure with the user's `mujoco`.
+    fn compile<'a>(&'a self, mujoco: &'a Py<PyAny>) -> impl FnMut() -> PyResult<Py<PyAny>> + 'a {
+        move || {
+            Python::attach(|py| {
+                let model =
+                    upcalls::get(py, "compile_xml")?.call1((mujoco.bind(py), &*self.xml))?;
+                Ok(model.unbind())
+            })
+        }
+    }
+
+    /// The core's error as Python's.
+    fn error(&self, e: CacheError<PyErr>) -> PyErr {
+        match e {
+            CacheError::Backend(e) => e,
+            CacheError::OtherStructure { found } => mjcf_error(vec![
+                ErrorKind::OtherStructure {
+                    variant: self.index,
+                    key: self.key.to_string(),
+                    found,
+                }
+                .to_string(),
+            ]),
+            CacheError::NotThisStructure(m) => mjcf_error(vec![m]),
+        }
+    }
+}
+
+#[pymethods]
+impl PyCacheCore {
+    #[new]
+    #[pyo3(signature = (mujoco, max_models, max_bytes, fixed, superset=None, derive=None))]
+    fn new(
+        mujoco: Py<PyAny>,
+        max_models: usize,
+        max_bytes: Option<usize>,
+        fixed: Vec<String>,
+        superset: Option<Py<PySuperset>>,
+        derive: Option<Py<PyAny>>,
+    ) -> Self {
+        let core = split::CacheCore::new(max_models, max_bytes, superset.is_some());
+        PyCacheCore {
+            inner: Mutex::new(Inner {
+                core,
+                backend: UserBackend { mujoco, derive },
+            }),
+            superset,
+            fixed: split::fixed_statistics_mask(fixed.iter().map(String::as_str)),
+        }
+    }
+
+    /// The model of ``variant`` (see ``ModelCache.model``).
+    fn model(&self, py: Python<'_>, variant: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
+        let asked = self.asked(py, variant)?;
+        let mut inner = self.inner()?;
+        let Inner { core, backend } = &mut *inner;
+        let mujoco = backend.mujoco.clone_ref(py);
+        let r = core.model(backend, &asked.request(self.fixed), asked.compile(&mujoco));
+        match r {
+            Ok(model) => Ok(model.clone_ref(py)),
+            Err(e) => Err(asked.error(e)),
+        }
+    }
+
+    /// ``model`` patched in place into ``variant``'s (see ``ModelCache.apply``).
+    fn apply(
+        &self,
+        py: Python<'_>,
+        variant: &Bound<'_, PyAny>,
+        model: Py<PyAny>,
+    ) -> PyResult<Py<PyAny>> {
+        let asked = self.asked(py, variant)?;
+        let mut inner = self.inner()?;
+        let Inner { core, backend } = &mut *inner;
+        let mujoco = backend.mujoco.clone_ref(py);
+        let mut target = model.clone_ref(py);
+        core.apply(
+            backend,
+            &asked.request(self.fixed),
+            &mut target,
+            asked.compile(&mujoco),
+        )
+        .map_err(|e| asked.error(e))?;
+        Ok(model)
+    }
+
+    /// Superset: the plan of ``model`` (a copy of the superset model, not checked), made
+    /// on first sight; the caller patches through it and counts the patch
+    /// (:meth:`count_patch`).
+    fn plan_for(&self, py: Python<'_>, model: Py<PyAny>) -> PyResult<Py<PyPatchPlan>> {
+        let Some(sup) = &self.superset else {
+            return Err(mjcf_error(vec![ErrorKind::NeedsSuperset.to_string()]));
+        };
+        let sup = sup.get();
+        let asked = Asked {
+            index: 0,
+            key: Cow::Borrowed(&sup.superset.structure_key),
+            entries: Cow::Borrowed(&[]),
+            parked: None,
+            xml: Cow::Borrowed(&sup.xml),
+        };
+        let mut inner = self.inner()?;
+        let Inner { core, backend } = &mut *inner;
+        let mujoco = backend.mujoco.clone_ref(py);
+        let request = asked.request(self.fixed);
+        match core.plan_for(backend, &request, &model, asked.compile(&mujoco)) {
+            Ok(plan) => Ok(plan.0.clone_ref(py)),
+            Err(e) => Err(asked.error(e)),
+        }
+    }
+
+    /// Counts a patch applied through :meth:`plan_for`'s plan.
+    fn count_patch(&self) -> PyResult<()> {
+        self.inner()?.core.count_patch();
+        Ok(())
+    }
+
+    /// The plan kept for ``model``, or ``None``.
+    fn plan(&self, py: Python<'_>, model: Py<PyAny>) -> PyResult<Option<Py<PyPatchPlan>>> {
+        let inner = self.inner()?;
+        Ok(inner
+            .core
+            .plan_of(&model)
+            .filter(|k| k.0.get().model().is(&model))
+            .map(|k| k.0.clone_ref(py)))
+    }
+
+    /// The models, least recently used first.
+    fn models(&self, py: Python<'_>) -> PyResult<Py<PyList>> {
+        let inner = self.inner()?;
+        Ok(PyList::new(py, inner.core.models().map(|m| m.clone_ref(py)))?.unbind())
+    }
+
+    /// Models compiled so far (misses).
+    #[getter]
+    fn compiles(&self) -> PyResult<u64> {
+        Ok(self.inner()?.core.compiles())
+    }
+
+    /// Patches applied so far.
+    #[getter]
+    fn patches(&self) -> PyResult<u64> {
+        Ok(self.inner()?.core.patches())
+    }
+
+    /// Bytes held: every model and its scratch data.
+    #[getter]
+    fn nbytes(&self) -> PyResult<usize> {
+        Ok(self.inner()?.core.nbytes())
+    }
+
+    fn __len__(&self) -> PyResult<usize> {
+        Ok(self.inner()?.core.len())
+    }
+
+    fn __repr__(&self) -> PyResult<String> {
+        let inner = self.inner()?;
+        Ok(format!(
+            "CacheCore({} models, {} compiles, {} patches)",
+            inner.core.len(),
+            inner.core.compiles(),
+            inner.core.patches()
+        ))
+    }
+}
