@@ -203,24 +203,7 @@ class ModelCache:
         """Superset: ``model`` patched for one world as :meth:`Superset.worlds` gives it
         (``world``: its index, numbers, strings and parked roots; ``patch0``: a patch of its
         layout, resolved once), as :meth:`apply` patches it."""
-        _index, numbers, strings, parked = world
-        plan = self._core.plan_for(model)
-        if plan.source is not patch0:
-            plan.resolve(patch0)
-            plan.source = patch0
-            plan.string_geoms = [e[2] in MODEL_FIELDS for e in patch0 if isinstance(e[3], str)]
-        values = np.frombuffer(numbers, dtype=np.float64)
-        if strings:
-            geoms = plan.string_geoms
-            materials = [v for v, g in zip(strings, geoms) if not g]
-            bodies = [v for v, g in zip(strings, geoms) if g]
-        else:
-            materials, bodies = [], []
-        plan.write(values, materials, bodies)
-        plan.finish(self._tree_derive(plan, parked, self._core.patches))
-        plan.variant_inertia(list(parked))
-        self._core.count_patch()
-        return model
+        return self._core.apply_world(model, world, patch0)
 
     def batch(self, variants: Any, progress: Any = None) -> dict[str, np.ndarray]:
         """Per-world arrays for batched simulation (``superset=True``): for every field of

@@ -10,7 +10,7 @@ use std::sync::{Mutex, MutexGuard, TryLockError};
 
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
-use pyo3::types::PyList;
+use pyo3::types::{PyBytes, PyList};
 
 use crate::document::patch::patch_entry;
 use crate::errors::mjcf_error;
@@ -310,8 +310,7 @@ impl PyCacheCore {
     }
 
     /// Superset: the plan of ``model`` (a copy of the superset model, not checked), made
-    /// on first sight; the caller patches through it and counts the patch
-    /// (:meth:`count_patch`).
+    /// on first sight (:meth:`apply_world` patches through it).
     fn plan_for(&self, py: Python<'_>, model: Py<PyAny>) -> PyResult<Py<PyPatchPlan>> {
         let Some(sup) = &self.superset else {
             return Err(mjcf_error(vec![ErrorKind::NeedsSuperset.to_string()]));
@@ -334,10 +333,34 @@ impl PyCacheCore {
         }
     }
 
-    /// Counts a patch applied through :meth:`plan_for`'s plan.
-    fn count_patch(&self) -> PyResult<()> {
+    /// Superset: ``model`` (a copy of the superset model) patched in place for one world
+    /// of ``Superset.worlds`` (``world``: its index, numbers, strings and parked roots;
+    /// ``patch0``: a patch of its layout), as :meth:`apply` patches a variant.
+    fn apply_world(
+        &self,
+        py: Python<'_>,
+        model: Py<PyAny>,
+        world: (u64, Bound<'_, PyBytes>, Vec<String>, Vec<String>),
+        patch0: Bound<'_, PyAny>,
+    ) -> PyResult<Py<PyAny>> {
+        let (_index, numbers, strings, parked) = world;
+        let plan = self.plan_for(py, model.clone_ref(py))?;
+        let (patches, hook) = {
+            let inner = self.inner()?;
+            let hook = inner.backend.derive.as_ref().map(|d| d.clone_ref(py));
+            (inner.core.patches(), hook)
+        };
+        let derive = match hook {
+            Some(hook) => Some(
+                hook.bind(py)
+                    .call1((plan.bind(py), parked.clone(), patches))?,
+            ),
+            None => None,
+        };
+        plan.get()
+            .patch_world(py, &patch0, numbers.as_bytes(), strings, derive, &parked)?;
         self.inner()?.core.count_patch();
-        Ok(())
+        Ok(model)
     }
 
     /// The plan kept for ``model``, or ``None``.

@@ -363,8 +363,8 @@ pub(crate) struct PyPatchPlan {
     #[pyo3(get)]
     derivations: Py<PyDict>,
     derived_at: AtomicI64,
+    /// The world patch the layout was last resolved from (`patch_world`).
     source: Mutex<Py<PyAny>>,
-    string_geoms: Mutex<Py<PyAny>>,
 }
 
 /// The user's model and the split tier's plan over it.
@@ -482,7 +482,6 @@ impl PyPatchPlan {
             derivations: PyDict::new(py).unbind(),
             derived_at: AtomicI64::new(-1),
             source: Mutex::new(py.None()),
-            string_geoms: Mutex::new(PyList::empty(py).into_any().unbind()),
         })
     }
 
@@ -525,6 +524,58 @@ impl PyPatchPlan {
             Some(raised) => PatchFailure::Backend(raised),
             None => PatchFailure::NotThisStructure(e),
         })
+    }
+
+    /// A superset world's patch as `Superset.worlds` gives it: its numbers end to end
+    /// (`numbers`, native-endian `f64` bytes) and its strings (material names and body
+    /// models, in entry order), of the layout of `patch0` (resolved when it is not the
+    /// patch this plan last resolved); then what follows (`derive`) and the world's
+    /// `stat.meaninertia` (`parked`).
+    pub(crate) fn patch_world(
+        &self,
+        py: Python<'_>,
+        patch0: &Bound<'_, PyAny>,
+        numbers: &[u8],
+        strings: Vec<String>,
+        derive: Option<Bound<'_, PyAny>>,
+        parked: &[String],
+    ) -> PyResult<()> {
+        let mut core = hold(&self.core)?;
+        if !hold(&self.source)?.is(patch0) {
+            let (layout, _, _, bodies) = read(patch0)?;
+            self.resolve_read(py, &mut core, patch0, layout, &bodies)?;
+            *hold(&self.source)? = patch0.clone().unbind();
+        }
+        let values: Vec<f64> = numbers
+            .chunks_exact(8)
+            .map(|b| f64::from_ne_bytes(b.try_into().unwrap_or([0; 8])))
+            .collect();
+        let (mut materials, mut bodies) = (Vec::new(), Vec::new());
+        let layout = core.plan.layout();
+        let carried = layout
+            .iter()
+            .filter(|e| !matches!(e.carried, Carried::Numbers(_)));
+        for (value, entry) in strings.into_iter().zip(carried) {
+            match entry.carried {
+                Carried::BodyModel => bodies.push(value),
+                _ => materials.push(value),
+            }
+        }
+        let patch = PatchValues {
+            numbers: &values,
+            materials: &materials,
+            bodies: &bodies,
+        };
+        let Core { user, plan } = &mut *core;
+        if let Err(e) = plan.write(user, patch) {
+            return Err(core.error(e));
+        }
+        self.finish_with(py, &mut core, derive)?;
+        let Core { user, plan } = &mut *core;
+        match plan.variant_inertia(user, parked) {
+            Ok(()) => Ok(()),
+            Err(e) => Err(core.error(e)),
+        }
     }
 
     /// `entries`' layout as ``(object, name or id, field)`` tuples: the fields a
@@ -653,30 +704,6 @@ impl PyPatchPlan {
     #[setter]
     fn set_derived_at(&self, value: i64) {
         self.derived_at.store(value, Ordering::Relaxed);
-    }
-
-    /// The patch the layout was last resolved from, as the caller marks it.
-    #[getter]
-    fn source(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        Ok(hold(&self.source)?.clone_ref(py))
-    }
-
-    #[setter]
-    fn set_source(&self, value: Py<PyAny>) -> PyResult<()> {
-        *hold(&self.source)? = value;
-        Ok(())
-    }
-
-    /// Which string values of that patch are body models, as the caller marks them.
-    #[getter]
-    fn string_geoms(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        Ok(hold(&self.string_geoms)?.clone_ref(py))
-    }
-
-    #[setter]
-    fn set_string_geoms(&self, value: Py<PyAny>) -> PyResult<()> {
-        *hold(&self.string_geoms)? = value;
-        Ok(())
     }
 
     /// Where every entry of ``patch`` lands (the next :meth:`write` takes a patch of its
