@@ -230,7 +230,7 @@ fn checkout_files(root: &Path, dir: &Path, out: &mut Vec<String>) {
 
 /// The names of our files in `text`: a path whose first folder is one of ours
 /// (`scene/patch.rs`, `python/tests/helpers.py`), or a private module or test file of the
-/// Python package named alone (`_trees.py`, `test_world_batch.py`).
+/// Python package named alone (`_cache.py`, `test_world_batch.py`).
 fn pointers(text: &str) -> Vec<(usize, String)> {
     let part = |c: char| c.is_ascii_alphanumeric() || matches!(c, '_' | '.' | '/' | '-');
     let mut out = Vec::new();
@@ -327,11 +327,11 @@ fn every_file_a_comment_or_page_names_exists() {
 
 #[test]
 fn pointers_are_found_in_prose_and_code() {
-    let text = "see `scene/patch.rs` and python/tests/helpers.py.\nbench_*.py, _trees.py, \
+    let text = "see `scene/patch.rs` and python/tests/helpers.py.\nbench_*.py, _cache.py, \
                 robosuite's binding_utils.py, x/scene/y.rs";
     let found: Vec<String> = pointers(text).into_iter().map(|(_, t)| t).collect();
     assert_eq!(
         found,
-        ["scene/patch.rs", "python/tests/helpers.py", "_trees.py"]
+        ["scene/patch.rs", "python/tests/helpers.py", "_cache.py"]
     );
 }

@@ -14,14 +14,11 @@ from __future__ import annotations
 
 import copy
 import os
-import weakref
 from typing import Any
 
 import numpy as np
 
 from ._mjcf_forge import (
-    LAYOUTS_KEPT,
-    MODEL_FIELDS,
     STATIC_PREFIXES,
     STATISTIC_NAMES,
     CacheCore,
@@ -29,25 +26,10 @@ from ._mjcf_forge import (
     Scene,
 )
 from ._progress import progress_of
-from ._trees import TreeDerivation
 
 
 def copy_value(value: Any) -> Any:
     return value.copy() if hasattr(value, "copy") else value
-
-
-def _bodies_from_geoms(model: Any) -> None:
-    """What ``mj_setConst`` also derives from the geoms and no tree derivation does: each
-    body's ``contype`` and ``conaffinity`` (its geoms' flags or-ed) and ``margin`` (their
-    largest margin, 0 without geoms). A body's geoms are contiguous, in body order."""
-    num = model.body_geomnum
-    has = np.flatnonzero(num > 0)
-    if not len(has):
-        return
-    starts = model.body_geomadr[has]
-    model.body_margin[has] = np.maximum(np.maximum.reduceat(model.geom_margin, starts), 0.0)
-    model.body_contype[has] = np.bitwise_or.reduceat(model.geom_contype, starts)
-    model.body_conaffinity[has] = np.bitwise_or.reduceat(model.geom_conaffinity, starts)
 
 
 class ModelCache:
@@ -102,20 +84,11 @@ class ModelCache:
         self.superset = scene.superset() if superset else None
         # Superset: body ids by name (one structure).
         self._body_ids: dict[str, int] = {}
-        #: Superset patches whose derived values came tree by tree (not mj_setConst).
-        self.by_tree = 0
-        # The rules (misses, patches, a caller's model checked, the bound) are the split
-        # tier's cache core, the C face's too; this class is its face. The derivation it
-        # calls back holds the cache weakly (no cycle through the core).
-        ref = weakref.ref(self)
-
-        def derive(plan: PatchPlan, parked: list, patches: int) -> Any:
-            cache = ref()
-            return None if cache is None else cache._tree_derive(plan, parked, patches)
-
+        # The rules (misses, patches, a caller's model checked, the bound, a superset's
+        # worlds derived tree by tree) are the split tier's cache core, the C face's too;
+        # this class is its face.
         self._core = CacheCore(
-            mujoco, max_models, max_bytes, list(scene.fixed_statistics), self.superset,
-            derive if superset else None,
+            mujoco, max_models, max_bytes, list(scene.fixed_statistics), self.superset
         )
 
     def __len__(self) -> int:
@@ -136,6 +109,22 @@ class ModelCache:
         """Patches applied so far."""
         return self._core.patches
 
+    @property
+    def by_tree(self) -> int:
+        """Superset patches whose derived values came tree by tree (not ``mj_setConst``)."""
+        return self._core.by_tree
+
+    @property
+    def derive_by_tree(self) -> bool:
+        """Superset: whether a patch derives what ``mj_setConst`` would tree by tree where
+        its layout allows (``mjcf_forge::split::TreeDerivation``: the same bits, at a
+        fraction of the cost for a large superset). ``False``: ``mj_setConst`` always."""
+        return self._core.derive_by_tree
+
+    @derive_by_tree.setter
+    def derive_by_tree(self, value: bool) -> None:
+        self._core.derive_by_tree = bool(value)
+
     def model(self, variant: Any) -> Any:
         """A compiled model equal to MuJoCo's compile of ``variant.xml`` (see the class);
         with ``superset=True``, the superset model patched for the variant."""
@@ -145,47 +134,6 @@ class ModelCache:
         """Patches ``model`` (of ``variant``'s structure) in place into ``variant``'s
         compiled model; returns it. Raises :class:`MjcfError` when its structure differs."""
         return self._core.apply(variant, model)
-
-    # Superset: derive what mj_setConst does tree by tree (see _trees; the same bits)
-    # where a patch allows. False: always the whole mj_setConst (the tests compare both).
-    _by_tree = True
-
-    def _tree_derive(self, plan: PatchPlan, parked: Any, patches: int) -> Any:
-        """Superset: ``derive(model, data, layout)`` for ``PatchPlan.finish``, deriving
-        tree by tree (:class:`TreeDerivation`, per plan and patch layout) what
-        ``mj_setConst`` would, or None (``mj_setConst``): no superset, or turned off.
-        ``patches``: the cache's count of patches before this one."""
-        if self.superset is None or not self._by_tree or parked is None:
-            return None
-        derivations = plan.derivations
-        roots = set(self._body_ids_of(plan.model, parked))
-
-        def derive(model: Any, data: Any, layout: list) -> bool:
-            entry = derivations.get(id(layout))
-            if entry is None or entry[0] is not layout:
-                if len(derivations) >= LAYOUTS_KEPT:
-                    derivations.clear()
-                entry = derivations[id(layout)] = (layout, TreeDerivation.build(self._mujoco, model, layout))
-            derivation = entry[1]
-            # mj_setConst also counts the bodies with gravity compensation (ngravcomp,
-            # which the engines read only to apply it at all: zero or not), a size the
-            # bindings cannot set and no tree derivation writes: where the patch turns
-            # that count to or from zero (objects parked after a variant that placed them
-            # all), mj_setConst itself.
-            compensated = bool((model.body_gravcomp > 0).any())  # as mj_setConst counts
-            if derivation is None or compensated != bool(model.ngravcomp):
-                self._mujoco.mj_setConst(model, data)
-                return False
-            if plan.derived_at != patches:
-                derivation.forget()  # patched another way since this plan's last derivation
-            self.by_tree += 1
-            # The caller counts this patch next (patches + 1): nothing between.
-            plan.derived_at = patches + 1
-            fresh = derivation(model, data, roots)
-            _bodies_from_geoms(model)
-            return fresh
-
-        return derive
 
     def _body_ids_of(self, model: Any, names: Any) -> list[int]:
         """Superset: the ids of the bodies ``names`` in ``model`` (of the superset's one

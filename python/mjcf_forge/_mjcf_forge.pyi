@@ -32,6 +32,7 @@ LAYOUTS_KEPT: int
 SET_CONST_DERIVED: tuple[str, ...]
 BODY_MODEL_WRITES: tuple[str, ...]
 BULK_SIZES: tuple[str, ...]
+FROM_GEOMS: tuple[str, ...]
 BULK_PREFIXES: tuple[str, ...]
 
 def target_array(object: str, field: str) -> Optional[str]: ...
@@ -78,6 +79,8 @@ class CacheCore:
     compiles: int
     patches: int
     nbytes: int
+    by_tree: int
+    derive_by_tree: bool
     def __init__(
         self,
         mujoco: Any,
@@ -85,7 +88,6 @@ class CacheCore:
         max_bytes: Optional[int],
         fixed: Sequence[str],
         superset: Optional[Superset] = None,
-        derive: Optional[Callable[[PatchPlan, list[str], int], Any]] = None,
     ) -> None: ...
     def __len__(self) -> int: ...
     def model(self, variant: Any) -> Any: ...
@@ -103,18 +105,16 @@ class PatchPlan:
     key: str
     nbytes: int
     data: Any
-    fields: Optional[list[tuple[str, Union[str, int], str]]]
-    derivations: dict[int, Any]
-    derived_at: int
+    by_tree: int
     compiled_parts: int
     body_models: int
     def __init__(self, mujoco: Any, model: Any, key: str, fixed: Sequence[tuple[str, Any]]) -> None: ...
     def resolve(self, patch: Sequence[Any]) -> None: ...
-    def apply(self, patch: Sequence[Any], derive: Optional[Callable[[Any, Any, Any], bool]] = None) -> None: ...
+    def apply(self, patch: Sequence[Any]) -> None: ...
     def write(
         self, values: npt.NDArray[np.float64], materials: Sequence[str], bodies: Sequence[str] = ...
     ) -> None: ...
-    def finish(self, derive: Optional[Callable[[Any, Any, Any], bool]] = None) -> None: ...
+    def finish(self) -> None: ...
     def mean_inertia(self, dofs: Sequence[int]) -> float: ...
     def variant_inertia(self, parked: Sequence[str]) -> None: ...
 

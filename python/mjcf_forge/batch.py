@@ -37,6 +37,7 @@ from ._cache import ModelCache, apply_world, body_ids_of, mujoco_of, plan_of
 from ._errors import error
 from ._mjcf_forge import (
     BODY_MODEL_WRITES,
+    FROM_GEOMS,
     LAYOUTS_KEPT,
     SET_CONST_DERIVED,
     STATIC_PREFIXES,
@@ -52,8 +53,7 @@ from ._warp import WarpWorlds
 # variant even when no patch entry names them), and what a world's patch writes besides
 # its own arrays (BODY_MODEL_WRITES: a body model's copy and the same-frame flags).
 # What the tree-by-tree derivation writes from the geoms, as mj_setConst does
-# (_cache._bodies_from_geoms): a world's geom margins move its bodies' margins.
-_FROM_GEOMS = ("body_margin", "body_contype", "body_conaffinity")
+# (FROM_GEOMS, mjcf_forge::split's): a world's geom margins move its bodies' margins.
 # A model's keyframe arrays (each world's rows: WorldBatch.keys): its arrays of prefix
 # key_.
 _KEY_PREFIX = "key_"
@@ -136,9 +136,9 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         self._layouts: dict[tuple, Any] = {}
         self._written = [n for n in BODY_MODEL_WRITES if n in self._others]
         self._flags = [n for n in self._written if n.endswith("_sameframe")]
-        self._from_geoms = [n for n in _FROM_GEOMS if n in self._others]
+        self._from_geoms = [n for n in FROM_GEOMS if n in self._others]
         #: Worlds whose derived values came tree by tree (the others: mj_setConst; see
-        #: ``_trees.py``: the same bits).
+        #: ``mjcf_forge::split::TreeDerivation``: the same bits).
         self.derived_by_tree = 0
         bar = progress_of(progress, len(indices), "worlds")
         try:

@@ -1,9 +1,10 @@
 //! `CacheCore`: the split tier's model cache ([`mjcf_forge::split::CacheCore`], the rules
 //! the C face's `ModelCache` runs too) over the user's `mujoco`: its `MjModel`s kept,
 //! each patched by its `PatchPlan` (`split/plan.rs`), compiled by the package's
-//! `compile_xml` (through `upcalls.rs`). The package's `ModelCache` is its face: a
-//! variant's path through `ModelCache.model` crosses into Rust once, and back up only for
-//! a compile or a superset's tree-by-tree derivation.
+//! `compile_xml` (through `upcalls.rs`), a superset's worlds derived tree by tree
+//! (`mjcf_forge::split::Derivations`). The package's `ModelCache` is its face: a variant's
+//! path through `ModelCache.model` crosses into Rust once, and calls up only into the
+//! user's `mujoco`.
 
 use std::borrow::Cow;
 use std::sync::{Mutex, MutexGuard, TryLockError};
@@ -23,12 +24,13 @@ use mjcf_forge::split::{
     Signature, Statistics,
 };
 
-/// The user's `mujoco` as the cache core runs it, and the caller's derivation: `derive(plan,
-/// parked, patches)` gives what `PatchPlan.finish` takes in place of `mj_setConst` (or
-/// `None`) for a superset's patch.
+/// The user's `mujoco` as the cache core runs it: whether a superset's patches derive
+/// tree by tree where their layout allows (`mjcf_forge::split::Derivations`), and how many
+/// did.
 struct UserBackend {
     mujoco: Py<PyAny>,
-    derive: Option<Py<PyAny>>,
+    by_tree: bool,
+    derived: u64,
 }
 
 /// A model's plan, kept by the core (the plan holds its model, so its id stays its own).
@@ -98,22 +100,14 @@ impl CacheBackend for UserBackend {
         plan: &mut Kept,
         _model: &mut Py<PyAny>,
         request: &Request<'_>,
-        patches: u64,
+        _patches: u64,
     ) -> Result<(), PatchFailure<PyErr>> {
-        Python::attach(|py| {
-            let derive = match (&self.derive, request.parked) {
-                (Some(derive), Some(parked)) => Some(
-                    derive
-                        .bind(py)
-                        .call1((plan.0.bind(py), parked.to_vec(), patches))
-                        .map_err(PatchFailure::Backend)?,
-                ),
-                _ => None,
-            };
-            plan.0
-                .get()
-                .patch(py, request.entries, derive, request.parked)
-        })
+        let derived = plan
+            .0
+            .get()
+            .patch(request.entries, request.parked, self.by_tree)?;
+        self.derived += u64::from(derived);
+        Ok(())
     }
 }
 
@@ -127,8 +121,8 @@ struct Inner {
 /// one compiled ``MjModel`` per structure, patched per variant by its ``PatchPlan``,
 /// bounded (``max_models``, ``max_bytes``), least recently used out. ``fixed``: the
 /// statistics the scene's ``<statistic>`` fixes; ``superset``: every variant a patch of
-/// it; ``derive(plan, parked, patches)``: a superset patch's derivation in place of
-/// ``mj_setConst`` (or ``None``). The package's :class:`mjcf_forge.ModelCache` is its face.
+/// it, each world's derived values found tree by tree where its layout allows
+/// (:attr:`derive_by_tree`). The package's :class:`mjcf_forge.ModelCache` is its face.
 ///
 /// >>> import mujoco, mjcf_forge
 /// >>> from mjcf_forge._mjcf_forge import CacheCore
@@ -254,20 +248,23 @@ impl Asked<'_> {
 #[pymethods]
 impl PyCacheCore {
     #[new]
-    #[pyo3(signature = (mujoco, max_models, max_bytes, fixed, superset=None, derive=None))]
+    #[pyo3(signature = (mujoco, max_models, max_bytes, fixed, superset=None))]
     fn new(
         mujoco: Py<PyAny>,
         max_models: usize,
         max_bytes: Option<usize>,
         fixed: Vec<String>,
         superset: Option<Py<PySuperset>>,
-        derive: Option<Py<PyAny>>,
     ) -> Self {
         let core = split::CacheCore::new(max_models, max_bytes, superset.is_some());
         PyCacheCore {
             inner: Mutex::new(Inner {
                 core,
-                backend: UserBackend { mujoco, derive },
+                backend: UserBackend {
+                    mujoco,
+                    by_tree: true,
+                    derived: 0,
+                },
             }),
             superset,
             fixed: split::fixed_statistics_mask(fixed.iter().map(String::as_str)),
@@ -311,7 +308,7 @@ impl PyCacheCore {
 
     /// Superset: the plan of ``model`` (a copy of the superset model, not checked), made
     /// on first sight (:meth:`apply_world` patches through it).
-    fn plan_for(&self, py: Python<'_>, model: Py<PyAny>) -> PyResult<Py<PyPatchPlan>> {
+    pub(crate) fn plan_for(&self, py: Python<'_>, model: Py<PyAny>) -> PyResult<Py<PyPatchPlan>> {
         let Some(sup) = &self.superset else {
             return Err(mjcf_error(vec![ErrorKind::NeedsSuperset.to_string()]));
         };
@@ -345,22 +342,33 @@ impl PyCacheCore {
     ) -> PyResult<Py<PyAny>> {
         let (_index, numbers, strings, parked) = world;
         let plan = self.plan_for(py, model.clone_ref(py))?;
-        let (patches, hook) = {
-            let inner = self.inner()?;
-            let hook = inner.backend.derive.as_ref().map(|d| d.clone_ref(py));
-            (inner.core.patches(), hook)
-        };
-        let derive = match hook {
-            Some(hook) => Some(
-                hook.bind(py)
-                    .call1((plan.bind(py), parked.clone(), patches))?,
-            ),
-            None => None,
-        };
-        plan.get()
-            .patch_world(py, &patch0, numbers.as_bytes(), strings, derive, &parked)?;
-        self.inner()?.core.count_patch();
+        let by_tree = self.inner()?.backend.by_tree;
+        let derived =
+            plan.get()
+                .patch_world(&patch0, numbers.as_bytes(), strings, &parked, by_tree)?;
+        let mut inner = self.inner()?;
+        inner.core.count_patch();
+        inner.backend.derived += u64::from(derived);
         Ok(model)
+    }
+
+    /// Superset: whether patches derive what ``mj_setConst`` would tree by tree, where
+    /// their layout allows (the same bits; ``False``: ``mj_setConst`` always).
+    #[getter]
+    fn get_derive_by_tree(&self) -> PyResult<bool> {
+        Ok(self.inner()?.backend.by_tree)
+    }
+
+    #[setter]
+    fn set_derive_by_tree(&self, value: bool) -> PyResult<()> {
+        self.inner()?.backend.by_tree = value;
+        Ok(())
+    }
+
+    /// Superset patches derived tree by tree so far.
+    #[getter]
+    fn by_tree(&self) -> PyResult<u64> {
+        Ok(self.inner()?.backend.derived)
     }
 
     /// The plan kept for ``model``, or ``None``.

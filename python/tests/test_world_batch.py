@@ -34,7 +34,7 @@ LIFT5 = ROOT / "benches" / "scenes" / "lift5.toml"
     ],
     ids=lambda p: p.stem if isinstance(p, Path) else str(p),
 )
-def test_worlds_derived_tree_by_tree_are_mj_setconsts(path, worlds, by_tree, monkeypatch):
+def test_worlds_derived_tree_by_tree_are_mj_setconsts(path, worlds, by_tree):
     # WorldBatch derives what mj_setConst would, per tree the patch writes into (each
     # compiled alone as a skeleton) and on the superset for what spans trees: every
     # per-world array and statistic must be the same bits as with mj_setConst itself.
@@ -54,12 +54,12 @@ def test_worlds_derived_tree_by_tree_are_mj_setconsts(path, worlds, by_tree, mon
     by_tree_before = cache.by_tree
     ready = []
     for k in (200, 201, 202):
-        monkeypatch.setattr(mjcf_forge.ModelCache, "_by_tree", False)
+        cache.derive_by_tree = False
         cache.model(scene.variant(worlds + 300 + k))
-        monkeypatch.setattr(mjcf_forge.ModelCache, "_by_tree", True)
+        cache.derive_by_tree = True
         ready.append(copy.copy(cache.model(scene.variant(worlds + k))))
     assert cache.by_tree == by_tree_before + (3 if by_tree else 0)
-    monkeypatch.setattr(mjcf_forge.ModelCache, "_by_tree", False)
+    cache.derive_by_tree = False
     for k, model in zip((200, 201, 202), ready):
         assert not_bit_identical(cache.model(scene.variant(worlds + k)), model) == [], k
     whole = WorldBatch(cache, range(worlds))

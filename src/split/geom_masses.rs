@@ -193,7 +193,7 @@ pub const FRAME_FLAGS: [&str; 3] = ["body_sameframe", "geom_sameframe", "site_sa
 /// Sets the same-frame flags of `bodies`, `geoms` and `sites` from their frames and their
 /// bodies' inertial frames ([`body_frame_flag`], [`frame_flag`]): what MuJoCo 4.0's
 /// `mj_setConst` sets again (3.17.0's keeps the compiler's), for a superset world derived
-/// tree by tree (`python/mjcf_forge/_trees.py`).
+/// tree by tree ([`super::TreeDerivation`]).
 pub fn write_frame_flags(
     model: &mut impl ModelArraysMut,
     bodies: &[usize],

@@ -38,7 +38,8 @@
 //! body's mass properties from its geoms' densities or masses, at patch cost; with
 //! `crate::document::rotation`, the compiler's rotations and eigen-decomposition, and `volumes.rs`, its
 //! bounding-volume trees), `statistics.rs` (the
-//! compiler's statistics at `qpos0`, computed over a model's arrays for both faces). The scene tier reads its
+//! compiler's statistics at `qpos0`, computed over a model's arrays for both faces),
+//! `trees.rs` (what `mj_setConst` derives for a superset world, tree by tree). The scene tier reads its
 //! drawn variants through the same rules (`scene/patch.rs`).
 //!
 //! May use: the document tier and `crate::error`. Knows nothing of scenes or of MuJoCo
@@ -56,6 +57,7 @@ mod signature;
 mod statistics;
 mod store;
 mod targets;
+mod trees;
 mod volumes;
 
 pub use body_copy::{
@@ -70,7 +72,7 @@ pub use geom_masses::{
     write_geom_masses,
 };
 pub use landing::{ArrayMut, Carried, Landing, ModelLayout, Run, land};
-pub use plan::{LayoutEntry, PatchModel, PatchPlan, PatchValues};
+pub use plan::{Derive, LayoutEntry, PatchModel, PatchPlan, PatchValues};
 pub use rules::{PATCHABLE, PatchEntry, PatchValue};
 pub use signature::{Signature, SignatureSource};
 pub use statistics::{
@@ -84,6 +86,7 @@ pub use targets::{
     SET_CONST_DERIVED, SIGNATURE_ARRAYS, SIGNATURE_SKIPPED_SIZES, STATIC_PREFIXES, joint_widths,
     target_array,
 };
+pub use trees::{Derivations, FROM_GEOMS, TreeDerivation, TreeModel};
 pub use volumes::{Volume, VolumeNode, bounding_volumes};
 
 pub(crate) use body_model::{UnitCache, body_model_entries, carried_by, unit_model_entries};

@@ -79,6 +79,12 @@ pub trait PatchModel: ModelArraysMut + ModelLayout {
     fn set_stat(&mut self, stat: &Statistics) -> Result<(), String>;
 }
 
+/// A derivation in place of `mj_setConst` ([`PatchPlan::finish`]): given the model, its
+/// scratch data and the layout resolved, it writes what `mj_setConst` would and says
+/// whether the data then holds the kinematics at `qpos0`.
+pub type Derive<'a, M> =
+    &'a mut dyn FnMut(&mut M, &mut <M as PatchModel>::Data, &[LayoutEntry]) -> Result<bool, String>;
+
 /// One entry of a patch's layout: the element and field it writes and what it carries
 /// (the value itself is the patch's: [`PatchPlan::write`] takes them laid out by kind).
 #[derive(Clone, Debug, PartialEq)]
@@ -194,6 +200,8 @@ pub struct PatchPlan<M: PatchModel> {
     fixed_values: Statistics,
     nbytes: usize,
     compiled_parts: u64,
+    /// How many times [`PatchPlan::finish`] ran.
+    finishes: u64,
     /// A superset's parked roots seen so far, by name: the dofs of each one's subtree.
     subtree_dofs: Vec<(String, Vec<usize>)>,
 }
@@ -221,6 +229,7 @@ impl<M: PatchModel> PatchPlan<M> {
             fixed_values,
             nbytes,
             compiled_parts: 0,
+            finishes: 0,
             subtree_dofs: Vec::new(),
         })
     }
@@ -233,6 +242,12 @@ impl<M: PatchModel> PatchPlan<M> {
     /// How many body models and unit models this plan has compiled.
     pub fn compiled_parts(&self) -> u64 {
         self.compiled_parts
+    }
+
+    /// How many times [`PatchPlan::finish`] ran (a derivation made before another
+    /// finish knows the model was patched some other way since).
+    pub fn finishes(&self) -> u64 {
+        self.finishes
     }
 
     /// How many body-model and unit-model entries the layout last resolved has.
@@ -320,13 +335,19 @@ impl<M: PatchModel> PatchPlan<M> {
     }
 
     /// [`PatchPlan::apply`] with [`PatchPlan::finish`]'s `derive` in place of `mj_setConst`.
-    #[allow(clippy::type_complexity)]
     pub fn apply_with(
         &mut self,
         model: &mut M,
         patch: &[PatchEntry],
-        derive: Option<&mut dyn FnMut(&mut M, &mut M::Data) -> Result<bool, String>>,
+        derive: Option<Derive<'_, M>>,
     ) -> Result<(), String> {
+        self.write_patch(model, patch)?;
+        self.finish(model, derive)
+    }
+
+    /// Writes `patch` (of any layout: resolved again where it differs from the last), and
+    /// nothing of what follows from it ([`PatchPlan::finish`]).
+    pub fn write_patch(&mut self, model: &mut M, patch: &[PatchEntry]) -> Result<(), String> {
         let same = self.is_layout_of(patch);
         let mut numbers = Vec::new();
         let (mut materials, mut bodies) = (Vec::new(), Vec::new());
@@ -346,8 +367,7 @@ impl<M: PatchModel> PatchPlan<M> {
             materials: &materials,
             bodies: &bodies,
         };
-        self.write(model, values)?;
-        self.finish(model, derive)
+        self.write(model, values)
     }
 
     /// Records the body texts of the patch the layout was resolved with (a body model
@@ -460,21 +480,17 @@ impl<M: PatchModel> PatchPlan<M> {
         Ok(self.parts.len() - 1)
     }
 
-    /// What follows the values: `mj_setConst` (or `derive(model, data)`, which writes
-    /// the same and says whether the data then holds the kinematics at `qpos0`), the
-    /// compiler's statistics and dof lengths, then the statistics the document fixes.
-    #[allow(clippy::type_complexity)]
-    pub fn finish(
-        &mut self,
-        model: &mut M,
-        derive: Option<&mut dyn FnMut(&mut M, &mut M::Data) -> Result<bool, String>>,
-    ) -> Result<(), String> {
+    /// What follows the values: `mj_setConst` (or `derive(model, data, layout)`, which
+    /// writes the same and says whether the data then holds the kinematics at `qpos0`),
+    /// the compiler's statistics and dof lengths, then the statistics the document fixes.
+    pub fn finish(&mut self, model: &mut M, derive: Option<Derive<'_, M>>) -> Result<(), String> {
+        self.finishes += 1;
         let fresh = match derive {
             None => {
                 model.set_const(&mut self.data)?;
                 false
             }
-            Some(derive) => derive(model, &mut self.data)?,
+            Some(derive) => derive(model, &mut self.data, &self.layout)?,
         };
         if !fresh {
             model.kinematics(&mut self.data)?;

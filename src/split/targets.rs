@@ -1,7 +1,7 @@
 //! Where a patch lands in MuJoCo's compiled model: the `mjModel` array of each patch
 //! entry, the arrays no patch changes, and the integer arrays that tell one structure from
 //! another. The one copy of these tables: the model caches (`crate::compiled`) and the
-//! Python package's caches (`_cache.py`, `batch.py`, `_trees.py`, through the extension)
+//! Python package's caches (`_cache.py`, `batch.py`, through the extension)
 //! read them here.
 //!
 //! ```

@@ -44,6 +44,58 @@ const INTS: [&str; 14] = [
     "site_bodyid",
 ];
 const BYTES: [&str; 3] = ["body_sameframe", "geom_sameframe", "site_sameframe"];
+/// The arrays a superset's tree-by-tree derivation reads or writes besides
+/// (`mjcf_forge::split::TreeDerivation`), where this MuJoCo has them.
+const TREE_FLOATS: [&str; 17] = [
+    "jnt_pos",
+    "jnt_axis",
+    "dof_armature",
+    "qpos0",
+    "body_invweight0",
+    "dof_invweight0",
+    "dof_M0",
+    "body_subtreemass",
+    "cam_pos0",
+    "cam_poscom0",
+    "cam_mat0",
+    "light_pos0",
+    "light_poscom0",
+    "light_dir0",
+    "geom_margin",
+    "body_margin",
+    "body_gravcomp",
+];
+const TREE_INTS: [&str; 28] = [
+    "body_rootid",
+    "body_weldid",
+    "jnt_bodyid",
+    "jnt_qposadr",
+    "jnt_dofadr",
+    "jnt_type",
+    "dof_simplenum",
+    "M_rownnz",
+    "M_rowadr",
+    "M_colind",
+    "cam_bodyid",
+    "cam_targetbodyid",
+    "cam_mode",
+    "light_bodyid",
+    "light_targetbodyid",
+    "light_mode",
+    "body_contype",
+    "body_conaffinity",
+    "tendon_adr",
+    "tendon_num",
+    "wrap_type",
+    "wrap_objid",
+    "actuator_trntype",
+    "actuator_trnid",
+    "eq_type",
+    "eq_objtype",
+    "eq_obj1id",
+    "eq_obj2id",
+];
+const TREE_BYTES: [&str; 1] = ["body_simple"];
 
 /// A compiled model's arrays a body model is copied from or into, found once.
 ///
@@ -166,6 +218,24 @@ impl PyModelArrays {
             arrays
                 .bytes
                 .insert(name, Array::of(&model.getattr(name)?, name, true)?);
+        }
+        // Where this MuJoCo has them (an older one may lack some: the derivation then
+        // declines, and mj_setConst runs).
+        let found = |name: &str| model.getattr(name).ok().filter(|a| !a.is_none());
+        for name in TREE_FLOATS {
+            if let Some(a) = found(name) {
+                arrays.floats.insert(name, Array::of(&a, name, true)?);
+            }
+        }
+        for name in TREE_INTS {
+            if let Some(a) = found(name) {
+                arrays.ints.insert(name, Array::of(&a, name, true)?);
+            }
+        }
+        for name in TREE_BYTES {
+            if let Some(a) = found(name) {
+                arrays.bytes.insert(name, Array::of(&a, name, true)?);
+            }
         }
         arrays.massless = split::massless_frames(&arrays).map_err(PyValueError::new_err)?;
         Ok(arrays)

@@ -18,6 +18,8 @@ mod signature;
 mod statistics;
 mod store;
 mod tables;
+#[allow(unsafe_code)]
+mod user_model;
 
 use pyo3::prelude::*;
 

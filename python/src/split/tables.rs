@@ -1,10 +1,10 @@
-//! The split tier's tables the package's caches read (`mjcf_forge._cache`, `_trees`,
+//! The split tier's tables the package's caches read (`mjcf_forge._cache`,
 //! `batch`, `_mujoco`): the one copy of each, `mjcf_forge::split::targets`.
 
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
-/// The split tier's tables the package's caches read (`mjcf_forge._cache`, `_trees`,
+/// The split tier's tables the package's caches read (`mjcf_forge._cache`,
 /// `batch`, `_mujoco`), added to the module: the one copy of each (`mjcf_forge::split::targets`).
 pub(super) fn add(m: &Bound<'_, PyModule>) -> PyResult<()> {
     use mjcf_forge::split;
@@ -33,6 +33,7 @@ pub(super) fn add(m: &Bound<'_, PyModule>) -> PyResult<()> {
         PyTuple::new(py, split::body_model_writes())?,
     )?;
     m.add("BULK_SIZES", PyTuple::new(py, split::BULK_SIZES)?)?;
+    m.add("FROM_GEOMS", PyTuple::new(py, split::FROM_GEOMS)?)?;
     m.add("BULK_PREFIXES", PyTuple::new(py, split::BULK_PREFIXES)?)?;
     m.add_function(wrap_pyfunction!(target_array, m)?)?;
     m.add_function(wrap_pyfunction!(joint_widths, m)?)?;
