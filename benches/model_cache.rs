@@ -10,7 +10,12 @@
 //! - `document_cache/split`: a variant taken as a plain document, split into its
 //!   structure key and patch (`split_document`, no MuJoCo);
 //! - `document_cache/hit`: `DocumentCache::model` on such a document of a cached
-//!   structure: the split, the patch written, `mj_setConst` and the statistics.
+//!   structure: the split, the patch written, `mj_setConst` and the statistics;
+//! - `superset/by_tree` and `superset/set_const`: a variant of `benches/scenes/lift5.toml`
+//!   (five slots, six objects each) as a patch of its superset (`ModelCache::model` with
+//!   `with_superset`), what `mj_setConst` derives found tree by tree
+//!   (`split::TreeDerivation`) or by `mj_setConst` on the whole superset
+//!   (`deriving_by_tree(false)`): the same bits, timed in one run.
 //!
 //! Needs MuJoCo: `cargo bench --features mujoco --bench model_cache` (the MuJoCo build.rs
 //! finds: 3.17.0 in the repository, or the one in `MJCF_FORGE_MUJOCO_DIR`). Without the
@@ -62,6 +67,32 @@ mod with_mujoco {
         group.finish();
     }
 
+    pub fn superset(c: &mut Criterion) {
+        let scene = Scene::load(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/benches/scenes/lift5.toml"
+        ))
+        .unwrap_or_else(|e| panic!("{e}\n(the scene's robosuite models: run scripts/setup.sh)"));
+        let mut group = c.benchmark_group("superset");
+        group.throughput(Throughput::Elements(1));
+        for (name, by_tree) in [("by_tree", true), ("set_const", false)] {
+            let mut cache = ModelCache::new(&scene, 2, None)
+                .with_superset()
+                .expect("a superset")
+                .deriving_by_tree(by_tree);
+            cache.model(0).expect("variant 0");
+            let mut next = 1u64;
+            group.bench_function(name, |b| {
+                b.iter(|| {
+                    black_box(cache.model(next).expect("patched"));
+                    next += 1;
+                });
+            });
+            assert_eq!(cache.derived_by_tree() > 0, by_tree);
+        }
+        group.finish();
+    }
+
     pub fn document_cache(c: &mut Criterion) {
         let scene = lift5_fixed();
         // Documents made before timing: the cache is what is measured.
@@ -94,7 +125,8 @@ mod with_mujoco {
 criterion::criterion_group!(
     benches,
     with_mujoco::model_cache,
-    with_mujoco::document_cache
+    with_mujoco::document_cache,
+    with_mujoco::superset
 );
 #[cfg(mjcf_mujoco)]
 criterion::criterion_main!(benches);

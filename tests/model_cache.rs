@@ -649,3 +649,56 @@ fn per_world_arrays_hold_each_worlds_superset_model() {
     assert_eq!(plain_err.first().kind, ErrorKind::NeedsSuperset);
     assert!(plain_err.to_string().contains("with_superset"));
 }
+
+/// A superset's worlds derived tree by tree (each placed tree's skeleton through
+/// `mj_setConst`, parked trees' values kept, what spans trees on the superset) against
+/// `mj_setConst` on the whole model: every array and statistic bit for bit, world after
+/// world (placed and parked trees changing between them), and through `apply` into a
+/// model of one's own. A scene whose patches write a robot's armature (`patch.toml`) has no
+/// tree derivation: `mj_setConst` runs.
+#[test]
+fn superset_worlds_derived_tree_by_tree_are_mj_setconsts() {
+    let mut scenes = vec![
+        ("corpora/scenes/patch/mass.toml", true),
+        ("corpora/scenes/patch/fixed.toml", true),
+        ("corpora/scenes/patch/boxes.toml", true),
+        ("corpora/scenes/patch/patch.toml", false),
+    ];
+    if root().join(".cache/corpus/robosuite-1.5.2").is_dir() {
+        scenes.push(("benches/scenes/lift5.toml", true));
+    }
+    for (path, by_tree) in scenes {
+        let scene = Scene::load(root().join(path)).unwrap();
+        let mut fast = ModelCache::new(&scene, 2, None).with_superset().unwrap();
+        let mut whole = ModelCache::new(&scene, 2, None)
+            .with_superset()
+            .unwrap()
+            .deriving_by_tree(false);
+        let n = 12;
+        for i in 0..n {
+            let want = whole.model(i).unwrap().clone();
+            let got = fast.model(i).unwrap();
+            assert_eq!(
+                got.differences(&want),
+                Vec::<String>::new(),
+                "{path}: variant {i}"
+            );
+        }
+        assert_eq!(
+            fast.derived_by_tree(),
+            if by_tree { n } else { 0 },
+            "{path}"
+        );
+        assert_eq!(whole.derived_by_tree(), 0);
+        let mut mine = fast.model(0).unwrap().clone();
+        for i in [5, 3, 5] {
+            fast.apply(i, &mut mine).unwrap();
+            let want = whole.model(i).unwrap();
+            assert_eq!(
+                mine.differences(want),
+                Vec::<String>::new(),
+                "{path}: apply {i}"
+            );
+        }
+    }
+}

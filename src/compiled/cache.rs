@@ -160,6 +160,7 @@ pub struct ModelCache<'s> {
     /// The statistics the scene's `<statistic>` fixes, as bits.
     fixed: u32,
     core: Core,
+    linked: Linked,
     max: (usize, Option<usize>),
 }
 
@@ -173,6 +174,7 @@ impl<'s> ModelCache<'s> {
             superset: None,
             fixed: fixed_statistics_mask(scene.fixed_statistics()),
             core: Core::new(max_models, max_bytes, false),
+            linked: Linked::default(),
             max: (max_models, max_bytes),
         }
     }
@@ -192,6 +194,19 @@ impl<'s> ModelCache<'s> {
         self.superset = Some(SupersetState { superset, xml });
         self.core = Core::new(self.max.0, self.max.1, true);
         Ok(self)
+    }
+
+    /// Superset: whether a patch derives what `mj_setConst` would tree by tree, where its
+    /// layout allows (`split::TreeDerivation`: the same bits, a fraction of the cost on a
+    /// large superset; on by default), or runs `mj_setConst` always.
+    pub fn deriving_by_tree(mut self, by_tree: bool) -> Self {
+        self.linked.by_tree = by_tree;
+        self
+    }
+
+    /// Superset patches whose derived values came tree by tree so far.
+    pub fn derived_by_tree(&self) -> u64 {
+        self.linked.derived
     }
 
     /// Whether every variant is a patch of the superset ([`ModelCache::with_superset`]).
@@ -252,7 +267,7 @@ impl<'s> ModelCache<'s> {
         let request = self.request(&patch, parked.as_deref());
         let compile = compiler(self.scene, &self.superset, self.dir.as_deref(), index);
         self.core
-            .model(&mut Linked, &request, compile)
+            .model(&mut self.linked, &request, compile)
             .map_err(|e| cache_error(e, index, &patch.structure_key))
     }
 
@@ -263,7 +278,7 @@ impl<'s> ModelCache<'s> {
         let request = self.request(&patch, parked.as_deref());
         let compile = compiler(self.scene, &self.superset, self.dir.as_deref(), index);
         self.core
-            .apply(&mut Linked, &request, model, compile)
+            .apply(&mut self.linked, &request, model, compile)
             .map_err(|e| cache_error(e, index, &patch.structure_key))
     }
 

@@ -76,7 +76,7 @@ impl DocumentCache {
         // after its next patch, which writes every entry of the structure.
         let compile = || compile_document(doc).map_err(|e| Errors(vec![e]));
         self.core
-            .model(&mut Linked, &request, compile)
+            .model(&mut Linked::default(), &request, compile)
             .map_err(|e| cache_error(e, 0, &split.structure_key))
     }
 

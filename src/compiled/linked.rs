@@ -2,7 +2,8 @@
 //! one implementation both faces' caches run): a [`CompiledModel`] as a
 //! [`PatchModel`], its arrays found by name through `patch.c` ([`Arrays`]), its scratch
 //! data, body models compiled by the FFI, and `mj_setConst` and the kinematics called
-//! through `patch.c`.
+//! through `patch.c`; and as a [`TreeModel`], what a superset's tree-by-tree derivation
+//! needs besides (skeletons compiled, MuJoCo's constants, `mj_camlight`, the frames).
 
 use std::ffi::CString;
 use std::path::Path;
@@ -14,10 +15,12 @@ use super::sys::{
     RawData, mjf_patch_delete_data, mjf_patch_get_stat, mjf_patch_id2name, mjf_patch_kinematics,
     mjf_patch_make_data, mjf_patch_make_m, mjf_patch_name2id, mjf_patch_nbytes, mjf_patch_option,
     mjf_patch_set_const, mjf_patch_set_stat, mjf_patch_size, mjf_patch_size_name,
+    mjf_tree_camlight, mjf_tree_constant, mjf_tree_data,
 };
 use crate::mujoco::{CompiledModel, compile_str};
 use crate::split::{
     ArrayMut, ModelArrays, ModelArraysMut, ModelLayout, PatchModel, StatArrays, Statistics,
+    TreeModel,
 };
 
 /// Scratch mjData for `mj_setConst` (which overwrites the qpos of the data it is given).
@@ -232,5 +235,66 @@ impl PatchModel for CompiledModel {
         // SAFETY: the model is live; `stat` holds 7 values.
         unsafe { mjf_patch_set_stat(self.as_mut_ptr(), stat.as_ptr()) };
         Ok(())
+    }
+}
+
+/// Whether the linked MuJoCo's `mj_setConst` sets the same-frame flags again.
+static RECOMPUTES_SAMEFRAME: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+
+impl TreeModel for CompiledModel {
+    fn compile_model(&self, xml: &str) -> Result<CompiledModel, String> {
+        compile_str(xml, Path::new(".")).map_err(|e| e.to_string())
+    }
+
+    fn constant(&self, name: &str) -> Option<i32> {
+        let name = CString::new(name).ok()?;
+        let mut found = 0;
+        // SAFETY: a NUL-terminated name; the C side only reads it.
+        let value = unsafe { mjf_tree_constant(name.as_ptr(), &mut found) };
+        (found != 0).then_some(value)
+    }
+
+    fn recomputes_sameframe(&self) -> Result<bool, String> {
+        if let Some(&known) = RECOMPUTES_SAMEFRAME.get() {
+            return Ok(known);
+        }
+        let xml = r#"<mujoco><worldbody><body><freejoint/><geom size=".1" pos=".1 0 0"/></body></worldbody></mujoco>"#;
+        let mut model = self.compile_model(xml)?;
+        let none = self
+            .constant("mjSAMEFRAME_NONE")
+            .ok_or("no mjSAMEFRAME_NONE")?;
+        let none = u8::try_from(none).map_err(|e| e.to_string())?;
+        model.bytes_mut("body_sameframe")?[1] = none;
+        let mut data = model.make_data()?;
+        model.set_const(&mut data)?;
+        let now = model.bytes("body_sameframe")?[1];
+        Ok(*RECOMPUTES_SAMEFRAME.get_or_init(|| now != none))
+    }
+
+    fn camlight(&mut self, data: &mut Scratch) -> Result<(), String> {
+        // SAFETY: the model and its scratch data are live and of one structure.
+        unsafe { mjf_tree_camlight(self.raw(), data.0.as_ptr()) };
+        Ok(())
+    }
+
+    fn with_data<R>(
+        &self,
+        data: &Scratch,
+        names: &[&str],
+        f: impl FnOnce(&[&[f64]]) -> R,
+    ) -> Result<R, String> {
+        let mut slices = Vec::with_capacity(names.len());
+        for name in names {
+            let c = CString::new(*name).map_err(|e| e.to_string())?;
+            let mut count = 0usize;
+            // SAFETY: live model and data; a NUL-terminated name.
+            let p = unsafe { mjf_tree_data(self.raw(), data.0.as_ptr(), c.as_ptr(), &mut count) };
+            if p.is_null() && count > 0 {
+                return Err(format!("no mjData array {name} here"));
+            }
+            // SAFETY: `count` numbers of the live data, read while it is borrowed.
+            slices.push(unsafe { crate::mujoco::slice_or_empty(p, count) });
+        }
+        Ok(f(&slices))
     }
 }

@@ -213,3 +213,63 @@ const char* mjf_patch_names(const mjModel* m, long long* len) {
   *len = (long long)m->nnames;
   return m->names;
 }
+
+// MuJoCo's enum constant `name`, as a superset's tree-by-tree derivation asks for them
+// (split/trees.rs); 0 with *found = 0 for any other name.
+int mjf_tree_constant(const char* name, int* found) {
+  static const struct {
+    const char* name;
+    int value;
+  } table[] = {
+      {"mjWRAP_JOINT", mjWRAP_JOINT},       {"mjWRAP_SITE", mjWRAP_SITE},
+      {"mjWRAP_SPHERE", mjWRAP_SPHERE},     {"mjWRAP_CYLINDER", mjWRAP_CYLINDER},
+      {"mjTRN_JOINT", mjTRN_JOINT},         {"mjTRN_JOINTINPARENT", mjTRN_JOINTINPARENT},
+      {"mjTRN_SITE", mjTRN_SITE},           {"mjTRN_SLIDERCRANK", mjTRN_SLIDERCRANK},
+      {"mjTRN_BODY", mjTRN_BODY},           {"mjTRN_TENDON", mjTRN_TENDON},
+      {"mjEQ_JOINT", mjEQ_JOINT},           {"mjEQ_TENDON", mjEQ_TENDON},
+      {"mjOBJ_BODY", mjOBJ_BODY},           {"mjOBJ_SITE", mjOBJ_SITE},
+      {"mjSAMEFRAME_NONE", mjSAMEFRAME_NONE},
+  };
+  for (size_t i = 0; i < sizeof(table) / sizeof(table[0]); i++) {
+    if (strcmp(name, table[i].name) == 0) {
+      *found = 1;
+      return table[i].value;
+    }
+  }
+  *found = 0;
+  return 0;
+}
+
+void mjf_tree_camlight(const mjModel* m, mjData* d) { mj_camlight(m, d); }
+
+// The mjData array `name` of the frames a tree-by-tree derivation reads after the
+// kinematics, and how many numbers it holds; NULL and 0 for any other name.
+const mjtNum* mjf_tree_data(const mjModel* m, const mjData* d, const char* name,
+                            size_t* count) {
+  if (strcmp(name, "xpos") == 0) {
+    *count = 3 * (size_t)m->nbody;
+    return d->xpos;
+  }
+  if (strcmp(name, "subtree_com") == 0) {
+    *count = 3 * (size_t)m->nbody;
+    return d->subtree_com;
+  }
+  if (strcmp(name, "cam_xpos") == 0) {
+    *count = 3 * (size_t)m->ncam;
+    return d->cam_xpos;
+  }
+  if (strcmp(name, "cam_xmat") == 0) {
+    *count = 9 * (size_t)m->ncam;
+    return d->cam_xmat;
+  }
+  if (strcmp(name, "light_xpos") == 0) {
+    *count = 3 * (size_t)m->nlight;
+    return d->light_xpos;
+  }
+  if (strcmp(name, "light_xdir") == 0) {
+    *count = 3 * (size_t)m->nlight;
+    return d->light_xdir;
+  }
+  *count = 0;
+  return NULL;
+}

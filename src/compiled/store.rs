@@ -15,17 +15,21 @@ use super::sys::{mjf_patch_names, mjf_patch_size, mjf_patch_size_name};
 use super::{bare, internal};
 use crate::mujoco::CompiledModel;
 use crate::split::{
-    CacheBackend, CacheCore, CacheError, Held, PatchFailure, PatchModel, PatchPlan, Request,
-    Signature, SignatureSource, Statistics,
+    CacheBackend, CacheCore, CacheError, Derivations, Held, PatchFailure, PatchModel, PatchPlan,
+    Request, Signature, SignatureSource, Statistics,
 };
 use crate::{ErrorKind, Errors};
 
-/// How to patch one model: the split tier's [`PatchPlan`] over the linked MuJoCo.
-pub(super) struct Plan(pub(super) PatchPlan<CompiledModel>);
+/// How to patch one model: the split tier's [`PatchPlan`] over the linked MuJoCo, and a
+/// superset's tree-by-tree derivations ([`Derivations`]).
+pub(super) struct Plan {
+    plan: PatchPlan<CompiledModel>,
+    trees: Derivations<CompiledModel>,
+}
 
 impl Held for Plan {
     fn nbytes(&self) -> usize {
-        self.0.nbytes()
+        self.plan.nbytes()
     }
 }
 
@@ -75,7 +79,22 @@ impl SignatureSource for CompiledModel {
 /// The linked MuJoCo as the split tier's cache core runs it ([`CacheBackend`]): compiled
 /// models by serial, their [`PatchPlan`]s, each patch's failure the structure's (a patch
 /// that does not land compiles the variant, as the core's rule says).
-pub(super) struct Linked;
+#[derive(Debug)]
+pub(super) struct Linked {
+    /// Whether a superset's patches derive tree by tree where their layout allows.
+    pub(super) by_tree: bool,
+    /// Superset patches derived tree by tree so far.
+    pub(super) derived: u64,
+}
+
+impl Default for Linked {
+    fn default() -> Self {
+        Linked {
+            by_tree: true,
+            derived: 0,
+        }
+    }
+}
 
 /// The cache core over the linked MuJoCo, as both caches of this face keep it.
 pub(super) type Core = CacheCore<Linked>;
@@ -104,9 +123,11 @@ impl CacheBackend for Linked {
         fixed: u32,
         values: Statistics,
     ) -> Result<Plan, Errors> {
-        PatchPlan::new(model, key, fixed, values)
-            .map(Plan)
-            .map_err(internal)
+        let plan = PatchPlan::new(model, key, fixed, values).map_err(internal)?;
+        Ok(Plan {
+            plan,
+            trees: Derivations::default(),
+        })
     }
 
     fn patch(
@@ -116,14 +137,13 @@ impl CacheBackend for Linked {
         request: &Request<'_>,
         _patches: u64,
     ) -> Result<(), PatchFailure<Errors>> {
+        let Plan { plan, trees } = plan;
         let r = plan
-            .0
-            .apply(model, request.entries)
-            .and_then(|()| match request.parked {
-                Some(parked) => plan.0.variant_inertia(model, parked),
-                None => Ok(()),
-            });
-        r.map_err(PatchFailure::NotThisStructure)
+            .write_patch(model, request.entries)
+            .and_then(|()| trees.finish(plan, model, request.parked, self.by_tree));
+        let derived = r.map_err(PatchFailure::NotThisStructure)?;
+        self.derived += u64::from(derived);
+        Ok(())
     }
 }
 

@@ -49,6 +49,14 @@ unsafe extern "C" {
     pub(super) fn mjf_patch_size(m: *const MjModel, i: c_int) -> i64;
     pub(super) fn mjf_patch_names(m: *const MjModel, len: *mut i64) -> *const c_char;
     pub(super) fn mjf_patch_array_type(i: c_int) -> *const c_char;
+    pub(super) fn mjf_tree_constant(name: *const c_char, found: *mut c_int) -> c_int;
+    pub(super) fn mjf_tree_camlight(m: *const MjModel, d: *mut RawData);
+    pub(super) fn mjf_tree_data(
+        m: *const MjModel,
+        d: *const RawData,
+        name: *const c_char,
+        count: *mut usize,
+    ) -> *const f64;
     pub(super) fn mjf_patch_option(
         m: *mut MjModel,
         name: *const c_char,

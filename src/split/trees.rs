@@ -25,7 +25,7 @@
 
 use std::collections::{BTreeMap, HashMap};
 
-use super::plan::LayoutEntry;
+use super::plan::{LayoutEntry, PatchPlan};
 use super::targets::{GEOM_FACTORS, JOINT_TYPES, LAYOUTS_KEPT, MODEL_FIELDS, joint_widths};
 use super::{PatchModel, target_array, write_frame_flags};
 
@@ -892,6 +892,36 @@ impl<M: TreeModel> Default for Derivations<M> {
 }
 
 impl<M: TreeModel> Derivations<M> {
+    /// What follows a patch `plan` wrote into `model` ([`PatchPlan::finish`]): for a
+    /// superset world (`parked`: the root bodies of the objects it parks) with `by_tree`,
+    /// derived tree by tree where its layout allows, else `mj_setConst`; then for a
+    /// superset the world's `stat.meaninertia` ([`PatchPlan::variant_inertia`]). Whether it
+    /// was derived tree by tree. The rule both faces' caches follow.
+    pub fn finish<S: AsRef<str>>(
+        &mut self,
+        plan: &mut PatchPlan<M>,
+        model: &mut M,
+        parked: Option<&[S]>,
+        by_tree: bool,
+    ) -> Result<bool, String> {
+        let mut derived = false;
+        match parked.filter(|_| by_tree) {
+            None => plan.finish(model, None)?,
+            Some(roots) => {
+                let finishes = plan.finishes();
+                let mut derive = |m: &mut M, d: &mut M::Data, layout: &[LayoutEntry]| {
+                    derived = self.derive(m, d, layout, roots, finishes)?;
+                    Ok(derived)
+                };
+                plan.finish(model, Some(&mut derive))?;
+            }
+        }
+        if let Some(roots) = parked {
+            plan.variant_inertia(model, roots)?;
+        }
+        Ok(derived)
+    }
+
     /// What `mj_setConst` derives for a superset world of `layout` whose objects named
     /// `parked` are parked: tree by tree where the layout allows (returns true: `data`
     /// then holds the kinematics at `qpos0`), else `mj_setConst` itself (false).

@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyString;
 
 use super::arrays::Array;
-use super::user_model::{UserData, UserModel};
+use super::user_model::UserModel;
 use crate::errors::mjcf_error;
 use mjcf_forge::split::{
     self, Carried, Derivations, LayoutEntry, PatchEntry, PatchFailure, PatchModel, PatchValues,
@@ -126,22 +126,7 @@ impl Core {
     /// derivation ran tree by tree.
     fn finish(&mut self, parked: Option<&[String]>, by_tree: bool) -> Result<bool, String> {
         let Core { user, plan, trees } = self;
-        let mut derived = false;
-        match parked.filter(|_| by_tree) {
-            None => plan.finish(user, None)?,
-            Some(roots) => {
-                let finishes = plan.finishes();
-                let mut derive = |m: &mut UserModel, d: &mut UserData, layout: &[LayoutEntry]| {
-                    derived = trees.derive(m, d, layout, roots, finishes)?;
-                    Ok(derived)
-                };
-                plan.finish(user, Some(&mut derive))?;
-            }
-        }
-        if let Some(roots) = parked {
-            plan.variant_inertia(user, roots)?;
-        }
-        Ok(derived)
+        trees.finish(plan, user, parked, by_tree)
     }
 }
 
