@@ -215,7 +215,7 @@ const char* mjf_patch_names(const mjModel* m, long long* len) {
 }
 
 // MuJoCo's enum constant `name`, as a superset's tree-by-tree derivation asks for them
-// (split/trees.rs); 0 with *found = 0 for any other name.
+// (split/trees/); 0 with *found = 0 for any other name.
 int mjf_tree_constant(const char* name, int* found) {
   static const struct {
     const char* name;

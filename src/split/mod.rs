@@ -39,7 +39,7 @@
 //! `crate::document::rotation`, the compiler's rotations and eigen-decomposition, and `volumes.rs`, its
 //! bounding-volume trees), `statistics.rs` (the
 //! compiler's statistics at `qpos0`, computed over a model's arrays for both faces),
-//! `trees.rs` (what `mj_setConst` derives for a superset world, tree by tree). The scene tier reads its
+//! `trees/` (what `mj_setConst` derives for a superset world, tree by tree). The scene tier reads its
 //! drawn variants through the same rules (`scene/patch.rs`).
 //!
 //! May use: the document tier and `crate::error`. Knows nothing of scenes or of MuJoCo
