@@ -258,17 +258,8 @@ impl TreeModel for CompiledModel {
         if let Some(&known) = RECOMPUTES_SAMEFRAME.get() {
             return Ok(known);
         }
-        let xml = r#"<mujoco><worldbody><body><freejoint/><geom size=".1" pos=".1 0 0"/></body></worldbody></mujoco>"#;
-        let mut model = self.compile_model(xml)?;
-        let none = self
-            .constant("mjSAMEFRAME_NONE")
-            .ok_or("no mjSAMEFRAME_NONE")?;
-        let none = u8::try_from(none).map_err(|e| e.to_string())?;
-        model.bytes_mut("body_sameframe")?[1] = none;
-        let mut data = model.make_data()?;
-        model.set_const(&mut data)?;
-        let now = model.bytes("body_sameframe")?[1];
-        Ok(*RECOMPUTES_SAMEFRAME.get_or_init(|| now != none))
+        let probed = self.sameframe_probe()?;
+        Ok(*RECOMPUTES_SAMEFRAME.get_or_init(|| probed))
     }
 
     fn camlight(&mut self, data: &mut Scratch) -> Result<(), String> {

@@ -329,7 +329,8 @@ impl PatchModel for UserModel {
 }
 
 /// The enum of MuJoCo's bindings that holds constant `name`, by its prefix.
-const ENUMS: [(&str, &str); 4] = [
+const ENUMS: [(&str, &str); 5] = [
+    ("mjSAMEFRAME_", "mjtSameFrame"),
     ("mjWRAP_", "mjtWrap"),
     ("mjTRN_", "mjtTrn"),
     ("mjEQ_", "mjtEq"),
@@ -368,20 +369,8 @@ impl TreeModel for UserModel {
         if let Some(&known) = RECOMPUTES_SAMEFRAME.get() {
             return Ok(known);
         }
-        let r = Python::attach(|py| -> PyResult<bool> {
-            let mujoco = self.mujoco.bind(py);
-            let xml = r#"<mujoco><worldbody><body><freejoint/><geom size=".1" pos=".1 0 0"/></body></worldbody></mujoco>"#;
-            let model = upcalls::get(py, "compile_xml")?.call1((mujoco, xml))?;
-            let none = mujoco.getattr("mjtSameFrame")?.getattr("mjSAMEFRAME_NONE")?;
-            let none: i64 = none.extract()?;
-            model.getattr("body_sameframe")?.set_item(1, none)?;
-            let data = mujoco.getattr("MjData")?.call1((&model,))?;
-            mujoco.getattr("mj_setConst")?.call1((&model, data))?;
-            let now: i64 = model.getattr("body_sameframe")?.get_item(1)?.extract()?;
-            Ok(now != none)
-        })
-        .map_err(|e| e.to_string())?;
-        Ok(*RECOMPUTES_SAMEFRAME.get_or_init(|| r))
+        let probed = self.sameframe_probe()?;
+        Ok(*RECOMPUTES_SAMEFRAME.get_or_init(|| probed))
     }
 
     fn camlight(&mut self, data: &mut UserData) -> Result<(), String> {

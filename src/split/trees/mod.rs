@@ -44,8 +44,23 @@ pub trait TreeModel: PatchModel + Sized {
     /// `mjEQ_JOINT`, `mjOBJ_SITE`...), as this MuJoCo numbers it.
     fn constant(&self, name: &str) -> Option<i32>;
     /// Whether this MuJoCo's `mj_setConst` sets the bodies', geoms' and sites' same-frame
-    /// flags again from their frames (4.0 does; 3.17 keeps the compiler's).
+    /// flags again from their frames (4.0 does; 3.17 keeps the compiler's): the face keeps
+    /// the answer of [`TreeModel::sameframe_probe`] (one MuJoCo per process).
     fn recomputes_sameframe(&self) -> Result<bool, String>;
+    /// Asks this MuJoCo [`TreeModel::recomputes_sameframe`]'s question: a body's flag set
+    /// to `mjSAMEFRAME_NONE` in a compiled model, then `mj_setConst`.
+    fn sameframe_probe(&self) -> Result<bool, String> {
+        let xml = r#"<mujoco><worldbody><body><freejoint/><geom size=".1" pos=".1 0 0"/></body></worldbody></mujoco>"#;
+        let mut model = self.compile_model(xml)?;
+        let none = self
+            .constant("mjSAMEFRAME_NONE")
+            .and_then(|n| u8::try_from(n).ok())
+            .ok_or("this MuJoCo has no mjSAMEFRAME_NONE")?;
+        model.bytes_mut("body_sameframe")?[1] = none;
+        let mut data = model.make_data()?;
+        model.set_const(&mut data)?;
+        Ok(model.bytes("body_sameframe")?[1] != none)
+    }
     /// `mj_camlight` on `data` (its kinematics and centres of mass done).
     fn camlight(&mut self, data: &mut Self::Data) -> Result<(), String>;
     /// Calls `f` with `data`'s `mjtNum` arrays `names`, in order.
