@@ -194,6 +194,32 @@ impl split::ModelArraysMut for Writer<'_> {
     }
 }
 
+impl PyModelArrays {
+    /// Adds the arrays a superset's tree-by-tree derivation reads and writes (the
+    /// patched model's and its skeletons', not a body model's).
+    pub(super) fn add_tree_arrays(&mut self, model: &Bound<'_, PyAny>) -> PyResult<()> {
+        // Where this MuJoCo has them (an older one may lack some: the derivation then
+        // declines, and mj_setConst runs).
+        let found = |name: &str| model.getattr(name).ok().filter(|a| !a.is_none());
+        for name in TREE_FLOATS {
+            if let Some(a) = found(name) {
+                self.floats.insert(name, Array::of(&a, name, true)?);
+            }
+        }
+        for name in TREE_INTS {
+            if let Some(a) = found(name) {
+                self.ints.insert(name, Array::of(&a, name, true)?);
+            }
+        }
+        for name in TREE_BYTES {
+            if let Some(a) = found(name) {
+                self.bytes.insert(name, Array::of(&a, name, true)?);
+            }
+        }
+        Ok(())
+    }
+}
+
 #[pymethods]
 impl PyModelArrays {
     #[new]
@@ -218,24 +244,6 @@ impl PyModelArrays {
             arrays
                 .bytes
                 .insert(name, Array::of(&model.getattr(name)?, name, true)?);
-        }
-        // Where this MuJoCo has them (an older one may lack some: the derivation then
-        // declines, and mj_setConst runs).
-        let found = |name: &str| model.getattr(name).ok().filter(|a| !a.is_none());
-        for name in TREE_FLOATS {
-            if let Some(a) = found(name) {
-                arrays.floats.insert(name, Array::of(&a, name, true)?);
-            }
-        }
-        for name in TREE_INTS {
-            if let Some(a) = found(name) {
-                arrays.ints.insert(name, Array::of(&a, name, true)?);
-            }
-        }
-        for name in TREE_BYTES {
-            if let Some(a) = found(name) {
-                arrays.bytes.insert(name, Array::of(&a, name, true)?);
-            }
         }
         arrays.massless = split::massless_frames(&arrays).map_err(PyValueError::new_err)?;
         Ok(arrays)

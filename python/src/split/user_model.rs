@@ -129,8 +129,10 @@ impl UserModel {
     /// `model` of the user's `mujoco`, its arrays found once.
     pub(super) fn new(mujoco: Bound<'_, PyAny>, model: Bound<'_, PyAny>) -> PyResult<UserModel> {
         let stat = model.getattr("stat")?;
+        let mut arrays = PyModelArrays::new(&model)?;
+        arrays.add_tree_arrays(&model)?;
         Ok(UserModel {
-            arrays: PyModelArrays::new(&model)?,
+            arrays,
             center: Array::of(&stat.getattr("center")?, "stat.center", true)?,
             opt: model.getattr("opt")?.unbind(),
             stat: stat.unbind(),
