@@ -67,6 +67,27 @@ def restored_arrays(mujoco: Any, model: Any) -> list[str]:
     return [n for n in names if isinstance(getattr(model, n, None), np.ndarray)]
 
 
+def snapshot_fields(mujoco: Any, model: Any) -> list[tuple[tuple[str, ...], str]]:
+    """What ``DocumentCache`` writes back into a model before each patch, as
+    ``(path, name)`` pairs (``model.<path...>.<name>``): every array but the bulk data
+    (:func:`restored_arrays`), and the numbers of ``model.opt`` and ``model.vis``.
+
+    >>> import mujoco
+    >>> model = mujoco.MjModel.from_xml_string("<mujoco/>")
+    >>> fields = snapshot_fields(mujoco, model)
+    >>> ((), "body_mass") in fields, (("opt",), "timestep") in fields
+    (True, True)
+    """
+    fields: list[tuple[tuple[str, ...], str]] = [((), n) for n in restored_arrays(mujoco, model)]
+    for path in [("opt",)] + [("vis", v) for v in VISUAL]:
+        obj = model
+        for part in path:
+            obj = getattr(obj, part, None)
+        if obj is not None:
+            fields.extend((path, n) for n in struct_fields(obj))
+    return fields
+
+
 def struct_fields(obj: Any) -> list[str]:
     """The number fields of a struct of the bindings (``model.opt``, ``model.vis.map``)."""
     return [

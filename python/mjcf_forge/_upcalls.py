@@ -23,7 +23,7 @@ from typing import Any, Optional
 from ._errors import MjcfFileNotFoundError
 from ._last_xml import compile_xml
 from ._mjcf_utils import without_materials
-from ._mujoco import inertia_diagonal, make_inertia
+from ._mujoco import inertia_diagonal, make_inertia, snapshot_fields
 from ._preview import preview
 from ._progress import progress_of
 from ._settings import model_cache
@@ -39,6 +39,7 @@ __all__ = [
     "mujoco_version",
     "preview",
     "progress_of",
+    "snapshot_fields",
 ]
 
 

@@ -56,23 +56,7 @@ impl CacheBackend for UserBackend {
     }
 
     fn stat(&self, model: &Py<PyAny>) -> Statistics {
-        let mut out = [0.0; 7];
-        Python::attach(|py| {
-            let Ok(stat) = model.bind(py).getattr("stat") else {
-                return;
-            };
-            for (k, name) in STATISTIC_NAMES[..4].iter().enumerate() {
-                out[k] = stat.getattr(*name).and_then(|v| v.extract()).unwrap_or(0.0);
-            }
-            let center: Vec<f64> = stat
-                .getattr("center")
-                .and_then(|c| c.extract())
-                .unwrap_or_default();
-            if center.len() == 3 {
-                out[4..].copy_from_slice(&center);
-            }
-        });
-        out
+        Python::attach(|py| statistics_of(model.bind(py)))
     }
 
     fn plan(
@@ -109,6 +93,25 @@ impl CacheBackend for UserBackend {
         self.derived += u64::from(derived);
         Ok(())
     }
+}
+
+/// `model.stat`'s numbers in `STATISTIC_NAMES`' order (zeros where one cannot be read).
+pub(crate) fn statistics_of(model: &Bound<'_, PyAny>) -> Statistics {
+    let mut out = [0.0; 7];
+    let Ok(stat) = model.getattr("stat") else {
+        return out;
+    };
+    for (k, name) in STATISTIC_NAMES[..4].iter().enumerate() {
+        out[k] = stat.getattr(*name).and_then(|v| v.extract()).unwrap_or(0.0);
+    }
+    let center: Vec<f64> = stat
+        .getattr("center")
+        .and_then(|c| c.extract())
+        .unwrap_or_default();
+    if center.len() == 3 {
+        out[4..].copy_from_slice(&center);
+    }
+    out
 }
 
 /// The core and its backend, one call at a time.

@@ -11,6 +11,7 @@
 //! compile_xml(mujoco, xml)          a PatchPlan's body model compiled by the user's mujoco
 //! inertia_diagonal(model, data)     where that version keeps the joint-space inertia
 //! make_inertia(mujoco, model, data) that version's mj_makeM (or mj_crb)
+//! snapshot_fields(mujoco, model)    what DocumentCache writes back before a patch
 //! ```
 //!
 //! Every other import the extension makes (the standard library's `json`, `errno`,

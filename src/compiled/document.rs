@@ -7,11 +7,97 @@
 
 use std::path::Path;
 
-use super::store::{Core, Linked, cache_error};
+use super::internal;
+use super::store::{Linked, Plan, cache_error};
 use crate::document::Document;
 use crate::error::Errors;
 use crate::mujoco::{CompiledModel, compile_document};
-use crate::split::{Request, SplitOptions, fixed_statistics_mask, split_document_with};
+use crate::split::{
+    CacheBackend, DocumentBackend, DocumentCore, Held, PatchFailure, Request, SplitOptions,
+    Statistics, Step, fixed_statistics_mask, split_document_with,
+};
+
+/// The linked MuJoCo as the split tier's document cache runs it ([`DocumentBackend`]):
+/// each model with its [`Plan`], patched as the model cache patches its models. The cache
+/// lends its models (`&CompiledModel`), so no caller holds or changes one: nothing is
+/// written back before a patch, and no model is ever held (the pools keep one model).
+struct LinkedDocs(Linked);
+
+/// One model of a structure and its plan.
+struct Working {
+    model: CompiledModel,
+    plan: Plan,
+}
+
+impl Held for Working {
+    fn nbytes(&self) -> usize {
+        self.plan.nbytes()
+    }
+}
+
+/// A structure's snapshot on this face: the statistics as compiled (what the document
+/// fixes is kept at these values).
+struct Compiled(Statistics);
+
+impl Held for Compiled {
+    fn nbytes(&self) -> usize {
+        0
+    }
+}
+
+impl DocumentBackend for LinkedDocs {
+    type Model = CompiledModel;
+    type Working = Working;
+    type Snapshot = Compiled;
+    type Error = Errors;
+
+    fn id(model: &CompiledModel) -> u64 {
+        model.serial()
+    }
+
+    fn model(working: &Working) -> &CompiledModel {
+        &working.model
+    }
+
+    fn snapshot(&mut self, model: &CompiledModel) -> Result<Compiled, Errors> {
+        Ok(Compiled(self.0.stat(model)))
+    }
+
+    fn working(
+        &mut self,
+        mut model: CompiledModel,
+        snapshot: &Compiled,
+        request: &Request<'_>,
+    ) -> Result<Working, (CompiledModel, PatchFailure<Errors>)> {
+        let plan = self.0.plan(&model, request.key, request.fixed, snapshot.0);
+        let mut plan = match plan {
+            Ok(plan) => plan,
+            Err(e) => return Err((model, PatchFailure::Backend(e))),
+        };
+        if let Err(m) = plan.resolve(&mut model, request.entries) {
+            return Err((model, PatchFailure::NotThisStructure(m)));
+        }
+        Ok(Working { model, plan })
+    }
+
+    fn held(&self, _working: &Working) -> bool {
+        false
+    }
+
+    fn copy(&mut self, working: &Working) -> Result<CompiledModel, Errors> {
+        Ok(working.model.clone())
+    }
+
+    fn patch(
+        &mut self,
+        working: &mut Working,
+        _snapshot: &Compiled,
+        request: &Request<'_>,
+    ) -> Result<(), PatchFailure<Errors>> {
+        let Working { model, plan } = working;
+        self.0.patch(plan, model, request, 0)
+    }
+}
 
 /// Compiled models of documents, one per structure, patched per document; bounded in
 /// count and bytes (models and their scratch data), least recently used out.
@@ -47,7 +133,10 @@ use crate::split::{Request, SplitOptions, fixed_statistics_mask, split_document_
 /// # Ok::<(), mjcf_forge::Errors>(())
 /// ```
 pub struct DocumentCache {
-    core: Core,
+    core: DocumentCore<LinkedDocs>,
+    backend: LinkedDocs,
+    /// The last compile that the cache could not keep (its structure's layout refused).
+    alone: Option<CompiledModel>,
 }
 
 impl DocumentCache {
@@ -55,7 +144,9 @@ impl DocumentCache {
     /// given, about `max_bytes` of models and scratch data.
     pub fn new(max_models: usize, max_bytes: Option<usize>) -> DocumentCache {
         DocumentCache {
-            core: Core::new(max_models, max_bytes, false),
+            core: DocumentCore::new(max_models, max_bytes),
+            backend: LinkedDocs(Linked::default()),
+            alone: None,
         }
     }
 
@@ -71,13 +162,29 @@ impl DocumentCache {
             parked: None,
             fixed: fixed_statistics_mask(split.fixed_statistics.iter().copied()),
         };
-        // When a value does not fit the cached model (a material that does not exist),
-        // MuJoCo's own verdict follows (the core compiles). The cached model is whole again
-        // after its next patch, which writes every entry of the structure.
-        let compile = || compile_document(doc).map_err(|e| Errors(vec![e]));
+        let key = &split.structure_key;
+        let step = self.core.model(&mut self.backend, &request, &[]);
+        let replace = match step.map_err(|e| cache_error(e, 0, key))? {
+            Step::Ready => return self.given(key),
+            Step::Compile { replace } => replace,
+            // This cache is `&mut`: no other call compiles meanwhile.
+            Step::Wait => return Err(internal(format!("structure {key} is being compiled"))),
+        };
+        let compiled = compile_document(doc).map_err(|e| Errors(vec![e]));
+        let kept = self
+            .core
+            .compiled(&mut self.backend, &request, compiled, replace)
+            .map_err(|e| cache_error(e, 0, key))?;
+        match kept {
+            Some(alone) => Ok(self.alone.insert(alone)),
+            None => self.given(key),
+        }
+    }
+
+    fn given(&self, key: &str) -> Result<&CompiledModel, Errors> {
         self.core
-            .model(&mut Linked::default(), &request, compile)
-            .map_err(|e| cache_error(e, 0, &split.structure_key))
+            .given()
+            .ok_or_else(|| internal(format!("structure {key} has no model")))
     }
 
     /// The MJCF text `xml` as MuJoCo compiles it, relative file names resolved against

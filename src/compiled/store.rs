@@ -27,6 +27,17 @@ pub(super) struct Plan {
     trees: Derivations<CompiledModel>,
 }
 
+impl Plan {
+    /// Where every entry of `entries` lands in `model` (see `PatchPlan::resolve_patch`).
+    pub(super) fn resolve(
+        &mut self,
+        model: &mut CompiledModel,
+        entries: &[crate::split::PatchEntry],
+    ) -> Result<(), String> {
+        self.plan.resolve_patch(model, entries)
+    }
+}
+
 impl Held for Plan {
     fn nbytes(&self) -> usize {
         self.plan.nbytes()

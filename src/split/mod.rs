@@ -31,7 +31,9 @@
 //! written, for both faces), `plan.rs` (one model patched in place: the patch plan both
 //! faces' caches run, over their own MuJoCo), `store.rs` (the models and plans a cache
 //! keeps, and the bound on them), `cache.rs` (the model cache both faces run over their
-//! MuJoCo: misses, patches, a caller's model checked), `signature.rs` (what tells one structure's compiled model
+//! MuJoCo: misses, patches, a caller's model checked), `documents.rs` (the document cache
+//! both faces run: per-thread pools of models given out, snapshots, `into`, one compile per
+//! structure across threads), `signature.rs` (what tells one structure's compiled model
 //! from another's), `document.rs` (any document split by reading it), `body_model.rs` (a body's geoms as a
 //! model of their own, for what MuJoCo derives from their sizes), `body_copy.rs` (that
 //! model's compile copied into a structure's model, for both faces), `geom_masses.rs` (a
@@ -49,6 +51,7 @@ mod body_copy;
 mod body_model;
 mod cache;
 mod document;
+mod documents;
 mod geom_masses;
 mod landing;
 mod plan;
@@ -67,6 +70,7 @@ pub use cache::{CacheBackend, CacheCore, CacheError, PatchFailure, Request};
 pub use document::{
     DocumentPatch, PATCHABLE_OPTIONS, SplitOptions, split_document, split_document_with,
 };
+pub use documents::{DocumentBackend, DocumentCore, POOL, Refused, Step};
 pub use geom_masses::{
     BodyMass, FRAME_FLAGS, GeomMass, body_frame_flag, body_mass, frame_flag, write_frame_flags,
     write_geom_masses,

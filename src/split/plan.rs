@@ -359,8 +359,7 @@ impl<M: PatchModel> PatchPlan<M> {
             }
         }
         if !same {
-            self.resolve(model, patch.iter().map(LayoutEntry::of).collect())?;
-            self.set_resolved_bodies(&bodies);
+            self.resolve_patch(model, patch)?;
         }
         let values = PatchValues {
             numbers: &numbers,
@@ -368,6 +367,21 @@ impl<M: PatchModel> PatchPlan<M> {
             bodies: &bodies,
         };
         self.write(model, values)
+    }
+
+    /// Where every entry of `patch` lands in `model` ([`PatchPlan::resolve`] of its
+    /// layout), its body models taken as what the model holds.
+    pub fn resolve_patch(&mut self, model: &mut M, patch: &[PatchEntry]) -> Result<(), String> {
+        self.resolve(model, patch.iter().map(LayoutEntry::of).collect())?;
+        let bodies: Vec<&str> = patch
+            .iter()
+            .filter_map(|e| match &e.value {
+                PatchValue::BodyModel(xml) => Some(xml.as_str()),
+                _ => None,
+            })
+            .collect();
+        self.set_resolved_bodies(&bodies);
+        Ok(())
     }
 
     /// Records the body texts of the patch the layout was resolved with (a body model

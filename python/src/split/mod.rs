@@ -1,8 +1,8 @@
 //! The split tier's face in Python: its tables (`tables.rs`, the one copy of each the
 //! package's caches read) and the rules the caches run over the user's `MjModel` in place
-//! (`plan.rs`, the split tier's patch plan over the user's `mujoco`, and `store.rs`, its
-//! bound on what a cache keeps; with `patch.rs`,
-//! `statistics.rs`, `body_models.rs`, through `arrays.rs`).
+//! (`plan.rs`, the split tier's patch plan over the user's `mujoco`, and `snapshot.rs`,
+//! what the document cache writes back before a patch; with `patch.rs`, `statistics.rs`,
+//! `body_models.rs`, through `arrays.rs`).
 
 // NumPy's memory read in place: the bindings' only unsafe code.
 #[allow(unsafe_code)]
@@ -15,8 +15,9 @@ mod patch;
 mod plan;
 mod signature;
 #[allow(unsafe_code)]
+mod snapshot;
+#[allow(unsafe_code)]
 mod statistics;
-mod store;
 mod tables;
 #[allow(unsafe_code)]
 mod user_model;
@@ -25,6 +26,7 @@ use pyo3::prelude::*;
 
 pub(crate) use plan::PyPatchPlan;
 pub(crate) use signature::signature_of;
+pub(crate) use snapshot::{Snapshot, Views, references};
 
 /// Adds the tier's tables, functions and classes to the module.
 pub(crate) fn add(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -32,7 +34,6 @@ pub(crate) fn add(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<statistics::PyStatistics>()?;
     m.add_class::<body_models::PyModelArrays>()?;
     m.add_class::<plan::PyPatchPlan>()?;
-    m.add_class::<store::PyModelStore>()?;
     m.add_function(wrap_pyfunction!(signature::structure_signature, m)?)?;
     Ok(())
 }

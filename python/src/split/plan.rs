@@ -201,6 +201,21 @@ impl PyPatchPlan {
         })
     }
 
+    /// Where every entry of `entries` lands (the document cache's check that a model
+    /// takes its structure's layout).
+    pub(crate) fn resolve_entries(
+        &self,
+        entries: &[PatchEntry],
+    ) -> Result<(), PatchFailure<PyErr>> {
+        let mut core = hold(&self.core).map_err(PatchFailure::Backend)?;
+        let Core { user, plan, .. } = &mut *core;
+        let r = plan.resolve_patch(user, entries);
+        r.map_err(|e| match core.user.pending.take() {
+            Some(raised) => PatchFailure::Backend(raised),
+            None => PatchFailure::NotThisStructure(e),
+        })
+    }
+
     /// A superset world's patch as `Superset.worlds` gives it: its numbers end to end
     /// (`numbers`, native-endian `f64` bytes) and its strings (material names and body
     /// models, in entry order), of the layout of `patch0` (resolved when it is not the
