@@ -1,9 +1,8 @@
 //! What both faces' model caches keep, and the one rule that bounds it: a [`ModelStore`]
 //! of models by structure key (least recently used first) and of patch plans by model
 //! (the cache's own models' and its callers'), bounded by a count and about a number of
-//! bytes. The C face keeps compiled models and `PatchPlan`s in it (`compiled/store.rs`),
-//! the Python face the user's `MjModel`s and their plans (`python/src/split/store.rs`,
-//! for `ModelCache` and `DocumentCache`).
+//! bytes. The cache cores keep it: [`CacheCore`](super::CacheCore) models and their
+//! plans, [`DocumentCore`](super::DocumentCore) structures, each counting its own bytes.
 //!
 //! ```
 //! use mjcf_forge::split::{Held, ModelStore};
