@@ -18,18 +18,8 @@ from typing import Any
 
 import numpy as np
 
-from ._mjcf_forge import (
-    STATIC_PREFIXES,
-    STATISTIC_NAMES,
-    CacheCore,
-    PatchPlan,
-    Scene,
-)
+from ._mjcf_forge import CacheCore, PatchPlan, Scene, WorldRows
 from ._progress import progress_of
-
-
-def copy_value(value: Any) -> Any:
-    return value.copy() if hasattr(value, "copy") else value
 
 
 class ModelCache:
@@ -175,34 +165,17 @@ class ModelCache:
                 bar.close()
             return {}
         model = copy.copy(self.model(variants[0]))
-        names = [
-            n
-            for n in dir(model)
-            if not n.startswith("_")
-            and isinstance(getattr(model, n, None), np.ndarray)
-            and not n.startswith(STATIC_PREFIXES)
-        ]
-        rows: dict[str, list[np.ndarray]] = {n: [] for n in names}
-        stats = {f"stat.{s}": [] for s in STATISTIC_NAMES}
+        rows = WorldRows(model, model, ["qpos0"])
         try:
             for v in variants:
                 self.apply(v, model)
-                for n in names:
-                    rows[n].append(getattr(model, n).copy())
-                for s in stats:
-                    stats[s].append(np.array(getattr(model.stat, s[5:]), dtype=np.float64))
+                rows.push()
                 if bar is not None:
                     bar.update(1)
         finally:
             if bar is not None:
                 bar.close()
-        out = {}
-        for n, r in rows.items():
-            stacked = np.stack(r)
-            if n == "qpos0" or not (stacked == stacked[0]).all():
-                out[n] = stacked
-        out.update((s, np.stack(r)) for s, r in stats.items())
-        return out
+        return rows.arrays()
 
 
 # The batch tier's access to a superset cache (batch.py, _warp.py): functions of this

@@ -40,8 +40,9 @@ from ._mjcf_forge import (
     FROM_GEOMS,
     LAYOUTS_KEPT,
     SET_CONST_DERIVED,
-    STATIC_PREFIXES,
     STATISTIC_NAMES,
+    WorldRows,
+    patchable_arrays,
     target_array,
 )
 from ._mjx import MjxWorlds
@@ -117,50 +118,46 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         self.key = self._key_id(key)
         self._patched = _patched_arrays(self.superset.patch(indices[0]))
         model = self.model
-        self._fields = [
-            n
-            for n in dir(model)
-            if not n.startswith("_")
-            and isinstance(getattr(model, n, None), np.ndarray)
-            and not n.startswith(STATIC_PREFIXES)
-        ]
-        self._candidates = sorted((self._patched | set(SET_CONST_DERIVED)) & set(self._fields))
-        # Every other field as the batch's first world holds it: a world's row of one is
-        # kept only when it differs (no superset patch makes one differ; checked anyway).
-        self._others = {
-            n: getattr(model, n).tobytes() for n in self._fields if n not in self._candidates
-        }
+        fields = patchable_arrays(model)
+        self._candidates = sorted((self._patched | set(SET_CONST_DERIVED)) & set(fields))
+        others = set(fields) - set(self._candidates)
+        keys = self._key_arrays(model) if model.nkey else []
+        # Every world's rows of the candidates (and keyframes); of every other field, only
+        # where a world differs from the batch's first (no superset patch makes one differ;
+        # checked anyway): split::WorldRows, the rule ModelCache.batch keeps too.
+        self._rows_of = WorldRows(model, self._scratch, self._candidates + keys, fields + keys)
         self._data: Any = None
         self._root_of_geom = model.body_rootid[model.geom_bodyid]
         # A patch of each layout Superset.worlds has given, by layout.
         self._layouts: dict[tuple, Any] = {}
-        self._written = [n for n in BODY_MODEL_WRITES if n in self._others]
+        self._written = [n for n in BODY_MODEL_WRITES if n in others]
         self._flags = [n for n in self._written if n.endswith("_sameframe")]
-        self._from_geoms = [n for n in FROM_GEOMS if n in self._others]
+        self._from_geoms = [n for n in FROM_GEOMS if n in others]
         #: Worlds whose derived values came tree by tree (the others: mj_setConst; see
         #: ``mjcf_forge::split::TreeDerivation``: the same bits).
         self.derived_by_tree = 0
         bar = progress_of(progress, len(indices), "worlds")
+        parked = []
         try:
-            rows = []
             for world in self._worlds(indices):
-                rows.append(self._rows(world))
+                compare, mask = self._patch(world)
+                self._rows_of.push(compare)
+                parked.append(mask)
                 if bar is not None:
                     bar.update(1)
         finally:
             if bar is not None:
                 bar.close()
-        varying = sorted({n for r in rows for n in r if n in self._others})
+        kept = self._rows_of.arrays()
+        varying = sorted(n for n in kept if n in others)
         self.per_world = self._candidates + varying + [f"stat.{s}" for s in STATISTIC_NAMES]
-        self.arrays = {
-            n: np.stack([r[n] if n in r else getattr(model, n) for r in rows]) for n in self.per_world
-        }
-        self.parked_geoms = np.stack([r["parked_geoms"] for r in rows])
+        self.arrays = {n: kept[n] for n in self.per_world}
+        self.parked_geoms = np.stack(parked)
         #: Every world's keyframes as its own patched model holds them (a key's rows for
         #: an object's free joint are its pose in that world, placed or parked):
         #: ``key_qpos`` ``(nworld, nkey, nq)``, ``key_qvel``, ``key_act``, ``key_ctrl``,
         #: ``key_mpos``, ``key_mquat``, ``key_time``; empty without keyframes.
-        self.keys = {n: np.stack([r[n] for r in rows]) for n in self._key_arrays(model) if n in rows[0]}
+        self.keys = {n: kept[n] for n in keys}
         self.world_variant = np.array(indices, dtype=np.int64)
         self._warp: Any = None
         self._mjx: Any = None
@@ -286,9 +283,10 @@ class WorldBatch(WarpWorlds, MjxWorlds):
             ]
         return names
 
-    def _rows(self, world: tuple) -> dict[str, np.ndarray]:
-        """Every field of the superset patched for one world (``_worlds``), its
-        statistics, its parked geoms; a parked geom that touches anything at the initial
+    def _patch(self, world: tuple) -> tuple[list[str] | None, np.ndarray]:
+        """The superset patched for one world (``_worlds``) into the scratch model: which
+        arrays beyond the candidates it may have written (``None``: any, ``mj_setConst``
+        ran), and its parked geoms; a parked geom that touches anything at the initial
         pose is an error."""
         index, numbers, strings, parked_names, patch0 = world
         cache = self.cache
@@ -297,27 +295,17 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         model = apply_world(cache, self._scratch, (index, numbers, strings, parked_names), patch0)
         by_tree = cache.by_tree != before
         self.derived_by_tree += by_tree
-        out = {n: getattr(model, n).copy() for n in self._candidates}
         # mj_setConst may write any field (none differs for a superset patch); derived
         # tree by tree, only the patch and its body models write.
+        compare: list[str] | None
         if not by_tree:
-            others = self._others
+            compare = None
         elif self._plan_of_scratch().body_models:
-            others = self._written + self._from_geoms
+            compare = self._written + self._from_geoms
         else:
-            others = self._flags + self._from_geoms
-        for n in others:
-            value = getattr(model, n)
-            if value.tobytes() != self._others[n]:
-                out[n] = value.copy()
-        for s in STATISTIC_NAMES:
-            out[f"stat.{s}"] = np.array(getattr(model.stat, s), dtype=np.float64)
-        if model.nkey:
-            for n in self._key_arrays(model):
-                out[n] = getattr(model, n).copy()
+            compare = self._flags + self._from_geoms
         mujoco = mujoco_of(self.cache)
         parked = np.isin(self._root_of_geom, parked_roots)
-        out["parked_geoms"] = parked
         # The initial pose's contacts: positions and collision only. The statistics left
         # the patch's scratch data at qpos0's positions; mocap bodies take theirs from
         # the data, so a model with some starts from a reset.
@@ -339,7 +327,7 @@ class WorldBatch(WarpWorlds, MjxWorlds):
                 f"'{model.body(int(self._root_of_geom[a])).name}') touches geom "
                 f"'{model.geom(b).name or b}': its parking cell is within reach"
             )
-        return out
+        return compare, parked
 
     def _plan_of_scratch(self) -> Any:
         return plan_of(self.cache, self._scratch)
@@ -359,20 +347,20 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         for w in worlds:
             if not 0 <= w < self.nworld:
                 raise error(f"world {w} is not in the batch (0 to {self.nworld - 1})")
-        rows = [self._rows(world) for world in self._worlds(indices)]
-        for i, r in zip(indices, rows):
-            for n in r:
-                if n not in self.arrays and n != "parked_geoms" and n not in self.keys:
-                    raise error(
-                        f"variant {i}: field {n} differs from the batch's, where all worlds "
-                        "share one value (build a new WorldBatch)"
-                    )
-        for w, i, r in zip(worlds, indices, rows):
+        for w, i, world in zip(worlds, indices, self._worlds(indices)):
+            compare, parked = self._patch(world)
+            differing = self._rows_of.differing(compare)
+            if differing:
+                raise error(
+                    f"variant {i}: field {differing[0]} differs from the batch's, where all "
+                    "worlds share one value (build a new WorldBatch)"
+                )
+            row = self._rows_of.row()
             for n in self.per_world:
-                self.arrays[n][w] = r[n] if n in r else getattr(self.model, n)
+                self.arrays[n][w] = row[n] if n in row else getattr(self.model, n)
             for n in self.keys:
-                self.keys[n][w] = r[n]
-            self.parked_geoms[w] = r["parked_geoms"]
+                self.keys[n][w] = row[n]
+            self.parked_geoms[w] = parked
             self.world_variant[w] = i
         mask = np.zeros(self.nworld, dtype=bool)
         mask[worlds] = True

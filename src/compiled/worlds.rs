@@ -17,7 +17,7 @@ use std::ffi::CStr;
 use super::cache::ModelCache;
 use super::sys::{mjf_patch_array, mjf_patch_array_name, mjf_patch_array_type, mjf_patch_get_stat};
 use crate::mujoco::CompiledModel;
-use crate::split::STATIC_PREFIXES;
+use crate::split::{STATIC_PREFIXES, WorldRows};
 use crate::{ErrorKind, Errors};
 
 use super::{bare, internal};
@@ -144,7 +144,7 @@ impl WorldArrays {
 }
 
 /// An array of a live model by its number in MuJoCo's table: name, C type, bytes.
-fn array(model: &mut CompiledModel, i: i32) -> Option<(String, Dtype, &[u8])> {
+fn array(model: &CompiledModel, i: i32) -> Option<(String, Dtype, &[u8])> {
     // SAFETY: static NUL-terminated strings or null.
     let (name, c_type) = unsafe { (mjf_patch_array_name(i), mjf_patch_array_type(i)) };
     if name.is_null() || c_type.is_null() {
@@ -153,9 +153,10 @@ fn array(model: &mut CompiledModel, i: i32) -> Option<(String, Dtype, &[u8])> {
     // SAFETY: NUL-terminated static strings.
     let (name, c_type) = unsafe { (CStr::from_ptr(name), CStr::from_ptr(c_type)) };
     let (mut elem, mut count) = (0usize, 0usize);
-    // SAFETY: the model is live; `name` is NUL-terminated; nothing is written here.
-    let p = unsafe { mjf_patch_array(model.as_mut_ptr(), name.as_ptr(), &mut elem, &mut count) };
-    // SAFETY: `elem * count` bytes at `p` belong to the live model.
+    let raw = std::ptr::from_ref(model.raw()).cast_mut();
+    // SAFETY: the model is live; `name` is NUL-terminated; the lookup writes nothing.
+    let p = unsafe { mjf_patch_array(raw, name.as_ptr(), &mut elem, &mut count) };
+    // SAFETY: `elem * count` bytes at `p` belong to the live model, borrowed as long.
     let bytes = unsafe { crate::mujoco::slice_or_empty(p.cast::<u8>().cast_const(), elem * count) };
     Some((
         name.to_string_lossy().into_owned(),
@@ -199,54 +200,56 @@ impl ModelCache<'_> {
             .iter()
             .map(|&i| self.parked(i))
             .collect::<Result<Vec<_>, _>>()?;
-        let mut model = self.model(first)?.clone();
+        let model = self.model(first)?.clone();
         let mut scratch = model.clone();
-        // World 0's bytes of every array a patch may change, by table number.
-        let mut base: Vec<(i32, String, Dtype, Vec<u8>)> = Vec::new();
+        // World 0's bytes of every array a patch may change, by table number; `qpos0` kept
+        // for every world (split::WorldRows, the rule the Python face keeps too).
+        let (mut arrays, mut first_rows) = (Vec::new(), Vec::new());
         for i in 0.. {
-            let Some((name, dtype, bytes)) = array(&mut model, i) else {
+            let Some((name, dtype, bytes)) = array(&model, i) else {
                 break;
             };
             if !STATIC_PREFIXES.iter().any(|p| name.starts_with(p)) {
-                base.push((i, name, dtype, bytes.to_vec()));
+                arrays.push((i, dtype, bytes.len()));
+                let always = name == "qpos0";
+                first_rows.push((name, bytes.to_vec(), always));
             }
         }
-        let n = indices.len();
-        // Rows per compared array (None: the same as world 0's so far).
-        let mut rows: Vec<Option<Vec<u8>>> = vec![None; base.len()];
-        let mut stats = Vec::with_capacity(n);
-        for (w, &index) in indices.iter().enumerate() {
+        let mut rows = WorldRows::new(first_rows);
+        for &index in indices {
             self.apply(index, &mut scratch)?;
-            stats.push(statistics(&scratch));
-            for (k, (i, name, _, first_bytes)) in base.iter().enumerate() {
-                let Some((_, _, bytes)) = array(&mut scratch, *i) else {
-                    return Err(internal(format!("mjModel.{name} vanished")));
+            let mut views = Vec::with_capacity(arrays.len());
+            for (i, _, _) in &arrays {
+                let Some((name, _, bytes)) = array(&scratch, *i) else {
+                    return Err(internal(format!("mjModel array {i} vanished")));
                 };
-                match &mut rows[k] {
-                    Some(r) => r.extend_from_slice(bytes),
-                    None if bytes != first_bytes.as_slice() || name == "qpos0" => {
-                        // The worlds before this one held world 0's row.
-                        let mut r = Vec::with_capacity(n * first_bytes.len());
-                        for _ in 0..w {
-                            r.extend_from_slice(first_bytes);
-                        }
-                        r.extend_from_slice(bytes);
-                        rows[k] = Some(r);
-                    }
-                    None => {}
+                if bytes.len() != arrays[views.len()].2 {
+                    return Err(internal(format!("mjModel.{name} changed its size")));
                 }
+                views.push(bytes);
             }
+            rows.push(|k| views.get(k).copied(), statistics(&scratch));
         }
-        let fields = base
+        let dtypes: Vec<(String, Dtype)> = rows
+            .names()
+            .map(str::to_string)
+            .zip(arrays.iter().map(|(_, dtype, _)| *dtype))
+            .collect();
+        let (kept, stats) = rows.into_kept();
+        let fields = kept
             .into_iter()
-            .zip(rows)
-            .filter_map(|((_, name, dtype, first_bytes), r)| {
-                r.map(|bytes| WorldField {
+            .map(|(name, bytes)| {
+                let dtype = dtypes
+                    .iter()
+                    .find(|(n, _)| *n == name)
+                    .map_or(Dtype::U8, |(_, d)| *d);
+                let len = bytes.len() / indices.len().max(1) / dtype.size().max(1);
+                WorldField {
                     name,
                     dtype,
-                    len: first_bytes.len() / dtype.size().max(1),
+                    len,
                     bytes,
-                })
+                }
             })
             .collect();
         Ok(WorldArrays {

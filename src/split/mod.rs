@@ -41,7 +41,8 @@
 //! `crate::document::rotation`, the compiler's rotations and eigen-decomposition, and `volumes.rs`, its
 //! bounding-volume trees), `statistics.rs` (the
 //! compiler's statistics at `qpos0`, computed over a model's arrays for both faces),
-//! `trees/` (what `mj_setConst` derives for a superset world, tree by tree). The scene tier reads its
+//! `trees/` (what `mj_setConst` derives for a superset world, tree by tree), `worlds.rs`
+//! (which arrays a superset's worlds keep a row of, for both faces). The scene tier reads its
 //! drawn variants through the same rules (`scene/patch.rs`).
 //!
 //! May use: the document tier and `crate::error`. Knows nothing of scenes or of MuJoCo
@@ -62,6 +63,7 @@ mod store;
 mod targets;
 mod trees;
 mod volumes;
+mod worlds;
 
 pub use body_copy::{
     MasslessFrame, ModelArrays, ModelArraysMut, body_model_writes, copy_body_model, massless_frames,
@@ -92,6 +94,7 @@ pub use targets::{
 };
 pub use trees::{Derivations, FROM_GEOMS, TreeDerivation, TreeModel};
 pub use volumes::{Volume, VolumeNode, bounding_volumes};
+pub use worlds::WorldRows;
 
 pub(crate) use body_model::{UnitCache, body_model_entries, carried_by, unit_model_entries};
 pub(crate) use rules::{

@@ -101,3 +101,63 @@ impl<T: Element> Array<T> {
         unsafe { std::slice::from_raw_parts_mut(self.address as *mut T, self.len) }
     }
 }
+
+/// A C-contiguous NumPy array's memory, of any element type, kept alive while this lives.
+pub(crate) struct Memory {
+    address: usize,
+    nbytes: usize,
+    /// NumPy's type string of the elements (`<f8`).
+    pub(crate) typestr: String,
+    /// The array's shape.
+    pub(crate) shape: Vec<usize>,
+    _owner: Py<PyAny>,
+}
+
+impl Memory {
+    /// `obj`'s memory through its `__array_interface__`, or `None` when it is not an array.
+    pub(crate) fn of(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<Memory>> {
+        let Ok(interface) = obj.getattr("__array_interface__") else {
+            return Ok(None);
+        };
+        let wrong = |why: &str| PyValueError::new_err(format!("{what}: {why}"));
+        if !interface.get_item("strides")?.is_none() {
+            return Err(wrong("not C-contiguous"));
+        }
+        let typestr: String = interface.get_item("typestr")?.extract()?;
+        let size: usize = typestr
+            .get(2..)
+            .and_then(|n| n.parse().ok())
+            .ok_or_else(|| wrong("an element type of no size"))?;
+        let shape: Vec<usize> = interface.get_item("shape")?.extract()?;
+        let (address, readonly): (usize, bool) = interface.get_item("data")?.extract()?;
+        if readonly {
+            return Err(wrong("read-only"));
+        }
+        Ok(Some(Memory {
+            address,
+            nbytes: size * shape.iter().product::<usize>(),
+            typestr,
+            shape,
+            _owner: obj.clone().unbind(),
+        }))
+    }
+
+    pub(crate) fn bytes(&self) -> &[u8] {
+        if self.nbytes == 0 || self.address == 0 {
+            return &[];
+        }
+        // SAFETY: `nbytes` bytes at `address`, owned by the array this holds; the GIL is
+        // held and no Python code runs while the slice lives.
+        unsafe { std::slice::from_raw_parts(self.address as *const u8, self.nbytes) }
+    }
+
+    pub(crate) fn write(&self, saved: &[u8]) {
+        if self.nbytes == 0 || self.address == 0 || saved.len() != self.nbytes {
+            return;
+        }
+        // SAFETY: as in `bytes`, and the array is writable (checked when made); `saved` is
+        // the snapshot's own memory, never the model's.
+        unsafe { std::slice::from_raw_parts_mut(self.address as *mut u8, self.nbytes) }
+            .copy_from_slice(saved);
+    }
+}

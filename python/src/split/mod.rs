@@ -1,7 +1,8 @@
 //! The split tier's face in Python: its tables (`tables.rs`, the one copy of each the
 //! package's caches read) and the rules the caches run over the user's `MjModel` in place
 //! (`plan.rs`, the split tier's patch plan over the user's `mujoco`, and `snapshot.rs`,
-//! what the document cache writes back before a patch; with `patch.rs`, `statistics.rs`,
+//! what the document cache writes back before a patch, and `rows.rs`, a superset's
+//! per-world rows; with `patch.rs`, `statistics.rs`,
 //! `body_models.rs`, through `arrays.rs`).
 
 // NumPy's memory read in place: the bindings' only unsafe code.
@@ -13,6 +14,7 @@ mod body_models;
 mod patch;
 #[allow(unsafe_code)]
 mod plan;
+mod rows;
 mod signature;
 #[allow(unsafe_code)]
 mod snapshot;
@@ -34,6 +36,8 @@ pub(crate) fn add(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<statistics::PyStatistics>()?;
     m.add_class::<body_models::PyModelArrays>()?;
     m.add_class::<plan::PyPatchPlan>()?;
+    m.add_class::<rows::PyWorldRows>()?;
+    m.add_function(wrap_pyfunction!(rows::patchable_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(signature::structure_signature, m)?)?;
     Ok(())
 }

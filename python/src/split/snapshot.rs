@@ -4,66 +4,12 @@
 //! and written back into a model of the structure before each patch: what the document
 //! cache's snapshot is on this face (`mjcf_forge::split::DocumentBackend::Snapshot`).
 
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyString;
 
+use super::arrays::Memory;
 use crate::upcalls;
 use mjcf_forge::split::{Held, Statistics};
-
-/// A C-contiguous NumPy array's memory, of any element type, kept alive while this lives.
-struct Memory {
-    address: usize,
-    nbytes: usize,
-    _owner: Py<PyAny>,
-}
-
-impl Memory {
-    /// `obj`'s memory through its `__array_interface__`, or `None` when it is not an array.
-    fn of(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<Memory>> {
-        let Ok(interface) = obj.getattr("__array_interface__") else {
-            return Ok(None);
-        };
-        let wrong = |why: &str| PyValueError::new_err(format!("{what}: {why}"));
-        if !interface.get_item("strides")?.is_none() {
-            return Err(wrong("not C-contiguous"));
-        }
-        let typestr: String = interface.get_item("typestr")?.extract()?;
-        let size: usize = typestr
-            .get(2..)
-            .and_then(|n| n.parse().ok())
-            .ok_or_else(|| wrong("an element type of no size"))?;
-        let shape: Vec<usize> = interface.get_item("shape")?.extract()?;
-        let (address, readonly): (usize, bool) = interface.get_item("data")?.extract()?;
-        if readonly {
-            return Err(wrong("read-only"));
-        }
-        Ok(Some(Memory {
-            address,
-            nbytes: size * shape.iter().product::<usize>(),
-            _owner: obj.clone().unbind(),
-        }))
-    }
-
-    fn bytes(&self) -> &[u8] {
-        if self.nbytes == 0 || self.address == 0 {
-            return &[];
-        }
-        // SAFETY: `nbytes` bytes at `address`, owned by the array this holds; the GIL is
-        // held and no Python code runs while the slice lives.
-        unsafe { std::slice::from_raw_parts(self.address as *const u8, self.nbytes) }
-    }
-
-    fn write(&self, saved: &[u8]) {
-        if self.nbytes == 0 || self.address == 0 || saved.len() != self.nbytes {
-            return;
-        }
-        // SAFETY: as in `bytes`, and the array is writable (checked when made); `saved` is
-        // the snapshot's own memory, never the model's.
-        unsafe { std::slice::from_raw_parts_mut(self.address as *mut u8, self.nbytes) }
-            .copy_from_slice(saved);
-    }
-}
 
 /// One field as compiled: an array's bytes, or a number (immutable in Python).
 enum Saved {
@@ -118,7 +64,7 @@ impl Snapshot {
             let value = walk(model, &path)?.getattr(name.as_str())?;
             let saved = match Memory::of(&value, &name)? {
                 Some(memory) => {
-                    nbytes += memory.nbytes;
+                    nbytes += memory.bytes().len();
                     Saved::Bytes(memory.bytes().to_vec())
                 }
                 None => Saved::Value(value.unbind()),
