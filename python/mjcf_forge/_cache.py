@@ -125,24 +125,6 @@ class ModelCache:
         compiled model; returns it. Raises :class:`MjcfError` when its structure differs."""
         return self._core.apply(variant, model)
 
-    def _body_ids_of(self, model: Any, names: Any) -> list[int]:
-        """Superset: the ids of the bodies ``names`` in ``model`` (of the superset's one
-        structure), looked up once per name."""
-        ids = self._body_ids
-        out = []
-        for name in names:
-            i = ids.get(name)
-            if i is None:
-                i = ids[name] = model.body(name).id
-            out.append(i)
-        return out
-
-    def _apply_world(self, model: Any, world: tuple, patch0: list) -> Any:
-        """Superset: ``model`` patched for one world as :meth:`Superset.worlds` gives it
-        (``world``: its index, numbers, strings and parked roots; ``patch0``: a patch of its
-        layout, resolved once), as :meth:`apply` patches it."""
-        return self._core.apply_world(model, world, patch0)
-
     def batch(self, variants: Any, progress: Any = None) -> dict[str, np.ndarray]:
         """Per-world arrays for batched simulation (``superset=True``): for every field of
         the superset model that differs between the given variants, and always for
@@ -186,14 +168,17 @@ def mujoco_of(cache: ModelCache) -> Any:
 
 
 def body_ids_of(cache: ModelCache, model: Any, names: Any) -> list[int]:
-    """The ids of the bodies ``names`` in ``model``, of ``cache``'s superset structure."""
-    return cache._body_ids_of(model, names)
+    """The ids of the bodies ``names`` in ``model``, of ``cache``'s superset structure
+    (looked up once per name)."""
+    ids = cache._body_ids
+    return [ids[n] if n in ids else ids.setdefault(n, model.body(n).id) for n in names]
 
 
 def apply_world(cache: ModelCache, model: Any, world: tuple, patch0: list) -> Any:
     """``model`` patched in place for one world of ``Superset.worlds`` (``world``: its
-    index, numbers, strings and parked roots; ``patch0``: a patch of its layout)."""
-    return cache._apply_world(model, world, patch0)
+    index, numbers, strings and parked roots; ``patch0``: a patch of its layout, resolved
+    once), as :meth:`ModelCache.apply` patches a variant."""
+    return cache._core.apply_world(model, world, patch0)
 
 
 def plan_of(cache: ModelCache, model: Any) -> PatchPlan:

@@ -121,7 +121,9 @@ class WorldBatch(WarpWorlds, MjxWorlds):
         fields = patchable_arrays(model)
         self._candidates = sorted((self._patched | set(SET_CONST_DERIVED)) & set(fields))
         others = set(fields) - set(self._candidates)
-        keys = self._key_arrays(model) if model.nkey else []
+        keys = [
+            n for n in dir(model) if n.startswith(_KEY_PREFIX) and isinstance(getattr(model, n), np.ndarray)
+        ] if model.nkey else []
         # Every world's rows of the candidates (and keyframes); of every other field, only
         # where a world differs from the batch's first (no superset patch makes one differ;
         # checked anyway): split::WorldRows, the rule ModelCache.batch keeps too.
@@ -272,16 +274,6 @@ class WorldBatch(WarpWorlds, MjxWorlds):
                 patches[layout] = self._layouts[key]
             for index, (layout, numbers, strings, parked) in zip(part, worlds):
                 yield index, numbers, strings, parked, patches[layout]
-
-    def _key_arrays(self, model: Any) -> list[str]:
-        """The model's keyframe arrays (its arrays of prefix ``key_``), found once."""
-        names = self.__dict__.get("_key_names")
-        if names is None:
-            names = self._key_names = [
-                n for n in dir(model)
-                if n.startswith(_KEY_PREFIX) and isinstance(getattr(model, n, None), np.ndarray)
-            ]
-        return names
 
     def _patch(self, world: tuple) -> tuple[list[str] | None, np.ndarray]:
         """The superset patched for one world (``_worlds``) into the scratch model: which

@@ -201,6 +201,35 @@ impl PyCacheCore {
     }
 }
 
+impl PyCacheCore {
+    /// The superset plan of `model`, made on first sight, under the lock held (`inner`).
+    fn plan_in(
+        &self,
+        py: Python<'_>,
+        inner: &mut Inner,
+        model: &Py<PyAny>,
+    ) -> PyResult<Py<PyPatchPlan>> {
+        let Some(sup) = &self.superset else {
+            return Err(mjcf_error(vec![ErrorKind::NeedsSuperset.to_string()]));
+        };
+        let sup = sup.get();
+        let asked = Asked {
+            index: 0,
+            key: Cow::Borrowed(&sup.superset.structure_key),
+            entries: Cow::Borrowed(&[]),
+            parked: None,
+            xml: Cow::Borrowed(&sup.xml),
+        };
+        let Inner { core, backend } = inner;
+        let mujoco = backend.mujoco.clone_ref(py);
+        let request = asked.request(self.fixed);
+        match core.plan_for(backend, &request, model, asked.compile(&mujoco)) {
+            Ok(plan) => Ok(plan.0.clone_ref(py)),
+            Err(e) => Err(asked.error(e)),
+        }
+    }
+}
+
 /// What a variant asks of the cache (see `PyCacheCore::asked`).
 struct Asked<'a> {
     index: u64,
@@ -312,25 +341,7 @@ impl PyCacheCore {
     /// Superset: the plan of ``model`` (a copy of the superset model, not checked), made
     /// on first sight (:meth:`apply_world` patches through it).
     pub(crate) fn plan_for(&self, py: Python<'_>, model: Py<PyAny>) -> PyResult<Py<PyPatchPlan>> {
-        let Some(sup) = &self.superset else {
-            return Err(mjcf_error(vec![ErrorKind::NeedsSuperset.to_string()]));
-        };
-        let sup = sup.get();
-        let asked = Asked {
-            index: 0,
-            key: Cow::Borrowed(&sup.superset.structure_key),
-            entries: Cow::Borrowed(&[]),
-            parked: None,
-            xml: Cow::Borrowed(&sup.xml),
-        };
-        let mut inner = self.inner()?;
-        let Inner { core, backend } = &mut *inner;
-        let mujoco = backend.mujoco.clone_ref(py);
-        let request = asked.request(self.fixed);
-        match core.plan_for(backend, &request, &model, asked.compile(&mujoco)) {
-            Ok(plan) => Ok(plan.0.clone_ref(py)),
-            Err(e) => Err(asked.error(e)),
-        }
+        self.plan_in(py, &mut *self.inner()?, &model)
     }
 
     /// Superset: ``model`` (a copy of the superset model) patched in place for one world
@@ -344,12 +355,13 @@ impl PyCacheCore {
         patch0: Bound<'_, PyAny>,
     ) -> PyResult<Py<PyAny>> {
         let (_index, numbers, strings, parked) = world;
-        let plan = self.plan_for(py, model.clone_ref(py))?;
-        let by_tree = self.inner()?.backend.by_tree;
+        // One lock for the world: the plan, its patch, the counts.
+        let mut inner = self.inner()?;
+        let plan = self.plan_in(py, &mut inner, &model)?;
+        let by_tree = inner.backend.by_tree;
         let derived =
             plan.get()
                 .patch_world(&patch0, numbers.as_bytes(), strings, &parked, by_tree)?;
-        let mut inner = self.inner()?;
         inner.core.count_patch();
         inner.backend.derived += u64::from(derived);
         Ok(model)

@@ -119,6 +119,9 @@ pub(crate) struct PyModelArrays {
     pub(super) bytes: AHashMap<&'static str, Array<u8>>,
     /// The massless bodies' inertial frames as the model held them when this was made.
     massless: Vec<(usize, MasslessFrame)>,
+    /// The model, held while its arrays are (NumPy's views of the bindings' arrays do not
+    /// hold the model itself).
+    _model: Py<PyAny>,
 }
 
 fn missing(name: &str) -> String {
@@ -229,6 +232,7 @@ impl PyModelArrays {
             ints: AHashMap::new(),
             bytes: AHashMap::new(),
             massless: Vec::new(),
+            _model: model.clone().unbind(),
         };
         for name in FLOATS {
             arrays

@@ -41,24 +41,6 @@ pub(super) struct UserData {
     nbytes: usize,
 }
 
-/// A body model or unit model the user's `mujoco` compiled, and its arrays.
-pub(super) struct UserPart {
-    _model: Py<PyAny>,
-    arrays: PyModelArrays,
-}
-
-impl split::ModelArrays for UserPart {
-    fn floats(&self, name: &str) -> Result<&[f64], String> {
-        self.arrays.floats(name)
-    }
-    fn ints(&self, name: &str) -> Result<&[i32], String> {
-        self.arrays.ints(name)
-    }
-    fn bytes(&self, name: &str) -> Result<&[u8], String> {
-        self.arrays.bytes(name)
-    }
-}
-
 fn missing(name: &str) -> String {
     format!("no array {name} here")
 }
@@ -166,7 +148,9 @@ impl UserModel {
 
 impl PatchModel for UserModel {
     type Target = Whole;
-    type Part = UserPart;
+    /// A body model or unit model the user's `mujoco` compiled, by its arrays (which
+    /// hold the model).
+    type Part = PyModelArrays;
     type Data = UserData;
 
     fn target(&mut self, name: &str, _int: bool) -> Result<Whole, String> {
@@ -239,13 +223,10 @@ impl PatchModel for UserModel {
         .unwrap_or_else(|_| body.to_string())
     }
 
-    fn compile_part(&self, xml: &str) -> Result<UserPart, String> {
+    fn compile_part(&self, xml: &str) -> Result<PyModelArrays, String> {
         Python::attach(|py| {
             let part = upcalls::get(py, "compile_xml")?.call1((self.mujoco.bind(py), xml))?;
-            Ok(UserPart {
-                arrays: PyModelArrays::new(&part)?,
-                _model: part.unbind(),
-            })
+            PyModelArrays::new(&part)
         })
         .map_err(|e: PyErr| e.to_string())
     }
