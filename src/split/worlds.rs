@@ -136,3 +136,56 @@ impl WorldRows {
         (kept, self.statistics)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rows() -> WorldRows {
+        WorldRows::new(vec![
+            ("qpos0".into(), vec![0; 2], true),
+            ("a".into(), vec![1; 2], false),
+            ("b".into(), vec![2; 2], false),
+        ])
+    }
+
+    #[test]
+    fn a_row_per_world_from_the_first_that_differs_with_the_earlier_worlds_as_world_0() {
+        let mut r = rows();
+        let worlds: [[&[u8]; 3]; 3] = [
+            [&[0, 0], &[1, 1], &[2, 2]],
+            [&[5, 5], &[1, 1], &[2, 2]],
+            [&[6, 6], &[1, 1], &[9, 9]],
+        ];
+        for w in &worlds {
+            r.push(|k| Some(w[k]), [w[0][0].into(); 7]);
+        }
+        let kept: Vec<(&str, &[u8])> = r.kept().collect();
+        assert_eq!(
+            kept,
+            [
+                ("qpos0", &[0, 0, 5, 5, 6, 6][..]),
+                ("b", &[2, 2, 2, 2, 9, 9][..])
+            ]
+        );
+        assert_eq!(r.statistics()[2][0], 6.0);
+        // A later world: `a` differs (not kept), `b` is kept anyway, unread arrays are not.
+        assert_eq!(
+            r.differing(|k| [None, Some(&[3u8, 3][..]), Some(&[0u8, 0][..])][k]),
+            ["a"]
+        );
+        assert!(r.differing(|_| None).is_empty());
+    }
+
+    #[test]
+    fn an_unread_array_is_world_0_and_kept_ones_fill_in() {
+        let mut r = rows();
+        r.push(|_| None, [0.0; 7]);
+        r.push(|k| (k == 2).then_some(&[7u8, 7][..]), [0.0; 7]);
+        r.push(|_| None, [0.0; 7]);
+        let (kept, stats) = r.into_kept();
+        assert_eq!(kept[0], ("qpos0".to_string(), vec![0; 6]));
+        assert_eq!(kept[1], ("b".to_string(), vec![2, 2, 7, 7, 2, 2]));
+        assert_eq!((kept.len(), stats.len()), (2, 3));
+    }
+}
