@@ -12,7 +12,8 @@
 //! `upcalls.rs` the one way up into the package's Python code; `testing.rs` the tests' and
 //! benches' entry points, in a submodule of their own. `cache.rs` is the compiled tier's
 //! face: the split tier's model cache over the user's own `mujoco` package
-//! (`mjcf_forge/_cache.py`'s `ModelCache` is its Python face).
+//! (`mjcf_forge/_cache.py`'s `ModelCache` is its Python face). `sheet.rs` is the contact
+//! sheet's rules (`mjcf_forge::sheet`) for `mjcf_forge/_preview.py`.
 //!
 //! No `unsafe` but in `split/`, which reads and writes NumPy arrays of the user's MuJoCo
 //! in place (`split/arrays.rs`).
@@ -23,6 +24,7 @@ mod document;
 mod errors;
 mod model;
 mod scene;
+mod sheet;
 mod split;
 mod testing;
 mod upcalls;
@@ -58,6 +60,7 @@ fn _mjcf_forge(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::PySuperset>()?;
     split::add(m)?;
     m.add_class::<cache::PyCacheCore>()?;
+    sheet::add(m)?;
     testing::add(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
