@@ -72,6 +72,7 @@ pub use document::vocab;
 pub use document::{Document, Section};
 pub use error::{Error, ErrorKind, Errors, Location, Warning};
 pub use model::geometry;
+pub use model::sort;
 pub use model::{
     MergeOptions, MergePart, MergeReport, MujocoModel, Offsets, XmlModel, XmlModelOptions,
 };

@@ -17,7 +17,7 @@ const TIERS: [&str; 10] = [
 const PY_TIERS: [&str; 6] = ["upcalls", "errors", "document", "model", "split", "scene"];
 
 /// The crate root's re-exports (`crate::Document`) and the tier each belongs to.
-const ROOT_ITEMS: [(&str, &str); 20] = [
+const ROOT_ITEMS: [(&str, &str); 21] = [
     ("Error", "error"),
     ("ErrorKind", "error"),
     ("Errors", "error"),
@@ -38,6 +38,7 @@ const ROOT_ITEMS: [(&str, &str); 20] = [
     ("XmlModel", "model"),
     ("MujocoModel", "model"),
     ("geometry", "model"),
+    ("sort", "model"),
 ];
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
