@@ -306,8 +306,8 @@ void mjf_gl_free(mjfGl* gl) {
 // only carries out: mjv_defaultFreeCamera's six numbers (lookat x y z, distance, azimuth,
 // elevation) into `cam`; `<visual><global fovy>` into `fovy`; per geom, at the initial
 // pose (qpos0, mj_kinematics), its world position (3 each) into `xpos` and whether it
-// collides (contype or conaffinity not 0) into `collides`. 0 on success, -1 when mjData
-// cannot be made (`xpos` then left as it was).
+// collides (contype or conaffinity not 0) into `collides`; `xpos` NULL skips the pose.
+// 0 on success, -1 when mjData cannot be made (`xpos` then left as it was).
 int mjf_sheet_inputs(const mjModel* m, double cam[6], double* fovy, double* xpos,
                      int* collides) {
   mjvCamera c;
@@ -322,6 +322,7 @@ int mjf_sheet_inputs(const mjModel* m, double cam[6], double* fovy, double* xpos
   for (int g = 0; g < m->ngeom; g++) {
     collides[g] = m->geom_contype[g] != 0 || m->geom_conaffinity[g] != 0;
   }
+  if (!xpos) return 0;
   mjData* d = mj_makeData(m);
   if (!d) return -1;
   mj_kinematics(m, d);

@@ -56,7 +56,7 @@ impl Camera {
     /// `center`, 1.5 `extent`s away). The rule is the sheet's ([`FreeCamera::framing`]),
     /// which Python's `Scene.preview` runs too; this reads its inputs from the model.
     pub fn free(model: &CompiledModel) -> Camera {
-        let inputs = sys::sheet_inputs(model.raw(), model.sizes().ngeom);
+        let inputs = sys::sheet_inputs(model.raw(), model.sizes().ngeom, true);
         let default = FreeCamera::from_array(inputs.default_cam);
         let cam = match &inputs.xpos {
             Some(xpos) => {
@@ -245,7 +245,7 @@ impl Renderer {
             }
         };
         let sizes = model.sizes();
-        let inputs = sys::sheet_inputs(model.raw(), sizes.ngeom);
+        let inputs = sys::sheet_inputs(model.raw(), sizes.ngeom, false);
         let choice = geoms.choose(
             &inputs.collides,
             model.geom_bodyid(),

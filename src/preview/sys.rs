@@ -108,7 +108,8 @@ pub(super) struct SheetInputs {
     pub default_cam: [f64; 6],
     /// `<visual><global fovy>`.
     pub fovy: f64,
-    /// Per geom at `qpos0`: its world position; `None` when mjData could not be made.
+    /// Per geom at `qpos0`: its world position; `None` when not asked for or when mjData
+    /// could not be made.
     pub xpos: Option<Vec<[f64; 3]>>,
     /// Per geom: whether it collides.
     pub collides: Vec<bool>,
@@ -118,21 +119,27 @@ pub(super) struct SheetInputs {
     pub ngroup: usize,
 }
 
-/// What the sheet's rules read of `m`, which has `ngeom` geoms.
-pub(super) fn sheet_inputs(m: &MjModel, ngeom: usize) -> SheetInputs {
+/// What the sheet's rules read of `m`, which has `ngeom` geoms; the geoms' positions at
+/// `qpos0` only with `pose` (they need an mjData).
+pub(super) fn sheet_inputs(m: &MjModel, ngeom: usize, pose: bool) -> SheetInputs {
     let mut cam = [0.0; 6];
     let mut fovy = 0.0;
-    let mut xpos = vec![0.0; ngeom * 3];
+    let mut xpos = vec![0.0; if pose { ngeom * 3 } else { 0 }];
     let mut collides: Vec<c_int> = vec![0; ngeom];
     let mut rbound = vec![0.0; ngeom];
     // SAFETY: `m` is live and only read, with `ngeom` geoms; the buffers hold what is
-    // written: six numbers, one, 3 per geom, one per geom, one per geom.
+    // written: six numbers, one, 3 per geom (or NULL, not written), one per geom, one per
+    // geom.
     let (made, ngroup) = unsafe {
         let made = mjf_sheet_inputs(
             m,
             cam.as_mut_ptr(),
             &mut fovy,
-            xpos.as_mut_ptr(),
+            if pose {
+                xpos.as_mut_ptr()
+            } else {
+                std::ptr::null_mut()
+            },
             collides.as_mut_ptr(),
         );
         (made == 0, mjf_geom_rbound(m, rbound.as_mut_ptr()))
@@ -140,7 +147,7 @@ pub(super) fn sheet_inputs(m: &MjModel, ngeom: usize) -> SheetInputs {
     SheetInputs {
         default_cam: cam,
         fovy,
-        xpos: made.then(|| xpos.chunks(3).map(|p| [p[0], p[1], p[2]]).collect()),
+        xpos: (made && pose).then(|| xpos.chunks(3).map(|p| [p[0], p[1], p[2]]).collect()),
         collides: collides.iter().map(|c| *c != 0).collect(),
         rbound,
         ngroup: usize::try_from(ngroup).unwrap_or(0),
