@@ -12,6 +12,7 @@
 //! | `split/` | a model as a structure key and a patch: what a model cache patches |
 //! | `scene/` | the batch tier: a scene file in, seeded variants out |
 //! | `compiled/` | compiled variants at patch cost (builds with the `mujoco` feature) |
+//! | `sheet/` | contact sheets' rules without a renderer: layout, image and PNG, labels, camera |
 //! | `preview/` | contact sheets of variants, drawn by MuJoCo's renderer (`mujoco` feature) |
 //!
 //! The faces sit on top: the command line (`src/main.rs`, `src/cli/`) and the Python
@@ -55,6 +56,7 @@ pub mod output;
 #[cfg(mjcf_mujoco)]
 pub mod preview;
 pub mod scene;
+pub mod sheet;
 pub mod split;
 
 /// Entry points for the fuzz targets in `fuzz/`: internals they compare, not a supported API.
@@ -70,6 +72,7 @@ pub use document::vocab;
 pub use document::{Document, Section};
 pub use error::{Error, ErrorKind, Errors, Location, Warning};
 pub use model::geometry;
+pub use model::sort;
 pub use model::{
     MergeOptions, MergePart, MergeReport, MujocoModel, Offsets, XmlModel, XmlModelOptions,
 };

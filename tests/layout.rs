@@ -7,8 +7,9 @@
 use std::path::{Path, PathBuf};
 
 /// The tiers from the bottom up: a file of a tier may name itself and anything earlier.
-const TIERS: [&str; 9] = [
-    "error", "output", "document", "mujoco", "model", "split", "scene", "compiled", "preview",
+const TIERS: [&str; 10] = [
+    "error", "output", "document", "mujoco", "model", "split", "scene", "compiled", "sheet",
+    "preview",
 ];
 
 /// The Python bindings' modules (`python/src/`), which mirror the tiers, from the bottom up.
@@ -16,7 +17,7 @@ const TIERS: [&str; 9] = [
 const PY_TIERS: [&str; 6] = ["upcalls", "errors", "document", "model", "split", "scene"];
 
 /// The crate root's re-exports (`crate::Document`) and the tier each belongs to.
-const ROOT_ITEMS: [(&str, &str); 20] = [
+const ROOT_ITEMS: [(&str, &str); 21] = [
     ("Error", "error"),
     ("ErrorKind", "error"),
     ("Errors", "error"),
@@ -37,6 +38,7 @@ const ROOT_ITEMS: [(&str, &str); 20] = [
     ("XmlModel", "model"),
     ("MujocoModel", "model"),
     ("geometry", "model"),
+    ("sort", "model"),
 ];
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -198,10 +200,10 @@ fn the_crate_root_holds_at_most_four_files() {
 
 /// Where a source or page may name a file of ours: the top-level folders, the library's
 /// and the bindings' tier folders.
-const OUR_FOLDERS: [&str; 20] = [
+const OUR_FOLDERS: [&str; 21] = [
     "src", "python", "tests", "benches", "scripts", "docs", "corpora", "examples", "fuzz",
-    "document", "output", "mujoco", "model", "split", "scene", "compiled", "preview", "cli",
-    "judge", "drivers",
+    "document", "output", "mujoco", "model", "split", "scene", "compiled", "sheet", "preview",
+    "cli", "judge", "drivers",
 ];
 
 /// The extensions of files a comment or page points to.

@@ -2,9 +2,13 @@
 rules where robosuite's differ, and the element helpers its merges need.
 
 ``base`` re-exports the public ones (``array_to_string``, ``string_to_array``,
-``sort_elements``) and robosuite's private ``_element_filter``; its native element
-sorting (``Document._sort_elements``, ``python/src/document/sort.rs``) gives what
-:func:`sort_elements` with :func:`element_filter` gives.
+``sort_elements``) and robosuite's private ``_element_filter``. The rule of
+:func:`element_filter` is written once, in Rust (``mjcf_forge::sort``, the one
+``mjcf_forge.Model``'s lists run too): :func:`sort_elements` with the default filter over
+our elements runs it natively (``Element._sort_elements``), as ``base`` does
+(``Document._sort_elements``); the Python functions stay, robosuite's replaceable API,
+for a filter of the user's, for ``xml.etree`` elements, and as what a replaced
+``group`` or ``tree_parent`` changes.
 """
 
 from __future__ import annotations
@@ -98,6 +102,9 @@ def sort_elements(
     """robosuite's ``sort_elements``: every element under ``root`` (itself included, in
     document order) grouped in lists under the key ``element_filter(element, parent)``
     returns (None: left out). The default filter is :func:`element_filter`."""
+    if element_filter is None and _elements_dict is None and _native_default(root, parent):
+        elements, _names = root._sort_elements()
+        return elements
     if _elements_dict is None:
         _elements_dict = {}
     if element_filter is None:
@@ -112,6 +119,25 @@ def sort_elements(
         children = list(element)
         stack.extend((child, element) for child in reversed(children))
     return _elements_dict
+
+
+# The rule's functions as written here: while they are the ones in use, the native sort
+# (mjcf_forge::sort) is theirs.
+_RULE = {"element_filter": element_filter, "group": group, "tree_parent": tree_parent}
+
+
+def _native_default(root: Any, parent: Any) -> bool:
+    """Whether ``sort_elements(root, parent)`` with the default filter may run natively:
+    ``root`` is one of our elements, ``parent`` its own parent (the filter reads both),
+    and the rule's functions are not replaced on this module."""
+    from ._mjcf_forge import Element
+
+    g = globals()
+    return (
+        isinstance(root, Element)
+        and parent is root.parent
+        and all(g[name] is fn for name, fn in _RULE.items())
+    )
 
 
 def without_materials(xml: str) -> str:

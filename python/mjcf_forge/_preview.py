@@ -2,10 +2,12 @@
 
 Each variant is compiled with the user's ``mujoco`` (``Variant.compile()``) and drawn by
 ``mujoco.Renderer`` at its initial pose into one cell of a grid, labelled with its index;
-the grid is returned as a numpy array and written as PNG (zlib and struct, no Pillow).
-The camera and the geom sets are the command line's (``mjcf-forge preview``,
-docs/cli.md); the labels are drawn with a small bitmap font here, so the cells are not
-the command line's pixel for pixel.
+the grid is returned as a numpy array and written as PNG. Only the drawing is here, over
+the user's ``mujoco``: every rule is the extension's, the command line's own
+(``mjcf-forge preview``, docs/cli.md; ``mjcf_forge::sheet``): the grid (``SheetLayout``),
+the placing, the labels and the PNG (``ContactSheet``), the free camera
+(``sheet_free_camera``, over the values read here) and the geom sets
+(``sheet_geom_groups``).
 
 The OpenGL platform is ``mujoco``'s, chosen by ``MUJOCO_GL`` when ``mujoco`` is imported:
 when ``MUJOCO_GL`` is unset and ``mujoco`` not imported yet, this module sets it to
@@ -14,37 +16,21 @@ when ``MUJOCO_GL`` is unset and ``mujoco`` not imported yet, this module sets it
 
 from __future__ import annotations
 
-import math
 import os
-import struct
 import sys
-import zlib
 from typing import Iterable, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
+from . import _mjcf_forge as _native
 from ._files import write_atomic
 
-GAP = 2
+GAP = _native.SHEET_GAP
 """Pixels between cells."""
-GAP_COLOR = (32, 32, 32)
+GAP_COLOR = _native.SHEET_GAP_COLOR
 """The colour between cells (and of unused cells)."""
 
-GEOMS = ("default", "visual", "collision", "all")
-
-# 3x5 digits, a row per string, '#' lit; drawn scaled.
-_DIGITS = {
-    "0": ("###", "#.#", "#.#", "#.#", "###"),
-    "1": (".#.", "##.", ".#.", ".#.", "###"),
-    "2": ("###", "..#", "###", "#..", "###"),
-    "3": ("###", "..#", "###", "..#", "###"),
-    "4": ("#.#", "#.#", "###", "..#", "..#"),
-    "5": ("###", "#..", "###", "..#", "###"),
-    "6": ("###", "#..", "###", "#.#", "###"),
-    "7": ("###", "..#", "..#", "..#", "..#"),
-    "8": ("###", "#.#", "###", "#.#", "###"),
-    "9": ("###", "#.#", "###", "..#", "###"),
-}
+GEOMS = _native.SHEET_GEOMS
 
 
 def _choose_gl() -> None:
@@ -97,96 +83,58 @@ def _mujoco():
 def free_camera(mujoco, model) -> Tuple[np.ndarray, float, float, float]:
     """The sheet's free camera for ``model``: lookat, distance, azimuth, elevation.
 
-    From MuJoCo's default azimuth and elevation (``mjv_defaultFreeCamera``), looking at
-    the centre of the bounding box of every geom of a body other than the world (world
-    geoms and planes left out) at ``qpos0``, from the distance at which the sphere around
-    that box fits ``<visual><global fovy>``; ``mjv_defaultFreeCamera`` as it is when every
-    geom is the world's. The command line's rule, the same numbers.
+    The command line's rule (``mjcf_forge::sheet::FreeCamera::framing``: the bodies other
+    than the world framed at ``qpos0``), over what the user's ``mujoco`` gives:
+    ``mjv_defaultFreeCamera``, the geoms after ``mj_kinematics``, ``vis.global_.fovy``.
     """
     cam = mujoco.MjvCamera()
     mujoco.mjv_defaultFreeCamera(model, cam)
-    lookat = np.array(cam.lookat, dtype=float)
-    distance = float(cam.distance)
+    default = [*cam.lookat, cam.distance, cam.azimuth, cam.elevation]
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)
-    keep = (model.geom_bodyid != 0) & (model.geom_type != mujoco.mjtGeom.mjGEOM_PLANE)
-    if keep.any():
-        r = model.geom_rbound[keep][:, None]
-        pos = data.geom_xpos[keep]
-        lo, hi = (pos - r).min(axis=0), (pos + r).max(axis=0)
-        lookat = (lo + hi) / 2
-        radius = math.sqrt(float(((hi - lo) ** 2).sum()) / 4)
-        s = math.sin(model.vis.global_.fovy * math.pi / 360)
-        if radius > 0 and s > 0:
-            distance = radius / s
-    return lookat, distance, float(cam.azimuth), float(cam.elevation)
+    x, y, z, distance, azimuth, elevation = _native.sheet_free_camera(
+        [float(v) for v in default],
+        model.geom_bodyid.tolist(),
+        (model.geom_type == mujoco.mjtGeom.mjGEOM_PLANE).tolist(),
+        data.geom_xpos.ravel().tolist(),
+        model.geom_rbound.tolist(),
+        float(model.vis.global_.fovy),
+    )
+    return np.array([x, y, z]), distance, azimuth, elevation
 
 
 def _choose_geoms(model, geoms: str, option) -> None:
-    """What each geom set keeps, as the command line does: kept geoms in group 0, the
-    others in the last group, only group 0 drawn; ``default`` changes nothing."""
+    """Sets the geom set's groups (``mjcf_forge::sheet::Geoms::choose``) on ``model`` and
+    ``option``; sites are not drawn."""
     option.sitegroup[:] = 0
-    if geoms == "default":
-        return
-    ngroup = len(option.geomgroup)
-    if geoms == "all":
-        option.geomgroup[:] = 1
-        return
     collides = (model.geom_contype != 0) | (model.geom_conaffinity != 0)
-    if geoms == "collision":
-        keep = collides
-    else:
-        has_visual = np.zeros(model.nbody, dtype=bool)
-        has_visual[model.geom_bodyid[~collides]] = True
-        keep = ~collides | ~has_visual[model.geom_bodyid]
-    model.geom_group[:] = np.where(keep, 0, ngroup - 1)
-    option.geomgroup[:] = 0
-    option.geomgroup[0] = 1
-
-
-def _label(cell: np.ndarray, text: str, scale: int) -> None:
-    """``text`` (digits) in white on a dark box in the top left corner of ``cell``."""
-    pad = scale
-    w = len(text) * 4 * scale - scale + 2 * pad
-    h = 5 * scale + 2 * pad
-    cell[:h, :w] = (cell[:h, :w] * 0.3).astype(np.uint8)
-    for n, ch in enumerate(text):
-        for row, bits in enumerate(_DIGITS.get(ch, _DIGITS["0"])):
-            for col, bit in enumerate(bits):
-                if bit == "#":
-                    y = pad + row * scale
-                    x = pad + (n * 4 + col) * scale
-                    cell[y : y + scale, x : x + scale] = 255
+    groups, on = _native.sheet_geom_groups(
+        geoms, collides.tolist(), model.geom_bodyid.tolist(), model.nbody, len(option.geomgroup)
+    )
+    if groups is not None:
+        model.geom_group[:] = groups
+    if on is not None:
+        option.geomgroup[:] = on
 
 
 def png_bytes(image: np.ndarray) -> bytes:
-    """An RGB ``uint8`` array (height, width, 3) as a PNG file's bytes."""
+    """An RGB ``uint8`` array (height, width, 3) as a PNG file's bytes (the extension's
+    encoder, the command line's)."""
     image = np.ascontiguousarray(image, dtype=np.uint8)
     height, width, _ = image.shape
-    raw = np.zeros((height, width * 3 + 1), dtype=np.uint8)  # filter byte 0 per row
-    raw[:, 1:] = image.reshape(height, width * 3)
-
-    def chunk(kind: bytes, body: bytes) -> bytes:
-        crc = zlib.crc32(kind + body) & 0xFFFFFFFF
-        return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", crc)
-
-    header = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
-    return (
-        b"\x89PNG\r\n\x1a\n"
-        + chunk(b"IHDR", header)
-        + chunk(b"IDAT", zlib.compress(raw.tobytes(), 9))
-        + chunk(b"IEND", b"")
-    )
+    sheet = _native.ContactSheet(_native.SheetLayout(1, width, height))
+    sheet.place(0, image.tobytes())
+    return sheet.png()
 
 
 def cell_origin(k: int, columns: int, cell: Tuple[int, int]) -> Tuple[int, int]:
     """The top left corner (x, y) of cell ``k`` in a sheet of ``columns`` columns."""
-    return (k % columns) * (cell[0] + GAP), (k // columns) * (cell[1] + GAP)
+    return _native.SheetLayout(max(k + 1, columns), cell[0], cell[1], columns).origin(k)
 
 
 def default_columns(n: int) -> int:
     """The smallest number of columns whose square holds ``n`` cells."""
-    return max(1, math.ceil(math.sqrt(n) - 1e-9))
+    return _native.SheetLayout(max(1, n), 1, 1).columns
 
 
 def preview(
@@ -217,16 +165,11 @@ def preview(
     if segmentation and path is not None:
         raise ValueError("a segmentation sheet is returned, not written: pass no path")
     mujoco = _mujoco()
-    columns = min(columns or default_columns(len(indices)), len(indices))
-    rows = -(-len(indices) // columns)
-    sheet_w = columns * (width + GAP) - GAP
-    sheet_h = rows * (height + GAP) - GAP
+    layout = _native.SheetLayout(len(indices), width, height, columns)
     if segmentation:
-        sheet = np.full((sheet_h, sheet_w), -1, dtype=np.int32)
+        ids = np.full((layout.height, layout.width), -1, dtype=np.int32)
     else:
-        sheet = np.empty((sheet_h, sheet_w, 3), dtype=np.uint8)
-        sheet[:] = GAP_COLOR
-    scale = max(1, min(width, height) // 60)
+        sheet = _native.ContactSheet(layout)
     free = None
     for k, index in enumerate(indices):
         model = scene.variant(index).compile()
@@ -259,17 +202,18 @@ def preview(
                 renderer.enable_segmentation_rendering()
             renderer.update_scene(data, camera=cam, scene_option=option)
             pixels = renderer.render()
-        x, y = cell_origin(k, columns, (width, height))
         if segmentation:
+            x, y = layout.origin(k)
             geom = np.where(
                 pixels[:, :, 1] == int(mujoco.mjtObj.mjOBJ_GEOM), pixels[:, :, 0], -1
             )
-            sheet[y : y + height, x : x + width] = geom
+            ids[y : y + height, x : x + width] = geom
         else:
-            out = sheet[y : y + height, x : x + width]
-            out[:] = pixels
-            if labels:
-                _label(out, str(index), scale)
+            rgb = np.ascontiguousarray(pixels, dtype=np.uint8).tobytes()
+            sheet.place(k, rgb, str(index) if labels else None)
+    if segmentation:
+        return ids
     if path is not None:
-        write_atomic(path, png_bytes(sheet))
-    return sheet
+        write_atomic(path, sheet.png())
+    rgb = np.frombuffer(sheet.rgb(), dtype=np.uint8)
+    return rgb.reshape(layout.height, layout.width, 3).copy()

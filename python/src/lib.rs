@@ -13,7 +13,8 @@
 //! benches' entry points, in a submodule of their own. `cache.rs` is the compiled tier's
 //! face: the split tier's model cache over the user's own `mujoco` package
 //! (`mjcf_forge/_cache.py`'s `ModelCache` is its Python face), and `documents.rs` the
-//! split tier's document cache over it (under `_doc_cache.py`'s `DocumentCache`).
+//! split tier's document cache over it (under `_doc_cache.py`'s `DocumentCache`). `sheet.rs` is
+//! the contact sheet's rules (`mjcf_forge::sheet`) for `mjcf_forge/_preview.py`.
 //!
 //! No `unsafe` but in `split/`, which reads and writes NumPy arrays of the user's MuJoCo
 //! in place (`split/arrays.rs`).
@@ -25,6 +26,7 @@ mod documents;
 mod errors;
 mod model;
 mod scene;
+mod sheet;
 mod split;
 mod testing;
 mod upcalls;
@@ -61,6 +63,7 @@ fn _mjcf_forge(m: &Bound<'_, PyModule>) -> PyResult<()> {
     split::add(m)?;
     m.add_class::<cache::PyCacheCore>()?;
     m.add_class::<documents::PyDocumentCore>()?;
+    sheet::add(m)?;
     testing::add(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

@@ -78,6 +78,51 @@ def test_odd_group_spellings_are_read_as_pythons_int(odd):
     assert model._bodies == ["b", None]
 
 
+@pytest.mark.parametrize("path", FILES + ["odd"], ids=lambda p: getattr(p, "stem", p))
+def test_sort_elements_default_path_is_native_and_equals_the_python_filter(path, odd, monkeypatch):
+    """_mjcf_utils.sort_elements with the default filter over our elements runs the one
+    native sort (mjcf_forge::sort); a filter passed in, or a replaced rule function of the
+    module, runs the Python filter: the same elements, for the document and a subtree."""
+    from mjcf_forge import Document, _mjcf_utils
+
+    doc = Document.load(str(odd if path == "odd" else path))
+    root = doc.getroot()
+    world = root.find("worldbody")
+    for top, parent in [(root, None), (world, root)]:
+        assert _mjcf_utils._native_default(top, parent)
+        native = _mjcf_utils.sort_elements(top, parent)
+        python = _mjcf_utils.sort_elements(top, parent, element_filter=_mjcf_utils.element_filter)
+        assert list(native) == list(python)
+        assert all(all(a is b for a, b in zip(native[k], python[k])) for k in native)
+        assert all(len(native[k]) == len(python[k]) for k in native)
+    # Not its own parent: the filter reads the one passed.
+    assert not _mjcf_utils._native_default(world, None)
+    monkeypatch.setattr(_mjcf_utils, "group", lambda element: 0)
+    assert not _mjcf_utils._native_default(root, None)
+
+
+def test_model_lists_and_base_lists_are_one_sort(odd):
+    """mjcf_forge.Model's lists (XmlModel, MuJoCo's lists) and MujocoXMLModel's (robosuite's
+    keys) come from one sort: the same geoms, sites, bodies; Model lists <freejoint>s too,
+    as MuJoCo lists its joints."""
+    from mjcf_forge import Document, Model
+
+    def named(names):
+        # An empty name: robosuite's prefixing makes it "s_", MuJoCo's (Model's) keeps it.
+        return [n for n in names if n not in ("", "s_")]
+
+    for path in FILES + [odd]:
+        ours = make(path, idn="s")
+        model = Model(Document.load(str(path)), "s")
+        assert named(model.contact_geoms) == named(ours.contact_geoms), path
+        assert named(model.visual_geoms) == named(ours.visual_geoms), path
+        assert model.sites == ours.sites, path
+        # Model names an unnamed root body (`root`); robosuite's classes leave it unnamed.
+        assert model.bodies[1:] == ours.bodies[1 if ours.root_body else 0 :], path
+        free = [j.get("name") for j in ours.worldbody.iter("freejoint") if j.get("name")]
+        assert sorted(model.joints) == sorted(ours.joints + free), path
+
+
 def test_a_replaced_element_filter_is_honoured(monkeypatch):
     seen = []
     original = base._element_filter

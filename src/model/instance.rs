@@ -2,6 +2,7 @@
 //! semantic lists robot-learning code asks for (robosuite's `MujocoModel` vocabulary).
 
 use std::collections::BTreeMap;
+use std::convert::Infallible;
 use std::sync::OnceLock;
 
 use crate::document::import::NodeMap;
@@ -12,6 +13,7 @@ use crate::document::{Document, Section};
 use crate::error::{Error, ErrorKind, Errors};
 use crate::model::geometry;
 use crate::model::merge::MergeReport;
+use crate::model::sort::{SortKey, SortRules, geom_group, name_unnamed_geoms, sort_elements};
 
 /// What a model in a scene offers: its names, its parts sorted by role, and where it sits.
 /// Names returned by the list methods carry the model's prefix.
@@ -171,63 +173,38 @@ struct Lists {
 }
 
 impl Lists {
-    /// Reads the lists off a document whose top-level body is `root`.
+    /// Reads the lists off a document whose top-level body is `root`: the element sort
+    /// with MuJoCo's lists ([`SortRules::MUJOCO`]), `root` first among the bodies.
     fn of(doc: &Document, root: Node) -> Lists {
-        let syms = Syms::get();
         let mut l = Lists::default();
-        let name = |n: Node| doc.attr_sym(n, syms.name).map(str::to_string);
-        l.bodies.extend(name(root));
-        if let Some(world) = doc.find_section(Section::Worldbody) {
-            for n in doc.descendants(world) {
-                let Some(tag) = doc.tag_sym(n) else { continue };
-                let list = if tag == syms.body {
-                    if n == root {
-                        continue;
-                    }
-                    &mut l.bodies
-                } else if (tag == syms.joint || tag == syms.freejoint) && doc.is_body_child(n) {
-                    &mut l.joints
-                } else if tag == syms.site && doc.is_body_child(n) {
-                    &mut l.sites
-                } else if tag == syms.geom && doc.is_body_child(n) {
-                    match group_of(doc, n) {
-                        0 => &mut l.contact_geoms,
-                        1 => &mut l.visual_geoms,
-                        _ => continue,
-                    }
-                } else {
-                    continue;
-                };
-                list.extend(name(n));
-            }
-        }
-        for (section, list) in [
-            (Section::Actuator, &mut l.actuators),
-            (Section::Sensor, &mut l.sensors),
-        ] {
-            if let Some(s) = doc.find_section(section) {
-                list.extend(doc.elements(s).filter_map(name));
+        l.bodies
+            .extend(doc.attr_sym(root, Syms::get().name).map(str::to_string));
+        let Ok(sorted) = sort_elements(doc, SortRules::MUJOCO, |v| {
+            Ok::<_, Infallible>(geom_group(v))
+        });
+        for s in sorted {
+            let list = match s.key {
+                SortKey::RootBody | SortKey::Bodies => &mut l.bodies,
+                SortKey::Joints => &mut l.joints,
+                SortKey::Actuators => &mut l.actuators,
+                SortKey::Sites => &mut l.sites,
+                SortKey::Sensors => &mut l.sensors,
+                SortKey::ContactGeoms => &mut l.contact_geoms,
+                SortKey::VisualGeoms => &mut l.visual_geoms,
+            };
+            for (node, name) in s.nodes.into_iter().zip(s.names) {
+                if node != root {
+                    list.extend(name);
+                }
             }
         }
         l
     }
 }
 
-fn group_of(doc: &Document, geom: Node) -> i64 {
-    doc.attr_sym(geom, Syms::get().group)
-        .and_then(|v| v.trim().parse().ok())
-        .unwrap_or(0)
-}
-
 /// Names this module looks up often, interned once.
 struct Syms {
-    body: Sym,
-    joint: Sym,
-    freejoint: Sym,
-    site: Sym,
-    geom: Sym,
     name: Sym,
-    group: Sym,
     rgba: Sym,
     material: Sym,
 }
@@ -236,13 +213,7 @@ impl Syms {
     fn get() -> &'static Syms {
         static SYMS: OnceLock<Syms> = OnceLock::new();
         SYMS.get_or_init(|| Syms {
-            body: sym("body"),
-            joint: sym("joint"),
-            freejoint: sym("freejoint"),
-            site: sym("site"),
-            geom: sym("geom"),
             name: sym("name"),
-            group: sym("group"),
             rgba: sym("rgba"),
             material: sym("material"),
         })
@@ -305,43 +276,23 @@ impl XmlModel {
             )
             .into());
         }
-        // One pass over the kinematic tree: the elements of each list, in document order
-        // (only those that are a body's own, as MuJoCo lets those carry a name).
+        // The element sort (robosuite's, `sort.rs`) names the unnamed geoms and finds the
+        // collision geoms to colour.
         let syms = Syms::get();
         let root = roots[0];
         name_unnamed_root(&mut doc, root);
-        let geoms: Vec<Node> = doc
-            .descendants(world)
-            .filter(|&n| doc.tag_sym(n) == Some(syms.geom) && doc.is_body_child(n))
-            .collect();
-        let groups: Vec<i64> = geoms.iter().map(|&g| group_of(&doc, g)).collect();
+        let Ok(mut sorted) = sort_elements(&doc, SortRules::MUJOCO, |v| {
+            Ok::<_, Infallible>(geom_group(v))
+        });
         if options.name_unnamed_geoms {
-            let (mut col, mut vis) = (0, 0);
-            for (&g, &grp) in geoms.iter().zip(&groups) {
-                if doc.attr_sym(g, syms.name).is_some() {
-                    continue;
-                }
-                let name = match grp {
-                    0 => format!("g{col}_col"),
-                    1 => format!("g{vis}_vis"),
-                    _ => continue,
-                };
-                if grp == 0 {
-                    col += 1
-                } else {
-                    vis += 1
-                }
-                let value = doc.push_str(&name);
-                doc.set_attr_ref(g, syms.name, value);
-            }
+            name_unnamed_geoms(&mut doc, &mut sorted);
         }
         if let Some(rgba) = options.contact_geom_rgba {
             let value = doc.push_str(&rgba.map(|x| format!("{x}")).join(" "));
-            for (&g, &grp) in geoms.iter().zip(&groups) {
-                if grp == 0 {
-                    doc.set_attr_ref(g, syms.rgba, value);
-                    doc.remove_attr_sym(g, syms.material);
-                }
+            let contact = sorted.iter().filter(|s| s.key == SortKey::ContactGeoms);
+            for &g in contact.flat_map(|s| &s.nodes) {
+                doc.set_attr_ref(g, syms.rgba, value);
+                doc.remove_attr_sym(g, syms.material);
             }
         }
         let exclude = options.exclude_from_prefixing.clone();

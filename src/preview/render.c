@@ -302,91 +302,55 @@ void mjf_gl_free(mjfGl* gl) {
 // ---------------------------------------------------------------------------------------
 // Rendering.
 
-// The free camera of a contact sheet: MuJoCo's viewer's azimuth and elevation
-// (mjv_defaultFreeCamera, i.e. <visual><global azimuth elevation>), looking at the centre
-// of the bounding box of every geom of a body other than the world (floors, walls and
-// other world geoms left out; planes too), from the distance at which the sphere around
-// that box fits the vertical field of view (<visual><global fovy>). A model whose geoms are
-// all the world's gets mjv_defaultFreeCamera as it is (the statistic center, 1.5 extents
-// away). At the initial pose (qpos0). out = lookat x y z, distance, azimuth, elevation.
-void mjf_free_camera(const mjModel* m, double out[6]) {
-  mjvCamera cam;
-  mjv_defaultFreeCamera(m, &cam);
-  double lo[3] = {mjMAXVAL, mjMAXVAL, mjMAXVAL}, hi[3] = {-mjMAXVAL, -mjMAXVAL, -mjMAXVAL};
-  int found = 0;
+// What the contact sheet's rules (src/sheet/, in Rust) read of `m`, which this file then
+// only carries out: mjv_defaultFreeCamera's six numbers (lookat x y z, distance, azimuth,
+// elevation) into `cam`; `<visual><global fovy>` into `fovy`; per geom, at the initial
+// pose (qpos0, mj_kinematics), its world position (3 each) into `xpos` and whether it
+// collides (contype or conaffinity not 0) into `collides`; `xpos` NULL skips the pose.
+// 0 on success, -1 when mjData cannot be made (`xpos` then left as it was).
+int mjf_sheet_inputs(const mjModel* m, double cam[6], double* fovy, double* xpos,
+                     int* collides) {
+  mjvCamera c;
+  mjv_defaultFreeCamera(m, &c);
+  cam[0] = c.lookat[0];
+  cam[1] = c.lookat[1];
+  cam[2] = c.lookat[2];
+  cam[3] = c.distance;
+  cam[4] = c.azimuth;
+  cam[5] = c.elevation;
+  *fovy = m->vis.global.fovy;
+  for (int g = 0; g < m->ngeom; g++) {
+    collides[g] = m->geom_contype[g] != 0 || m->geom_conaffinity[g] != 0;
+  }
+  if (!xpos) return 0;
   mjData* d = mj_makeData(m);
-  if (d) {
-    mj_kinematics(m, d);
-    for (int g = 0; g < m->ngeom; g++) {
-      if (m->geom_bodyid[g] == 0 || m->geom_type[g] == mjGEOM_PLANE) continue;
-      double r = m->geom_rbound[g];
-      for (int k = 0; k < 3; k++) {
-        double c = d->geom_xpos[3 * g + k];
-        if (c - r < lo[k]) lo[k] = c - r;
-        if (c + r > hi[k]) hi[k] = c + r;
-      }
-      found = 1;
-    }
-    mj_deleteData(d);
-  }
-  if (found) {
-    double half = 0;
-    for (int k = 0; k < 3; k++) {
-      cam.lookat[k] = (lo[k] + hi[k]) / 2;
-      half += (hi[k] - lo[k]) * (hi[k] - lo[k]) / 4;
-    }
-    double radius = sqrt(half);
-    double s = sin(m->vis.global.fovy * mjPI / 360);
-    if (radius > 0 && s > 0) cam.distance = radius / s;
-  }
-  out[0] = cam.lookat[0];
-  out[1] = cam.lookat[1];
-  out[2] = cam.lookat[2];
-  out[3] = cam.distance;
-  out[4] = cam.azimuth;
-  out[5] = cam.elevation;
+  if (!d) return -1;
+  mj_kinematics(m, d);
+  memcpy(xpos, d->geom_xpos, sizeof(double) * 3 * (size_t)m->ngeom);
+  mj_deleteData(d);
+  return 0;
 }
 
-// Which geoms are drawn: what each mode keeps, written into geom_group as group 0 (kept) or
-// mjNGROUP-1 (hidden) for a render with only group 0 on. Mode 0 changes nothing.
-static void choose_geoms(mjModel* m, int mode) {
-  if (mode == 0) return;
-  // mode 1 (visual): geoms that do not collide; and all the geoms of a body that has no
-  // such geom (a body drawn by its collision geoms alone stays visible).
-  int* body_has_visual = NULL;
-  if (mode == 1) {
-    body_has_visual = (int*)calloc((size_t)m->nbody, sizeof(int));
-    for (int g = 0; g < m->ngeom && body_has_visual; g++) {
-      if (m->geom_contype[g] == 0 && m->geom_conaffinity[g] == 0) {
-        body_has_visual[m->geom_bodyid[g]] = 1;
-      }
-    }
-  }
-  for (int g = 0; g < m->ngeom; g++) {
-    int collides = m->geom_contype[g] != 0 || m->geom_conaffinity[g] != 0;
-    int keep = 1;
-    if (mode == 1) {
-      keep = !collides || !body_has_visual || !body_has_visual[m->geom_bodyid[g]];
-    } else if (mode == 2) {
-      keep = collides;
-    }
-    m->geom_group[g] = keep ? 0 : mjNGROUP - 1;
-  }
-  free(body_has_visual);
+// Each geom's radius of its bounding sphere (ngeom of them) into `rbound`; MuJoCo's
+// number of geom groups (mjNGROUP) returned.
+int mjf_geom_rbound(const mjModel* m, double* rbound) {
+  memcpy(rbound, m->geom_rbound, sizeof(double) * (size_t)m->ngeom);
+  return mjNGROUP;
 }
 
 // Renders `m` at its initial pose (qpos0, mj_forward) into `rgb` (width x height x 3 bytes,
 // bottom row first, as glReadPixels gives), from the free camera `free_cam`
-// (mjf_free_camera's six numbers) or from the model's camera `camid` when it is >= 0.
-// `geoms`: 0 as MuJoCo draws by default (groups 0-2), 1 visual, 2 collision, 3 every
-// group. `label`, when not NULL, is drawn in the top left corner (mjr_overlay).
-// With `segment`, draws segmentation instead (flat colours, no label, no multisampling)
+// (the six numbers of src/sheet/'s FreeCamera) or from the model's camera `camid` when it
+// is >= 0. The geoms drawn are the sheet's rule's (src/sheet/geoms.rs): `groups_set`, when not
+// NULL, each geom's group for the render (ngeom of them); `groups_on`, when not NULL, which
+// of the mjNGROUP geom groups are drawn (else MuJoCo's default option). Sites are not
+// drawn. With `segment`, draws segmentation instead (flat colours, no multisampling)
 // and writes into `seg` (width x height ints, bottom row first) the geom id of each pixel,
 // -1 where no geom is. The model's visual settings and geom groups are restored before
 // returning. 0 on success, else -1 with the reason in `err`.
 int mjf_render(mjModel* m, int width, int height, const double free_cam[6], int camid,
-               int geoms, const char* label, int segment, unsigned char* rgb, int* seg,
-               char* err, int err_len) {
+               const int* groups_set, const int* groups_on, int segment, unsigned char* rgb,
+               int* seg, char* err, int err_len) {
   if (err && err_len > 0) err[0] = '\0';
   int* groups = (int*)malloc(sizeof(int) * (size_t)(m->ngeom > 0 ? m->ngeom : 1));
   if (!groups) {
@@ -399,7 +363,7 @@ int mjf_render(mjModel* m, int width, int height, const double free_cam[6], int 
   if (m->vis.global.offwidth < width) m->vis.global.offwidth = width;
   if (m->vis.global.offheight < height) m->vis.global.offheight = height;
   if (segment) m->vis.quality.offsamples = 0;
-  choose_geoms(m, geoms);
+  if (groups_set) memcpy(m->geom_group, groups_set, sizeof(int) * (size_t)m->ngeom);
 
   int result = -1;
   mjData* d = mj_makeData(m);
@@ -417,11 +381,7 @@ int mjf_render(mjModel* m, int width, int height, const double free_cam[6], int 
   mjv_defaultOption(&opt);
   for (int i = 0; i < mjNGROUP; i++) {
     opt.sitegroup[i] = 0;  // sites are markers, not the scene
-    if (geoms != 0) opt.geomgroup[i] = (i == 0);
-    if (geoms == 3) opt.geomgroup[i] = 1;
-  }
-  if (geoms == 3) {
-    for (int g = 0; g < m->ngeom; g++) m->geom_group[g] = groups[g];
+    if (groups_on) opt.geomgroup[i] = groups_on[i] ? 1 : 0;
   }
 
   mjvCamera cam;
@@ -453,9 +413,6 @@ int mjf_render(mjModel* m, int width, int height, const double free_cam[6], int 
   mjr_setBuffer(mjFB_OFFSCREEN, &con);
   mjrRect rect = {0, 0, width, height};
   mjr_render(rect, &scn, &con);
-  if (label && !segment) {
-    mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, rect, label, NULL, &con);
-  }
   mjr_readPixels(rgb, NULL, rect, &con);
 
   if (segment && seg) {

@@ -5,76 +5,14 @@ use std::ffi::c_int;
 use std::fmt;
 use std::marker::PhantomData;
 use std::ptr::NonNull;
-use std::str::FromStr;
 
-use super::image::Image;
 use super::sys::{self, RawGl};
 use crate::error::{Error, ErrorKind};
 use crate::mujoco::{CompiledModel, ObjType};
+use crate::sheet::{FramedGeom, FreeCamera, Geoms, Image, draw_label, label_scale};
 
-/// Which geoms are drawn.
-///
-/// ```
-/// use mjcf_forge::preview::Geoms;
-///
-/// assert_eq!("collision".parse::<Geoms>(), Ok(Geoms::Collision));
-/// assert_eq!(Geoms::default().to_string(), "default");
-/// assert!("nope".parse::<Geoms>().is_err());
-/// ```
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum Geoms {
-    /// As MuJoCo draws a model by default: the geoms of groups 0, 1 and 2.
-    #[default]
-    Default,
-    /// The geoms that do not collide (`contype` and `conaffinity` 0), in any group, and
-    /// every geom of a body that has no such geom (so no body disappears).
-    Visual,
-    /// The geoms that collide (`contype` or `conaffinity` not 0), in any group.
-    Collision,
-    /// Every geom of every group.
-    All,
-}
-
-impl Geoms {
-    /// Every value, in declaration order.
-    pub const ALL: [Geoms; 4] = [Geoms::Default, Geoms::Visual, Geoms::Collision, Geoms::All];
-
-    /// Its name on the command line and in Python: `default`, `visual`, `collision`, `all`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Geoms::Default => "default",
-            Geoms::Visual => "visual",
-            Geoms::Collision => "collision",
-            Geoms::All => "all",
-        }
-    }
-
-    fn code(self) -> c_int {
-        match self {
-            Geoms::Default => 0,
-            Geoms::Visual => 1,
-            Geoms::Collision => 2,
-            Geoms::All => 3,
-        }
-    }
-}
-
-impl fmt::Display for Geoms {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.as_str())
-    }
-}
-
-impl FromStr for Geoms {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Geoms, String> {
-        Geoms::ALL
-            .into_iter()
-            .find(|g| g.as_str() == s)
-            .ok_or_else(|| format!("unknown geom set '{s}' (default, visual, collision, all)"))
-    }
-}
+/// `mjGEOM_PLANE` in `mjtGeom`.
+const GEOM_PLANE: i32 = 0;
 
 /// Where a render looks from.
 ///
@@ -115,14 +53,30 @@ impl Camera {
     /// world body left out, and planes), from the distance at which the sphere around that
     /// box fits the vertical field of view (`<visual><global fovy>`). A model whose geoms
     /// all belong to the world gets `mjv_defaultFreeCamera` unchanged (the statistic
-    /// `center`, 1.5 `extent`s away).
+    /// `center`, 1.5 `extent`s away). The rule is the sheet's ([`FreeCamera::framing`]),
+    /// which Python's `Scene.preview` runs too; this reads its inputs from the model.
     pub fn free(model: &CompiledModel) -> Camera {
-        let [x, y, z, distance, azimuth, elevation] = sys::free_camera(model.raw());
+        let inputs = sys::sheet_inputs(model.raw(), model.sizes().ngeom, true);
+        let default = FreeCamera::from_array(inputs.default_cam);
+        let cam = match &inputs.xpos {
+            Some(xpos) => {
+                let geoms = (model.geom_bodyid().iter().zip(model.geom_type()))
+                    .zip(xpos.iter().zip(&inputs.rbound))
+                    .map(|((&body, &kind), (&pos, &rbound))| FramedGeom {
+                        body: i64::from(body),
+                        plane: kind == GEOM_PLANE,
+                        pos,
+                        rbound,
+                    });
+                FreeCamera::framing(default, geoms, inputs.fovy)
+            }
+            None => default,
+        };
         Camera::Free {
-            lookat: [x, y, z],
-            distance,
-            azimuth,
-            elevation,
+            lookat: cam.lookat,
+            distance: cam.distance,
+            azimuth: cam.azimuth,
+            elevation: cam.elevation,
         }
     }
 
@@ -228,7 +182,8 @@ impl Renderer {
     }
 
     /// `model` at its initial pose (`qpos0`) drawn from `camera`, with `label` in the top
-    /// left corner (MuJoCo's `mjr_overlay`); sites are not drawn. The model's visual
+    /// left corner (the sheet's bitmap digits, [`draw_label`], as Python's `Scene.preview`
+    /// draws them); sites are not drawn. The model's visual
     /// settings and geom groups are changed for the render and restored before this
     /// returns, hence `&mut`.
     pub fn render(
@@ -238,8 +193,12 @@ impl Renderer {
         geoms: Geoms,
         label: Option<&str>,
     ) -> Result<Image, Error> {
-        let (rgb, _) = self.run(model, camera, geoms, label, false)?;
-        Ok(Image::from_bottom_up(self.width, self.height, rgb))
+        let (rgb, _) = self.run(model, camera, geoms, false)?;
+        let mut image = Image::from_bottom_up(self.width, self.height, rgb);
+        if let Some(label) = label {
+            draw_label(&mut image, label, label_scale(self.width, self.height));
+        }
+        Ok(image)
     }
 
     /// Segmentation: for each pixel (top row first, `width * height` of them) the id of
@@ -251,7 +210,7 @@ impl Renderer {
         camera: Camera,
         geoms: Geoms,
     ) -> Result<Vec<i32>, Error> {
-        let (_, seg) = self.run(model, camera, geoms, None, true)?;
+        let (_, seg) = self.run(model, camera, geoms, true)?;
         let row = self.width as usize;
         Ok(seg.chunks(row.max(1)).rev().flatten().copied().collect())
     }
@@ -261,7 +220,6 @@ impl Renderer {
         model: &mut CompiledModel,
         camera: Camera,
         geoms: Geoms,
-        label: Option<&str>,
         segment: bool,
     ) -> Result<(Vec<u8>, Vec<i32>), Error> {
         let (free_cam, camid) = match camera {
@@ -286,13 +244,23 @@ impl Renderer {
                 ([0.0; 6], id as c_int)
             }
         };
+        let sizes = model.sizes();
+        let inputs = sys::sheet_inputs(model.raw(), sizes.ngeom, false);
+        let choice = geoms.choose(
+            &inputs.collides,
+            model.geom_bodyid(),
+            sizes.nbody,
+            inputs.ngroup,
+        );
         let job = sys::Job {
             width: self.width as c_int,
             height: self.height as c_int,
             free_cam,
             camid,
-            geoms: geoms.code(),
-            label,
+            groups: choice.groups,
+            groups_on: choice
+                .groups_on
+                .map(|on| on.into_iter().map(c_int::from).collect()),
             segment,
         };
         // Another renderer on this thread may have taken the context since.

@@ -1,7 +1,7 @@
 //! The extern declarations of `render.c` and their wrappers, each stating what it needs of
 //! its caller; the rest of the tier goes through them.
 
-use std::ffi::{CStr, CString, c_char, c_int};
+use std::ffi::{CStr, c_char, c_int};
 use std::ptr::NonNull;
 
 use crate::mujoco::MjModel;
@@ -23,15 +23,22 @@ unsafe extern "C" {
     fn mjf_gl_kind(gl: *const RawGl) -> *const c_char;
     fn mjf_gl_make_current(gl: *mut RawGl) -> c_int;
     fn mjf_gl_free(gl: *mut RawGl);
-    fn mjf_free_camera(m: *const MjModel, out: *mut f64);
+    fn mjf_sheet_inputs(
+        m: *const MjModel,
+        cam: *mut f64,
+        fovy: *mut f64,
+        xpos: *mut f64,
+        collides: *mut c_int,
+    ) -> c_int;
+    fn mjf_geom_rbound(m: *const MjModel, rbound: *mut f64) -> c_int;
     fn mjf_render(
         m: *mut MjModel,
         width: c_int,
         height: c_int,
         free_cam: *const f64,
         camid: c_int,
-        geoms: c_int,
-        label: *const c_char,
+        groups_set: *const c_int,
+        groups_on: *const c_int,
         segment: c_int,
         rgb: *mut u8,
         seg: *mut c_int,
@@ -95,22 +102,68 @@ pub(super) unsafe fn gl_free(gl: NonNull<RawGl>) {
     unsafe { mjf_gl_free(gl.as_ptr()) }
 }
 
-/// `mjv_defaultFreeCamera`'s lookat (3), distance, azimuth and elevation.
-pub(super) fn free_camera(m: &MjModel) -> [f64; 6] {
-    let mut out = [0.0; 6];
-    // SAFETY: `m` is live and only read; `out` holds the six numbers written.
-    unsafe { mjf_free_camera(m, out.as_mut_ptr()) };
-    out
+/// What the sheet's rules read of a model (see `mjf_sheet_inputs`).
+pub(super) struct SheetInputs {
+    /// `mjv_defaultFreeCamera`'s lookat (3), distance, azimuth and elevation.
+    pub default_cam: [f64; 6],
+    /// `<visual><global fovy>`.
+    pub fovy: f64,
+    /// Per geom at `qpos0`: its world position; `None` when not asked for or when mjData
+    /// could not be made.
+    pub xpos: Option<Vec<[f64; 3]>>,
+    /// Per geom: whether it collides.
+    pub collides: Vec<bool>,
+    /// Per geom: its bounding sphere's radius.
+    pub rbound: Vec<f64>,
+    /// MuJoCo's number of geom groups (`mjNGROUP`).
+    pub ngroup: usize,
+}
+
+/// What the sheet's rules read of `m`, which has `ngeom` geoms; the geoms' positions at
+/// `qpos0` only with `pose` (they need an mjData).
+pub(super) fn sheet_inputs(m: &MjModel, ngeom: usize, pose: bool) -> SheetInputs {
+    let mut cam = [0.0; 6];
+    let mut fovy = 0.0;
+    let mut xpos = vec![0.0; if pose { ngeom * 3 } else { 0 }];
+    let mut collides: Vec<c_int> = vec![0; ngeom];
+    let mut rbound = vec![0.0; ngeom];
+    // SAFETY: `m` is live and only read, with `ngeom` geoms; the buffers hold what is
+    // written: six numbers, one, 3 per geom (or NULL, not written), one per geom, one per
+    // geom.
+    let (made, ngroup) = unsafe {
+        let made = mjf_sheet_inputs(
+            m,
+            cam.as_mut_ptr(),
+            &mut fovy,
+            if pose {
+                xpos.as_mut_ptr()
+            } else {
+                std::ptr::null_mut()
+            },
+            collides.as_mut_ptr(),
+        );
+        (made == 0, mjf_geom_rbound(m, rbound.as_mut_ptr()))
+    };
+    SheetInputs {
+        default_cam: cam,
+        fovy,
+        xpos: (made && pose).then(|| xpos.chunks(3).map(|p| [p[0], p[1], p[2]]).collect()),
+        collides: collides.iter().map(|c| *c != 0).collect(),
+        rbound,
+        ngroup: usize::try_from(ngroup).unwrap_or(0),
+    }
 }
 
 /// What one render asks for (see `mjf_render` in `render.c`).
-pub(super) struct Job<'a> {
+pub(super) struct Job {
     pub width: c_int,
     pub height: c_int,
     pub free_cam: [f64; 6],
     pub camid: c_int,
-    pub geoms: c_int,
-    pub label: Option<&'a str>,
+    /// Each geom's group for the render (`ngeom` of them), or the compiled ones.
+    pub groups: Option<Vec<c_int>>,
+    /// Which of the `mjNGROUP` geom groups are drawn, or MuJoCo's default option.
+    pub groups_on: Option<Vec<c_int>>,
     /// Also the geom id of every pixel.
     pub segment: bool,
 }
@@ -120,8 +173,9 @@ pub(super) struct Job<'a> {
 ///
 /// # Safety
 /// `m` is a live model nobody else reads or writes during the call (it is changed and
-/// restored), and an OpenGL context of [`gl_new`] is current on this thread.
-pub(super) unsafe fn render(m: *mut MjModel, job: &Job<'_>) -> Result<(Vec<u8>, Vec<i32>), String> {
+/// restored), with as many geoms as `job.groups` has (when set), and an OpenGL context of
+/// [`gl_new`] is current on this thread; `job.groups_on` (when set) has `mjNGROUP` flags.
+pub(super) unsafe fn render(m: *mut MjModel, job: &Job) -> Result<(Vec<u8>, Vec<i32>), String> {
     let pixels = job.width as usize * job.height as usize;
     let mut rgb = vec![0u8; pixels * 3];
     let mut seg = if job.segment {
@@ -129,14 +183,10 @@ pub(super) unsafe fn render(m: *mut MjModel, job: &Job<'_>) -> Result<(Vec<u8>, 
     } else {
         Vec::new()
     };
-    // A label with a NUL in it cannot be drawn: it is cut there.
-    let label = job
-        .label
-        .map(|l| CString::new(l.split('\0').next().unwrap_or_default()).unwrap_or_default());
     let mut err = vec![0 as c_char; ERR_LEN];
     // SAFETY: see the contract; `rgb` holds width x height x 3 bytes and `seg` width x
     // height ints when segmenting (NULL otherwise, never written then); `err` holds
-    // `ERR_LEN` bytes; `label` is NULL or NUL-terminated and outlives the call.
+    // `ERR_LEN` bytes; the groups are NULL or as long as the contract says.
     let code = unsafe {
         mjf_render(
             m,
@@ -144,8 +194,10 @@ pub(super) unsafe fn render(m: *mut MjModel, job: &Job<'_>) -> Result<(Vec<u8>, 
             job.height,
             job.free_cam.as_ptr(),
             job.camid,
-            job.geoms,
-            label.as_ref().map_or(std::ptr::null(), |l| l.as_ptr()),
+            job.groups.as_ref().map_or(std::ptr::null(), |g| g.as_ptr()),
+            job.groups_on
+                .as_ref()
+                .map_or(std::ptr::null(), |g| g.as_ptr()),
             c_int::from(job.segment),
             rgb.as_mut_ptr(),
             if job.segment {

@@ -504,6 +504,22 @@ impl PyElement {
         parent.map(|p| proxy(py, &cell, p)).transpose()
     }
 
+    /// ``mjcf_forge._mjcf_utils.sort_elements(self, self.parent)``'s default path in one
+    /// native pass (the element sort of ``Document._sort_elements``, over the elements
+    /// under this one, itself included): a dict of the keys, in the order they first
+    /// appear, to their elements in document order, and one of the same keys to those
+    /// elements' names (None for an unnamed one); unnamed geoms of groups 0 and 1 named
+    /// ``g{n}_col`` / ``g{n}_vis`` first when ``name_geoms``.
+    #[pyo3(signature = (name_geoms = false))]
+    fn _sort_elements<'py>(
+        &self,
+        py: Python<'py>,
+        name_geoms: bool,
+    ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
+        let (cell, node) = self.target();
+        super::sort::sorted_dicts(py, &cell, node, name_geoms)
+    }
+
     /// Where the element was read: ``file:line:col`` (with ``(included from ...)`` when
     /// it came from an included file).
     #[getter]

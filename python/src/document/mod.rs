@@ -647,17 +647,8 @@ impl PyDocument {
         py: Python<'py>,
         name_geoms: bool,
     ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
-        let sorted = {
-            let mut doc = self.doc.write(py);
-            sort::sort(py, &mut doc, name_geoms)?
-        };
-        let elements = PyDict::new(py);
-        let names = PyDict::new(py);
-        for (key, nodes, found) in sorted {
-            elements.set_item(key, cell::proxies(py, &self.doc, nodes)?)?;
-            names.set_item(key, found)?;
-        }
-        Ok((elements, names))
+        let root = self.doc.read(py).root();
+        sort::sorted_dicts(py, &self.doc, root, name_geoms)
     }
 
     /// Sets ``key`` to ``value`` (as :meth:`Element.set`) on every element of

@@ -1,23 +1,19 @@
-//! robosuite's `sort_elements` with `mjcf_forge.base._element_filter` (and the naming of
-//! unnamed geoms), done in one native pass: what `MujocoXMLModel.__init__` asks for.
+//! `mjcf_forge.base`'s element sorting in one native pass, what `MujocoXMLModel.__init__`
+//! asks for: the library's element sort (`mjcf_forge::sort`, the one `XmlModel`'s lists
+//! run) with robosuite's keys, a geom's group read as Python's `int` reads it, and the
+//! naming of unnamed geoms.
+
+use mjcf_forge::sort::{SortRules, Sorted, name_unnamed_geoms, sort_elements_under};
+use std::sync::Arc;
 
 use mjcf_forge::{Document, Node};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
-/// The keys of `_element_filter`, in the order of the `KEYS` table.
-const KEYS: [&str; 8] = [
-    "root_body",
-    "bodies",
-    "joints",
-    "actuators",
-    "sites",
-    "sensors",
-    "contact_geoms",
-    "visual_geoms",
-];
+use super::cell::DocCell;
 
-/// One key of the sorting: its elements and their names (None for an unnamed one).
-pub(crate) type Sorted = (&'static str, Vec<Node>, Vec<Option<String>>);
+/// One key of the sorting: its name, its elements and their names (None for an unnamed one).
+pub(crate) type SortedKey = (&'static str, Vec<Node>, Vec<Option<String>>);
 
 /// A geom's group as `base._group` reads it: 0 when absent, `int(value.strip())`, or
 /// None when Python's `int` refuses it. Plain ASCII integers are read here; anything
@@ -41,75 +37,43 @@ fn group(py: Python<'_>, value: Option<&str>) -> PyResult<Option<i64>> {
     }
 }
 
-/// The key (index into `KEYS`) `_element_filter(node, parent)` gives, or None.
-fn key(py: Python<'_>, doc: &Document, node: Node) -> PyResult<Option<usize>> {
-    let Some(parent) = doc.parent(node) else {
-        return Ok(None);
-    };
-    let above_tag = doc.tag(parent);
-    match above_tag {
-        "actuator" => return Ok(Some(3)),
-        "sensor" => return Ok(Some(5)),
-        "worldbody" | "body" | "frame" | "replicate" => {}
-        _ => return Ok(None),
+/// The sorted elements (key, nodes, names), keys in the order they first appear, every
+/// element under `top` (itself included) in document order; unnamed geoms of groups 0 and
+/// 1 named `g{n}_col` / `g{n}_vis` first when `name_geoms`.
+pub(crate) fn sort(
+    py: Python<'_>,
+    doc: &mut Document,
+    top: Node,
+    name_geoms: bool,
+) -> PyResult<Vec<SortedKey>> {
+    let mut sorted: Vec<Sorted> =
+        sort_elements_under(doc, top, SortRules::ROBOSUITE, |v| group(py, v))?;
+    if name_geoms {
+        name_unnamed_geoms(doc, &mut sorted);
     }
-    Ok(match doc.tag(node) {
-        "joint" => Some(2),
-        "body" => {
-            let mut above = Some(parent);
-            while let Some(a) = above {
-                if matches!(doc.tag(a), "frame" | "replicate") {
-                    above = doc.parent(a);
-                } else {
-                    break;
-                }
-            }
-            if above.is_some_and(|a| doc.tag(a) == "body") {
-                Some(1)
-            } else {
-                Some(0)
-            }
-        }
-        "site" => Some(4),
-        "geom" => match group(py, doc.attr(node, "group"))? {
-            Some(0) => Some(6),
-            Some(1) => Some(7),
-            _ => None,
-        },
-        _ => None,
-    })
+    Ok(sorted
+        .into_iter()
+        .map(|s| (s.key.as_str(), s.nodes, s.names))
+        .collect())
 }
 
-/// The sorted elements (key, nodes, names), keys in the order they first appear, every
-/// element under the root in document order; unnamed geoms of groups 0 and 1 named
-/// `g{n}_col` / `g{n}_vis` first when `name_geoms`.
-pub(crate) fn sort(py: Python<'_>, doc: &mut Document, name_geoms: bool) -> PyResult<Vec<Sorted>> {
-    let mut slots: [Option<usize>; 8] = [None; 8];
-    let mut out: Vec<Sorted> = Vec::new();
-    let (mut col, mut vis) = (0usize, 0usize);
-    let nodes: Vec<Node> = doc.descendants(doc.root()).collect();
-    for node in nodes {
-        let Some(k) = key(py, doc, node)? else {
-            continue;
-        };
-        let mut name = doc.attr(node, "name").map(str::to_owned);
-        if name_geoms && (k == 6 || k == 7) && name.is_none() {
-            let made = if k == 6 {
-                col += 1;
-                format!("g{}_col", col - 1)
-            } else {
-                vis += 1;
-                format!("g{}_vis", vis - 1)
-            };
-            doc.set_attr(node, "name", &made);
-            name = Some(made);
-        }
-        let slot = *slots[k].get_or_insert_with(|| {
-            out.push((KEYS[k], Vec::new(), Vec::new()));
-            out.len() - 1
-        });
-        out[slot].1.push(node);
-        out[slot].2.push(name);
+/// [`sort`] as the two dicts `Document._sort_elements` and `Element._sort_elements` return:
+/// each key to its elements (proxies) and to their names.
+pub(crate) fn sorted_dicts<'py>(
+    py: Python<'py>,
+    cell: &Arc<DocCell>,
+    top: Node,
+    name_geoms: bool,
+) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyDict>)> {
+    let sorted = {
+        let mut doc = cell.write(py);
+        sort(py, &mut doc, top, name_geoms)?
+    };
+    let elements = PyDict::new(py);
+    let names = PyDict::new(py);
+    for (key, nodes, found) in sorted {
+        elements.set_item(key, super::cell::proxies(py, cell, nodes)?)?;
+        names.set_item(key, found)?;
     }
-    Ok(out)
+    Ok((elements, names))
 }

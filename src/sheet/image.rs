@@ -2,13 +2,12 @@
 
 use std::path::Path;
 
-use super::render::invalid;
-use crate::error::Error;
+use crate::error::{Error, ErrorKind};
 
 /// An RGB image, 8 bits per channel, rows from the top.
 ///
 /// ```
-/// use mjcf_forge::preview::Image;
+/// use mjcf_forge::sheet::Image;
 ///
 /// let mut image = Image::new(4, 2, [10, 20, 30]);
 /// image.put(3, 1, [255, 0, 0]);
@@ -39,7 +38,7 @@ impl Image {
     }
 
     /// An image from OpenGL's rows (bottom row first).
-    pub(super) fn from_bottom_up(width: u32, height: u32, rgb: Vec<u8>) -> Image {
+    pub fn from_bottom_up(width: u32, height: u32, rgb: Vec<u8>) -> Image {
         let row = width as usize * 3;
         let rgb = rgb.chunks(row.max(1)).rev().flatten().copied().collect();
         Image { width, height, rgb }
@@ -85,13 +84,36 @@ impl Image {
         Image { width, height, rgb }
     }
 
-    /// The image as a PNG file's bytes (8-bit RGB).
+    /// An image of `width` x `height` from `rgb` (R, G, B per pixel, top row first); an
+    /// error when the length is not `width * height * 3`.
+    ///
+    /// ```
+    /// use mjcf_forge::sheet::Image;
+    ///
+    /// let image = Image::from_rgb(2, 1, vec![1, 2, 3, 4, 5, 6]).unwrap();
+    /// assert_eq!(image.pixel(1, 0), [4, 5, 6]);
+    /// assert!(Image::from_rgb(2, 2, vec![0; 6]).is_err());
+    /// ```
+    pub fn from_rgb(width: u32, height: u32, rgb: Vec<u8>) -> Result<Image, Error> {
+        let want = width as usize * height as usize * 3;
+        if rgb.len() != want {
+            return Err(invalid(format!(
+                "an image of {width}x{height} pixels takes {want} bytes of RGB, not {}",
+                rgb.len()
+            )));
+        }
+        Ok(Image { width, height, rgb })
+    }
+
+    /// The image as a PNG file's bytes: 8-bit RGB, every row unfiltered (filter type 0, so
+    /// that a reader needs only zlib), compressed at zlib's level 9 (`Compression::High`).
     pub fn to_png(&self) -> Result<Vec<u8>, Error> {
         let mut out = Vec::new();
         let mut encoder = png::Encoder::new(&mut out, self.width, self.height);
         encoder.set_color(png::ColorType::Rgb);
         encoder.set_depth(png::BitDepth::Eight);
         encoder.set_compression(png::Compression::High);
+        encoder.set_filter(png::Filter::NoFilter);
         let fail = |e: png::EncodingError| invalid(format!("cannot encode the PNG image: {e}"));
         let mut writer = encoder.write_header().map_err(fail)?;
         writer.write_image_data(&self.rgb).map_err(fail)?;
@@ -104,5 +126,12 @@ impl Image {
     pub fn write_png(&self, path: &Path) -> Result<(), Error> {
         let bytes = self.to_png()?;
         crate::output::write_atomic(path, &bytes)
+    }
+}
+
+fn invalid(message: String) -> Error {
+    Error {
+        location: None,
+        kind: ErrorKind::Invalid(message),
     }
 }
