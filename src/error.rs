@@ -132,6 +132,24 @@ pub enum ErrorKind {
     NeedsSuperset,
     /// A batch of worlds with no variant.
     NoWorlds,
+    /// An element's geometry cannot be read the way MuJoCo's compiler reads it (the
+    /// geometry functions, `XmlModel::try_offsets`): a malformed number or orientation, an
+    /// `eulerseq` or `angle` MuJoCo refuses, a mesh file that cannot be read, a subtree
+    /// with no measurable geom, a model with no root body to measure. In words that name
+    /// the element and end with its `file:line:col` (which is why the error's `location`
+    /// stays empty).
+    ///
+    /// ```
+    /// use mjcf_forge::geometry::{element_pose, Angles};
+    /// let doc = mjcf_forge::Document::from_str(
+    ///     "<mujoco><worldbody><geom name='g' size='1' pos='0 x 0'/></worldbody></mujoco>", ".")?;
+    /// let geom = doc.descendants(doc.root()).find(|&n| doc.tag(n) == "geom").unwrap();
+    /// let e = element_pose(&doc, geom, &Angles::default()).unwrap_err();
+    /// assert!(matches!(e.kind, mjcf_forge::ErrorKind::Geometry(_)));
+    /// assert_eq!(e.to_string(), "<geom name=\"g\">: attribute 'pos': 'x' is not a number at <string>:1:20");
+    /// # Ok::<(), mjcf_forge::Errors>(())
+    /// ```
+    Geometry(String),
 }
 
 impl fmt::Display for ErrorKind {
@@ -207,6 +225,7 @@ impl fmt::Display for ErrorKind {
             ErrorKind::NoWorlds => {
                 f.write_str("a batch needs at least one world: no variant was given (0 worlds)")
             }
+            ErrorKind::Geometry(msg) => f.write_str(msg),
         }
     }
 }
