@@ -150,6 +150,54 @@ pub enum ErrorKind {
     /// # Ok::<(), mjcf_forge::Errors>(())
     /// ```
     Geometry(String),
+    /// MuJoCo refused to compile the text of a scene's variant that
+    /// `scene::check_variant` was given.
+    CheckCompile {
+        /// The variant's index.
+        variant: u64,
+        /// MuJoCo's words.
+        message: String,
+    },
+    /// Two geoms of a variant interpenetrate at its initial pose, one of them of a placed
+    /// object (`scene::check_model`, `scene::check_variant`), deeper than
+    /// `scene::PENETRATION_TOLERANCE`.
+    ///
+    /// ```
+    /// let e = mjcf_forge::Error {
+    ///     location: None,
+    ///     kind: mjcf_forge::ErrorKind::Interpenetration {
+    ///         variant: 4,
+    ///         geoms: ["g".into(), "#7".into()],
+    ///         bodies: ["0_box".into(), "table".into()],
+    ///         depth_mm: "1.250".into(),
+    ///     },
+    /// };
+    /// assert_eq!(
+    ///     e.to_string(),
+    ///     "variant 4: geom g of '0_box' interpenetrates geom #7 of 'table' by 1.250 mm at the initial pose"
+    /// );
+    /// ```
+    Interpenetration {
+        /// The variant's index.
+        variant: u64,
+        /// The two geoms: each its name, or `#id` when it has none.
+        geoms: [String; 2],
+        /// The root bodies of the two geoms, in the same order.
+        bodies: [String; 2],
+        /// How deep, in millimetres with three decimals, as the message prints it (text, so
+        /// that the kind stays `Eq`).
+        depth_mm: String,
+    },
+    /// A camera name that the model does not have (`preview::Camera::named`).
+    UnknownCamera {
+        /// The name asked for.
+        name: String,
+        /// The model's named cameras, in their order (empty when it has none).
+        cameras: Vec<String>,
+    },
+    /// A geom set that is not one of `default`, `visual`, `collision`, `all`
+    /// (`preview::Geoms` from text).
+    UnknownGeoms(String),
 }
 
 impl fmt::Display for ErrorKind {
@@ -226,6 +274,34 @@ impl fmt::Display for ErrorKind {
                 f.write_str("a batch needs at least one world: no variant was given (0 worlds)")
             }
             ErrorKind::Geometry(msg) => f.write_str(msg),
+            ErrorKind::CheckCompile { variant, message } => {
+                write!(f, "variant {variant}: {message}")
+            }
+            ErrorKind::Interpenetration {
+                variant,
+                geoms,
+                bodies,
+                depth_mm,
+            } => write!(
+                f,
+                "variant {variant}: geom {} of '{}' interpenetrates geom {} of '{}' by \
+                 {depth_mm} mm at the initial pose",
+                geoms[0], bodies[0], geoms[1], bodies[1]
+            ),
+            ErrorKind::UnknownCamera { name, cameras } => {
+                write!(f, "the model has no camera named '{name}' (")?;
+                if cameras.is_empty() {
+                    f.write_str("it has no named camera)")
+                } else {
+                    write!(f, "its cameras: {})", cameras.join(", "))
+                }
+            }
+            ErrorKind::UnknownGeoms(s) => {
+                write!(
+                    f,
+                    "unknown geom set '{s}' (default, visual, collision, all)"
+                )
+            }
         }
     }
 }

@@ -19,7 +19,9 @@ use crate::mujoco::{CompiledModel, ObjType};
 ///
 /// assert_eq!("collision".parse::<Geoms>(), Ok(Geoms::Collision));
 /// assert_eq!(Geoms::default().to_string(), "default");
-/// assert!("nope".parse::<Geoms>().is_err());
+/// let unknown = "nope".parse::<Geoms>().unwrap_err();
+/// assert_eq!(unknown.kind, mjcf_forge::ErrorKind::UnknownGeoms("nope".into()));
+/// assert_eq!(unknown.to_string(), "unknown geom set 'nope' (default, visual, collision, all)");
 /// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Geoms {
@@ -66,13 +68,13 @@ impl fmt::Display for Geoms {
 }
 
 impl FromStr for Geoms {
-    type Err = String;
+    type Err = Error;
 
-    fn from_str(s: &str) -> Result<Geoms, String> {
+    fn from_str(s: &str) -> Result<Geoms, Error> {
         Geoms::ALL
             .into_iter()
             .find(|g| g.as_str() == s)
-            .ok_or_else(|| format!("unknown geom set '{s}' (default, visual, collision, all)"))
+            .ok_or_else(|| Error::bare(ErrorKind::UnknownGeoms(s.to_owned())))
     }
 }
 
@@ -86,7 +88,9 @@ impl FromStr for Geoms {
 /// let model = compile_str(r#"<mujoco><worldbody><camera name="top" pos="0 0 2"/>
 ///   <geom size="0.1"/></worldbody></mujoco>"#, Path::new(".")).unwrap();
 /// assert_eq!(Camera::named(&model, "top").unwrap(), Camera::Fixed(0));
-/// assert!(Camera::named(&model, "side").is_err());
+/// let unknown = Camera::named(&model, "side").unwrap_err();
+/// assert!(matches!(unknown.kind, mjcf_forge::ErrorKind::UnknownCamera { .. }));
+/// assert_eq!(unknown.to_string(), "the model has no camera named 'side' (its cameras: top)");
 /// let Camera::Free { distance, .. } = Camera::free(&model) else { unreachable!() };
 /// assert!(distance > 0.0);
 /// ```
@@ -127,24 +131,17 @@ impl Camera {
     }
 
     /// The model's camera named `name` (its full name, prefix included).
-    pub fn named(model: &CompiledModel, name: &str) -> Result<Camera, String> {
+    pub fn named(model: &CompiledModel, name: &str) -> Result<Camera, Error> {
         let names = model.names(ObjType::Camera);
         names
             .iter()
             .position(|n| n == name)
             .map(Camera::Fixed)
             .ok_or_else(|| {
-                let known = if names.iter().all(String::is_empty) {
-                    "it has no named camera".to_owned()
-                } else {
-                    let named: Vec<&str> = names
-                        .iter()
-                        .filter(|n| !n.is_empty())
-                        .map(String::as_str)
-                        .collect();
-                    format!("its cameras: {}", named.join(", "))
-                };
-                format!("the model has no camera named '{name}' ({known})")
+                Error::bare(ErrorKind::UnknownCamera {
+                    name: name.to_owned(),
+                    cameras: names.into_iter().filter(|n| !n.is_empty()).collect(),
+                })
             })
     }
 }
