@@ -198,6 +198,18 @@ pub enum ErrorKind {
     /// A geom set that is not one of `default`, `visual`, `collision`, `all`
     /// (`preview::Geoms` from text).
     UnknownGeoms(String),
+    /// A patch cannot be made or written over a compiled model (the split tier's
+    /// functions: `split::PatchPlan`, `split::land`, the body-model copies, geom masses
+    /// and tree derivations): the model's arrays are not of the plan's structure, or the
+    /// face's model (`split::PatchModel` and the other traits the faces implement) refused
+    /// a call. In the plan's or the face's words. The faces' caches take it for "not this
+    /// structure" and compile the variant instead where they can.
+    ///
+    /// ```
+    /// let e = mjcf_forge::split::body_mass(&[]).unwrap_err();
+    /// assert_eq!(e.kind, mjcf_forge::ErrorKind::Patch("no geom counts for its inertia".into()));
+    /// ```
+    Patch(String),
 }
 
 impl fmt::Display for ErrorKind {
@@ -296,6 +308,7 @@ impl fmt::Display for ErrorKind {
                     write!(f, "its cameras: {})", cameras.join(", "))
                 }
             }
+            ErrorKind::Patch(msg) => f.write_str(msg),
             ErrorKind::UnknownGeoms(s) => {
                 write!(
                     f,

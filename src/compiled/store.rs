@@ -123,7 +123,7 @@ impl CacheBackend for Linked {
         fixed: u32,
         values: Statistics,
     ) -> Result<Plan, Errors> {
-        let plan = PatchPlan::new(model, key, fixed, values).map_err(internal)?;
+        let plan = PatchPlan::new(model, key, fixed, values).map_err(Errors::from)?;
         Ok(Plan {
             plan,
             trees: Derivations::default(),
@@ -141,7 +141,7 @@ impl CacheBackend for Linked {
         let r = plan
             .write_patch(model, request.entries)
             .and_then(|()| trees.finish(plan, model, request.parked, self.by_tree));
-        let derived = r.map_err(PatchFailure::NotThisStructure)?;
+        let derived = r.map_err(|e| PatchFailure::NotThisStructure(e.to_string()))?;
         self.derived += u64::from(derived);
         Ok(())
     }
