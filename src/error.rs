@@ -160,34 +160,25 @@ pub enum ErrorKind {
     },
     /// Two geoms of a variant interpenetrate at its initial pose, one of them of a placed
     /// object (`scene::check_model`, `scene::check_variant`), deeper than
-    /// `scene::PENETRATION_TOLERANCE`.
+    /// `scene::PENETRATION_TOLERANCE`. Boxed: an `Error` stays small enough to return.
     ///
     /// ```
-    /// let e = mjcf_forge::Error {
+    /// use mjcf_forge::{Error, ErrorKind, Interpenetration};
+    /// let e = Error {
     ///     location: None,
-    ///     kind: mjcf_forge::ErrorKind::Interpenetration {
+    ///     kind: ErrorKind::Interpenetration(Box::new(Interpenetration {
     ///         variant: 4,
     ///         geoms: ["g".into(), "#7".into()],
     ///         bodies: ["0_box".into(), "table".into()],
     ///         depth_mm: "1.250".into(),
-    ///     },
+    ///     })),
     /// };
     /// assert_eq!(
     ///     e.to_string(),
     ///     "variant 4: geom g of '0_box' interpenetrates geom #7 of 'table' by 1.250 mm at the initial pose"
     /// );
     /// ```
-    Interpenetration {
-        /// The variant's index.
-        variant: u64,
-        /// The two geoms: each its name, or `#id` when it has none.
-        geoms: [String; 2],
-        /// The root bodies of the two geoms, in the same order.
-        bodies: [String; 2],
-        /// How deep, in millimetres with three decimals, as the message prints it (text, so
-        /// that the kind stays `Eq`).
-        depth_mm: String,
-    },
+    Interpenetration(Box<Interpenetration>),
     /// A camera name that the model does not have (`preview::Camera::named`).
     UnknownCamera {
         /// The name asked for.
@@ -289,16 +280,11 @@ impl fmt::Display for ErrorKind {
             ErrorKind::CheckCompile { variant, message } => {
                 write!(f, "variant {variant}: {message}")
             }
-            ErrorKind::Interpenetration {
-                variant,
-                geoms,
-                bodies,
-                depth_mm,
-            } => write!(
+            ErrorKind::Interpenetration(i) => write!(
                 f,
-                "variant {variant}: geom {} of '{}' interpenetrates geom {} of '{}' by \
-                 {depth_mm} mm at the initial pose",
-                geoms[0], bodies[0], geoms[1], bodies[1]
+                "variant {}: geom {} of '{}' interpenetrates geom {} of '{}' by \
+                 {} mm at the initial pose",
+                i.variant, i.geoms[0], i.bodies[0], i.geoms[1], i.bodies[1], i.depth_mm
             ),
             ErrorKind::UnknownCamera { name, cameras } => {
                 write!(f, "the model has no camera named '{name}' (")?;
@@ -317,6 +303,20 @@ impl fmt::Display for ErrorKind {
             }
         }
     }
+}
+
+/// Which two geoms of a variant interpenetrate, and how deep ([`ErrorKind::Interpenetration`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Interpenetration {
+    /// The variant's index.
+    pub variant: u64,
+    /// The two geoms: each its name, or `#id` when it has none.
+    pub geoms: [String; 2],
+    /// The root bodies of the two geoms, in the same order.
+    pub bodies: [String; 2],
+    /// How deep, in millimetres with three decimals, as the message prints it (text, so
+    /// that the kind stays `Eq`).
+    pub depth_mm: String,
 }
 
 /// An error with its position: `Display` gives `file:line:col: message`, followed by the

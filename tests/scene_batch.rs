@@ -562,14 +562,11 @@ overlap = "allow"
         let scene = Scene::from_toml_str(text, &dir).unwrap();
         let v = scene.variant(0).unwrap();
         let err = mjcf_forge::scene::check_variant(0, &v.params, &v.xml(), &dir).unwrap_err();
-        let mjcf_forge::ErrorKind::Interpenetration {
-            variant, bodies, ..
-        } = &err.kind
-        else {
+        let mjcf_forge::ErrorKind::Interpenetration(found) = &err.kind else {
             panic!("not an interpenetration: {err:?}");
         };
-        assert_eq!(*variant, 0);
-        assert!(bodies.iter().any(|b| b.starts_with("pile")), "{err}");
+        assert_eq!(found.variant, 0);
+        assert!(found.bodies.iter().any(|b| b.starts_with("pile")), "{err}");
         let err = err.to_string();
         assert!(err.starts_with("variant 0: geom pile"), "{err}");
         assert!(err.contains("interpenetrates"), "{err}");

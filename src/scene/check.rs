@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use crate::error::{Error, ErrorKind};
+use crate::error::{Error, ErrorKind, Interpenetration};
 use crate::mujoco::{CompiledModel, ObjType, compile_str};
 
 use super::Params;
@@ -71,12 +71,14 @@ pub fn check_model(index: u64, params: &Params, model: &CompiledModel) -> Result
                 let name = geoms.get(g).filter(|n| !n.is_empty()).cloned();
                 name.unwrap_or_else(|| format!("#{g}"))
             };
-            return Err(Error::bare(ErrorKind::Interpenetration {
-                variant: index,
-                geoms: [geom(c.geom1), geom(c.geom2)],
-                bodies: [bodies[a].clone(), bodies[b].clone()],
-                depth_mm: format!("{:.3}", -c.dist * 1e3),
-            }));
+            return Err(Error::bare(ErrorKind::Interpenetration(Box::new(
+                Interpenetration {
+                    variant: index,
+                    geoms: [geom(c.geom1), geom(c.geom2)],
+                    bodies: [bodies[a].clone(), bodies[b].clone()],
+                    depth_mm: format!("{:.3}", -c.dist * 1e3),
+                },
+            ))));
         }
     }
     Ok(())
