@@ -99,7 +99,7 @@ fn off_center(mass: f64, d: &[f64; 3]) -> [f64; 6] {
 /// ```
 pub fn body_mass(geoms: &[GeomMass]) -> Result<BodyMass, Error> {
     match geoms {
-        [] => Err(patch_error("no geom counts for its inertia".to_string())),
+        [] => Err(patch_error("no geom counts for its inertia")),
         [one] => Ok(BodyMass {
             mass: one.mass,
             inertia: one.inertia,
@@ -116,9 +116,7 @@ pub fn body_mass(geoms: &[GeomMass]) -> Result<BodyMass, Error> {
                 }
             }
             if mass < EPS {
-                return Err(patch_error(
-                    "its mass is too small for a centre of mass".to_string(),
-                ));
+                return Err(patch_error("its mass is too small for a centre of mass"));
             }
             let ipos = [com[0] / mass, com[1] / mass, com[2] / mass];
             let mut total = [0.0; 6];
@@ -137,7 +135,7 @@ pub fn body_mass(geoms: &[GeomMass]) -> Result<BodyMass, Error> {
             let (inertia, iquat) = eigen(&full);
             if inertia[2] < EPS {
                 return Err(patch_error(
-                    "its inertia has an eigenvalue that is not positive".to_string(),
+                    "its inertia has an eigenvalue that is not positive",
                 ));
             }
             Ok(BodyMass {
