@@ -132,6 +132,75 @@ pub enum ErrorKind {
     NeedsSuperset,
     /// A batch of worlds with no variant.
     NoWorlds,
+    /// An element's geometry cannot be read the way MuJoCo's compiler reads it (the
+    /// geometry functions, `XmlModel::try_offsets`): a malformed number or orientation, an
+    /// `eulerseq` or `angle` MuJoCo refuses, a mesh file that cannot be read, a subtree
+    /// with no measurable geom, a model with no root body to measure. In words that name
+    /// the element and end with its `file:line:col` (which is why the error's `location`
+    /// stays empty).
+    ///
+    /// ```
+    /// use mjcf_forge::geometry::{element_pose, Angles};
+    /// let doc = mjcf_forge::Document::from_str(
+    ///     "<mujoco><worldbody><geom name='g' size='1' pos='0 x 0'/></worldbody></mujoco>", ".")?;
+    /// let geom = doc.descendants(doc.root()).find(|&n| doc.tag(n) == "geom").unwrap();
+    /// let e = element_pose(&doc, geom, &Angles::default()).unwrap_err();
+    /// assert!(matches!(e.kind, mjcf_forge::ErrorKind::Geometry(_)));
+    /// assert_eq!(e.to_string(), "<geom name=\"g\">: attribute 'pos': 'x' is not a number at <string>:1:20");
+    /// # Ok::<(), mjcf_forge::Errors>(())
+    /// ```
+    Geometry(String),
+    /// MuJoCo refused to compile the text of a scene's variant that
+    /// `scene::check_variant` was given.
+    CheckCompile {
+        /// The variant's index.
+        variant: u64,
+        /// MuJoCo's words.
+        message: String,
+    },
+    /// Two geoms of a variant interpenetrate at its initial pose, one of them of a placed
+    /// object (`scene::check_model`, `scene::check_variant`), deeper than
+    /// `scene::PENETRATION_TOLERANCE`. Boxed: an `Error` stays small enough to return.
+    ///
+    /// ```
+    /// use mjcf_forge::{Error, ErrorKind, Interpenetration};
+    /// let e = Error {
+    ///     location: None,
+    ///     kind: ErrorKind::Interpenetration(Box::new(Interpenetration {
+    ///         variant: 4,
+    ///         geoms: ["g".into(), "#7".into()],
+    ///         bodies: ["0_box".into(), "table".into()],
+    ///         depth_mm: "1.250".into(),
+    ///     })),
+    /// };
+    /// assert_eq!(
+    ///     e.to_string(),
+    ///     "variant 4: geom g of '0_box' interpenetrates geom #7 of 'table' by 1.250 mm at the initial pose"
+    /// );
+    /// ```
+    Interpenetration(Box<Interpenetration>),
+    /// A camera name that the model does not have (`preview::Camera::named`).
+    UnknownCamera {
+        /// The name asked for.
+        name: String,
+        /// The model's named cameras, in their order (empty when it has none).
+        cameras: Vec<String>,
+    },
+    /// A geom set that is not one of `default`, `visual`, `collision`, `all`
+    /// (`sheet::Geoms` from text).
+    UnknownGeoms(String),
+    /// A patch cannot be made or written over a compiled model (the split tier's
+    /// functions: `split::PatchPlan`, `split::land`, the body-model copies, geom masses
+    /// and tree derivations): the model's arrays are not of the plan's structure, or the
+    /// face's model (`split::PatchModel` and the other traits the faces implement) refused
+    /// a call. In the plan's or the face's words. The faces' caches take it for "not this
+    /// structure" and compile the variant instead where they can.
+    ///
+    /// ```
+    /// let e = mjcf_forge::split::body_mass(&[]).unwrap_err();
+    /// assert_eq!(e.kind, mjcf_forge::ErrorKind::Patch("no geom counts for its inertia".into()));
+    /// ```
+    Patch(String),
 }
 
 impl fmt::Display for ErrorKind {
@@ -207,8 +276,47 @@ impl fmt::Display for ErrorKind {
             ErrorKind::NoWorlds => {
                 f.write_str("a batch needs at least one world: no variant was given (0 worlds)")
             }
+            ErrorKind::Geometry(msg) => f.write_str(msg),
+            ErrorKind::CheckCompile { variant, message } => {
+                write!(f, "variant {variant}: {message}")
+            }
+            ErrorKind::Interpenetration(i) => write!(
+                f,
+                "variant {}: geom {} of '{}' interpenetrates geom {} of '{}' by \
+                 {} mm at the initial pose",
+                i.variant, i.geoms[0], i.bodies[0], i.geoms[1], i.bodies[1], i.depth_mm
+            ),
+            ErrorKind::UnknownCamera { name, cameras } => {
+                write!(f, "the model has no camera named '{name}' (")?;
+                if cameras.is_empty() {
+                    f.write_str("it has no named camera)")
+                } else {
+                    write!(f, "its cameras: {})", cameras.join(", "))
+                }
+            }
+            ErrorKind::Patch(msg) => f.write_str(msg),
+            ErrorKind::UnknownGeoms(s) => {
+                write!(
+                    f,
+                    "unknown geom set '{s}' (default, visual, collision, all)"
+                )
+            }
         }
     }
+}
+
+/// Which two geoms of a variant interpenetrate, and how deep ([`ErrorKind::Interpenetration`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Interpenetration {
+    /// The variant's index.
+    pub variant: u64,
+    /// The two geoms: each its name, or `#id` when it has none.
+    pub geoms: [String; 2],
+    /// The root bodies of the two geoms, in the same order.
+    pub bodies: [String; 2],
+    /// How deep, in millimetres with three decimals, as the message prints it (text, so
+    /// that the kind stays `Eq`).
+    pub depth_mm: String,
 }
 
 /// An error with its position: `Display` gives `file:line:col: message`, followed by the

@@ -70,7 +70,7 @@ pub use document::tree::Node;
 pub use document::urdf::{UrdfActuators, UrdfImporter, UrdfOptions};
 pub use document::vocab;
 pub use document::{Document, Section};
-pub use error::{Error, ErrorKind, Errors, Location, Warning};
+pub use error::{Error, ErrorKind, Errors, Interpenetration, Location, Warning};
 pub use model::geometry;
 pub use model::sort;
 pub use model::{

@@ -295,7 +295,7 @@ struct Judged {
     /// One JSON object per model, same order.
     mujoco: Vec<Json>,
     /// Our bounds per model and case, same order.
-    ours: Vec<Vec<Result<Bounds, String>>>,
+    ours: Vec<Vec<Result<Bounds, mjcf_forge::Error>>>,
 }
 
 /// Loads every model and asks MuJoCo once, for all of them, while measuring them here;

@@ -17,7 +17,7 @@ use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use common::{forge, listing, path_arg, scratch, stderr};
-use mjcf_forge::{Document, Limits, MergeOptions};
+use mjcf_forge::{Document, ErrorKind, Limits, MergeOptions};
 
 /// The time every case must end in: well under a second in a release build
 /// (`cargo test --release --test hostile`); unoptimised builds take several times longer.
@@ -168,7 +168,8 @@ fn nesting_up_to_the_limit_loads_prefixes_merges_validates_and_writes_on_a_small
         part.apply_prefix("p_").map_err(|e| e.to_string())?;
         doc.validate().map_err(|e| e.to_string())?;
         let world = doc.section(mjcf_forge::Section::Worldbody);
-        let bounds = mjcf_forge::geometry::subtree_bounds(&doc, world, |_, _| true)?;
+        let bounds = mjcf_forge::geometry::subtree_bounds(&doc, world, |_, _| true)
+            .map_err(|e| e.to_string())?;
         assert_eq!(
             bounds.max[2],
             (bodies - 1) as f64,
@@ -407,6 +408,8 @@ fn meshes_and_skins_naming_special_files_are_refused() {
         mjcf_forge::geometry::mesh_vertices(&doc, m).map(|_| ())
     })
     .unwrap_err();
+    assert!(matches!(msg.kind, ErrorKind::Geometry(_)), "{msg:?}");
+    let msg = msg.to_string();
     assert!(
         msg.ends_with("not a regular file (a FIFO) at <string>:1:16"),
         "{msg}"
@@ -485,7 +488,9 @@ fn skin_and_mesh_headers_claiming_huge_counts_are_refused_without_reserving_memo
             let doc = Document::from_str(&xml, ".").unwrap();
             let asset = doc.find_section(mjcf_forge::Section::Asset).unwrap();
             let mesh = doc.elements(asset).next().unwrap();
-            meshes.push(mjcf_forge::geometry::mesh_vertices(&doc, mesh).unwrap_err());
+            let e = mjcf_forge::geometry::mesh_vertices(&doc, mesh).unwrap_err();
+            assert!(matches!(e.kind, ErrorKind::Geometry(_)), "{e:?}");
+            meshes.push(e.to_string());
         }
         (skin, meshes)
     });

@@ -702,3 +702,35 @@ fn superset_worlds_derived_tree_by_tree_are_mj_setconsts() {
         }
     }
 }
+
+#[test]
+fn the_patch_plan_refuses_with_errors_of_its_kind() {
+    use mjcf_forge::split::{PatchModel, PatchPlan, PatchValues};
+    let mut model = compile_str(
+        "<mujoco><worldbody><body><joint/><geom size='0.1'/></body></worldbody></mujoco>",
+        Path::new("."),
+    )
+    .unwrap();
+    let stat = model.stat();
+    let mut plan = PatchPlan::new(&model, "key", 0, stat).unwrap();
+    let none: &[&str] = &[];
+    let values = PatchValues {
+        numbers: &[],
+        materials: none,
+        bodies: none,
+    };
+    let e = plan.write(&mut model, values).unwrap_err();
+    assert_eq!(
+        e.kind,
+        ErrorKind::Patch("the plan has no layout to write".into())
+    );
+    let e = plan.mean_inertia(&mut model, &[]).unwrap_err();
+    assert_eq!(e.to_string(), "no dofs to take the mean inertia over");
+    assert!(matches!(e.kind, ErrorKind::Patch(_)), "{e:?}");
+    // The model's own refusal (an array this MuJoCo does not have) comes back as it is.
+    let e = model.target("no_such_array", false).err().unwrap();
+    assert_eq!(
+        e.kind,
+        ErrorKind::Patch("this MuJoCo's mjModel has no array no_such_array".into())
+    );
+}

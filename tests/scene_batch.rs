@@ -562,8 +562,22 @@ overlap = "allow"
         let scene = Scene::from_toml_str(text, &dir).unwrap();
         let v = scene.variant(0).unwrap();
         let err = mjcf_forge::scene::check_variant(0, &v.params, &v.xml(), &dir).unwrap_err();
+        let mjcf_forge::ErrorKind::Interpenetration(found) = &err.kind else {
+            panic!("not an interpenetration: {err:?}");
+        };
+        assert_eq!(found.variant, 0);
+        assert!(found.bodies.iter().any(|b| b.starts_with("pile")), "{err}");
+        let err = err.to_string();
         assert!(err.starts_with("variant 0: geom pile"), "{err}");
         assert!(err.contains("interpenetrates"), "{err}");
+        // Text MuJoCo refuses is MuJoCo's words after the variant, of their own kind.
+        let err = mjcf_forge::scene::check_variant(7, &v.params, "<mujoco><nope/></mujoco>", &dir)
+            .unwrap_err();
+        let mjcf_forge::ErrorKind::CheckCompile { variant, message } = &err.kind else {
+            panic!("not a compile error: {err:?}");
+        };
+        assert_eq!(*variant, 7);
+        assert_eq!(err.to_string(), format!("variant 7: {message}"));
     }
 
     #[test]

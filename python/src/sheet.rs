@@ -153,7 +153,9 @@ fn sheet_geom_groups(
     nbody: usize,
     ngroup: usize,
 ) -> PyResult<GroupsAndFlags> {
-    let set: Geoms = geoms.parse().map_err(PyValueError::new_err)?;
+    let set: Geoms = geoms
+        .parse()
+        .map_err(|e: mjcf_forge::Error| PyValueError::new_err(e.to_string()))?;
     if body.len() != collides.len() {
         return Err(PyValueError::new_err(
             "sheet_geom_groups: one collision flag and one body per geom",

@@ -77,6 +77,8 @@ fn compile(_input: &Path, _json: bool, _limits: &super::Loader) -> ExitCode {
 /// Compiles the document with MuJoCo, MuJoCo's error at the element it names in the
 /// user's sources (`mjcf_forge::mujoco::compile_document`), ready to print.
 #[cfg(mjcf_mujoco)]
-pub fn compile_document(doc: &Document) -> Result<mjcf_forge::mujoco::CompiledModel, String> {
+pub(crate) fn compile_document(
+    doc: &Document,
+) -> Result<mjcf_forge::mujoco::CompiledModel, String> {
     mjcf_forge::mujoco::compile_document(doc).map_err(|e| e.to_string())
 }

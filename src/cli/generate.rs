@@ -487,7 +487,7 @@ impl<'s> Validators<'s> {
         // elsewhere, after which the cache is still whole).
         let mut cache = self.0[k].lock().unwrap_or_else(|p| p.into_inner());
         let model = cache.model(i).map_err(|e| e.to_string())?;
-        mjcf_forge::scene::check_model(i, params, model)?;
+        mjcf_forge::scene::check_model(i, params, model).map_err(|e| e.to_string())?;
         Ok(t.elapsed())
     }
 

@@ -2,6 +2,10 @@
 //! finished document is written, how problems are reported, and `--validate`.
 //!
 //! A face, on top of every tier: it uses the library's public API only (`mjcf_forge::...`).
+//!
+//! Nothing here is library API: `mod cli` is private to the binary, and its problems are the
+//! lines it prints on standard error, so the helpers below pass them as `String` and are
+//! `pub(crate)`. The library's own errors reach them typed and become text only here.
 
 pub mod compile;
 pub mod export;
@@ -40,7 +44,7 @@ pub struct WriteOptions {
 
 /// The text of a finished document, validated first when asked: what every command that
 /// writes a model writes, once everything that can fail has run.
-pub fn render(doc: &Document, options: WriteOptions) -> Result<String, String> {
+pub(crate) fn render(doc: &Document, options: WriteOptions) -> Result<String, String> {
     if options.validate {
         validate(doc)?;
     }
@@ -55,7 +59,11 @@ pub fn render(doc: &Document, options: WriteOptions) -> Result<String, String> {
 /// The output is written only when everything before it succeeded, and atomically, so a
 /// failure leaves the old file intact (see [`mjcf_forge::write_atomic`] for symlinks and
 /// special files).
-pub fn emit(doc: &Document, output: Option<&Path>, options: WriteOptions) -> Result<(), String> {
+pub(crate) fn emit(
+    doc: &Document,
+    output: Option<&Path>,
+    options: WriteOptions,
+) -> Result<(), String> {
     let text = render(doc, options)?;
     match output {
         Some(path) => mjcf_forge::write_atomic(path, text.as_bytes()).map_err(|e| e.to_string()),
@@ -65,7 +73,7 @@ pub fn emit(doc: &Document, output: Option<&Path>, options: WriteOptions) -> Res
 
 /// `print!` would panic on a closed pipe; a failed write is an ordinary error here, and
 /// a reader that went away ([`QUIET_END`]) is no error at all.
-pub fn write_stdout(bytes: &[u8]) -> Result<(), String> {
+pub(crate) fn write_stdout(bytes: &[u8]) -> Result<(), String> {
     let mut out = std::io::stdout().lock();
     out.write_all(bytes)
         .and_then(|()| out.flush())
@@ -107,7 +115,7 @@ pub fn stdout_closed() -> bool {
 /// Prints the problems of all runs; success only when there were none. A run that ended
 /// because standard output was closed ([`QUIET_END`]) prints nothing and is a success
 /// unless another run failed.
-pub fn finish(results: &[Result<(), String>]) -> ExitCode {
+pub(crate) fn finish(results: &[Result<(), String>]) -> ExitCode {
     let mut failed = false;
     for problem in results.iter().filter_map(|r| r.as_ref().err()) {
         if problem == QUIET_END {
@@ -126,7 +134,7 @@ pub fn finish(results: &[Result<(), String>]) -> ExitCode {
 /// `Err` when the output folder `dir` already holds something: outputs are never mixed
 /// with a previous run's, so a folder that is not empty is replaced whole with
 /// `--replace` or refused (checked before any work, so nothing runs in vain).
-pub fn refuse_non_empty(dir: &Path, replace: bool) -> Result<(), String> {
+pub(crate) fn refuse_non_empty(dir: &Path, replace: bool) -> Result<(), String> {
     if replace {
         return Ok(());
     }
@@ -150,7 +158,7 @@ pub fn refuse_non_empty(dir: &Path, replace: bool) -> Result<(), String> {
 
 /// The output folder a run writes: staged beside `dir` and put in place whole at
 /// [`mjcf_forge::OutputDir::finish`] (replacing a folder there with `replace`).
-pub fn open_output_dir(dir: &Path, replace: bool) -> Result<mjcf_forge::OutputDir, String> {
+pub(crate) fn open_output_dir(dir: &Path, replace: bool) -> Result<mjcf_forge::OutputDir, String> {
     refuse_non_empty(dir, replace)?;
     if replace {
         mjcf_forge::OutputDir::replace(dir)
@@ -186,7 +194,7 @@ fn require_mujoco() -> Result<(), String> {
 /// every subcommand that writes a model. The error is ready to print: MuJoCo's message,
 /// prefixed with the position of the element it names (see
 /// [`compile::compile_document`]).
-pub fn validate(doc: &Document) -> Result<(), String> {
+pub(crate) fn validate(doc: &Document) -> Result<(), String> {
     #[cfg(mjcf_mujoco)]
     {
         compile::compile_document(doc).map(drop)
@@ -250,7 +258,7 @@ pub struct UrdfArgs {
 
 impl UrdfArgs {
     /// The options these flags ask for, or what is wrong with them.
-    pub fn options(&self) -> Result<mjcf_forge::UrdfOptions, String> {
+    pub(crate) fn options(&self) -> Result<mjcf_forge::UrdfOptions, String> {
         let mut o = mjcf_forge::UrdfOptions {
             visuals: self.urdf_visuals,
             fuse_static: !self.urdf_keep_static,
@@ -314,7 +322,7 @@ impl Loader {
 
     /// A model read as `Document::load` reads it, within the limits; its problems (or a
     /// bad URDF flag) as text.
-    pub fn load(&self, path: &Path) -> Result<mjcf_forge::Document, String> {
+    pub(crate) fn load(&self, path: &Path) -> Result<mjcf_forge::Document, String> {
         let urdf = self.urdf.as_ref().map_err(Clone::clone)?;
         let doc = mjcf_forge::Document::load_urdf_with(path, &self.limits, urdf)
             .map_err(|e| e.to_string())?;

@@ -74,8 +74,8 @@ impl DocumentBackend for LinkedDocs {
             Ok(plan) => plan,
             Err(e) => return Err((model, PatchFailure::Backend(e))),
         };
-        if let Err(m) = plan.resolve(&mut model, request.entries) {
-            return Err((model, PatchFailure::NotThisStructure(m)));
+        if let Err(e) = plan.resolve(&mut model, request.entries) {
+            return Err((model, PatchFailure::NotThisStructure(e.to_string())));
         }
         Ok(Working { model, plan })
     }

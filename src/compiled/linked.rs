@@ -17,10 +17,11 @@ use super::sys::{
     mjf_patch_set_const, mjf_patch_set_stat, mjf_patch_size, mjf_patch_size_name,
     mjf_tree_camlight, mjf_tree_constant, mjf_tree_data,
 };
+use crate::error::Error;
 use crate::mujoco::{CompiledModel, compile_str};
 use crate::split::{
     ArrayMut, ModelArrays, ModelArraysMut, ModelLayout, PatchModel, StatArrays, Statistics,
-    TreeModel,
+    TreeModel, patch_error,
 };
 
 /// Scratch mjData for `mj_setConst` (which overwrites the qpos of the data it is given).
@@ -54,17 +55,17 @@ fn arrays(model: &CompiledModel) -> Arrays {
 }
 
 impl ModelArrays for CompiledModel {
-    fn floats(&self, name: &str) -> Result<&[f64], String> {
+    fn floats(&self, name: &str) -> Result<&[f64], Error> {
         let (p, n) = arrays(self).typed::<f64>(name)?;
         // SAFETY: `n` elements of this live model, read while `self` is borrowed.
         Ok(unsafe { crate::mujoco::slice_or_empty(p.cast_const(), n) })
     }
-    fn ints(&self, name: &str) -> Result<&[i32], String> {
+    fn ints(&self, name: &str) -> Result<&[i32], Error> {
         let (p, n) = arrays(self).typed::<i32>(name)?;
         // SAFETY: as above.
         Ok(unsafe { crate::mujoco::slice_or_empty(p.cast_const(), n) })
     }
-    fn bytes(&self, name: &str) -> Result<&[u8], String> {
+    fn bytes(&self, name: &str) -> Result<&[u8], Error> {
         let (p, n) = arrays(self).typed::<u8>(name)?;
         // SAFETY: as above.
         Ok(unsafe { crate::mujoco::slice_or_empty(p.cast_const(), n) })
@@ -72,29 +73,29 @@ impl ModelArrays for CompiledModel {
 }
 
 /// `name`'s `n` elements of `T`, to write.
-fn whole_mut<'a, T>(model: &'a mut CompiledModel, name: &str) -> Result<&'a mut [T], String> {
+fn whole_mut<'a, T>(model: &'a mut CompiledModel, name: &str) -> Result<&'a mut [T], Error> {
     let (p, n) = Arrays(model.as_mut_ptr()).typed::<T>(name)?;
     // SAFETY: `n` elements of this live model, written through its `&mut` borrow only.
     Ok(unsafe { super::arrays::whole(p.cast(), n) })
 }
 
 impl ModelArraysMut for CompiledModel {
-    fn floats_mut(&mut self, name: &str) -> Result<&mut [f64], String> {
+    fn floats_mut(&mut self, name: &str) -> Result<&mut [f64], Error> {
         whole_mut(self, name)
     }
-    fn bytes_mut(&mut self, name: &str) -> Result<&mut [u8], String> {
+    fn bytes_mut(&mut self, name: &str) -> Result<&mut [u8], Error> {
         whole_mut(self, name)
     }
-    fn ints_mut(&mut self, name: &str) -> Result<&mut [i32], String> {
+    fn ints_mut(&mut self, name: &str) -> Result<&mut [i32], Error> {
         whole_mut(self, name)
     }
 }
 
 impl ModelLayout for CompiledModel {
-    fn int(&self, name: &str, i: usize) -> Result<i64, String> {
+    fn int(&self, name: &str, i: usize) -> Result<i64, Error> {
         arrays(self).int(name, i)
     }
-    fn len(&self, name: &str) -> Result<usize, String> {
+    fn len(&self, name: &str) -> Result<usize, Error> {
         arrays(self).len(name)
     }
 }
@@ -104,7 +105,7 @@ impl PatchModel for CompiledModel {
     type Part = CompiledModel;
     type Data = Scratch;
 
-    fn target(&mut self, name: &str, int: bool) -> Result<Target, String> {
+    fn target(&mut self, name: &str, int: bool) -> Result<Target, Error> {
         let (ptr, elem, count) = Arrays(self.as_mut_ptr()).find(name)?;
         Ok(Target {
             ptr,
@@ -154,16 +155,16 @@ impl PatchModel for CompiledModel {
         !p.is_null() && elem == std::mem::size_of::<f64>() && count == n
     }
 
-    fn write_option(&mut self, field: &str, values: &[f64]) -> Result<(), String> {
-        let c = CString::new(field).map_err(|x| x.to_string())?;
+    fn write_option(&mut self, field: &str, values: &[f64]) -> Result<(), Error> {
+        let c = CString::new(field).map_err(|x| patch_error(x.to_string()))?;
         let (mut elem, mut count) = (0usize, 0usize);
         // SAFETY: the model is live; `c` is NUL-terminated.
         let p = unsafe { mjf_patch_option(self.as_mut_ptr(), c.as_ptr(), &mut elem, &mut count) };
         if p.is_null() || elem != std::mem::size_of::<f64>() || count != values.len() {
-            return Err(format!(
+            return Err(patch_error(format!(
                 "this MuJoCo's mjOption has no field {field} of {}",
                 values.len()
-            ));
+            )));
         }
         // SAFETY: `count` doubles of the live model's mjOption, written through `&mut`.
         unsafe { std::slice::from_raw_parts_mut(p.cast::<f64>(), count) }.copy_from_slice(values);
@@ -180,16 +181,16 @@ impl PatchModel for CompiledModel {
         name.map_or_else(|| body.to_string(), |n| n.into_owned())
     }
 
-    fn compile_part(&self, xml: &str) -> Result<CompiledModel, String> {
-        compile_str(xml, Path::new(".")).map_err(|e| e.to_string())
+    fn compile_part(&self, xml: &str) -> Result<CompiledModel, Error> {
+        compile_str(xml, Path::new(".")).map_err(|e| patch_error(e.to_string()))
     }
 
-    fn make_data(&self) -> Result<Scratch, String> {
+    fn make_data(&self) -> Result<Scratch, Error> {
         // SAFETY: the model is live.
         let d = unsafe { mjf_patch_make_data(self.raw()) };
         NonNull::new(d)
             .map(Scratch)
-            .ok_or_else(|| "MuJoCo could not allocate mjData for the model".to_string())
+            .ok_or_else(|| patch_error("MuJoCo could not allocate mjData for the model"))
     }
 
     fn nbytes(&self, data: &Scratch) -> usize {
@@ -197,19 +198,19 @@ impl PatchModel for CompiledModel {
         usize::try_from(unsafe { mjf_patch_nbytes(self.raw(), data.0.as_ptr()) }).unwrap_or(0)
     }
 
-    fn set_const(&mut self, data: &mut Scratch) -> Result<(), String> {
+    fn set_const(&mut self, data: &mut Scratch) -> Result<(), Error> {
         // SAFETY: the model and its scratch data are live and of one structure.
         unsafe { mjf_patch_set_const(self.as_mut_ptr(), data.0.as_ptr()) };
         Ok(())
     }
 
-    fn kinematics(&mut self, data: &mut Scratch) -> Result<(), String> {
+    fn kinematics(&mut self, data: &mut Scratch) -> Result<(), Error> {
         // SAFETY: as above.
         unsafe { mjf_patch_kinematics(self.raw(), data.0.as_ptr()) };
         Ok(())
     }
 
-    fn inertia(&mut self, data: &mut Scratch) -> Result<(), String> {
+    fn inertia(&mut self, data: &mut Scratch) -> Result<(), Error> {
         // SAFETY: as above.
         unsafe { mjf_patch_make_m(self.raw(), data.0.as_ptr()) };
         Ok(())
@@ -219,7 +220,7 @@ impl PatchModel for CompiledModel {
         &mut self,
         data: &Scratch,
         f: impl FnOnce(&StatArrays<'_>, &mut [f64]) -> R,
-    ) -> Result<R, String> {
+    ) -> Result<R, Error> {
         // SAFETY: as above; nothing else touches them while `f` runs.
         Ok(unsafe { with_arrays(self.as_mut_ptr(), data.0.as_ptr(), f) })
     }
@@ -231,7 +232,7 @@ impl PatchModel for CompiledModel {
         stat
     }
 
-    fn set_stat(&mut self, stat: &Statistics) -> Result<(), String> {
+    fn set_stat(&mut self, stat: &Statistics) -> Result<(), Error> {
         // SAFETY: the model is live; `stat` holds 7 values.
         unsafe { mjf_patch_set_stat(self.as_mut_ptr(), stat.as_ptr()) };
         Ok(())
@@ -242,8 +243,8 @@ impl PatchModel for CompiledModel {
 static RECOMPUTES_SAMEFRAME: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
 
 impl TreeModel for CompiledModel {
-    fn compile_model(&self, xml: &str) -> Result<CompiledModel, String> {
-        compile_str(xml, Path::new(".")).map_err(|e| e.to_string())
+    fn compile_model(&self, xml: &str) -> Result<CompiledModel, Error> {
+        compile_str(xml, Path::new(".")).map_err(|e| patch_error(e.to_string()))
     }
 
     fn constant(&self, name: &str) -> Option<i32> {
@@ -254,7 +255,7 @@ impl TreeModel for CompiledModel {
         (found != 0).then_some(value)
     }
 
-    fn recomputes_sameframe(&self) -> Result<bool, String> {
+    fn recomputes_sameframe(&self) -> Result<bool, Error> {
         if let Some(&known) = RECOMPUTES_SAMEFRAME.get() {
             return Ok(known);
         }
@@ -262,7 +263,7 @@ impl TreeModel for CompiledModel {
         Ok(*RECOMPUTES_SAMEFRAME.get_or_init(|| probed))
     }
 
-    fn camlight(&mut self, data: &mut Scratch) -> Result<(), String> {
+    fn camlight(&mut self, data: &mut Scratch) -> Result<(), Error> {
         // SAFETY: the model and its scratch data are live and of one structure.
         unsafe { mjf_tree_camlight(self.raw(), data.0.as_ptr()) };
         Ok(())
@@ -273,15 +274,15 @@ impl TreeModel for CompiledModel {
         data: &Scratch,
         names: &[&str],
         f: impl FnOnce(&[&[f64]]) -> R,
-    ) -> Result<R, String> {
+    ) -> Result<R, Error> {
         let mut slices = Vec::with_capacity(names.len());
         for name in names {
-            let c = CString::new(*name).map_err(|e| e.to_string())?;
+            let c = CString::new(*name).map_err(|e| patch_error(e.to_string()))?;
             let mut count = 0usize;
             // SAFETY: live model and data; a NUL-terminated name.
             let p = unsafe { mjf_tree_data(self.raw(), data.0.as_ptr(), c.as_ptr(), &mut count) };
             if p.is_null() && count > 0 {
-                return Err(format!("no mjData array {name} here"));
+                return Err(patch_error(format!("no mjData array {name} here")));
             }
             // SAFETY: `count` numbers of the live data, read while it is borrowed.
             slices.push(unsafe { crate::mujoco::slice_or_empty(p, count) });

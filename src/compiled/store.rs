@@ -33,7 +33,7 @@ impl Plan {
         &mut self,
         model: &mut CompiledModel,
         entries: &[crate::split::PatchEntry],
-    ) -> Result<(), String> {
+    ) -> Result<(), crate::Error> {
         self.plan.resolve_patch(model, entries)
     }
 }
@@ -134,7 +134,7 @@ impl CacheBackend for Linked {
         fixed: u32,
         values: Statistics,
     ) -> Result<Plan, Errors> {
-        let plan = PatchPlan::new(model, key, fixed, values).map_err(internal)?;
+        let plan = PatchPlan::new(model, key, fixed, values).map_err(Errors::from)?;
         Ok(Plan {
             plan,
             trees: Derivations::default(),
@@ -152,7 +152,7 @@ impl CacheBackend for Linked {
         let r = plan
             .write_patch(model, request.entries)
             .and_then(|()| trees.finish(plan, model, request.parked, self.by_tree));
-        let derived = r.map_err(PatchFailure::NotThisStructure)?;
+        let derived = r.map_err(|e| PatchFailure::NotThisStructure(e.to_string()))?;
         self.derived += u64::from(derived);
         Ok(())
     }

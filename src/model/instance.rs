@@ -157,7 +157,7 @@ pub struct XmlModel {
     important_sites: BTreeMap<String, String>,
     important_sensors: BTreeMap<String, String>,
     /// Computed on first use (meshes are read from disk), unless set by hand.
-    offsets: OnceLock<Result<Offsets, String>>,
+    offsets: OnceLock<Result<Offsets, Error>>,
 }
 
 /// The semantic lists of a model (names with their prefix).
@@ -359,15 +359,31 @@ impl XmlModel {
     /// The offsets from the model's geometry (computed once, on first use): the root body's
     /// position, and the bounds of every geom below it in the root's frame with the tree as
     /// written (primitives exactly, meshes from their vertices; planes and height fields
-    /// left out). An unreadable mesh file is the error.
-    pub fn try_offsets(&self) -> Result<Offsets, String> {
+    /// left out). An unreadable mesh file is the error, an [`ErrorKind::Geometry`].
+    ///
+    /// ```
+    /// use mjcf_forge::{Document, ErrorKind, XmlModel};
+    /// let doc = Document::from_str(
+    ///     "<mujoco><worldbody><body name='b'><geom type='box' size='1 x 1'/></body></worldbody></mujoco>", ".")?;
+    /// let e = XmlModel::new(doc, 0)?.try_offsets().unwrap_err();
+    /// assert!(matches!(e.kind, ErrorKind::Geometry(_)));
+    /// assert!(e.to_string().contains("attribute 'size': 'x' is not a number at"), "{e}");
+    /// # Ok::<(), mjcf_forge::Errors>(())
+    /// ```
+    pub fn try_offsets(&self) -> Result<Offsets, Error> {
         self.offsets.get_or_init(|| self.compute_offsets()).clone()
     }
 
-    fn compute_offsets(&self) -> Result<Offsets, String> {
+    fn compute_offsets(&self) -> Result<Offsets, Error> {
         let doc = &self.doc;
-        let world = doc.find_section(Section::Worldbody).ok_or("no worldbody")?;
-        let root = *doc.top_level_bodies(world).first().ok_or("no root body")?;
+        let missing = |what: &str| Error::bare(ErrorKind::Geometry(what.to_string()));
+        let world = doc
+            .find_section(Section::Worldbody)
+            .ok_or_else(|| missing("no worldbody"))?;
+        let root = *doc
+            .top_level_bodies(world)
+            .first()
+            .ok_or_else(|| missing("no root body"))?;
         let angles = geometry::Angles::of(doc)?;
         let base = geometry::element_pose(doc, root, &angles)?.pos;
         let bounds = geometry::subtree_bounds(doc, root, |_, _| true)?;
@@ -555,7 +571,7 @@ struct Info<'a> {
     top_offset: [f64; 3],
     horizontal_radius: f64,
     #[serde(skip_serializing_if = "Option::is_none")]
-    geometry_error: Option<&'a str>,
+    geometry_error: Option<String>,
 }
 
 /// JSON on one line with Python's `json.dumps` separators (`", "`, `": "`), and numbers
@@ -633,7 +649,7 @@ impl XmlModel {
             bottom_offset: self.bottom_offset(),
             top_offset: self.top_offset(),
             horizontal_radius: self.horizontal_radius(),
-            geometry_error: offsets.as_ref().err().map(|e| e.as_str()),
+            geometry_error: offsets.as_ref().err().map(ToString::to_string),
         };
         let mut out = Vec::new();
         let mut writer = serde_json::Serializer::with_formatter(&mut out, OneLine);

@@ -24,7 +24,9 @@ const GEOM_PLANE: i32 = 0;
 /// let model = compile_str(r#"<mujoco><worldbody><camera name="top" pos="0 0 2"/>
 ///   <geom size="0.1"/></worldbody></mujoco>"#, Path::new(".")).unwrap();
 /// assert_eq!(Camera::named(&model, "top").unwrap(), Camera::Fixed(0));
-/// assert!(Camera::named(&model, "side").is_err());
+/// let unknown = Camera::named(&model, "side").unwrap_err();
+/// assert!(matches!(unknown.kind, mjcf_forge::ErrorKind::UnknownCamera { .. }));
+/// assert_eq!(unknown.to_string(), "the model has no camera named 'side' (its cameras: top)");
 /// let Camera::Free { distance, .. } = Camera::free(&model) else { unreachable!() };
 /// assert!(distance > 0.0);
 /// ```
@@ -81,24 +83,17 @@ impl Camera {
     }
 
     /// The model's camera named `name` (its full name, prefix included).
-    pub fn named(model: &CompiledModel, name: &str) -> Result<Camera, String> {
+    pub fn named(model: &CompiledModel, name: &str) -> Result<Camera, Error> {
         let names = model.names(ObjType::Camera);
         names
             .iter()
             .position(|n| n == name)
             .map(Camera::Fixed)
             .ok_or_else(|| {
-                let known = if names.iter().all(String::is_empty) {
-                    "it has no named camera".to_owned()
-                } else {
-                    let named: Vec<&str> = names
-                        .iter()
-                        .filter(|n| !n.is_empty())
-                        .map(String::as_str)
-                        .collect();
-                    format!("its cameras: {}", named.join(", "))
-                };
-                format!("the model has no camera named '{name}' ({known})")
+                Error::bare(ErrorKind::UnknownCamera {
+                    name: name.to_owned(),
+                    cameras: names.into_iter().filter(|n| !n.is_empty()).collect(),
+                })
             })
     }
 }

@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use crate::error::{Error, ErrorKind, Interpenetration};
 use crate::mujoco::{CompiledModel, ObjType, compile_str};
 
 use super::Params;
@@ -11,8 +12,9 @@ use super::Params;
 pub const PENETRATION_TOLERANCE: f64 = 1e-6;
 
 /// Compiles `xml` (the text of variant `index`, drawn with `params`; relative file names
-/// resolved against `dir`) and checks its placed objects: `Err` with MuJoCo's message, or
-/// the first pair of interpenetrating geoms that involves a placed object.
+/// resolved against `dir`) and checks its placed objects: `Err` with MuJoCo's message
+/// ([`ErrorKind::CheckCompile`]), or the first pair of interpenetrating geoms that involves
+/// a placed object ([`ErrorKind::Interpenetration`]).
 ///
 /// ```
 /// let scene = mjcf_forge::scene::Scene::demo()?;
@@ -25,14 +27,20 @@ pub fn check_variant(
     params: &Params,
     xml: &str,
     dir: &Path,
-) -> Result<CompiledModel, String> {
-    let model = compile_str(xml, dir).map_err(|e| format!("variant {index}: {e}"))?;
+) -> Result<CompiledModel, Error> {
+    let model = compile_str(xml, dir).map_err(|e| {
+        Error::bare(ErrorKind::CheckCompile {
+            variant: index,
+            message: e.message,
+        })
+    })?;
     check_model(index, params, &model)?;
     Ok(model)
 }
 
 /// [`check_variant`] on a model already compiled (or patched by a
-/// [`crate::compiled::ModelCache`]) for variant `index`.
+/// [`crate::compiled::ModelCache`]) for variant `index`. The first interpenetration found
+/// is an [`ErrorKind::Interpenetration`] naming both geoms and their root bodies.
 ///
 /// ```
 /// use mjcf_forge::compiled::ModelCache;
@@ -42,7 +50,7 @@ pub fn check_variant(
 /// mjcf_forge::scene::check_model(2, &params, cache.model(2).unwrap()).unwrap();
 /// # Ok::<(), mjcf_forge::Errors>(())
 /// ```
-pub fn check_model(index: u64, params: &Params, model: &CompiledModel) -> Result<(), String> {
+pub fn check_model(index: u64, params: &Params, model: &CompiledModel) -> Result<(), Error> {
     let bodies = model.names(ObjType::Body);
     let placed: Vec<usize> = params
         .objects
@@ -59,20 +67,18 @@ pub fn check_model(index: u64, params: &Params, model: &CompiledModel) -> Result
         }
         let (a, b) = (owner(c.geom1), owner(c.geom2));
         if placed.contains(&a) || placed.contains(&b) {
-            let label = |g: usize, body: usize| {
+            let geom = |g: usize| {
                 let name = geoms.get(g).filter(|n| !n.is_empty()).cloned();
-                format!(
-                    "geom {} of '{}'",
-                    name.unwrap_or_else(|| format!("#{g}")),
-                    bodies[body]
-                )
+                name.unwrap_or_else(|| format!("#{g}"))
             };
-            return Err(format!(
-                "variant {index}: {} interpenetrates {} by {:.3} mm at the initial pose",
-                label(c.geom1, a),
-                label(c.geom2, b),
-                -c.dist * 1e3
-            ));
+            return Err(Error::bare(ErrorKind::Interpenetration(Box::new(
+                Interpenetration {
+                    variant: index,
+                    geoms: [geom(c.geom1), geom(c.geom2)],
+                    bodies: [bodies[a].clone(), bodies[b].clone()],
+                    depth_mm: format!("{:.3}", -c.dist * 1e3),
+                },
+            ))));
         }
     }
     Ok(())

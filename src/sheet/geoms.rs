@@ -4,6 +4,8 @@
 use std::fmt;
 use std::str::FromStr;
 
+use crate::error::{Error, ErrorKind};
+
 /// Which geoms are drawn. Sites are never drawn (every `sitegroup` off): they are markers,
 /// not the scene.
 ///
@@ -12,7 +14,9 @@ use std::str::FromStr;
 ///
 /// assert_eq!("collision".parse::<Geoms>(), Ok(Geoms::Collision));
 /// assert_eq!(Geoms::default().to_string(), "default");
-/// assert!("nope".parse::<Geoms>().is_err());
+/// let unknown = "nope".parse::<Geoms>().unwrap_err();
+/// assert_eq!(unknown.kind, mjcf_forge::ErrorKind::UnknownGeoms("nope".into()));
+/// assert_eq!(unknown.to_string(), "unknown geom set 'nope' (default, visual, collision, all)");
 /// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Geoms {
@@ -121,12 +125,12 @@ impl fmt::Display for Geoms {
 }
 
 impl FromStr for Geoms {
-    type Err = String;
+    type Err = Error;
 
-    fn from_str(s: &str) -> Result<Geoms, String> {
+    fn from_str(s: &str) -> Result<Geoms, Error> {
         Geoms::ALL
             .into_iter()
             .find(|g| g.as_str() == s)
-            .ok_or_else(|| format!("unknown geom set '{s}' (default, visual, collision, all)"))
+            .ok_or_else(|| Error::bare(ErrorKind::UnknownGeoms(s.to_owned())))
     }
 }

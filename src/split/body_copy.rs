@@ -6,24 +6,27 @@
 //! `patch.c` (`compiled/linked.rs`), the Python face over the user's `MjModel` in
 //! place (`python/src/split/`).
 
+use super::patch_error;
+use crate::error::Error;
+
 /// A compiled model's arrays by their `mjModel` names.
 pub trait ModelArrays {
     /// An array of `mjtNum`; an error names an array this model does not have.
-    fn floats(&self, name: &str) -> Result<&[f64], String>;
+    fn floats(&self, name: &str) -> Result<&[f64], Error>;
     /// An array of `int`.
-    fn ints(&self, name: &str) -> Result<&[i32], String>;
+    fn ints(&self, name: &str) -> Result<&[i32], Error>;
     /// An array of `mjtByte`.
-    fn bytes(&self, name: &str) -> Result<&[u8], String>;
+    fn bytes(&self, name: &str) -> Result<&[u8], Error>;
 }
 
 /// A compiled model's arrays, to write.
 pub trait ModelArraysMut: ModelArrays {
     /// An array of `mjtNum`, to write.
-    fn floats_mut(&mut self, name: &str) -> Result<&mut [f64], String>;
+    fn floats_mut(&mut self, name: &str) -> Result<&mut [f64], Error>;
     /// An array of `mjtByte`, to write.
-    fn bytes_mut(&mut self, name: &str) -> Result<&mut [u8], String>;
+    fn bytes_mut(&mut self, name: &str) -> Result<&mut [u8], Error>;
     /// An array of `int`, to write.
-    fn ints_mut(&mut self, name: &str) -> Result<&mut [i32], String>;
+    fn ints_mut(&mut self, name: &str) -> Result<&mut [i32], Error>;
 }
 
 /// The arrays copied from a body model, each with its width: per geom of the body, per
@@ -73,33 +76,34 @@ pub struct MasslessFrame {
     sameframe: u8,
 }
 
-fn row<const N: usize>(a: &[f64], i: usize) -> Result<[f64; N], String> {
+fn row<const N: usize>(a: &[f64], i: usize) -> Result<[f64; N], Error> {
     a.get(N * i..N * (i + 1))
         .and_then(|r| r.try_into().ok())
-        .ok_or_else(|| format!("row {i} out of range"))
+        .ok_or_else(|| patch_error(format!("row {i} out of range")))
 }
 
 /// The massless bodies of `m` (no mass, no inertia) and their inertial frames, by body.
 ///
 /// ```
+/// # use mjcf_forge::Error;
 /// # use mjcf_forge::split::{ModelArrays, massless_frames};
 /// # struct One;
 /// # impl ModelArrays for One {
-/// #     fn floats(&self, name: &str) -> Result<&[f64], String> {
+/// #     fn floats(&self, name: &str) -> Result<&[f64], Error> {
 /// #         Ok(match name {
 /// #             "body_mass" => &[0.0, 0.0],
 /// #             "body_inertia" | "body_pos" | "body_ipos" => &[0.0; 6],
 /// #             _ => &[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0],
 /// #         })
 /// #     }
-/// #     fn ints(&self, _: &str) -> Result<&[i32], String> { Ok(&[]) }
-/// #     fn bytes(&self, _: &str) -> Result<&[u8], String> { Ok(&[1, 1]) }
+/// #     fn ints(&self, _: &str) -> Result<&[i32], Error> { Ok(&[]) }
+/// #     fn bytes(&self, _: &str) -> Result<&[u8], Error> { Ok(&[1, 1]) }
 /// # }
 /// // A world and one body without mass: the body's frame is kept (the world has none).
 /// assert_eq!(massless_frames(&One)?.iter().map(|(b, _)| *b).collect::<Vec<_>>(), [1]);
-/// # Ok::<(), String>(())
+/// # Ok::<(), Error>(())
 /// ```
-pub fn massless_frames(m: &impl ModelArrays) -> Result<Vec<(usize, MasslessFrame)>, String> {
+pub fn massless_frames(m: &impl ModelArrays) -> Result<Vec<(usize, MasslessFrame)>, Error> {
     let (mass, inertia) = (m.floats("body_mass")?, m.floats("body_inertia")?);
     let mut out = Vec::new();
     for (b, &weight) in mass.iter().enumerate().skip(1) {
@@ -111,7 +115,10 @@ pub fn massless_frames(m: &impl ModelArrays) -> Result<Vec<(usize, MasslessFrame
                     quat: row(m.floats("body_quat")?, b)?,
                     ipos: row(m.floats("body_ipos")?, b)?,
                     iquat: row(m.floats("body_iquat")?, b)?,
-                    sameframe: *m.bytes("body_sameframe")?.get(b).ok_or("body_sameframe")?,
+                    sameframe: *m
+                        .bytes("body_sameframe")?
+                        .get(b)
+                        .ok_or_else(|| patch_error("body_sameframe"))?,
                 },
             ));
         }
@@ -120,19 +127,19 @@ pub fn massless_frames(m: &impl ModelArrays) -> Result<Vec<(usize, MasslessFrame
 }
 
 /// `count` rows of `width` from `first`, checked.
-fn rows<T>(a: &[T], first: usize, count: usize, width: usize) -> Result<&[T], String> {
+fn rows<T>(a: &[T], first: usize, count: usize, width: usize) -> Result<&[T], Error> {
     a.get(width * first..width * (first + count))
-        .ok_or_else(|| format!("rows {first}..{} out of range", first + count))
+        .ok_or_else(|| patch_error(format!("rows {first}..{} out of range", first + count)))
 }
 
-fn index(a: &[i32], i: usize, name: &str) -> Result<usize, String> {
+fn index(a: &[i32], i: usize, name: &str) -> Result<usize, Error> {
     a.get(i)
         .map(|&v| v.max(0) as usize)
-        .ok_or_else(|| format!("{name}[{i}] out of range"))
+        .ok_or_else(|| patch_error(format!("{name}[{i}] out of range")))
 }
 
 /// Body `b`'s first geom, geom count, first bounding-volume node and node count.
-fn span(m: &(impl ModelArrays + ?Sized), b: usize) -> Result<(usize, usize, usize, usize), String> {
+fn span(m: &(impl ModelArrays + ?Sized), b: usize) -> Result<(usize, usize, usize, usize), Error> {
     Ok((
         index(m.ints("body_geomadr")?, b, "body_geomadr")?,
         index(m.ints("body_geomnum")?, b, "body_geomnum")?,
@@ -153,7 +160,7 @@ pub fn copy_body_model(
     name: &str,
     kept: Option<&MasslessFrame>,
     part: &impl ModelArrays,
-) -> Result<(), String> {
+) -> Result<(), Error> {
     let not_a_patch = || {
         format!(
             "body '{name}': its geoms compile to another layout than this structure's (sizes, \
@@ -162,7 +169,7 @@ pub fn copy_body_model(
         )
     };
     if part.floats("body_mass")?.len() != 2 {
-        return Err(not_a_patch());
+        return Err(patch_error(not_a_patch()));
     }
     // It has a mass now: its geoms place its inertial frame.
     let massive = part.floats("body_mass")?[1] != 0.0
@@ -174,15 +181,19 @@ pub fn copy_body_model(
         && (row::<3>(model.floats("body_pos")?, body)? != k.pos
             || row::<4>(model.floats("body_quat")?, body)? != k.quat)
     {
-        return Err(format!(
+        return Err(patch_error(format!(
             "body '{name}' has no mass and another frame: not a patch of it"
-        ));
+        )));
     }
     let (g, n, v, nv) = span(&*model, body)?;
     let (pg, pn, pv, pnv) = span(part, 1)?;
-    let sameframe = |m: &[u8], b: usize| m.get(b).copied().ok_or("body_sameframe");
+    let sameframe = |m: &[u8], b: usize| {
+        m.get(b)
+            .copied()
+            .ok_or_else(|| patch_error("body_sameframe"))
+    };
     let same_ints = |field: &str, width: usize, (a, b): ((usize, usize), (usize, usize))| {
-        Ok::<_, String>(
+        Ok::<_, Error>(
             rows(model.ints(field)?, a.0, a.1, width)? == rows(part.ints(field)?, b.0, b.1, width)?,
         )
     };
@@ -209,7 +220,7 @@ pub fn copy_body_model(
         && same_ints("bvh_depth", 1, ((v, nv), (pv, pnv)))?
         && shifted == rows(model.ints("bvh_nodeid")?, v, nv, 1)?;
     if !layout {
-        return Err(not_a_patch());
+        return Err(patch_error(not_a_patch()));
     }
     let copies = GEOM_FIELDS
         .iter()
@@ -221,7 +232,7 @@ pub fn copy_body_model(
         let target = model.floats_mut(field)?;
         target
             .get_mut(width * to..width * (to + count))
-            .ok_or_else(|| format!("{field}: rows out of range"))?
+            .ok_or_else(|| patch_error(format!("{field}: rows out of range")))?
             .copy_from_slice(source);
     }
     if let Some(k) = kept {

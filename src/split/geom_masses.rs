@@ -14,8 +14,10 @@
 //! [`write_geom_masses`] with their own MuJoCo's arrays.
 
 use super::body_copy::{ModelArrays, ModelArraysMut};
+use super::patch_error;
 use super::volumes::{Volume, bounding_volumes};
 use crate::document::rotation::{EPS, eigen, quat_to_mat};
+use crate::error::Error;
 
 /// The compiler's tolerance for "the same frame" (flags `mjtSameFrame`).
 const FRAME_EPS: f64 = 1e-6;
@@ -93,11 +95,11 @@ fn off_center(mass: f64, d: &[f64; 3]) -> [f64; 6] {
 /// let two = [unit, GeomMass { pos: [1.0, 0.0, 0.0], ..unit }];
 /// let body = body_mass(&two)?;
 /// assert_eq!((body.mass, body.ipos), (2.0, [0.5, 0.0, 0.0]));
-/// # Ok::<(), String>(())
+/// # Ok::<(), mjcf_forge::Error>(())
 /// ```
-pub fn body_mass(geoms: &[GeomMass]) -> Result<BodyMass, String> {
+pub fn body_mass(geoms: &[GeomMass]) -> Result<BodyMass, Error> {
     match geoms {
-        [] => Err("no geom counts for its inertia".to_string()),
+        [] => Err(patch_error("no geom counts for its inertia")),
         [one] => Ok(BodyMass {
             mass: one.mass,
             inertia: one.inertia,
@@ -114,7 +116,7 @@ pub fn body_mass(geoms: &[GeomMass]) -> Result<BodyMass, String> {
                 }
             }
             if mass < EPS {
-                return Err("its mass is too small for a centre of mass".to_string());
+                return Err(patch_error("its mass is too small for a centre of mass"));
             }
             let ipos = [com[0] / mass, com[1] / mass, com[2] / mass];
             let mut total = [0.0; 6];
@@ -132,7 +134,9 @@ pub fn body_mass(geoms: &[GeomMass]) -> Result<BodyMass, String> {
             ];
             let (inertia, iquat) = eigen(&full);
             if inertia[2] < EPS {
-                return Err("its inertia has an eigenvalue that is not positive".to_string());
+                return Err(patch_error(
+                    "its inertia has an eigenvalue that is not positive",
+                ));
             }
             Ok(BodyMass {
                 mass,
@@ -199,13 +203,13 @@ pub fn write_frame_flags(
     bodies: &[usize],
     geoms: &[usize],
     sites: &[usize],
-) -> Result<(), String> {
+) -> Result<(), Error> {
     let (ipos, iquat) = (model.floats("body_ipos")?, model.floats("body_iquat")?);
     let mut body_flags = Vec::with_capacity(bodies.len());
     for &b in bodies {
         body_flags.push((b, body_frame_flag(&row(ipos, b)?, &row(iquat, b)?)));
     }
-    let element_flags = |kind: &str, list: &[usize]| -> Result<Vec<(usize, u8)>, String> {
+    let element_flags = |kind: &str, list: &[usize]| -> Result<Vec<(usize, u8)>, Error> {
         let (pos, quat) = (
             model.floats(&format!("{kind}_pos"))?,
             model.floats(&format!("{kind}_quat"))?,
@@ -236,22 +240,22 @@ pub fn write_frame_flags(
         let out = model.bytes_mut(name)?;
         for (i, flag) in flags {
             *out.get_mut(i)
-                .ok_or_else(|| format!("{name}[{i}] out of range"))? = flag;
+                .ok_or_else(|| patch_error(format!("{name}[{i}] out of range")))? = flag;
         }
     }
     Ok(())
 }
 
-fn row<const N: usize>(a: &[f64], i: usize) -> Result<[f64; N], String> {
+fn row<const N: usize>(a: &[f64], i: usize) -> Result<[f64; N], Error> {
     a.get(N * i..N * (i + 1))
         .and_then(|r| r.try_into().ok())
-        .ok_or_else(|| format!("row {i} out of range"))
+        .ok_or_else(|| patch_error(format!("row {i} out of range")))
 }
 
-fn at(a: &[i32], i: usize, what: &str) -> Result<usize, String> {
+fn at(a: &[i32], i: usize, what: &str) -> Result<usize, Error> {
     a.get(i)
         .and_then(|&v| usize::try_from(v).ok())
-        .ok_or_else(|| format!("{what}[{i}] out of range"))
+        .ok_or_else(|| patch_error(format!("{what}[{i}] out of range")))
 }
 
 /// Writes into body `body` (named `name` in errors) of `model` its mass properties for
@@ -267,15 +271,15 @@ pub fn write_geom_masses(
     name: &str,
     unit: &impl ModelArrays,
     factors: &[f64],
-) -> Result<(), String> {
+) -> Result<(), Error> {
     let (um, ui) = (unit.floats("body_mass")?, unit.floats("body_inertia")?);
     let (up, uq) = (unit.floats("body_ipos")?, unit.floats("body_iquat")?);
     if um.len() != factors.len() + 1 {
-        return Err(format!(
+        return Err(patch_error(format!(
             "body '{name}': its unit model has {} bodies for {} geoms",
             um.len().saturating_sub(1),
             factors.len()
-        ));
+        )));
     }
     let geoms = factors
         .iter()
@@ -289,8 +293,8 @@ pub fn write_geom_masses(
                 quat: row(uq, k + 1)?,
             })
         })
-        .collect::<Result<Vec<_>, String>>()?;
-    let b = body_mass(&geoms).map_err(|e| format!("body '{name}': {e}"))?;
+        .collect::<Result<Vec<_>, Error>>()?;
+    let b = body_mass(&geoms).map_err(|e| patch_error(format!("body '{name}': {e}")))?;
     let not_a_patch = |what: &str| {
         format!(
             "body '{name}': its geoms' densities or masses move its inertial frame so that \
@@ -299,7 +303,7 @@ pub fn write_geom_masses(
     };
     if model.bytes("body_sameframe")?.get(body).copied() != Some(body_frame_flag(&b.ipos, &b.iquat))
     {
-        return Err(not_a_patch("its same-frame flag"));
+        return Err(patch_error(not_a_patch("its same-frame flag")));
     }
     let first = at(model.ints("body_geomadr")?, body, "body_geomadr")?;
     let count = at(model.ints("body_geomnum")?, body, "body_geomnum")?;
@@ -312,7 +316,7 @@ pub fn write_geom_masses(
         let (p, q) = (row(pos, g)?, row(quat, g)?);
         flags.push(frame_flag(&p, &q, &b.ipos, &b.iquat));
         volumes.push(Volume {
-            id: i32::try_from(g).map_err(|_| "too many geoms".to_string())?,
+            id: i32::try_from(g).map_err(|_| patch_error("too many geoms"))?,
             collides: contype.get(g).copied().unwrap_or(0) != 0
                 || conaffinity.get(g).copied().unwrap_or(0) != 0,
             pos: p,
@@ -330,7 +334,7 @@ pub fn write_geom_masses(
     let adr = at(model.ints("body_bvhadr")?, body, "body_bvhadr").unwrap_or(0);
     let num = at(model.ints("body_bvhnum")?, body, "body_bvhnum")?;
     if nodes.len() != num {
-        return Err(not_a_patch("its bounding-volume tree's size"));
+        return Err(patch_error(not_a_patch("its bounding-volume tree's size")));
     }
     model.floats_mut("body_mass")?[body] = b.mass;
     model.floats_mut("body_inertia")?[3 * body..3 * body + 3].copy_from_slice(&b.inertia);

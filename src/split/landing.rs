@@ -5,15 +5,16 @@
 //! (`python/src/split/plan.rs`).
 //!
 //! ```
+//! use mjcf_forge::Error;
 //! use mjcf_forge::split::{ArrayMut, Carried, Landing, ModelLayout, land};
 //!
 //! // A model with one hinge joint (type 3) whose dof is 2 of 3.
 //! struct Hinge;
 //! impl ModelLayout for Hinge {
-//!     fn int(&self, name: &str, _i: usize) -> Result<i64, String> {
+//!     fn int(&self, name: &str, _i: usize) -> Result<i64, Error> {
 //!         Ok(if name == "jnt_type" { 3 } else { 2 })
 //!     }
-//!     fn len(&self, _name: &str) -> Result<usize, String> {
+//!     fn len(&self, _name: &str) -> Result<usize, Error> {
 //!         Ok(3)
 //!     }
 //! }
@@ -25,18 +26,20 @@
 //! let mut damping = [0.0; 3];
 //! run.write(ArrayMut::F64(&mut damping), &[0.5])?;
 //! assert_eq!(damping, [0.0, 0.0, 0.5]);
-//! # Ok::<(), String>(())
+//! # Ok::<(), Error>(())
 //! ```
 
+use super::patch_error;
 use super::targets::{DOF_FIELDS, GEOM_FACTORS, QPOS_FIELDS, joint_widths, target_array};
+use crate::error::Error;
 
 /// What a model's layout tells [`land`]: its integer arrays and every array's length.
 pub trait ModelLayout {
     /// Element `i` of the `int` array `name`; an error names an array this model does
     /// not have or an index outside it.
-    fn int(&self, name: &str, i: usize) -> Result<i64, String>;
+    fn int(&self, name: &str, i: usize) -> Result<i64, Error>;
     /// How many numbers the array `name` holds (rows times columns).
-    fn len(&self, name: &str) -> Result<usize, String>;
+    fn len(&self, name: &str) -> Result<usize, Error>;
 }
 
 /// What a patch entry carries, as far as where it lands goes.
@@ -121,17 +124,17 @@ pub fn land(
     field: &str,
     carried: Carried,
     layout: &impl ModelLayout,
-) -> Result<Landing, String> {
+) -> Result<Landing, Error> {
     if object == "option" {
         return match carried {
             Carried::Numbers(n) => Ok(Landing::Option {
                 field: field.to_string(),
                 n,
             }),
-            _ => Err(format!("option {field}: not numbers")),
+            _ => Err(patch_error(format!("option {field}: not numbers"))),
         };
     }
-    let id = id.ok_or_else(|| format!("{object} {field}: no element id"))?;
+    let id = id.ok_or_else(|| patch_error(format!("{object} {field}: no element id")))?;
     let width = match carried {
         Carried::Numbers(n) => n,
         Carried::Id => 1,
@@ -141,9 +144,10 @@ pub fn land(
         return Ok(Landing::GeomFactors { body: id, n: width });
     }
     let array = target_array(object, field)
-        .ok_or_else(|| format!("a patch names no array for {object}.{field}"))?;
-    let index = |name: &str, i: usize| -> Result<usize, String> {
-        usize::try_from(layout.int(name, i)?).map_err(|_| format!("{name}[{i}] is negative"))
+        .ok_or_else(|| patch_error(format!("a patch names no array for {object}.{field}")))?;
+    let index = |name: &str, i: usize| -> Result<usize, Error> {
+        usize::try_from(layout.int(name, i)?)
+            .map_err(|_| patch_error(format!("{name}[{i}] is negative")))
     };
     let (mut runs, mut stride) = (1, 0);
     let (offset, n) = match object {
@@ -165,17 +169,17 @@ pub fn land(
     let count = layout.len(&array)?;
     let end = offset + n + runs.saturating_sub(1) * stride;
     if runs > 0 && end > count {
-        return Err(format!(
+        return Err(patch_error(format!(
             "{object} {id}: {array}[{offset}..{end}] is outside the model's {count}"
-        ));
+        )));
     }
     if let Carried::Numbers(k) = carried
         && k != 1
         && k != n
     {
-        return Err(format!(
+        return Err(patch_error(format!(
             "{object} {id}: {k} numbers for {n} elements of {array}"
-        ));
+        )));
     }
     Ok(Landing::Numbers(Run {
         array,
@@ -192,14 +196,14 @@ impl Run {
     /// Writes `values` (one fills every element; else one per element) into `whole`,
     /// this run's array: a `float` array takes them rounded, as MuJoCo's compiler rounds
     /// them; an `int` array (ids, collision bits) takes whole numbers.
-    pub fn write(&self, whole: ArrayMut<'_>, values: &[f64]) -> Result<(), String> {
+    pub fn write(&self, whole: ArrayMut<'_>, values: &[f64]) -> Result<(), Error> {
         if values.len() != 1 && values.len() != self.n {
-            return Err(format!(
+            return Err(patch_error(format!(
                 "{}: {} numbers for {} elements",
                 self.array,
                 values.len(),
                 self.n
-            ));
+            )));
         }
         let value = |k: usize| {
             if values.len() == 1 {
@@ -212,25 +216,32 @@ impl Run {
             ArrayMut::F64(a) if !self.int => self.fill(a, value),
             ArrayMut::F32(a) if !self.int => self.fill(a, |k| value(k) as f32),
             ArrayMut::I32(a) if self.int => self.fill(a, |k| value(k) as i32),
-            _ => Err(format!("{}: not an array of that type", self.array)),
+            _ => Err(patch_error(format!(
+                "{}: not an array of that type",
+                self.array
+            ))),
         }
     }
 
     /// Writes the id `id` (of the element the entry names) into `whole`, this run's array
     /// of `int`.
-    pub fn write_id(&self, whole: ArrayMut<'_>, id: usize) -> Result<(), String> {
-        let id = i32::try_from(id).map_err(|_| format!("{}: id {id} too large", self.array))?;
+    pub fn write_id(&self, whole: ArrayMut<'_>, id: usize) -> Result<(), Error> {
+        let id = i32::try_from(id)
+            .map_err(|_| patch_error(format!("{}: id {id} too large", self.array)))?;
         match whole {
             ArrayMut::I32(a) if self.int => self.fill(a, |_| id),
-            _ => Err(format!("{}: not an array of ids", self.array)),
+            _ => Err(patch_error(format!("{}: not an array of ids", self.array))),
         }
     }
 
-    fn fill<T>(&self, a: &mut [T], value: impl Fn(usize) -> T) -> Result<(), String> {
+    fn fill<T>(&self, a: &mut [T], value: impl Fn(usize) -> T) -> Result<(), Error> {
         for run in 0..self.runs {
             let start = self.offset + run * self.stride;
             let Some(rows) = a.get_mut(start..start + self.n) else {
-                return Err(format!("{}[{start}..] is outside the array", self.array));
+                return Err(patch_error(format!(
+                    "{}[{start}..] is outside the array",
+                    self.array
+                )));
             };
             for (k, x) in rows.iter_mut().enumerate() {
                 *x = value(k);
@@ -247,16 +258,16 @@ mod tests {
     /// Two keys of a model of nq 9: a free joint (7 coordinates) then a hinge.
     struct Keys;
     impl ModelLayout for Keys {
-        fn int(&self, name: &str, i: usize) -> Result<i64, String> {
+        fn int(&self, name: &str, i: usize) -> Result<i64, Error> {
             Ok(match (name, i) {
                 ("jnt_type", 0) => 0,
                 ("jnt_type", _) => 3,
                 ("jnt_qposadr", 0) => 0,
                 ("jnt_qposadr", _) => 7,
-                _ => return Err(format!("no {name}")),
+                _ => return Err(patch_error(format!("no {name}"))),
             })
         }
-        fn len(&self, name: &str) -> Result<usize, String> {
+        fn len(&self, name: &str) -> Result<usize, Error> {
             Ok(match name {
                 "qpos0" => 8,
                 "key_qpos" => 16,
@@ -282,7 +293,8 @@ mod tests {
     #[test]
     fn outside_the_array_is_an_error() {
         let e = land("geom", Some(1), "rgba", Carried::Numbers(4), &Keys).unwrap_err();
-        assert!(e.contains("outside"), "{e}");
+        assert!(matches!(e.kind, crate::ErrorKind::Patch(_)), "{e:?}");
+        assert!(e.to_string().contains("outside"), "{e}");
     }
 
     #[test]

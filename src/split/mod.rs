@@ -96,6 +96,13 @@ pub use trees::{Derivations, FROM_GEOMS, TreeDerivation, TreeModel};
 pub use volumes::{Volume, VolumeNode, bounding_volumes};
 pub use worlds::WorldRows;
 
+/// A problem of this tier's, in words ([`ErrorKind::Patch`](crate::ErrorKind::Patch)):
+/// what the public functions return for their own refusals and for the words of the traits
+/// the faces implement.
+pub(crate) fn patch_error(message: impl Into<String>) -> crate::Error {
+    crate::Error::bare(crate::ErrorKind::Patch(message.into()))
+}
+
 pub(crate) use body_model::{UnitCache, body_model_entries, carried_by, unit_model_entries};
 pub(crate) use rules::{
     Rules, discarded, dropped, entry, free_joint, massless, normalized, numbers, setting,

@@ -23,11 +23,17 @@ use super::body_copy::{MasslessFrame, ModelArrays, ModelArraysMut, copy_body_mod
 use super::geom_masses::write_geom_masses;
 use super::landing::{ArrayMut, Carried, Landing, ModelLayout, Run, land};
 use super::massless_frames;
+use super::patch_error;
 use super::rules::{PatchEntry, PatchValue};
 use super::statistics::{StatArrays, Statistics, keep_fixed, mean_inertia, statistics};
 use super::targets::{BODY_MODELS_KEPT, PATCH_OBJECTS};
+use crate::error::Error;
 
 /// A compiled model a [`PatchPlan`] writes into, with what its own MuJoCo does for it.
+///
+/// Its errors are the face's words as an [`ErrorKind::Patch`](crate::ErrorKind::Patch)
+/// (as are those of [`ModelArrays`], [`ModelLayout`] and
+/// [`TreeModel`](super::TreeModel)); the plan passes them on as they are.
 pub trait PatchModel: ModelArraysMut + ModelLayout {
     /// An array the plan writes, found once (where it starts, its type and length).
     type Target;
@@ -39,7 +45,7 @@ pub trait PatchModel: ModelArraysMut + ModelLayout {
 
     /// The array `name` (of integers: `int`), to write; an error names an array this
     /// MuJoCo does not have.
-    fn target(&mut self, name: &str, int: bool) -> Result<Self::Target, String>;
+    fn target(&mut self, name: &str, int: bool) -> Result<Self::Target, Error>;
     /// The whole array `target` (one of this model's), to write.
     fn target_mut<'a>(&'a mut self, target: &'a Self::Target) -> ArrayMut<'a>;
     /// The size `name` (`nbody`); `None` where this MuJoCo has none.
@@ -50,40 +56,40 @@ pub trait PatchModel: ModelArraysMut + ModelLayout {
     /// Whether this MuJoCo's `mjOption` has a field `field` of `n` numbers.
     fn has_option(&self, field: &str, n: usize) -> bool;
     /// Writes `values` into the `mjOption` field `field`.
-    fn write_option(&mut self, field: &str, values: &[f64]) -> Result<(), String>;
+    fn write_option(&mut self, field: &str, values: &[f64]) -> Result<(), Error>;
     /// The name of body `body`, for errors (asked once per layout resolved).
     fn body_name(&self, body: usize) -> String;
     /// `xml` compiled by this model's MuJoCo.
-    fn compile_part(&self, xml: &str) -> Result<Self::Part, String>;
+    fn compile_part(&self, xml: &str) -> Result<Self::Part, Error>;
     /// New scratch data for this model.
-    fn make_data(&self) -> Result<Self::Data, String>;
+    fn make_data(&self) -> Result<Self::Data, Error>;
     /// Bytes held by this model and `data`.
     fn nbytes(&self, data: &Self::Data) -> usize;
     /// `mj_setConst`.
-    fn set_const(&mut self, data: &mut Self::Data) -> Result<(), String>;
+    fn set_const(&mut self, data: &mut Self::Data) -> Result<(), Error>;
     /// `data.qpos` set to `qpos0`, then `mj_kinematics` and `mj_comPos`.
-    fn kinematics(&mut self, data: &mut Self::Data) -> Result<(), String>;
+    fn kinematics(&mut self, data: &mut Self::Data) -> Result<(), Error>;
     /// The joint-space inertia from the kinematics (`mj_makeM`, or `mj_crb` where MuJoCo
     /// has no `mj_makeM`).
-    fn inertia(&mut self, data: &mut Self::Data) -> Result<(), String>;
+    fn inertia(&mut self, data: &mut Self::Data) -> Result<(), Error>;
     /// Calls `f` with the arrays the statistics read (of this model and `data`) and this
     /// model's `dof_length` (empty where this MuJoCo has none).
     fn with_statistics<R>(
         &mut self,
         data: &Self::Data,
         f: impl FnOnce(&StatArrays<'_>, &mut [f64]) -> R,
-    ) -> Result<R, String>;
+    ) -> Result<R, Error>;
     /// The model's statistics, in [`STATISTIC_NAMES`](super::STATISTIC_NAMES)' order.
     fn stat(&self) -> Statistics;
     /// Sets the model's statistics.
-    fn set_stat(&mut self, stat: &Statistics) -> Result<(), String>;
+    fn set_stat(&mut self, stat: &Statistics) -> Result<(), Error>;
 }
 
 /// A derivation in place of `mj_setConst` ([`PatchPlan::finish`]): given the model, its
 /// scratch data and the layout resolved, it writes what `mj_setConst` would and says
 /// whether the data then holds the kinematics at `qpos0`.
 pub type Derive<'a, M> =
-    &'a mut dyn FnMut(&mut M, &mut <M as PatchModel>::Data, &[LayoutEntry]) -> Result<bool, String>;
+    &'a mut dyn FnMut(&mut M, &mut <M as PatchModel>::Data, &[LayoutEntry]) -> Result<bool, Error>;
 
 /// One entry of a patch's layout: the element and field it writes and what it carries
 /// (the value itself is the patch's: [`PatchPlan::write`] takes them laid out by kind).
@@ -209,7 +215,7 @@ pub struct PatchPlan<M: PatchModel> {
 impl<M: PatchModel> PatchPlan<M> {
     /// The plan of `model` (of structure `key`), its massless bodies' frames as it holds
     /// them now; `fixed` the statistics the document fixes, at `fixed_values`.
-    pub fn new(model: &M, key: &str, fixed: u32, fixed_values: Statistics) -> Result<Self, String> {
+    pub fn new(model: &M, key: &str, fixed: u32, fixed_values: Statistics) -> Result<Self, Error> {
         let data = model.make_data()?;
         let nbytes = model.nbytes(&data);
         Ok(PatchPlan {
@@ -262,7 +268,7 @@ impl<M: PatchModel> PatchPlan<M> {
 
     /// Where every entry of `layout` lands in `model`; the next [`PatchPlan::write`]
     /// takes a patch of it.
-    pub fn resolve(&mut self, model: &mut M, layout: Vec<LayoutEntry>) -> Result<(), String> {
+    pub fn resolve(&mut self, model: &mut M, layout: Vec<LayoutEntry>) -> Result<(), Error> {
         self.resolved = false;
         let (mut numbers, mut ids, mut options, mut factors, mut bodies) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
@@ -270,7 +276,7 @@ impl<M: PatchModel> PatchPlan<M> {
         for e in &layout {
             let id = element_id(model, e)?;
             let landing = land(&e.object, id, &e.field, e.carried, &*model)
-                .map_err(|x| format!("{} '{}': {x}", e.object, e.name))?;
+                .map_err(|x| patch_error(format!("{} '{}': {x}", e.object, e.name)))?;
             match landing {
                 Landing::Numbers(run) if run.id => {
                     let target = model.target(&run.array, run.int)?;
@@ -278,7 +284,10 @@ impl<M: PatchModel> PatchPlan<M> {
                 }
                 Landing::Numbers(run) => {
                     let Carried::Numbers(count) = e.carried else {
-                        return Err(format!("{} '{}': numbers expected", e.object, e.name));
+                        return Err(patch_error(format!(
+                            "{} '{}': numbers expected",
+                            e.object, e.name
+                        )));
                     };
                     let target = model.target(&run.array, run.int)?;
                     numbers.push(NumberTarget {
@@ -291,7 +300,9 @@ impl<M: PatchModel> PatchPlan<M> {
                 }
                 Landing::Option { field, n } => {
                     if !model.has_option(&field, n) {
-                        return Err(format!("this MuJoCo's mjOption has no field {field}"));
+                        return Err(patch_error(format!(
+                            "this MuJoCo's mjOption has no field {field}"
+                        )));
                     }
                     options.push((field, first, n));
                     first += n;
@@ -323,7 +334,7 @@ impl<M: PatchModel> PatchPlan<M> {
 
     /// Writes `patch` (of any layout: resolved again where it differs from the last) and
     /// what follows from it ([`PatchPlan::finish`], with `mj_setConst`).
-    pub fn apply(&mut self, model: &mut M, patch: &[PatchEntry]) -> Result<(), String> {
+    pub fn apply(&mut self, model: &mut M, patch: &[PatchEntry]) -> Result<(), Error> {
         self.apply_with(model, patch, None)
     }
 
@@ -340,14 +351,14 @@ impl<M: PatchModel> PatchPlan<M> {
         model: &mut M,
         patch: &[PatchEntry],
         derive: Option<Derive<'_, M>>,
-    ) -> Result<(), String> {
+    ) -> Result<(), Error> {
         self.write_patch(model, patch)?;
         self.finish(model, derive)
     }
 
     /// Writes `patch` (of any layout: resolved again where it differs from the last), and
     /// nothing of what follows from it ([`PatchPlan::finish`]).
-    pub fn write_patch(&mut self, model: &mut M, patch: &[PatchEntry]) -> Result<(), String> {
+    pub fn write_patch(&mut self, model: &mut M, patch: &[PatchEntry]) -> Result<(), Error> {
         let same = self.is_layout_of(patch);
         let mut numbers = Vec::new();
         let (mut materials, mut bodies) = (Vec::new(), Vec::new());
@@ -371,7 +382,7 @@ impl<M: PatchModel> PatchPlan<M> {
 
     /// Where every entry of `patch` lands in `model` ([`PatchPlan::resolve`] of its
     /// layout), its body models taken as what the model holds.
-    pub fn resolve_patch(&mut self, model: &mut M, patch: &[PatchEntry]) -> Result<(), String> {
+    pub fn resolve_patch(&mut self, model: &mut M, patch: &[PatchEntry]) -> Result<(), Error> {
         self.resolve(model, patch.iter().map(LayoutEntry::of).collect())?;
         let bodies: Vec<&str> = patch
             .iter()
@@ -399,37 +410,43 @@ impl<M: PatchModel> PatchPlan<M> {
         &mut self,
         model: &mut M,
         values: PatchValues<'_, S>,
-    ) -> Result<(), String> {
+    ) -> Result<(), Error> {
         if !self.resolved {
-            return Err("the plan has no layout to write".into());
+            return Err(patch_error("the plan has no layout to write"));
         }
         if values.materials.len() != self.ids.len() || values.bodies.len() != self.bodies.len() {
-            return Err(format!(
+            return Err(patch_error(format!(
                 "{} material names and {} body models for a layout of {} and {}",
                 values.materials.len(),
                 values.bodies.len(),
                 self.ids.len(),
                 self.bodies.len()
-            ));
+            )));
         }
         let numbers = values.numbers;
         for t in &self.numbers {
-            let v = numbers
-                .get(t.first..t.first + t.count)
-                .ok_or_else(|| format!("{} numbers: too few for this layout", numbers.len()))?;
+            let v = numbers.get(t.first..t.first + t.count).ok_or_else(|| {
+                patch_error(format!(
+                    "{} numbers: too few for this layout",
+                    numbers.len()
+                ))
+            })?;
             t.run.write(model.target_mut(&t.target), v)?;
         }
         for ((run, target), name) in self.ids.iter().zip(values.materials) {
             let name = name.as_ref();
             let id = model
                 .id("material", name)
-                .ok_or_else(|| format!("no material named '{name}'"))?;
+                .ok_or_else(|| patch_error(format!("no material named '{name}'")))?;
             run.write_id(model.target_mut(target), id)?;
         }
         for (field, first, n) in &self.options {
-            let v = numbers
-                .get(*first..first + n)
-                .ok_or_else(|| format!("{} numbers: too few for this layout", numbers.len()))?;
+            let v = numbers.get(*first..first + n).ok_or_else(|| {
+                patch_error(format!(
+                    "{} numbers: too few for this layout",
+                    numbers.len()
+                ))
+            })?;
             model.write_option(field, v)?;
         }
         for k in 0..self.bodies.len() {
@@ -467,10 +484,15 @@ impl<M: PatchModel> PatchPlan<M> {
                 .iter()
                 .find(|(b, _)| *b == body)
                 .and_then(|(_, xml)| self.parts.iter().find(|(x, _)| x == xml))
-                .ok_or_else(|| format!("body '{name}': geom factors without a unit model"))?;
-            let factors = numbers
-                .get(first..first + n)
-                .ok_or_else(|| format!("{} numbers: too few for this layout", numbers.len()))?;
+                .ok_or_else(|| {
+                    patch_error(format!("body '{name}': geom factors without a unit model"))
+                })?;
+            let factors = numbers.get(first..first + n).ok_or_else(|| {
+                patch_error(format!(
+                    "{} numbers: too few for this layout",
+                    numbers.len()
+                ))
+            })?;
             write_geom_masses(model, body, name, &unit.1, factors)?;
         }
         Ok(())
@@ -479,13 +501,16 @@ impl<M: PatchModel> PatchPlan<M> {
     /// The index of the compile of `xml` (a model of the geoms of the body of body entry
     /// `k`) in `parts`, compiled by the model's MuJoCo on first sight (the last
     /// [`BODY_MODELS_KEPT`] kept).
-    fn compiled(&mut self, model: &M, k: usize, xml: &str) -> Result<usize, String> {
+    fn compiled(&mut self, model: &M, k: usize, xml: &str) -> Result<usize, Error> {
         if let Some(at) = self.parts.iter().position(|(x, _)| x == xml) {
             return Ok(at);
         }
-        let part = model
-            .compile_part(xml)
-            .map_err(|e| format!("body '{}': its geoms alone: {e}", self.bodies[k].name))?;
+        let part = model.compile_part(xml).map_err(|e| {
+            patch_error(format!(
+                "body '{}': its geoms alone: {e}",
+                self.bodies[k].name
+            ))
+        })?;
         self.compiled_parts += 1;
         if self.parts.len() >= BODY_MODELS_KEPT {
             self.parts.remove(0);
@@ -497,7 +522,7 @@ impl<M: PatchModel> PatchPlan<M> {
     /// What follows the values: `mj_setConst` (or `derive(model, data, layout)`, which
     /// writes the same and says whether the data then holds the kinematics at `qpos0`),
     /// the compiler's statistics and dof lengths, then the statistics the document fixes.
-    pub fn finish(&mut self, model: &mut M, derive: Option<Derive<'_, M>>) -> Result<(), String> {
+    pub fn finish(&mut self, model: &mut M, derive: Option<Derive<'_, M>>) -> Result<(), Error> {
         self.finishes += 1;
         let fresh = match derive {
             None => {
@@ -521,9 +546,9 @@ impl<M: PatchModel> PatchPlan<M> {
     /// The mean of the joint-space inertia's diagonal over `dofs` (in order), from the
     /// scratch data as [`PatchPlan::finish`] left it: a superset world's
     /// `stat.meaninertia`, the dofs of what its variant places.
-    pub fn mean_inertia(&self, model: &mut M, dofs: &[usize]) -> Result<f64, String> {
+    pub fn mean_inertia(&self, model: &mut M, dofs: &[usize]) -> Result<f64, Error> {
         if dofs.is_empty() {
-            return Err("no dofs to take the mean inertia over".into());
+            return Err(patch_error("no dofs to take the mean inertia over"));
         }
         model.with_statistics(&self.data, |arrays, _| {
             mean_inertia(arrays, dofs.iter().copied())
@@ -541,7 +566,7 @@ impl<M: PatchModel> PatchPlan<M> {
         &mut self,
         model: &mut M,
         parked: &[S],
-    ) -> Result<(), String> {
+    ) -> Result<(), Error> {
         let nv = model.ints("dof_bodyid")?.len();
         let mut out = vec![false; nv];
         for root in parked {
@@ -569,15 +594,16 @@ impl<M: PatchModel> PatchPlan<M> {
 }
 
 /// The dofs of the subtree of the body named `root` in `model`, in order.
-fn subtree_dofs<M: PatchModel>(model: &M, root: &str) -> Result<Vec<usize>, String> {
+fn subtree_dofs<M: PatchModel>(model: &M, root: &str) -> Result<Vec<usize>, Error> {
     let id = model
         .id("body", root)
-        .ok_or_else(|| format!("the superset has no body '{root}'"))?;
+        .ok_or_else(|| patch_error(format!("the superset has no body '{root}'")))?;
     let parent = model.ints("body_parentid")?;
     let mut inside = vec![false; parent.len()];
     *inside
         .get_mut(id)
-        .ok_or_else(|| format!("body '{root}': an id past the model's bodies"))? = true;
+        .ok_or_else(|| patch_error(format!("body '{root}': an id past the model's bodies")))? =
+        true;
     // Bodies come after their parents: one pass marks the whole subtree.
     for b in 1..parent.len() {
         let up = usize::try_from(parent[b])
@@ -596,15 +622,15 @@ fn subtree_dofs<M: PatchModel>(model: &M, root: &str) -> Result<Vec<usize>, Stri
 
 /// The id of `e`'s element in `model` (none for an option): its own, checked against the
 /// model's count, or its name's.
-fn element_id<M: PatchModel>(model: &M, e: &LayoutEntry) -> Result<Option<usize>, String> {
+fn element_id<M: PatchModel>(model: &M, e: &LayoutEntry) -> Result<Option<usize>, Error> {
     if e.object == "option" {
         return Ok(None);
     }
     let missing = || {
-        format!(
+        patch_error(format!(
             "the patch names {} '{}', which the compiled model does not have",
             e.object, e.name
-        )
+        ))
     };
     match e.id {
         Some(id) => {

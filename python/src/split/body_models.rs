@@ -8,6 +8,8 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use super::arrays::Array;
+use super::patch_error;
+use mjcf_forge::Error;
 use mjcf_forge::split::{self, MasslessFrame};
 
 /// The arrays the copy reads or writes, by type.
@@ -124,8 +126,8 @@ pub(crate) struct PyModelArrays {
     _model: Py<PyAny>,
 }
 
-fn missing(name: &str) -> String {
-    format!("no array {name} here")
+fn missing(name: &str) -> Error {
+    patch_error(format!("no array {name} here"))
 }
 
 /// Write access to the model, for the length of one copy (the GIL held, no Python code
@@ -133,7 +135,7 @@ fn missing(name: &str) -> String {
 struct Writer<'a>(&'a PyModelArrays);
 
 impl split::ModelArrays for PyModelArrays {
-    fn floats(&self, name: &str) -> Result<&[f64], String> {
+    fn floats(&self, name: &str) -> Result<&[f64], Error> {
         // SAFETY: the GIL is held and no Python code runs while the slice lives; the
         // part and the model are different models (checked by `copy_body_model`).
         self.floats
@@ -141,14 +143,14 @@ impl split::ModelArrays for PyModelArrays {
             .map(|a| unsafe { a.slice() })
             .ok_or_else(|| missing(name))
     }
-    fn ints(&self, name: &str) -> Result<&[i32], String> {
+    fn ints(&self, name: &str) -> Result<&[i32], Error> {
         // SAFETY: as above.
         self.ints
             .get(name)
             .map(|a| unsafe { a.slice() })
             .ok_or_else(|| missing(name))
     }
-    fn bytes(&self, name: &str) -> Result<&[u8], String> {
+    fn bytes(&self, name: &str) -> Result<&[u8], Error> {
         // SAFETY: as above.
         self.bytes
             .get(name)
@@ -158,19 +160,19 @@ impl split::ModelArrays for PyModelArrays {
 }
 
 impl split::ModelArrays for Writer<'_> {
-    fn floats(&self, name: &str) -> Result<&[f64], String> {
+    fn floats(&self, name: &str) -> Result<&[f64], Error> {
         self.0.floats(name)
     }
-    fn ints(&self, name: &str) -> Result<&[i32], String> {
+    fn ints(&self, name: &str) -> Result<&[i32], Error> {
         self.0.ints(name)
     }
-    fn bytes(&self, name: &str) -> Result<&[u8], String> {
+    fn bytes(&self, name: &str) -> Result<&[u8], Error> {
         self.0.bytes(name)
     }
 }
 
 impl split::ModelArraysMut for Writer<'_> {
-    fn floats_mut(&mut self, name: &str) -> Result<&mut [f64], String> {
+    fn floats_mut(&mut self, name: &str) -> Result<&mut [f64], Error> {
         // SAFETY: the only view of this array while `self` is borrowed mutably (each array
         // is one entry; the GIL is held and no Python code runs).
         self.0
@@ -179,7 +181,7 @@ impl split::ModelArraysMut for Writer<'_> {
             .map(|a| unsafe { a.slice_mut() })
             .ok_or_else(|| missing(name))
     }
-    fn bytes_mut(&mut self, name: &str) -> Result<&mut [u8], String> {
+    fn bytes_mut(&mut self, name: &str) -> Result<&mut [u8], Error> {
         // SAFETY: as above.
         self.0
             .bytes
@@ -187,7 +189,7 @@ impl split::ModelArraysMut for Writer<'_> {
             .map(|a| unsafe { a.slice_mut() })
             .ok_or_else(|| missing(name))
     }
-    fn ints_mut(&mut self, name: &str) -> Result<&mut [i32], String> {
+    fn ints_mut(&mut self, name: &str) -> Result<&mut [i32], Error> {
         // SAFETY: as above.
         self.0
             .ints
@@ -249,7 +251,8 @@ impl PyModelArrays {
                 .bytes
                 .insert(name, Array::of(&model.getattr(name)?, name, true)?);
         }
-        arrays.massless = split::massless_frames(&arrays).map_err(PyValueError::new_err)?;
+        arrays.massless =
+            split::massless_frames(&arrays).map_err(|e| PyValueError::new_err(e.to_string()))?;
         Ok(arrays)
     }
 
@@ -276,7 +279,7 @@ impl PyModelArrays {
             .find(|(b, _)| *b == body)
             .map(|(_, k)| k);
         split::copy_body_model(&mut Writer(self), body, name, kept, part)
-            .map_err(PyValueError::new_err)
+            .map_err(|e| PyValueError::new_err(e.to_string()))
     }
 
     /// Sets the same-frame flags of ``bodies``, ``geoms`` and ``sites`` of this model from
@@ -289,7 +292,7 @@ impl PyModelArrays {
         sites: Vec<usize>,
     ) -> PyResult<()> {
         split::write_frame_flags(&mut Writer(self), &bodies, &geoms, &sites)
-            .map_err(PyValueError::new_err)
+            .map_err(|e| PyValueError::new_err(e.to_string()))
     }
 
     /// Writes into body ``body`` (``name`` in errors) of this model its mass properties
@@ -309,6 +312,6 @@ impl PyModelArrays {
             return Err(PyValueError::new_err("a unit model is another model"));
         }
         split::write_geom_masses(&mut Writer(self), body, name, unit, &factors)
-            .map_err(PyValueError::new_err)
+            .map_err(|e| PyValueError::new_err(e.to_string()))
     }
 }

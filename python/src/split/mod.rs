@@ -30,6 +30,15 @@ pub(crate) use plan::PyPatchPlan;
 pub(crate) use signature::signature_of;
 pub(crate) use snapshot::{Snapshot, Views, references};
 
+/// A refusal of this face's model to the split tier's rules, in words (the kind of the
+/// rules' own, `ErrorKind::Patch`).
+fn patch_error(message: impl Into<String>) -> mjcf_forge::Error {
+    mjcf_forge::Error {
+        location: None,
+        kind: mjcf_forge::ErrorKind::Patch(message.into()),
+    }
+}
+
 /// Adds the tier's tables, functions and classes to the module.
 pub(crate) fn add(m: &Bound<'_, PyModule>) -> PyResult<()> {
     tables::add(m)?;

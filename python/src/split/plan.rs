@@ -13,6 +13,7 @@ use pyo3::types::PyString;
 use super::arrays::Array;
 use super::user_model::UserModel;
 use crate::errors::mjcf_error;
+use mjcf_forge::Error;
 use mjcf_forge::split::{
     self, Carried, Derivations, LayoutEntry, PatchEntry, PatchFailure, PatchModel, PatchValues,
     STATISTIC_NAMES, Statistics,
@@ -113,18 +114,18 @@ fn read(patch: &Bound<'_, PyAny>) -> PyResult<Read> {
 
 impl Core {
     /// The plan's error as Python's: the call up's own, else an `MjcfError`.
-    fn error(&mut self, message: String) -> PyErr {
+    fn error(&mut self, error: Error) -> PyErr {
         self.user
             .pending
             .take()
-            .unwrap_or_else(|| mjcf_error(vec![message]))
+            .unwrap_or_else(|| mjcf_error(vec![error.to_string()]))
     }
 
     /// What follows the values: `mj_setConst`, or for a superset world (`parked`: the
     /// objects it parks, by root body) with `by_tree` the tree-by-tree derivation where
     /// its layout allows; then for a superset the world's `stat.meaninertia`. Whether the
     /// derivation ran tree by tree.
-    fn finish(&mut self, parked: Option<&[String]>, by_tree: bool) -> Result<bool, String> {
+    fn finish(&mut self, parked: Option<&[String]>, by_tree: bool) -> Result<bool, Error> {
         let Core { user, plan, trees } = self;
         trees.finish(plan, user, parked, by_tree)
     }
@@ -163,8 +164,8 @@ impl PyPatchPlan {
         values: Statistics,
     ) -> PyResult<Self> {
         let user = UserModel::new(mujoco, model.clone())?;
-        let plan =
-            split::PatchPlan::new(&user, &key, fixed, values).map_err(PyValueError::new_err)?;
+        let plan = split::PatchPlan::new(&user, &key, fixed, values)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
         let data = plan.data.data.clone_ref(py);
         Ok(PyPatchPlan {
             nbytes: plan.nbytes(),
@@ -197,7 +198,7 @@ impl PyPatchPlan {
         let r = r.and_then(|()| core.finish(parked, by_tree));
         r.map_err(|e| match core.user.pending.take() {
             Some(raised) => PatchFailure::Backend(raised),
-            None => PatchFailure::NotThisStructure(e),
+            None => PatchFailure::NotThisStructure(e.to_string()),
         })
     }
 
@@ -212,7 +213,7 @@ impl PyPatchPlan {
         let r = plan.resolve_patch(user, entries);
         r.map_err(|e| match core.user.pending.take() {
             Some(raised) => PatchFailure::Backend(raised),
-            None => PatchFailure::NotThisStructure(e),
+            None => PatchFailure::NotThisStructure(e.to_string()),
         })
     }
 
@@ -388,7 +389,7 @@ impl PyPatchPlan {
         }
         let Core { user, plan, .. } = &mut *core;
         plan.mean_inertia(user, &dofs)
-            .map_err(PyValueError::new_err)
+            .map_err(|e| PyValueError::new_err(e.to_string()))
     }
 
     /// Superset: ``model.stat.meaninertia`` as the variant's own model has it, after

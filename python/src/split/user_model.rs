@@ -13,8 +13,10 @@ use pyo3::prelude::*;
 use super::arrays::Array;
 use super::body_models::PyModelArrays;
 use super::patch::Whole;
+use super::patch_error;
 use super::statistics::PyStatistics;
 use crate::upcalls;
+use mjcf_forge::Error;
 use mjcf_forge::split::{
     self, ArrayMut, PatchModel, STATISTIC_NAMES, StatArrays, Statistics, TreeModel,
 };
@@ -41,18 +43,18 @@ pub(super) struct UserData {
     nbytes: usize,
 }
 
-fn missing(name: &str) -> String {
-    format!("no array {name} here")
+fn missing(name: &str) -> Error {
+    patch_error(format!("no array {name} here"))
 }
 
 impl split::ModelArrays for UserModel {
-    fn floats(&self, name: &str) -> Result<&[f64], String> {
+    fn floats(&self, name: &str) -> Result<&[f64], Error> {
         self.arrays.floats(name)
     }
-    fn ints(&self, name: &str) -> Result<&[i32], String> {
+    fn ints(&self, name: &str) -> Result<&[i32], Error> {
         self.arrays.ints(name)
     }
-    fn bytes(&self, name: &str) -> Result<&[u8], String> {
+    fn bytes(&self, name: &str) -> Result<&[u8], Error> {
         self.arrays.bytes(name)
     }
 }
@@ -63,7 +65,7 @@ impl split::ModelArrays for UserModel {
 fn writable<'a, T: super::arrays::Element>(
     arrays: &'a ahash::AHashMap<&'static str, Array<T>>,
     name: &str,
-) -> Result<&'a mut [T], String> {
+) -> Result<&'a mut [T], Error> {
     // SAFETY: the only view of this array while the model is borrowed mutably (each array
     // is one entry; the GIL is held and no Python code runs meanwhile).
     arrays
@@ -73,36 +75,36 @@ fn writable<'a, T: super::arrays::Element>(
 }
 
 impl split::ModelArraysMut for UserModel {
-    fn floats_mut(&mut self, name: &str) -> Result<&mut [f64], String> {
+    fn floats_mut(&mut self, name: &str) -> Result<&mut [f64], Error> {
         writable(&self.arrays.floats, name)
     }
-    fn bytes_mut(&mut self, name: &str) -> Result<&mut [u8], String> {
+    fn bytes_mut(&mut self, name: &str) -> Result<&mut [u8], Error> {
         writable(&self.arrays.bytes, name)
     }
-    fn ints_mut(&mut self, name: &str) -> Result<&mut [i32], String> {
+    fn ints_mut(&mut self, name: &str) -> Result<&mut [i32], Error> {
         writable(&self.arrays.ints, name)
     }
 }
 
 impl split::ModelLayout for UserModel {
-    fn int(&self, name: &str, i: usize) -> Result<i64, String> {
+    fn int(&self, name: &str, i: usize) -> Result<i64, Error> {
         Python::attach(|py| {
             self.model
                 .bind(py)
                 .getattr(name)
                 .and_then(|a| a.get_item(i))
                 .and_then(|v| v.extract::<i64>())
-                .map_err(|_| format!("{name}[{i}]: no such integer"))
+                .map_err(|_| patch_error(format!("{name}[{i}]: no such integer")))
         })
     }
-    fn len(&self, name: &str) -> Result<usize, String> {
+    fn len(&self, name: &str) -> Result<usize, Error> {
         Python::attach(|py| {
             self.model
                 .bind(py)
                 .getattr(name)
                 .and_then(|a| a.getattr("size"))
                 .and_then(|v| v.extract::<usize>())
-                .map_err(|_| format!("this MuJoCo's MjModel has no array {name}"))
+                .map_err(|_| patch_error(format!("this MuJoCo's MjModel has no array {name}")))
         })
     }
 }
@@ -125,16 +127,16 @@ impl UserModel {
     }
 
     /// `f`'s Python error kept to raise (the first), told as its message.
-    pub(super) fn keep<T>(&mut self, r: PyResult<T>) -> Result<T, String> {
+    pub(super) fn keep<T>(&mut self, r: PyResult<T>) -> Result<T, Error> {
         r.map_err(|e| {
             let message = e.to_string();
             self.pending.get_or_insert(e);
-            message
+            patch_error(message)
         })
     }
 
     /// `mujoco.name(model, data)`.
-    fn call(&mut self, name: &str, data: &UserData) -> Result<(), String> {
+    fn call(&mut self, name: &str, data: &UserData) -> Result<(), Error> {
         let r = Python::attach(|py| {
             self.mujoco
                 .bind(py)
@@ -153,8 +155,9 @@ impl PatchModel for UserModel {
     type Part = PyModelArrays;
     type Data = UserData;
 
-    fn target(&mut self, name: &str, _int: bool) -> Result<Whole, String> {
-        Python::attach(|py| Whole::of(self.model.bind(py), name)).map_err(|e| e.to_string())
+    fn target(&mut self, name: &str, _int: bool) -> Result<Whole, Error> {
+        Python::attach(|py| Whole::of(self.model.bind(py), name))
+            .map_err(|e| patch_error(e.to_string()))
     }
 
     fn target_mut<'a>(&'a mut self, target: &'a Whole) -> ArrayMut<'a> {
@@ -190,7 +193,7 @@ impl PatchModel for UserModel {
         Python::attach(|py| self.opt.bind(py).hasattr(field).unwrap_or(false))
     }
 
-    fn write_option(&mut self, field: &str, values: &[f64]) -> Result<(), String> {
+    fn write_option(&mut self, field: &str, values: &[f64]) -> Result<(), Error> {
         let r = Python::attach(|py| {
             let opt = self.opt.bind(py);
             if let [v] = values {
@@ -223,15 +226,15 @@ impl PatchModel for UserModel {
         .unwrap_or_else(|_| body.to_string())
     }
 
-    fn compile_part(&self, xml: &str) -> Result<PyModelArrays, String> {
+    fn compile_part(&self, xml: &str) -> Result<PyModelArrays, Error> {
         Python::attach(|py| {
             let part = upcalls::get(py, "compile_xml")?.call1((self.mujoco.bind(py), xml))?;
             PyModelArrays::new(&part)
         })
-        .map_err(|e: PyErr| e.to_string())
+        .map_err(|e: PyErr| patch_error(e.to_string()))
     }
 
-    fn make_data(&self) -> Result<UserData, String> {
+    fn make_data(&self) -> Result<UserData, Error> {
         Python::attach(|py| {
             let model = self.model.bind(py);
             let data = self.mujoco.bind(py).getattr("MjData")?.call1((model,))?;
@@ -248,25 +251,25 @@ impl PatchModel for UserModel {
                 nbytes,
             })
         })
-        .map_err(|e: PyErr| e.to_string())
+        .map_err(|e: PyErr| patch_error(e.to_string()))
     }
 
     fn nbytes(&self, data: &UserData) -> usize {
         data.nbytes
     }
 
-    fn set_const(&mut self, data: &mut UserData) -> Result<(), String> {
+    fn set_const(&mut self, data: &mut UserData) -> Result<(), Error> {
         self.call("mj_setConst", data)
     }
 
-    fn kinematics(&mut self, data: &mut UserData) -> Result<(), String> {
+    fn kinematics(&mut self, data: &mut UserData) -> Result<(), Error> {
         // SAFETY: the data's and model's own arrays, distinct, while no Python code runs.
         unsafe { data.qpos.slice_mut() }.copy_from_slice(unsafe { data.qpos0.slice() });
         self.call("mj_kinematics", data)?;
         self.call("mj_comPos", data)
     }
 
-    fn inertia(&mut self, data: &mut UserData) -> Result<(), String> {
+    fn inertia(&mut self, data: &mut UserData) -> Result<(), Error> {
         let r = Python::attach(|py| {
             let (mujoco, model) = (self.mujoco.bind(py), self.model.bind(py));
             upcalls::get(py, "make_inertia")?
@@ -280,7 +283,7 @@ impl PatchModel for UserModel {
         &mut self,
         data: &UserData,
         f: impl FnOnce(&StatArrays<'_>, &mut [f64]) -> R,
-    ) -> Result<R, String> {
+    ) -> Result<R, Error> {
         Ok(data.statistics.with_lengths(f))
     }
 
@@ -297,7 +300,7 @@ impl PatchModel for UserModel {
         out
     }
 
-    fn set_stat(&mut self, stat: &Statistics) -> Result<(), String> {
+    fn set_stat(&mut self, stat: &Statistics) -> Result<(), Error> {
         let r = Python::attach(|py| {
             let s = self.stat.bind(py);
             for (k, name) in STATISTIC_NAMES[..4].iter().enumerate() {
@@ -325,13 +328,13 @@ const ENUMS: [(&str, &str); 5] = [
 static RECOMPUTES_SAMEFRAME: OnceLock<bool> = OnceLock::new();
 
 impl TreeModel for UserModel {
-    fn compile_model(&self, xml: &str) -> Result<UserModel, String> {
+    fn compile_model(&self, xml: &str) -> Result<UserModel, Error> {
         Python::attach(|py| {
             let mujoco = self.mujoco.bind(py);
             let model = upcalls::get(py, "compile_xml")?.call1((mujoco, xml))?;
             UserModel::new(mujoco.clone(), model)
         })
-        .map_err(|e: PyErr| e.to_string())
+        .map_err(|e: PyErr| patch_error(e.to_string()))
     }
 
     fn constant(&self, name: &str) -> Option<i32> {
@@ -348,7 +351,7 @@ impl TreeModel for UserModel {
         })
     }
 
-    fn recomputes_sameframe(&self) -> Result<bool, String> {
+    fn recomputes_sameframe(&self) -> Result<bool, Error> {
         if let Some(&known) = RECOMPUTES_SAMEFRAME.get() {
             return Ok(known);
         }
@@ -356,7 +359,7 @@ impl TreeModel for UserModel {
         Ok(*RECOMPUTES_SAMEFRAME.get_or_init(|| probed))
     }
 
-    fn camlight(&mut self, data: &mut UserData) -> Result<(), String> {
+    fn camlight(&mut self, data: &mut UserData) -> Result<(), Error> {
         self.call("mj_camlight", data)
     }
 
@@ -365,7 +368,7 @@ impl TreeModel for UserModel {
         data: &UserData,
         names: &[&str],
         f: impl FnOnce(&[&[f64]]) -> R,
-    ) -> Result<R, String> {
+    ) -> Result<R, Error> {
         Python::attach(|py| {
             let d = data.data.bind(py);
             let arrays = names
@@ -377,6 +380,6 @@ impl TreeModel for UserModel {
             let slices: Vec<&[f64]> = arrays.iter().map(|a| unsafe { a.slice() }).collect();
             Ok(f(&slices))
         })
-        .map_err(|e: PyErr| e.to_string())
+        .map_err(|e: PyErr| patch_error(e.to_string()))
     }
 }

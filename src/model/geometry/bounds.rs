@@ -23,6 +23,7 @@ use super::mesh::{find_mesh, mesh_vertices};
 use super::{err_at, up_to};
 use crate::document::Document;
 use crate::document::tree::Node;
+use crate::error::Error;
 
 /// An axis-aligned box and a horizontal radius, in the frame of the measured body.
 ///
@@ -93,7 +94,7 @@ pub fn subtree_bounds(
     doc: &Document,
     body: Node,
     filter: impl Fn(&Document, Node) -> bool,
-) -> Result<Bounds, String> {
+) -> Result<Bounds, Error> {
     let tag = doc.tag(body);
     if tag != "body" && tag != "worldbody" {
         return Err(err_at(
@@ -126,7 +127,7 @@ struct Walk<'a, F> {
 impl<F: Fn(&Document, Node) -> bool> Walk<'_, F> {
     /// Measures every geom below `node`, in document order, from an explicit stack (bodies
     /// nest without bound; this may run on a worker thread with a small stack).
-    fn subtree(&mut self, node: Node, pose: &Pose) -> Result<(), String> {
+    fn subtree(&mut self, node: Node, pose: &Pose) -> Result<(), Error> {
         let doc = self.doc;
         let mut stack: Vec<(Node, Pose)> = Vec::new();
         let push_kids = |stack: &mut Vec<(Node, Pose)>, node: Node, pose: &Pose| {
@@ -164,7 +165,7 @@ impl<F: Fn(&Document, Node) -> bool> Walk<'_, F> {
     }
 
     /// The bounds of one geom whose parent frame is `parent` (in the measured body's frame).
-    fn geom(&mut self, geom: Node, parent: &Pose) -> Result<Option<Bounds>, String> {
+    fn geom(&mut self, geom: Node, parent: &Pose) -> Result<Option<Bounds>, Error> {
         let doc = self.doc;
         let ty = doc.attr(geom, "type").unwrap_or("sphere").trim();
         if matches!(ty, "plane" | "hfield" | "sdf") {
@@ -401,6 +402,7 @@ fn max_norm_on_ellipse(c: [f64; 2], e1: [f64; 2], s1: f64, s2: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    use super::super::words;
     use super::*;
 
     /// A brute-force reference: dense sampling, then golden-section refinement.
@@ -451,7 +453,7 @@ mod tests {
         }
     }
 
-    fn bounds_of(xml: &str) -> Result<Bounds, String> {
+    fn bounds_of(xml: &str) -> Result<Bounds, Error> {
         let doc = Document::from_str(xml, ".").unwrap();
         let body = doc
             .descendants(doc.root())
@@ -496,12 +498,14 @@ mod tests {
 
     #[test]
     fn planes_are_skipped_and_empty_subtrees_are_errors() {
-        let e = bounds_of(r#"<mujoco><worldbody><body><geom type="plane" size="1 1 1"/></body></worldbody></mujoco>"#).unwrap_err();
+        let e = words(bounds_of(r#"<mujoco><worldbody><body><geom type="plane" size="1 1 1"/></body></worldbody></mujoco>"#).unwrap_err());
         assert!(e.contains("no geom with a finite extent"), "{e}");
-        let e = bounds_of(
-            r#"<mujoco><worldbody><body><geom type="sphere"/></body></worldbody></mujoco>"#,
-        )
-        .unwrap_err();
+        let e = words(
+            bounds_of(
+                r#"<mujoco><worldbody><body><geom type="sphere"/></body></worldbody></mujoco>"#,
+            )
+            .unwrap_err(),
+        );
         assert!(e.contains("size[0] of a sphere must be positive"), "{e}");
     }
 }

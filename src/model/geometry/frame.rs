@@ -6,9 +6,10 @@
 //! quaternions agree with the compiled `body_quat`/`geom_quat`/`site_quat` to rounding
 //! (sign included: MuJoCo keeps a written `quat` with negative `w` as it is).
 
-use super::{err_at, exact};
+use super::{err_at, exact, geometry_error};
 use crate::document::Document;
 use crate::document::tree::Node;
+use crate::error::Error;
 
 /// MuJoCo's `mjEPS`: below this a vector counts as zero.
 const EPS: f64 = 1e-14;
@@ -49,18 +50,20 @@ impl Angles {
     /// ```
     /// use mjcf_forge::geometry::Angles;
     /// assert_eq!(Angles::new(false, "XYZ")?.seq, *b"XYZ");
-    /// assert!(Angles::new(true, "xyw").is_err());
-    /// # Ok::<(), String>(())
+    /// let wrong = Angles::new(true, "xyw").unwrap_err();
+    /// assert!(matches!(wrong.kind, mjcf_forge::ErrorKind::Geometry(_)));
+    /// assert_eq!(wrong.to_string(), "eulerseq 'xyw' can only contain x, y, z, X, Y, Z");
+    /// # Ok::<(), mjcf_forge::Error>(())
     /// ```
-    pub fn new(degrees: bool, seq: &str) -> Result<Angles, String> {
+    pub fn new(degrees: bool, seq: &str) -> Result<Angles, Error> {
         let bytes: [u8; 3] = seq.as_bytes().try_into().map_err(|_| {
             let seq = crate::document::read::clip(seq, 40);
-            format!("eulerseq '{seq}' must have exactly 3 letters")
+            geometry_error(format!("eulerseq '{seq}' must have exactly 3 letters"))
         })?;
         if !bytes.iter().all(|c| b"xyzXYZ".contains(c)) {
-            return Err(format!(
+            return Err(geometry_error(format!(
                 "eulerseq '{seq}' can only contain x, y, z, X, Y, Z"
-            ));
+            )));
         }
         Ok(Angles {
             degrees,
@@ -78,7 +81,7 @@ impl Angles {
     /// assert_eq!(mjcf_forge::geometry::Angles::of(&doc)?, Default::default());
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
-    pub fn of(doc: &Document) -> Result<Angles, String> {
+    pub fn of(doc: &Document) -> Result<Angles, Error> {
         let mut angles = Angles::default();
         for c in doc
             .elements(doc.root())
@@ -371,7 +374,7 @@ fn frame_to_quat(x: [f64; 3], y: [f64; 3], z: [f64; 3]) -> [f64; 4] {
 /// let a = euler_to_quat([10.0, 20.0, 30.0], &xyz);
 /// let b = euler_to_quat([30.0, 20.0, 10.0], &Angles::new(true, "ZYX")?);
 /// assert!(a.iter().zip(b).all(|(u, v)| (u - v).abs() < 1e-15));
-/// # Ok::<(), String>(())
+/// # Ok::<(), mjcf_forge::Error>(())
 /// ```
 pub fn euler_to_quat(euler: [f64; 3], angles: &Angles) -> [f64; 4] {
     let mut q = [1.0, 0.0, 0.0, 0.0];
@@ -397,7 +400,7 @@ pub fn euler_to_quat(euler: [f64; 3], angles: &Angles) -> [f64; 4] {
 const ORIENTATIONS: [&str; 5] = ["quat", "axisangle", "xyaxes", "zaxis", "euler"];
 
 /// The orientation of an element from its one orientation attribute (identity if none).
-fn orientation(doc: &Document, node: Node, angles: &Angles) -> Result<[f64; 4], String> {
+fn orientation(doc: &Document, node: Node, angles: &Angles) -> Result<[f64; 4], Error> {
     let given: Vec<&str> = ORIENTATIONS
         .into_iter()
         .filter(|a| doc.attr(node, a).is_some())
@@ -480,7 +483,7 @@ const FROMTO_TYPES: [&str; 4] = ["capsule", "cylinder", "box", "ellipsoid"];
 /// The pose and half length that `fromto` gives a geom or site, if it has one. The frame
 /// sits midway; its `z` axis is MuJoCo's `mjuu_z2quat(from - to)` (the geom is symmetric,
 /// and this is the sign MuJoCo compiles).
-pub(super) fn fromto(doc: &Document, node: Node) -> Result<Option<(Pose, f64)>, String> {
+pub(super) fn fromto(doc: &Document, node: Node) -> Result<Option<(Pose, f64)>, Error> {
     let tag = doc.tag(node);
     if tag != "geom" && tag != "site" {
         return Ok(None);
@@ -536,7 +539,7 @@ pub(super) fn fromto(doc: &Document, node: Node) -> Result<Option<(Pose, f64)>, 
 /// assert!((pose.quat[1] - 1.0).abs() < 1e-15); // z flipped: MuJoCo points it at `from`
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
-pub fn element_pose(doc: &Document, node: Node, angles: &Angles) -> Result<Pose, String> {
+pub fn element_pose(doc: &Document, node: Node, angles: &Angles) -> Result<Pose, Error> {
     if let Some((pose, _)) = fromto(doc, node)? {
         return Ok(pose);
     }
@@ -560,7 +563,7 @@ pub fn element_pose(doc: &Document, node: Node, angles: &Angles) -> Result<Pose,
 /// assert_eq!(body_relative_pose(&doc, geom, &Angles::default())?.pos, [1.0, 1.0, 0.0]);
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
-pub fn body_relative_pose(doc: &Document, node: Node, angles: &Angles) -> Result<Pose, String> {
+pub fn body_relative_pose(doc: &Document, node: Node, angles: &Angles) -> Result<Pose, Error> {
     if doc.tag(node) == "worldbody" {
         return Ok(Pose::IDENTITY);
     }
@@ -575,6 +578,7 @@ pub fn body_relative_pose(doc: &Document, node: Node, angles: &Angles) -> Result
 
 #[cfg(test)]
 mod tests {
+    use super::super::words;
     use super::*;
 
     fn close(a: &[f64], b: &[f64], tol: f64) -> bool {
@@ -684,7 +688,7 @@ mod tests {
         let (doc, g) = first_geom(
             r#"<mujoco><worldbody><geom euler="1 2 3" quat="1 0 0 0"/></worldbody></mujoco>"#,
         );
-        let e = element_pose(&doc, g, &Angles::default()).unwrap_err();
+        let e = words(element_pose(&doc, g, &Angles::default()).unwrap_err());
         assert!(
             e.contains("multiple orientation specifiers (quat, euler)")
                 && e.ends_with("<string>:1:20"),
@@ -693,13 +697,13 @@ mod tests {
         let (doc, g) = first_geom(
             r#"<mujoco><worldbody><geom type="sphere" size="1" fromto="0 0 0 1 0 0"/></worldbody></mujoco>"#,
         );
-        let e = element_pose(&doc, g, &Angles::default()).unwrap_err();
+        let e = words(element_pose(&doc, g, &Angles::default()).unwrap_err());
         assert!(
             e.contains("fromto requires capsule, cylinder, box or ellipsoid, not sphere"),
             "{e}"
         );
         let (doc, g) = first_geom(r#"<mujoco><worldbody><geom pos="1 2"/></worldbody></mujoco>"#);
-        let e = element_pose(&doc, g, &Angles::default()).unwrap_err();
+        let e = words(element_pose(&doc, g, &Angles::default()).unwrap_err());
         assert!(
             e.contains("attribute 'pos' needs 3 numbers, found 2"),
             "{e}"
@@ -716,15 +720,14 @@ mod tests {
             .filter(|&n| doc.tag(n) == "geom")
             .collect();
         assert!(element_pose(&doc, geoms[0], &angles).is_ok());
-        let e = element_pose(&doc, geoms[1], &angles).unwrap_err();
+        let e = words(element_pose(&doc, geoms[1], &angles).unwrap_err());
         assert!(
             e.contains("euler sequence can only contain x, y, z, X, Y, Z"),
             "{e}"
         );
         let doc = Document::from_str(r#"<mujoco><compiler eulerseq="xy"/></mujoco>"#, ".").unwrap();
         assert!(
-            Angles::of(&doc)
-                .unwrap_err()
+            words(Angles::of(&doc).unwrap_err())
                 .contains("eulerseq 'xy' must have exactly 3 letters")
         );
     }

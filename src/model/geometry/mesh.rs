@@ -18,6 +18,7 @@ use super::frame::quat_to_mat;
 use super::{err_at, exact, numbers};
 use crate::document::tree::Node;
 use crate::document::{Document, Section};
+use crate::error::Error;
 
 /// The `<mesh>` asset that a geom's `mesh` attribute names: by its `name`, or, for an
 /// unnamed mesh, by its file name without folder and extension (MuJoCo's rule).
@@ -61,7 +62,7 @@ pub(super) fn mesh_name(doc: &Document, mesh: Node) -> Option<String> {
 /// assert_eq!(v[1], [2.0, 0.0, 0.0]); // (2 - 1) * 2
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
-pub fn mesh_vertices(doc: &Document, mesh: Node) -> Result<Vec<[f64; 3]>, String> {
+pub fn mesh_vertices(doc: &Document, mesh: Node) -> Result<Vec<[f64; 3]>, Error> {
     let raw: Vec<[f32; 3]> = if let Some(file) = doc.attr(mesh, "file") {
         let kind = match doc.attr(mesh, "content_type").map(str::trim) {
             Some("model/stl") => "stl".to_string(),

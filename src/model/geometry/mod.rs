@@ -41,21 +41,35 @@ pub use mesh::{find_mesh, mesh_vertices};
 
 use crate::document::Document;
 use crate::document::tree::Node;
+use crate::error::{Error, ErrorKind};
 
-/// An error about `node`, ending with its source position (house style).
-fn err_at(doc: &Document, node: Node, msg: impl std::fmt::Display) -> String {
-    match doc.attr(node, "name") {
+/// The words of an error the geometry functions returned, checking its kind.
+#[cfg(test)]
+fn words(e: Error) -> String {
+    assert!(matches!(e.kind, ErrorKind::Geometry(_)), "{e:?}");
+    e.to_string()
+}
+
+/// A problem of this module's, in words ([`ErrorKind::Geometry`]).
+fn geometry_error(message: String) -> Error {
+    Error::bare(ErrorKind::Geometry(message))
+}
+
+/// An error about `node`, ending with its source position (house style). The position is
+/// part of the words, not the error's `location`, which `Display` would put first.
+fn err_at(doc: &Document, node: Node, msg: impl std::fmt::Display) -> Error {
+    geometry_error(match doc.attr(node, "name") {
         Some(name) => format!(
             "<{} name=\"{name}\">: {msg} at {}",
             doc.tag(node),
             doc.location(node)
         ),
         None => format!("<{}>: {msg} at {}", doc.tag(node), doc.location(node)),
-    }
+    })
 }
 
 /// The numbers of attribute `name`, `None` when it is absent.
-fn numbers(doc: &Document, node: Node, name: &str) -> Result<Option<Vec<f64>>, String> {
+fn numbers(doc: &Document, node: Node, name: &str) -> Result<Option<Vec<f64>>, Error> {
     let Some(text) = doc.attr(node, name) else {
         return Ok(None);
     };
@@ -69,7 +83,7 @@ fn numbers(doc: &Document, node: Node, name: &str) -> Result<Option<Vec<f64>>, S
                 )
             })
         })
-        .collect::<Result<Vec<f64>, String>>()
+        .collect::<Result<Vec<f64>, Error>>()
         .map(Some)
 }
 
@@ -78,7 +92,7 @@ fn exact<const N: usize>(
     doc: &Document,
     node: Node,
     name: &str,
-) -> Result<Option<[f64; N]>, String> {
+) -> Result<Option<[f64; N]>, Error> {
     let Some(v) = numbers(doc, node, name)? else {
         return Ok(None);
     };
@@ -98,7 +112,7 @@ fn up_to<const N: usize>(
     node: Node,
     name: &str,
     fill: [f64; N],
-) -> Result<[f64; N], String> {
+) -> Result<[f64; N], Error> {
     let mut out = fill;
     if let Some(v) = numbers(doc, node, name)? {
         if v.len() > N {

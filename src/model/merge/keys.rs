@@ -121,7 +121,8 @@ impl Document {
         }
         let mut world = geometry::Pose::default();
         for &n in chain.iter().rev() {
-            world = world.compose(&geometry::element_pose(self, n, angles)?);
+            let pose = geometry::element_pose(self, n, angles).map_err(|e| e.to_string())?;
+            world = world.compose(&pose);
         }
         let q = world.quat;
         let norm = q.iter().map(|x| x * x).sum::<f64>().sqrt();

@@ -357,10 +357,12 @@ fn rotation(
 
 /// The pose of a body or site in the world: its pose in its body, composed up the tree.
 fn world_pose(doc: &Document, node: Node, angles: &Angles) -> Result<Pose, String> {
-    let mut pose = geometry::body_relative_pose(doc, node, angles)?;
+    let mut pose = geometry::body_relative_pose(doc, node, angles).map_err(|e| e.to_string())?;
     let mut up = enclosing_body(doc, node);
     while let Some(body) = up {
-        pose = geometry::body_relative_pose(doc, body, angles)?.compose(&pose);
+        pose = geometry::body_relative_pose(doc, body, angles)
+            .map_err(|e| e.to_string())?
+            .compose(&pose);
         up = enclosing_body(doc, body);
     }
     Ok(pose)

@@ -390,8 +390,12 @@ fn build(
     }
 
     // Groups.
-    let angles = Angles::of(&template)
-        .map_err(|e| Error::at(src.location(spec.base.span()), ErrorKind::Invalid(e)))?;
+    let angles = Angles::of(&template).map_err(|e| {
+        Error::at(
+            src.location(spec.base.span()),
+            ErrorKind::Invalid(e.to_string()),
+        )
+    })?;
     let mut groups: Vec<Group> = Vec::new();
     for g in &spec.objects {
         let write = write_inertials(g, &randomizers, inertias.is_some());

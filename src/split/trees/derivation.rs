@@ -3,11 +3,13 @@
 
 use std::collections::{BTreeMap, HashMap};
 
+use super::super::patch_error;
 use super::super::plan::LayoutEntry;
 use super::super::targets::{GEOM_FACTORS, MODEL_FIELDS};
 use super::super::{target_array, write_frame_flags};
 use super::skeleton::Tree;
 use super::{TreeModel, int_at};
+use crate::error::Error;
 
 /// Patch targets `mj_setConst` reads: a tree written into through them is derived again.
 const INPUTS: [&str; 10] = [
@@ -74,7 +76,7 @@ fn same_quat(a: &[f64], i: usize, b: [f64; 4]) -> bool {
 impl<M: TreeModel> TreeDerivation<M> {
     /// The derivation for `model` (a superset) and patches of `layout`, or `None` when
     /// such a patch writes what it does not follow (`mj_setConst` then).
-    pub fn build(model: &M, layout: &[LayoutEntry]) -> Result<Option<TreeDerivation<M>>, String> {
+    pub fn build(model: &M, layout: &[LayoutEntry]) -> Result<Option<TreeDerivation<M>>, Error> {
         if model.size("nflex").unwrap_or(0) > 0 {
             return Ok(None);
         }
@@ -184,7 +186,7 @@ impl<M: TreeModel> TreeDerivation<M> {
             .iter()
             .map(|&p| p.max(0) as usize)
             .collect();
-        let targets = |body: &str, target: &str| -> Result<(Vec<usize>, Vec<usize>), String> {
+        let targets = |body: &str, target: &str| -> Result<(Vec<usize>, Vec<usize>), Error> {
             let b: Vec<usize> = model
                 .ints(body)?
                 .iter()
@@ -225,7 +227,7 @@ impl<M: TreeModel> TreeDerivation<M> {
         model: &mut M,
         data: &mut M::Data,
         parked: &[usize],
-    ) -> Result<(), String> {
+    ) -> Result<(), Error> {
         let mut changed = Vec::new();
         for &root in self.trees.keys() {
             let now = if parked.contains(&root) {
@@ -272,7 +274,7 @@ impl<M: TreeModel> TreeDerivation<M> {
     /// MuJoCo's kinematics and centres of mass at `qpos0`, and from them the cameras' and
     /// lights' offsets from their bodies and subtree centres, as `mj_setConst` takes them
     /// (every camera and light held fixed).
-    fn frames(&self, model: &mut M, data: &mut M::Data) -> Result<(), String> {
+    fn frames(&self, model: &mut M, data: &mut M::Data) -> Result<(), Error> {
         let (ncam, nlight) = (self.cam.0.len(), self.light.0.len());
         if ncam == 0 && nlight == 0 {
             return model.kinematics(data);
@@ -341,7 +343,7 @@ pub const FROM_GEOMS: [&str; 3] = ["body_margin", "body_contype", "body_conaffin
 /// What `mj_setConst` also derives from the geoms and no tree derivation does: each
 /// body's `contype` and `conaffinity` (its geoms' flags or-ed) and `margin` (their largest
 /// margin, 0 without geoms): [`FROM_GEOMS`]. A body's geoms are contiguous, in body order.
-fn bodies_from_geoms<M: TreeModel>(model: &mut M) -> Result<(), String> {
+fn bodies_from_geoms<M: TreeModel>(model: &mut M) -> Result<(), Error> {
     let num = model.ints("body_geomnum")?.to_vec();
     let adr = model.ints("body_geomadr")?.to_vec();
     let margin = model.floats("geom_margin")?.to_vec();
@@ -380,7 +382,7 @@ fn id_of<M: TreeModel>(model: &M, e: &LayoutEntry) -> Option<usize> {
 
 /// The body entry `e` writes into (its joint's or geom's; `None` for a site's or an
 /// unknown element).
-fn body_of<M: TreeModel>(model: &M, e: &LayoutEntry) -> Result<Option<usize>, String> {
+fn body_of<M: TreeModel>(model: &M, e: &LayoutEntry) -> Result<Option<usize>, Error> {
     let Some(i) = id_of(model, e) else {
         return Ok(None);
     };
@@ -395,7 +397,7 @@ fn body_of<M: TreeModel>(model: &M, e: &LayoutEntry) -> Result<Option<usize>, St
 /// Bodies an actuator, equality or tendon reaches (their trees' derived values are not
 /// the tree's own: `actuator_acc0`, `eq_data`, `tendon_invweight0`); `None` where a
 /// constant this MuJoCo should have is missing.
-fn tied_bodies<M: TreeModel>(model: &M) -> Result<Option<Vec<bool>>, String> {
+fn tied_bodies<M: TreeModel>(model: &M) -> Result<Option<Vec<bool>>, Error> {
     let nbody = model.ints("body_parentid")?.len();
     let mut tied = vec![false; nbody];
     let c = |name: &str| model.constant(name);
@@ -462,7 +464,10 @@ fn tied_bodies<M: TreeModel>(model: &M) -> Result<Option<Vec<bool>>, String> {
         } else if kind == trn_body {
             tied[obj] = true;
         } else if kind == trn_tendon {
-            for &b in tendon_bodies.get(obj).ok_or("an actuator's tendon")? {
+            for &b in tendon_bodies
+                .get(obj)
+                .ok_or_else(|| patch_error("an actuator's tendon"))?
+            {
                 tied[b] = true;
             }
         } else {
@@ -488,7 +493,10 @@ fn tied_bodies<M: TreeModel>(model: &M) -> Result<Option<Vec<bool>>, String> {
             if kind == eq_joint {
                 tied[int_at(jnt_body, j)?] = true;
             } else if kind == eq_tendon {
-                for &b in tendon_bodies.get(j).ok_or("an equality's tendon")? {
+                for &b in tendon_bodies
+                    .get(j)
+                    .ok_or_else(|| patch_error("an equality's tendon"))?
+                {
                     tied[b] = true;
                 }
             } else if objtype == obj_body {

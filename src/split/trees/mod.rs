@@ -31,45 +31,47 @@ mod skeleton;
 use std::collections::HashMap;
 
 use super::PatchModel;
+use super::patch_error;
 use super::plan::{LayoutEntry, PatchPlan};
 use super::targets::LAYOUTS_KEPT;
+use crate::error::Error;
 
 pub use derivation::{FROM_GEOMS, TreeDerivation};
 
 /// What a tree-by-tree derivation needs of a MuJoCo beyond a [`PatchModel`].
 pub trait TreeModel: PatchModel + Sized {
     /// MJCF text compiled by this model's MuJoCo, as a model of its own (a skeleton).
-    fn compile_model(&self, xml: &str) -> Result<Self, String>;
+    fn compile_model(&self, xml: &str) -> Result<Self, Error>;
     /// The value of MuJoCo's enum constant `name` (`mjWRAP_JOINT`, `mjTRN_BODY`,
     /// `mjEQ_JOINT`, `mjOBJ_SITE`...), as this MuJoCo numbers it.
     fn constant(&self, name: &str) -> Option<i32>;
     /// Whether this MuJoCo's `mj_setConst` sets the bodies', geoms' and sites' same-frame
     /// flags again from their frames (4.0 does; 3.17 keeps the compiler's): the face keeps
     /// the answer of [`TreeModel::sameframe_probe`] (one MuJoCo per process).
-    fn recomputes_sameframe(&self) -> Result<bool, String>;
+    fn recomputes_sameframe(&self) -> Result<bool, Error>;
     /// Asks this MuJoCo [`TreeModel::recomputes_sameframe`]'s question: a body's flag set
     /// to `mjSAMEFRAME_NONE` in a compiled model, then `mj_setConst`.
-    fn sameframe_probe(&self) -> Result<bool, String> {
+    fn sameframe_probe(&self) -> Result<bool, Error> {
         let xml = r#"<mujoco><worldbody><body><freejoint/><geom size=".1" pos=".1 0 0"/></body></worldbody></mujoco>"#;
         let mut model = self.compile_model(xml)?;
         let none = self
             .constant("mjSAMEFRAME_NONE")
             .and_then(|n| u8::try_from(n).ok())
-            .ok_or("this MuJoCo has no mjSAMEFRAME_NONE")?;
+            .ok_or_else(|| patch_error("this MuJoCo has no mjSAMEFRAME_NONE"))?;
         model.bytes_mut("body_sameframe")?[1] = none;
         let mut data = model.make_data()?;
         model.set_const(&mut data)?;
         Ok(model.bytes("body_sameframe")?[1] != none)
     }
     /// `mj_camlight` on `data` (its kinematics and centres of mass done).
-    fn camlight(&mut self, data: &mut Self::Data) -> Result<(), String>;
+    fn camlight(&mut self, data: &mut Self::Data) -> Result<(), Error>;
     /// Calls `f` with `data`'s `mjtNum` arrays `names`, in order.
     fn with_data<R>(
         &self,
         data: &Self::Data,
         names: &[&str],
         f: impl FnOnce(&[&[f64]]) -> R,
-    ) -> Result<R, String>;
+    ) -> Result<R, Error>;
 }
 
 /// An index range.
@@ -80,18 +82,18 @@ pub(super) fn span(first: usize, n: usize) -> Span {
 }
 
 /// `a[i*w .. (i+1)*w]` rows `rows` of an array of width `w`.
-pub(super) fn rows<T>(a: &[T], w: usize, r: &Span) -> Result<std::ops::Range<usize>, String> {
+pub(super) fn rows<T>(a: &[T], w: usize, r: &Span) -> Result<std::ops::Range<usize>, Error> {
     let range = r.start * w..r.end * w;
     if range.end > a.len() {
-        return Err("a tree's rows past its array".into());
+        return Err(patch_error("a tree's rows past its array"));
     }
     Ok(range)
 }
 
-pub(super) fn int_at(a: &[i32], i: usize) -> Result<usize, String> {
+pub(super) fn int_at(a: &[i32], i: usize) -> Result<usize, Error> {
     a.get(i)
         .and_then(|&v| usize::try_from(v).ok())
-        .ok_or_else(|| format!("no element {i}"))
+        .ok_or_else(|| patch_error(format!("no element {i}")))
 }
 
 /// A plan's tree-by-tree derivations, by the layout each follows (at most
@@ -128,7 +130,7 @@ impl<M: TreeModel> Derivations<M> {
         model: &mut M,
         parked: Option<&[S]>,
         by_tree: bool,
-    ) -> Result<bool, String> {
+    ) -> Result<bool, Error> {
         let mut derived = false;
         match parked.filter(|_| by_tree) {
             None => plan.finish(model, None)?,
@@ -159,7 +161,7 @@ impl<M: TreeModel> Derivations<M> {
         layout: &[LayoutEntry],
         parked: &[S],
         finishes: u64,
-    ) -> Result<bool, String> {
+    ) -> Result<bool, Error> {
         let at = match self.by_layout.iter().position(|(l, _)| l == layout) {
             Some(at) => at,
             None => {
@@ -196,7 +198,7 @@ impl<M: TreeModel> Derivations<M> {
                 None => {
                     let id = model
                         .id("body", name)
-                        .ok_or_else(|| format!("the superset has no body '{name}'"))?;
+                        .ok_or_else(|| patch_error(format!("the superset has no body '{name}'")))?;
                     self.body_ids.insert(name.to_string(), id);
                     id
                 }

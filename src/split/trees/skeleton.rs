@@ -3,8 +3,10 @@
 
 use std::collections::HashMap;
 
+use super::super::patch_error;
 use super::super::targets::{JOINT_TYPES, joint_widths};
 use super::{Span, TreeModel, int_at, rows, span};
+use crate::error::Error;
 
 /// Per-tree values copied into a skeleton (bodies, joints, dofs) and the flags that steer
 /// MuJoCo's computation (copied too: the skeleton's placeholder inertials set their own).
@@ -58,7 +60,7 @@ pub(super) struct Tree<M: TreeModel> {
 }
 
 impl<M: TreeModel> Tree<M> {
-    pub(super) fn new(model: &M, root: usize) -> Result<Tree<M>, String> {
+    pub(super) fn new(model: &M, root: usize) -> Result<Tree<M>, Error> {
         let rootid = model.ints("body_rootid")?;
         let bodies: Vec<usize> = (0..rootid.len())
             .filter(|&b| rootid[b] as usize == root)
@@ -75,7 +77,7 @@ impl<M: TreeModel> Tree<M> {
             .collect();
         let contiguous = |v: &[usize]| v.last().is_some_and(|&l| l - v[0] + 1 == v.len());
         if !contiguous(&bodies) || joints.is_empty() || !contiguous(&joints) || !contiguous(&dofs) {
-            return Err("not a contiguous moving tree".into());
+            return Err(patch_error("not a contiguous moving tree"));
         }
         let qposadr = model.ints("jnt_qposadr")?;
         let jnt_type = model.ints("jnt_type")?;
@@ -101,12 +103,12 @@ impl<M: TreeModel> Tree<M> {
             || sk_nv != before + count + after
             || sk_dofadr.get(before).copied() != Some(before as i32)
         {
-            return Err("the skeleton does not have the tree's layout".into());
+            return Err(patch_error("the skeleton does not have the tree's layout"));
         }
         // The mass matrix's sparsity, as the superset's (the dofs' own rows).
         let (Ok(sk_nnz), Ok(nnz)) = (skeleton.ints("M_rownnz"), model.ints("M_rownnz")) else {
             // MuJoCo 3.3 has no M_rownnz to compare (mj_setConst on the whole model then).
-            return Err("this MuJoCo has no M_rownnz".into());
+            return Err(patch_error("this MuJoCo has no M_rownnz"));
         };
         let (sk_adr, adr) = (skeleton.ints("M_rowadr")?, model.ints("M_rowadr")?);
         let (sk_col, col) = (skeleton.ints("M_colind")?, model.ints("M_colind")?);
@@ -114,7 +116,9 @@ impl<M: TreeModel> Tree<M> {
             let (a, b) = (before + k, start + k);
             let (na, nb) = (int_at(sk_nnz, a)?, int_at(nnz, b)?);
             if na != nb {
-                return Err("the skeleton's mass matrix is not laid out as the tree's".into());
+                return Err(patch_error(
+                    "the skeleton's mass matrix is not laid out as the tree's",
+                ));
             }
             let (pa, pb) = (int_at(sk_adr, a)?, int_at(adr, b)?);
             let same = (0..na).all(|i| {
@@ -122,7 +126,9 @@ impl<M: TreeModel> Tree<M> {
                 matches!((x, y), (Some(&x), Some(&y)) if x as i64 - before as i64 == y as i64 - start as i64)
             });
             if !same {
-                return Err("the skeleton's mass matrix is not laid out as the tree's".into());
+                return Err(patch_error(
+                    "the skeleton's mass matrix is not laid out as the tree's",
+                ));
             }
         }
         let bspan = span(bodies[0], bodies.len());
@@ -132,7 +138,9 @@ impl<M: TreeModel> Tree<M> {
             let sk = rows(sk_simple, 1, &span(b0, bodies.len()))?;
             let m = rows(simple, 1, &bspan)?;
             if sk_simple[sk] != simple[m] {
-                return Err("the skeleton's mass matrix is not laid out as the tree's".into());
+                return Err(patch_error(
+                    "the skeleton's mass matrix is not laid out as the tree's",
+                ));
             }
         }
         let data = skeleton.make_data()?;
@@ -148,12 +156,12 @@ impl<M: TreeModel> Tree<M> {
     }
 
     /// The tree's derived values for the superset's current values.
-    pub(super) fn derive(&mut self, model: &M) -> Result<Vec<Vec<f64>>, String> {
+    pub(super) fn derive(&mut self, model: &M) -> Result<Vec<Vec<f64>>, Error> {
         let (b0, j0, d0, q0) = self.at;
         let nb = self.bodies.len();
         let sk = &mut self.skeleton;
         let copy_floats =
-            |sk: &mut M, name: &str, mine: Span, theirs: &Span, n: usize| -> Result<(), String> {
+            |sk: &mut M, name: &str, mine: Span, theirs: &Span, n: usize| -> Result<(), Error> {
                 let from = model.floats(name)?;
                 let w = width(from.len(), n);
                 let src = rows(from, w, theirs)?;
@@ -215,7 +223,7 @@ impl<M: TreeModel> Tree<M> {
         Ok(out)
     }
 
-    pub(super) fn write(&self, model: &mut M, values: &[Vec<f64>]) -> Result<(), String> {
+    pub(super) fn write(&self, model: &mut M, values: &[Vec<f64>]) -> Result<(), Error> {
         let nbody = model.ints("body_parentid")?.len();
         for (name, v) in BODY_OUT.iter().zip(values) {
             let a = model.floats_mut(name)?;
@@ -241,7 +249,7 @@ fn skeleton_xml<M: TreeModel>(
     joints: &[usize],
     before: usize,
     after: usize,
-) -> Result<String, String> {
+) -> Result<String, Error> {
     let (jnt_body, jnt_type) = (model.ints("jnt_bodyid")?, model.ints("jnt_type")?);
     let (jnt_pos, jnt_axis) = (model.floats("jnt_pos")?, model.floats("jnt_axis")?);
     let (body_pos, body_quat) = (model.floats("body_pos")?, model.floats("body_quat")?);
@@ -255,7 +263,7 @@ fn skeleton_xml<M: TreeModel>(
     for &j in joints {
         let kind = JOINT_TYPES
             .get(int_at(jnt_type, j)?)
-            .ok_or("a joint of unknown type")?;
+            .ok_or_else(|| patch_error("a joint of unknown type"))?;
         joint_xml
             .entry(int_at(jnt_body, j)?)
             .or_default()
