@@ -189,6 +189,9 @@ pub enum ErrorKind {
     /// A geom set that is not one of `default`, `visual`, `collision`, `all`
     /// (`sheet::Geoms` from text).
     UnknownGeoms(String),
+    /// A part compiled alone for its masses and inertias was refused (an
+    /// `InertiaCompiler`'s words: MuJoCo's, or the caller's compiler's).
+    InertiaCompile(String),
     /// A patch cannot be made or written over a compiled model (the split tier's
     /// functions: `split::PatchPlan`, `split::land`, the body-model copies, geom masses
     /// and tree derivations): the model's arrays are not of the plan's structure, or the
@@ -295,6 +298,7 @@ impl fmt::Display for ErrorKind {
                 }
             }
             ErrorKind::Patch(msg) => f.write_str(msg),
+            ErrorKind::InertiaCompile(msg) => f.write_str(msg),
             ErrorKind::UnknownGeoms(s) => {
                 write!(
                     f,
@@ -337,6 +341,18 @@ pub struct Error {
 }
 
 impl Error {
+    /// An error of `kind` that is in no file: what an [`InertiaCompiler`](crate::InertiaCompiler)
+    /// of the caller's returns when its compile fails.
+    ///
+    /// ```
+    /// use mjcf_forge::{Error, ErrorKind};
+    /// let e = Error::new(ErrorKind::InertiaCompile("no MuJoCo here".into()));
+    /// assert_eq!((e.to_string(), e.location), ("no MuJoCo here".to_string(), None));
+    /// ```
+    pub fn new(kind: ErrorKind) -> Error {
+        Error::bare(kind)
+    }
+
     pub(crate) fn at(location: Location, kind: ErrorKind) -> Error {
         Error {
             location: Some(location),

@@ -596,7 +596,11 @@ fn needs_an_inertia_compiler(case: &Case) -> bool {
             prefix: "m0_",
         }],
         false,
-        &mut |_: &Document| Err(ASKED.to_string()),
+        &mut |_: &Document| {
+            Err(mjcf_forge::Error::new(
+                mjcf_forge::ErrorKind::InertiaCompile(ASKED.to_string()),
+            ))
+        },
     );
     merged.is_err_and(|e| e.to_string().contains(ASKED))
 }

@@ -681,8 +681,11 @@ fn written_inertials_need_mujoco_and_problems_name_the_pool_entry() {
     use mjcf_forge::{CompiledInertia, Document};
     let path = root().join("corpora/scenes/patch/inertials.toml");
     // The caller's MuJoCo failing: each pool entry's problem at its position.
-    let mut compile =
-        |_: &Document| -> Result<CompiledInertia, String> { Err("no MuJoCo here".to_string()) };
+    let mut compile = |_: &Document| -> Result<CompiledInertia, mjcf_forge::Error> {
+        Err(mjcf_forge::Error::new(
+            mjcf_forge::ErrorKind::InertiaCompile("no MuJoCo here".to_string()),
+        ))
+    };
     let err = Scene::load_with(&path, &mut compile).unwrap_err();
     assert_eq!(err.0.len(), 3, "{err}");
     let first = err.0[0].to_string();

@@ -3,6 +3,7 @@
 
 use crate::document::Document;
 use crate::document::tree::Node;
+use crate::error::{Error, ErrorKind};
 
 impl Document {
     /// Whether `body` has a geom (directly or in a `<frame>` inside it) in the compiler's
@@ -96,7 +97,7 @@ pub struct CompiledInertia {
 /// not (the text goes into the merge's error). The merge calls one when a part's compiler
 /// settings for masses and inertias differ from the base's
 /// ([`Document::merge_all_mapped_with`]).
-pub type InertiaCompiler<'a> = dyn FnMut(&Document) -> Result<CompiledInertia, String> + 'a;
+pub type InertiaCompiler<'a> = dyn FnMut(&Document) -> Result<CompiledInertia, Error> + 'a;
 
 impl Document {
     /// Writes an explicit `<inertial>` (mass, pos, quat, diaginertia, at full precision, as
@@ -126,13 +127,14 @@ impl Document {
     ///     iquat: vec![1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0],
     ///     inertia: vec![0.0, 0.0, 0.0, 0.016755160819145562, 0.016755160819145562, 0.016755160819145562],
     /// };
-    /// let written = doc.write_compiled_inertials(false, true, &mut |_: &Document| Ok::<_, String>(compiled.clone()))
-    ///     .map_err(|e: String| e)?;
+    /// let written = doc.write_compiled_inertials(false, true, &mut |_: &Document| {
+    ///     Ok::<_, mjcf_forge::Error>(compiled.clone())
+    /// })?;
     /// assert_eq!(written, 1);
     /// assert!(doc.to_xml_string().contains(r#"<inertial pos="0.0 0.0 0.0" quat="1.0 0.0 0.0 0.0" mass="4.1887902047863905""#));
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
-    pub fn write_compiled_inertials<E: From<String>>(
+    pub fn write_compiled_inertials<E: From<Error>>(
         &mut self,
         all: bool,
         from_geoms_refused: bool,
@@ -143,12 +145,12 @@ impl Document {
             .descendants(self.root)
             .find(|&n| refused.contains(&self.tag(n)))
         {
-            return Err(E::from(format!(
+            return Err(E::from(Error::bare(ErrorKind::Invalid(format!(
                 "{}: <{}> makes bodies when MuJoCo compiles; explicit inertials are written for \
                  plain <body> elements only",
                 self.location(n),
                 self.tag(n)
-            )));
+            )))));
         }
         for c in self
             .elements(self.root)
@@ -158,11 +160,11 @@ impl Document {
             if (from_geoms_refused && setting("inertiafromgeom", "true"))
                 || setting("fusestatic", "true")
             {
-                return Err(E::from(format!(
+                return Err(E::from(Error::bare(ErrorKind::Invalid(format!(
                     "{}: compiler inertiafromgeom=\"true\" or fusestatic=\"true\": explicit \
                      inertials would not carry the compiled inertia",
                     self.location(c)
-                )));
+                )))));
             }
         }
         let inferring = self.bodies_inferring_inertia();
@@ -178,11 +180,11 @@ impl Document {
         let names = &compiled.body_names;
         let n = bodies.len() + 1;
         if names.len() != n {
-            return Err(E::from(format!(
+            return Err(E::from(Error::bare(ErrorKind::Invalid(format!(
                 "MuJoCo compiled {} bodies from {} <body> elements",
                 names.len().saturating_sub(1),
                 bodies.len()
-            )));
+            )))));
         }
         let sizes = [
             ("body_mass", compiled.mass.len(), n),
@@ -191,18 +193,18 @@ impl Document {
             ("body_inertia", compiled.inertia.len(), 3 * n),
         ];
         if let Some((array, got, want)) = sizes.iter().find(|(_, got, want)| got != want) {
-            return Err(E::from(format!(
+            return Err(E::from(Error::bare(ErrorKind::Invalid(format!(
                 "{array} holds {got} numbers, not {want} for {n} bodies"
-            )));
+            )))));
         }
         for (i, &b) in bodies.iter().enumerate() {
             if self.attr(b, "name").is_some_and(|n| n != names[i + 1]) {
-                return Err(E::from(format!(
+                return Err(E::from(Error::bare(ErrorKind::Invalid(format!(
                     "{}: body {:?} compiled as {:?}: bodies do not match one to one",
                     self.location(b),
                     self.attr(b, "name").unwrap_or(""),
                     names[i + 1]
-                )));
+                )))));
             }
         }
         let (mass, ipos, iquat, inertia) = (
@@ -261,7 +263,7 @@ impl Document {
     pub(crate) fn write_compiled_inertials_from_geoms(
         &mut self,
         compile: &mut InertiaCompiler<'_>,
-    ) -> Result<usize, String> {
+    ) -> Result<usize, Error> {
         let n = self.write_compiled_inertials(true, false, compile)?;
         let compilers: Vec<Node> = self
             .elements(self.root())

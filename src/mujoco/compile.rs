@@ -93,6 +93,14 @@ impl From<String> for CompileError {
     }
 }
 
+/// A local error (no line) in the words of the crate's error (the document tier's checks
+/// when it writes compiled inertials back).
+impl From<crate::Error> for CompileError {
+    fn from(e: crate::Error) -> Self {
+        Self::local(e.to_string())
+    }
+}
+
 /// Compiles the MJCF (or URDF) file at `path`; its relative file references (includes,
 /// meshes, textures) resolve against the file's directory, as in MuJoCo.
 ///

@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 pub(crate) fn python_inertia(
     compile: &Py<PyAny>,
     part: &Document,
-) -> Result<CompiledInertia, String> {
+) -> Result<CompiledInertia, mjcf_forge::Error> {
     let xml = part.to_xml_string();
     let dir = part.model_dir().to_path_buf();
     type Arrays = (Vec<String>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>);
@@ -24,5 +24,8 @@ pub(crate) fn python_inertia(
             inertia,
         })
     })
-    .map_err(|e| format!("compile_inertia: {e}"))
+    .map_err(|e| mjcf_forge::Error {
+        location: None,
+        kind: mjcf_forge::ErrorKind::InertiaCompile(format!("compile_inertia: {e}")),
+    })
 }

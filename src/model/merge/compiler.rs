@@ -99,13 +99,16 @@ fn no_conversion_reason(attr: &str, base: &str, default: &str, compiles: bool) -
 }
 
 /// An [`InertiaCompiler`] that is a plain function.
-type CompileFn = fn(&Document) -> Result<CompiledInertia, String>;
+type CompileFn = fn(&Document) -> Result<CompiledInertia, crate::Error>;
 
 /// The build's own MuJoCo as an [`InertiaCompiler`], if it has one (the `mujoco` feature).
 pub(crate) fn builtin_compiler() -> Option<CompileFn> {
     #[cfg(mjcf_mujoco)]
     {
-        Some(|doc: &Document| crate::mujoco::compiled_inertia(doc).map_err(|e| e.to_string()))
+        Some(|doc: &Document| {
+            crate::mujoco::compiled_inertia(doc)
+                .map_err(|e| crate::Error::bare(crate::ErrorKind::InertiaCompile(e.to_string())))
+        })
     }
     #[cfg(not(mjcf_mujoco))]
     {

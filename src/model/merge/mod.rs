@@ -183,7 +183,7 @@ impl Document {
     ///     r#"<mujoco><worldbody><body name="t"><geom size="0.1"/><geom size="0.1" group="1"/></body></worldbody></mujoco>"#,
     ///     ".",
     /// )?;
-    /// let mut compile = |_: &Document| -> Result<CompiledInertia, String> {
+    /// let mut compile = |_: &Document| -> Result<CompiledInertia, mjcf_forge::Error> {
     ///     // What MuJoCo compiles the table to alone: both spheres count under "0 5".
     ///     Ok(CompiledInertia {
     ///         body_names: vec!["world".into(), "t".into()],

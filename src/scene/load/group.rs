@@ -141,11 +141,11 @@ pub(super) fn load(
             let mut written_doc = doc.clone();
             let written = match inertias.as_deref_mut() {
                 Some(compile) => written_doc.write_compiled_inertials(false, true, compile),
-                None => Err(
+                None => Err(crate::Error::bare(crate::ErrorKind::Invalid(
                     "write_inertials needs MuJoCo: load the scene from Python, or \
                      build mjcf-forge with the `mujoco` feature"
                         .to_string(),
-                ),
+                ))),
             };
             match written {
                 Ok(_) => doc = written_doc,

@@ -46,8 +46,9 @@ impl Scene {
     /// use mjcf_forge::{CompiledInertia, Document, scene::Scene};
     ///
     /// // A MuJoCo of the caller's that cannot compile: each pool model says so, at its place.
-    /// let mut compile =
-    ///     |_: &Document| -> Result<CompiledInertia, String> { Err("no MuJoCo here".into()) };
+    /// let mut compile = |_: &Document| -> Result<CompiledInertia, mjcf_forge::Error> {
+    ///     Err(mjcf_forge::Error::new(mjcf_forge::ErrorKind::InertiaCompile("no MuJoCo here".into())))
+    /// };
     /// let err = Scene::load_with("corpora/scenes/patch/inertials.toml", &mut compile).unwrap_err();
     /// assert_eq!(err.0.len(), 3);
     /// assert!(err.to_string().contains("cannot write the inertials of '../demo/box.xml': no MuJoCo here"));
