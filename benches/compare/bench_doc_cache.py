@@ -15,6 +15,8 @@ made before timing. In one process:
   hit       cache.model(doc) for a document of a cached structure: split, the snapshot
             written back, the patch written, mj_setConst and the compiler's statistics;
   text_hit  cache.model(xml) for the same document as MJCF text (read first);
+  into_hit  cache.model(doc, into=model) with a model the caller holds and hands back
+            (what a robosuite hard reset that keeps its simulation asks);
   copy      copy.copy(model): what returning a copy per call would add (why the cache
             writes back what it restores instead, see docs/compiled.md).
 
@@ -87,6 +89,7 @@ def main() -> int:
     hit_ms = each_ms(lambda i: cache.model(docs[i]), args.runs)
     text_ms = each_ms(lambda i: cache.model(xmls[i]), args.runs)
     model = cache.model(docs[0])
+    into_ms = each_ms(lambda i: cache.model(docs[i], into=model), args.runs)
     copy_ms = each_ms(lambda i: copy.copy(model), min(args.runs, 20))
     out = {
         "scene": str(Path(args.scene).relative_to(ROOT)) if args.scene.startswith(str(ROOT)) else args.scene,
@@ -101,6 +104,7 @@ def main() -> int:
         "split": summary(split_ms, 4),
         "hit": summary(hit_ms, 4),
         "text_hit": summary(text_ms, 4),
+        "into_hit": summary(into_ms, 4),
         "copy": summary(copy_ms, 4),
         "compiles": cache.compiles,
         "patches": cache.patches,
