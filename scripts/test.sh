@@ -37,7 +37,7 @@ case "${1:-}" in
 esac
 
 # The Rust tests whose outcome depends on the MuJoCo the build links: run once per version.
-LINKED=(mujoco_compile cli_compile model_cache document_cache document_differential
+LINKED=(mujoco_compile cli_compile model_cache model_store document_cache document_differential
         cli_preview cli_edges scene_batch merge_judge)
 
 SUMMARY=()

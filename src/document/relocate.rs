@@ -99,6 +99,34 @@ impl Document {
     }
 }
 
+impl Document {
+    /// Every file the model reads when MuJoCo compiles it (meshes, textures, height
+    /// fields, skins), as its file attributes name them (absolute once loaded), each once,
+    /// in document order: what the model store keys a compiled structure by
+    /// ([`crate::split::StoreKey::file`]).
+    ///
+    /// ```
+    /// use mjcf_forge::Document;
+    /// let dir = tempfile::tempdir()?;
+    /// std::fs::write(dir.path().join("m.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n")?;
+    /// let xml = r#"<mujoco><asset><mesh file="m.obj"/><mesh name="b" file="m.obj"/></asset></mujoco>"#;
+    /// let doc = Document::from_str(xml, dir.path())?;
+    /// assert_eq!(doc.files(), vec![dir.path().join("m.obj")]);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn files(&self) -> Vec<std::path::PathBuf> {
+        let mut out: Vec<std::path::PathBuf> = Vec::new();
+        for r in file_refs(self) {
+            let value = self.attr_sym(r.node, r.attr).unwrap_or_default();
+            let path = std::path::PathBuf::from(value);
+            if !out.contains(&path) {
+                out.push(path);
+            }
+        }
+        out
+    }
+}
+
 /// Every file attribute of the document, in document order. A walk with its own stack:
 /// nesting depth comes from the input and must not become recursion depth.
 fn file_refs(doc: &Document) -> Vec<FileRef> {

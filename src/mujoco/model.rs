@@ -42,6 +42,31 @@ pub struct CompiledModel {
 static SERIAL: AtomicU64 = AtomicU64::new(1);
 
 /// A deep copy (`mj_copyModel`): a model of the same structure, patched on its own.
+impl CompiledModel {
+    /// The model in MuJoCo's binary format (`mj_saveModel`): what the model store keeps
+    /// ([`crate::split::DiskStore`]), read back by [`CompiledModel::from_bytes`] to the
+    /// same model, every array and size.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        sys::save_model(self.raw())
+    }
+
+    /// A model from MuJoCo's binary format (what [`CompiledModel::to_bytes`] wrote, by
+    /// this MuJoCo), or `None` when MuJoCo cannot read it.
+    ///
+    /// ```
+    /// use mjcf_forge::mujoco::compile_str;
+    /// let xml = "<mujoco><worldbody><geom size='1'/></worldbody></mujoco>";
+    /// let m = compile_str(xml, std::path::Path::new("."))?;
+    /// let back = mjcf_forge::mujoco::CompiledModel::from_bytes(&m.to_bytes()).unwrap();
+    /// assert!(m.differences(&back).is_empty());
+    /// # Ok::<(), mjcf_forge::mujoco::CompileError>(())
+    /// ```
+    pub fn from_bytes(bytes: &[u8]) -> Option<CompiledModel> {
+        let ptr = NonNull::new(sys::load_model(bytes))?;
+        Some(CompiledModel::from_raw(ptr, None))
+    }
+}
+
 impl Clone for CompiledModel {
     fn clone(&self) -> Self {
         let copy = sys::copy_model(self.raw());

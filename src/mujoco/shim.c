@@ -21,6 +21,19 @@ int mjf_nbias(void) { return mjNBIAS; }
 // A deep copy into a new model (mj_copyModel allocates it), or NULL.
 mjModel* mjf_copy_model(const mjModel* m) { return mj_copyModel(NULL, m); }
 
+// The model in MuJoCo's binary format (mj_saveModel): with a NULL buffer its size in bytes;
+// else written into `buffer` of `size` bytes (the size first asked).
+long long mjf_save_model(const mjModel* m, void* buffer, long long size) {
+  if (!buffer) return (long long)mj_sizeModel(m);
+  mj_saveModel(m, NULL, buffer, (mjtSize)size);
+  return size;
+}
+
+// A model in MuJoCo's binary format read back (mj_loadModelBuffer), or NULL.
+mjModel* mjf_load_model(const void* buffer, long long size) {
+  return mj_loadModelBuffer(buffer, (mjtSize)size);
+}
+
 // mj_loadXML without making the parsed model MuJoCo's last loaded XML model (the one
 // mj_saveLastXML writes, process-wide): the same parse, compile and messages as MuJoCo's
 // own (xml_api.cc: the parser's error, else the compiler's, else the warnings joined by

@@ -48,6 +48,8 @@ unsafe extern "C" {
         error_sz: c_int,
     ) -> *mut MjModel;
     fn mjf_copy_model(m: *const MjModel) -> *mut MjModel;
+    fn mjf_save_model(m: *const MjModel, buffer: *mut c_void, size: i64) -> i64;
+    fn mjf_load_model(buffer: *const c_void, size: i64) -> *mut MjModel;
     fn mjf_vfs_new() -> *mut RawVfs;
     fn mjf_vfs_free(vfs: *mut RawVfs);
     fn mjf_obj_type(kind: *const c_char) -> c_int;
@@ -162,8 +164,29 @@ pub(super) fn copy_model(m: &MjModel) -> *mut MjModel {
     unsafe { mjf_copy_model(m) }
 }
 
+/// `m` in MuJoCo's binary format (`mj_saveModel`).
+pub(super) fn save_model(m: &MjModel) -> Vec<u8> {
+    // SAFETY: `m` is live; with a null buffer MuJoCo only measures it.
+    let size = unsafe { mjf_save_model(m, std::ptr::null_mut(), 0) };
+    let mut out = vec![0u8; usize::try_from(size).unwrap_or(0)];
+    if !out.is_empty() {
+        // SAFETY: `out` holds the `size` bytes MuJoCo asked for; `m` is only read.
+        unsafe { mjf_save_model(m, out.as_mut_ptr().cast(), size) };
+    }
+    out
+}
+
+/// A model read back from MuJoCo's binary format (`mj_loadModelBuffer`), or null.
+pub(super) fn load_model(bytes: &[u8]) -> *mut MjModel {
+    let Ok(size) = i64::try_from(bytes.len()) else {
+        return std::ptr::null_mut();
+    };
+    // SAFETY: `bytes` is live for the call; MuJoCo only reads it and copies what it keeps.
+    unsafe { mjf_load_model(bytes.as_ptr().cast(), size) }
+}
+
 /// # Safety
-/// `m` came from [`load_xml`] or [`copy_model`] and is not used afterwards.
+/// `m` came from [`load_xml`], [`copy_model`] or [`load_model`] and is not used afterwards.
 pub(super) unsafe fn delete_model(m: *mut MjModel) {
     // SAFETY: see the contract.
     unsafe { mj_deleteModel(m) }

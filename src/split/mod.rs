@@ -31,7 +31,8 @@
 //! written, for both faces), `plan.rs` (one model patched in place: the patch plan both
 //! faces' caches run, over their own MuJoCo), `store.rs` (the models and plans a cache
 //! keeps, and the bound on them), `cache.rs` (the model cache both faces run over their
-//! MuJoCo: misses, patches, a caller's model checked), `documents.rs` (the document cache
+//! MuJoCo: misses, patches, a caller's model checked), `disk.rs` (compiled models kept across processes, by structure,
+//! MuJoCo and file contents), `documents.rs` (the document cache
 //! both faces run: per-thread pools of models given out, snapshots, `into`, one compile per
 //! structure across threads), `signature.rs` (what tells one structure's compiled model
 //! from another's), `document.rs` (any document split by reading it), `body_model.rs` (a body's geoms as a
@@ -51,6 +52,7 @@
 mod body_copy;
 mod body_model;
 mod cache;
+mod disk;
 mod document;
 mod documents;
 mod geom_masses;
@@ -69,6 +71,9 @@ pub use body_copy::{
     MasslessFrame, ModelArrays, ModelArraysMut, body_model_writes, copy_body_model, massless_frames,
 };
 pub use cache::{CacheBackend, CacheCore, CacheError, PatchFailure, Request};
+pub use disk::{
+    DEFAULT_STORE_BYTES, DiskStore, STORE_MB_VAR, STORE_VAR, StoreEntry, StoreError, StoreKey,
+};
 pub use document::{
     DocumentPatch, PATCHABLE_OPTIONS, SplitOptions, split_document, split_document_with,
 };
