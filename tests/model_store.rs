@@ -12,6 +12,7 @@
 use std::path::PathBuf;
 
 use mjcf_forge::Document;
+use mjcf_forge::compiled::DocumentCache;
 use mjcf_forge::mujoco::{CompiledModel, compile_document};
 use mjcf_forge::scene::Scene;
 use mjcf_forge::split::{DiskStore, StoreKey, split_document};
@@ -23,7 +24,15 @@ fn root() -> PathBuf {
 /// `model` through MuJoCo's binary format, and what differs from it afterwards.
 fn round_trip(model: &CompiledModel) -> Vec<String> {
     let back = CompiledModel::from_bytes(&model.to_bytes()).expect("MuJoCo reads its own MJB");
-    back.differences(model)
+    let mut diffs = back.differences(model);
+    if back.signature() != model.signature() {
+        diffs.push(format!(
+            "signature {} != {}",
+            back.signature(),
+            model.signature()
+        ));
+    }
+    diffs
 }
 
 #[test]
@@ -65,6 +74,7 @@ fn a_stored_variant_loads_to_its_compile() {
             store.put(&key, &model.to_bytes()).unwrap();
             let bytes = store.get(&key).unwrap().expect("just stored");
             let back = CompiledModel::from_bytes(&bytes).unwrap();
+            assert_eq!(back.signature(), model.signature(), "variant {i}");
             assert_eq!(
                 back.differences(&model),
                 Vec::<String>::new(),
@@ -73,4 +83,74 @@ fn a_stored_variant_loads_to_its_compile() {
         }
     }
     assert!(!store.entries().unwrap().is_empty());
+}
+
+#[test]
+fn a_new_cache_loads_what_another_stored_and_patches_it_exactly() {
+    let dir = tempfile::tempdir().unwrap();
+    let store = || DiskStore::open(dir.path(), 1 << 30).unwrap();
+    let scene = Scene::load(root().join("benches/scenes/lift5_fixed.toml")).unwrap();
+    let docs: Vec<Document> = (0..4).map(|i| scene.variant(i).unwrap().document).collect();
+    let want: Vec<CompiledModel> = docs.iter().map(|d| compile_document(d).unwrap()).collect();
+    let mut first = DocumentCache::new(4, None).with_store(store());
+    first.model(&docs[0]).unwrap();
+    assert_eq!((first.compiles(), first.loads()), (1, 0));
+    // Another process, as far as the store is concerned: a cache of its own.
+    let mut second = DocumentCache::new(4, None).with_store(store());
+    for (doc, want) in docs.iter().zip(&want).rev() {
+        let got = second.model(doc).unwrap();
+        assert_eq!(got.signature(), want.signature());
+        assert_eq!(got.differences(want), Vec::<String>::new());
+    }
+    assert_eq!((second.compiles(), second.loads()), (1, 1));
+    // A corrupt entry is not loaded: compiled (and stored again), exact.
+    for e in store().entries().unwrap() {
+        let path = dir.path().join(format!("{}.mjfs", e.key));
+        let mut bytes = std::fs::read(&path).unwrap();
+        bytes.truncate(bytes.len() / 2);
+        std::fs::write(&path, bytes).unwrap();
+    }
+    let mut third = DocumentCache::new(4, None).with_store(store());
+    assert_eq!(
+        third.model(&docs[2]).unwrap().differences(&want[2]),
+        Vec::<String>::new()
+    );
+    assert_eq!((third.compiles(), third.loads()), (1, 0));
+    let mut fourth = DocumentCache::new(4, None).with_store(store());
+    fourth.model(&docs[1]).unwrap();
+    assert_eq!(fourth.loads(), 1, "the recompiled model was stored again");
+}
+
+#[test]
+fn a_changed_mesh_under_a_stored_structure_is_a_miss() {
+    let work = tempfile::tempdir().unwrap();
+    let mesh = work.path().join("box.obj");
+    let obj = |s: f64| {
+        let mut t = String::new();
+        for (x, y, z) in [(0., 0., 0.), (1., 0., 0.), (0., 1., 0.), (0., 0., 1.)] {
+            t += &format!("v {} {} {}\n", x * s, y * s, z * s);
+        }
+        t + "f 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n"
+    };
+    let xml = "<mujoco><asset><mesh name='m' file='box.obj'/></asset><worldbody><body>\
+               <freejoint/><geom type='mesh' mesh='m'/></body></worldbody></mujoco>";
+    let store_dir = tempfile::tempdir().unwrap();
+    let store = || DiskStore::open(store_dir.path(), 1 << 30).unwrap();
+    std::fs::write(&mesh, obj(1.0)).unwrap();
+    let doc = Document::from_str(xml, work.path()).unwrap();
+    DocumentCache::new(2, None)
+        .with_store(store())
+        .model(&doc)
+        .unwrap();
+    std::fs::write(&mesh, obj(2.0)).unwrap();
+    let want = compile_document(&doc).unwrap();
+    let mut cache = DocumentCache::new(2, None).with_store(store());
+    let got = cache.model(&doc).unwrap();
+    assert_eq!(got.differences(&want), Vec::<String>::new());
+    assert_eq!(
+        (cache.compiles(), cache.loads()),
+        (1, 0),
+        "a stale model was loaded"
+    );
+    assert_eq!(store().entries().unwrap().len(), 2);
 }

@@ -44,13 +44,20 @@ class DocumentCache:
     and ``model.vis`` are written back as compiled. The bulk data is shared between a
     structure's models as compiled: change it (a texture's pixels) in a ``copy.copy``.
 
+    Across processes, a structure compiled once is kept in a store, a folder
+    (``store``: ``None``, the default, takes the environment's ``MJCF_FORGE_STORE``, a
+    folder or ``off``, else ``$XDG_CACHE_HOME/mjcf-forge/models``; ``False`` none; or a
+    folder), keyed by the structure, the MuJoCo version and the bytes of every file the
+    model reads: a later process loads it and patches it (``loads`` counts those misses).
+    A corrupt entry or an unwritable folder gives a ``RuntimeWarning`` and a compile.
+
     Two threads asking for one structure compile it once; each gets a model of its own.
     MuJoCo's error, when it refuses a document, comes as an :class:`MjcfError` at the
     element it names in the document's sources (``file:line:col: message``), and leaves
     the cache as it was.
 
     >>> import mjcf_forge
-    >>> cache = mjcf_forge.DocumentCache(max_models=4)
+    >>> cache = mjcf_forge.DocumentCache(max_models=4, store=False)  # in this process only
     >>> xml = "<mujoco><worldbody><geom name='g' size='.1' rgba='{}'/></worldbody></mujoco>"
     >>> red = cache.model(xml.format("1 0 0 1"))     # compiled
     >>> blue = cache.model(xml.format("0 0 1 1"))    # the same structure: patched
@@ -58,20 +65,32 @@ class DocumentCache:
     ([0.0, 0.0, 1.0, 1.0], 1, 1)
     """
 
-    def __init__(self, max_models: int = 8, max_bytes: int | None = None) -> None:
+    def __init__(
+        self, max_models: int = 8, max_bytes: int | None = None, *, store: Any = None
+    ) -> None:
         import mujoco
 
         if max_models < 1:
             raise ValueError("max_models must be at least 1")
-        self._core = DocumentCore(mujoco, max_models, max_bytes)
+        self._core = DocumentCore(mujoco, max_models, max_bytes, store)
 
     def __len__(self) -> int:
         return len(self._core)
 
     @property
     def compiles(self) -> int:
-        """Models compiled (misses) so far."""
+        """Misses so far: models compiled, or loaded from the store."""
         return self._core.compiles
+
+    @property
+    def loads(self) -> int:
+        """Of the misses, the models loaded from the store (another process compiled them)."""
+        return self._core.loads
+
+    @property
+    def store(self) -> Any:
+        """The folder structures are kept in across processes, or ``None``."""
+        return self._core.store
 
     @property
     def patches(self) -> int:
@@ -94,7 +113,7 @@ class DocumentCache:
         (``result is into`` says which).
 
         >>> import mjcf_forge
-        >>> cache = mjcf_forge.DocumentCache()
+        >>> cache = mjcf_forge.DocumentCache(store=False)
         >>> xml = "<mujoco><worldbody><geom name='g' size='.1' rgba='{}'/></worldbody></mujoco>"
         >>> held = cache.model(xml.format("1 0 0 1"))
         >>> cache.model(xml.format("0 0 1 1"), into=held) is held, held.geom("g").rgba.tolist()

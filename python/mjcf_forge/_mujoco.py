@@ -88,6 +88,95 @@ def snapshot_fields(mujoco: Any, model: Any) -> list[tuple[tuple[str, ...], str]
     return fields
 
 
+# C sizes of the scalar types mjModel's fields are declared with (mujoco.introspect).
+_C_SIZES = {"int": 4, "unsigned int": 4, "float": 4, "mjtNum": 8, "double": 8, "mjtSize": 8,
+            "uint64_t": 8, "int64_t": 8, "size_t": 8, "mjtBool": 1, "mjtByte": 1, "char": 1,
+            "unsigned char": 1}
+_SIGNATURE_AT: dict = {}
+
+
+def _c_layout(fields: Any, structs: Any) -> tuple[int, int, dict]:
+    """A C struct's size, alignment and field offsets from its introspected fields."""
+    offset, align, offsets = 0, 1, {}
+    for f in fields:
+        size, a = _c_type(f.type, structs)
+        offset = (offset + a - 1) // a * a
+        offsets[f.name] = offset
+        offset += size
+        align = max(align, a)
+    return (offset + align - 1) // align * align, align, offsets
+
+
+def _c_type(t: Any, structs: Any) -> tuple[int, int]:
+    kind = type(t).__name__
+    if kind == "PointerType":
+        return 8, 8
+    if kind == "ArrayType":
+        size, a = _c_type(t.inner_type, structs)
+        for e in t.extents:
+            size *= int(e)
+        return size, a
+    if kind == "AnonymousStructDecl":
+        return _c_layout(t.fields, structs)[:2]
+    if t.name in _C_SIZES:
+        return _C_SIZES[t.name], _C_SIZES[t.name]
+    return _c_layout(structs[t.name].fields, structs)[:2]
+
+
+def signature_offset(mujoco: Any) -> Optional[int]:
+    """Where ``mjModel.signature`` sits in the struct (which MuJoCo's binary format does
+    not keep, and the bindings do not let set): from the headers' layout as
+    ``mujoco.introspect`` declares it, checked on two models; ``None`` when it cannot be."""
+    version = str(getattr(mujoco, "__version__", ""))
+    if version not in _SIGNATURE_AT:
+        found = None
+        try:
+            import ctypes
+
+            from mujoco.introspect import structs
+
+            offset = _c_layout(structs.STRUCTS["mjModel"].fields, structs.STRUCTS)[2]["signature"]
+            probes = [mujoco.MjModel.from_xml_string(x) for x in (
+                "<mujoco><worldbody><geom size='1'/></worldbody></mujoco>",
+                "<mujoco><worldbody><body><joint/><geom size='1'/></body></worldbody></mujoco>")]
+            sigs = [ctypes.c_uint64.from_address(p._address + offset).value for p in probes]
+            if sigs == [p.signature for p in probes] and sigs[0] != sigs[1] and 0 not in sigs:
+                found = offset
+        except Exception:  # an introspection this code does not know: no store
+            found = None
+        _SIGNATURE_AT[version] = found
+    return _SIGNATURE_AT[version]
+
+
+def model_bytes(mujoco: Any, model: Any) -> bytes:
+    """``model`` as the model store keeps it: its signature (8 bytes, little-endian), then
+    MuJoCo's binary format (``mj_saveModel``), which does not hold the signature."""
+    buffer = np.empty(mujoco.mj_sizeModel(model), dtype=np.uint8)
+    mujoco.mj_saveModel(model, None, buffer)
+    return int(model.signature).to_bytes(8, "little") + buffer.tobytes()
+
+
+def model_from_bytes(mujoco: Any, data: bytes) -> Any:
+    """The model :func:`model_bytes` wrote, read back by ``mujoco`` (through its VFS) with
+    its signature, or ``None``.
+
+    >>> import mujoco
+    >>> m = mujoco.MjModel.from_xml_string("<mujoco><worldbody><geom size='1'/></worldbody></mujoco>")
+    >>> back = model_from_bytes(mujoco, model_bytes(mujoco, m))
+    >>> back.signature == m.signature, back.geom_size.tolist() == m.geom_size.tolist()
+    (True, True)
+    """
+    import ctypes
+
+    offset = signature_offset(mujoco)
+    if offset is None or len(data) < 8:
+        return None
+    signature = int.from_bytes(data[:8], "little")
+    model = mujoco.MjModel.from_binary_path("model.mjb", {"model.mjb": data[8:]})
+    ctypes.c_uint64.from_address(model._address + offset).value = signature
+    return model if model.signature == signature else None
+
+
 def struct_fields(obj: Any) -> list[str]:
     """The number fields of a struct of the bindings (``model.opt``, ``model.vis.map``)."""
     return [

@@ -23,7 +23,14 @@ from typing import Any, Optional
 from ._errors import MjcfFileNotFoundError
 from ._last_xml import compile_xml
 from ._mjcf_utils import without_materials
-from ._mujoco import inertia_diagonal, make_inertia, snapshot_fields
+from ._mujoco import (
+    inertia_diagonal,
+    make_inertia,
+    model_bytes,
+    model_from_bytes,
+    signature_offset,
+    snapshot_fields,
+)
 from ._preview import preview
 from ._progress import progress_of
 from ._settings import model_cache
@@ -36,6 +43,9 @@ __all__ = [
     "fromstring",
     "inertia_diagonal",
     "make_inertia",
+    "model_bytes",
+    "model_from_bytes",
+    "signature_offset",
     "mujoco_version",
     "preview",
     "progress_of",

@@ -12,7 +12,7 @@ use std::sync::{Condvar, Mutex, MutexGuard};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::sync::MutexExt;
-use pyo3::types::{PyList, PyTuple};
+use pyo3::types::{PyBool, PyBytes, PyList, PyTuple};
 
 use crate::cache::statistics_of;
 use crate::document::PyDocument;
@@ -20,8 +20,8 @@ use crate::errors::{mjcf_error, run};
 use crate::split::{PyPatchPlan, Snapshot, Views, references};
 use crate::upcalls;
 use mjcf_forge::split::{
-    self, CacheError, DocumentBackend, Held, PatchEntry, PatchFailure, Request, SplitOptions, Step,
-    split_document_with,
+    self, CacheError, Compiled, DiskStore, DocumentBackend, Held, PatchEntry, PatchFailure,
+    Request, SplitOptions, Step, StoreKey, load_or_compile, split_document_with,
 };
 
 /// The user's `mujoco` as the document core runs it.
@@ -143,7 +143,7 @@ struct Inner {
 ///
 /// >>> import mujoco, mjcf_forge
 /// >>> from mjcf_forge._mjcf_forge import DocumentCore
-/// >>> core = DocumentCore(mujoco, 4, None)
+/// >>> core = DocumentCore(mujoco, 4, None, False)  # no store across processes
 /// >>> xml = "<mujoco><worldbody><geom name='g' size='.1' rgba='{}'/></worldbody></mujoco>"
 /// >>> red = core.model(mjcf_forge.Document.from_string(xml.format("1 0 0 1")))
 /// >>> del red
@@ -153,6 +153,8 @@ struct Inner {
 #[pyclass(name = "DocumentCore", module = "mjcf_forge._mjcf_forge", frozen)]
 pub(crate) struct PyDocumentCore {
     inner: Mutex<Inner>,
+    /// Where compiled structures are kept across processes, if anywhere.
+    store: Option<DiskStore>,
     /// Signalled when a compile ends (its waiters ask again).
     compiled: Condvar,
 }
@@ -178,6 +180,32 @@ impl PyDocumentCore {
             Err(e) => Err(e),
         }
     }
+}
+
+/// `message` as a Python `RuntimeWarning` (the store's failures: the cache compiles).
+fn warn(py: Python<'_>, message: &str) {
+    let warned = upcalls::python(py, "warnings", "warn")
+        .and_then(|w| w.call1((message, py.get_type::<pyo3::exceptions::PyRuntimeWarning>())));
+    if let Err(e) = warned {
+        // A filter that turns warnings into errors: the store's failure is not the call's.
+        e.print(py);
+    }
+}
+
+/// The store key of structure `key` of `doc` compiled by the user's `mujoco`: its version
+/// and every file the document reads (hashed with the GIL released).
+fn store_key(py: Python<'_>, doc: &PyDocument, key: &str, mujoco: &Py<PyAny>) -> PyResult<String> {
+    let version: String = mujoco.bind(py).getattr("__version__")?.extract()?;
+    run(py, || {
+        let doc = doc.doc.read_detached();
+        let mut k = StoreKey::new(key, &version);
+        for file in doc.files() {
+            if k.file(&file).is_err() {
+                k = StoreKey::new(&format!("{key} without {}", file.display()), &version);
+            }
+        }
+        Ok(k.finish())
+    })
 }
 
 /// The core's error as Python's.
@@ -208,14 +236,69 @@ fn ids(into: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<u64>> {
 #[pymethods]
 impl PyDocumentCore {
     #[new]
-    fn new(mujoco: Py<PyAny>, max_models: usize, max_bytes: Option<usize>) -> Self {
-        PyDocumentCore {
+    #[pyo3(signature = (mujoco, max_models, max_bytes, store=None))]
+    fn new(
+        py: Python<'_>,
+        mujoco: Py<PyAny>,
+        max_models: usize,
+        max_bytes: Option<usize>,
+        store: Option<Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let store = match store {
+            // The environment's (MJCF_FORGE_STORE), or the user cache folder's.
+            None => DiskStore::from_env(),
+            Some(s) if s.is_instance_of::<PyBool>() => {
+                if s.extract::<bool>()? {
+                    DiskStore::from_env()
+                } else {
+                    None
+                }
+            }
+            Some(s) => {
+                let dir: std::path::PathBuf = s.extract()?;
+                Some(DiskStore::open(dir, split::DEFAULT_STORE_BYTES))
+            }
+        };
+        let mut store = match store.transpose() {
+            Ok(store) => store,
+            Err(e) => {
+                warn(py, &e.to_string());
+                None
+            }
+        };
+        // A stored model must get its signature back (MuJoCo's binary format drops it).
+        if store.is_some()
+            && upcalls::get(py, "signature_offset")?
+                .call1((mujoco.bind(py),))?
+                .is_none()
+        {
+            warn(
+                py,
+                "model store: this mujoco's mjModel layout is not known, so a stored model \
+                 could not carry its signature: no store",
+            );
+            store = None;
+        }
+        Ok(PyDocumentCore {
             inner: Mutex::new(Inner {
                 core: split::DocumentCore::new(max_models, max_bytes),
                 backend: UserDocs { mujoco },
             }),
+            store,
             compiled: Condvar::new(),
-        }
+        })
+    }
+
+    /// The folder compiled structures are kept in across processes, or ``None``.
+    #[getter]
+    fn store(&self) -> Option<std::path::PathBuf> {
+        self.store.as_ref().map(|s| s.dir().to_path_buf())
+    }
+
+    /// Of the misses, the models loaded from the store.
+    #[getter]
+    fn loads(&self, py: Python<'_>) -> u64 {
+        self.inner(py).core.loads()
     }
 
     /// The model MuJoCo compiles from ``doc`` (see ``DocumentCache.model``); ``into``: a
@@ -242,6 +325,7 @@ impl PyDocumentCore {
             fixed: split::fixed_statistics_mask(split.fixed_statistics.iter().copied()),
         };
         let into = ids(into)?;
+        let mut use_store = true;
         loop {
             let (step, mujoco) = {
                 let mut inner = self.inner(py);
@@ -269,19 +353,51 @@ impl PyDocumentCore {
                     continue;
                 }
             };
-            let compiled = self.compile(py, doc, &mujoco);
+            // A failed patch compiles the document itself: the store's model is what failed.
+            let store = self.store.as_ref().filter(|_| use_store && !replace);
+            let (compiled, stored) = match store {
+                Some(store) => {
+                    let key = store_key(py, doc, request.key, &mujoco)?;
+                    let loaded = load_or_compile(
+                        Some((store, key.as_str())),
+                        |bytes| {
+                            upcalls::get(py, "model_from_bytes")
+                                .and_then(|f| f.call1((mujoco.bind(py), PyBytes::new(py, bytes))))
+                                .map(Bound::unbind)
+                                .ok()
+                        },
+                        |model: &Py<PyAny>| {
+                            upcalls::get(py, "model_bytes")
+                                .and_then(|f| f.call1((mujoco.bind(py), model.bind(py))))
+                                .and_then(|b| b.extract::<Vec<u8>>())
+                                .ok()
+                        },
+                        || self.compile(py, doc, &mujoco),
+                        &mut |w| warn(py, &w),
+                    );
+                    match loaded {
+                        Ok((m, stored)) => (Ok(m), stored),
+                        Err(e) => (Err(e), false),
+                    }
+                }
+                None => (self.compile(py, doc, &mujoco), false),
+            };
             let mut inner = self.inner(py);
             let Inner { core, backend } = &mut *inner;
-            let kept = core.compiled(backend, &request, compiled, replace);
+            let kept = core.compiled(backend, &request, compiled, replace, stored);
             let given = core.given().map(|m| m.clone_ref(py));
             drop(inner);
             if !replace {
                 self.compiled.notify_all();
             }
-            return match kept.map_err(error)? {
-                Some(alone) => Ok(alone),
-                None => given.ok_or_else(|| mjcf_error(vec!["no model given".into()])),
-            };
+            match kept.map_err(error)? {
+                Compiled::Alone(alone) => return Ok(alone),
+                Compiled::Kept => {
+                    return given.ok_or_else(|| mjcf_error(vec!["no model given".into()]));
+                }
+                Compiled::Stored => {}
+                Compiled::Refused => use_store = false,
+            }
         }
     }
 

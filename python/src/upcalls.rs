@@ -12,6 +12,9 @@
 //! inertia_diagonal(model, data)     where that version keeps the joint-space inertia
 //! make_inertia(mujoco, model, data) that version's mj_makeM (or mj_crb)
 //! snapshot_fields(mujoco, model)    what DocumentCache writes back before a patch
+//! model_bytes(mujoco, model)        a model as MuJoCo's binary format (the model store)
+//! model_from_bytes(mujoco, data)    and read back
+//! signature_offset(mujoco)          where mjModel.signature sits (None: no model store)
 //! ```
 //!
 //! Every other import the extension makes (the standard library's `json`, `errno`,

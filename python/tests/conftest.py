@@ -17,6 +17,9 @@ import pytest
 # Headless rendering for the whole run (test_preview.py): mujoco reads MUJOCO_GL once, when
 # the first test module imports it.
 os.environ.setdefault("MUJOCO_GL", "egl")
+# No model store across processes unless a test names one (test_model_store.py): every
+# test's counts of compiles and patches are then the same whatever ran before.
+os.environ.setdefault("MJCF_FORGE_STORE", "off")
 
 from helpers import ROOT  # noqa: E402  (tests/ is on the path: pytest puts it there)
 

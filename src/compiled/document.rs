@@ -13,9 +13,25 @@ use crate::document::Document;
 use crate::error::Errors;
 use crate::mujoco::{CompiledModel, compile_document};
 use crate::split::{
-    CacheBackend, DocumentBackend, DocumentCore, Held, PatchFailure, Request, SplitOptions,
-    Statistics, Step, fixed_statistics_mask, split_document_with,
+    CacheBackend, Compiled, DiskStore, DocumentBackend, DocumentCore, Held, PatchFailure, Request,
+    SplitOptions, Statistics, Step, StoreKey, fixed_statistics_mask, load_or_compile,
+    split_document_with,
 };
+
+/// The store key of structure `key` of `doc` compiled by the linked MuJoCo: its version and
+/// every file the document reads (a file that cannot be read is keyed by its absence).
+fn store_key(key: &str, doc: &Document) -> String {
+    let mut k = StoreKey::new(key, &crate::mujoco::version());
+    for file in doc.files() {
+        if k.file(&file).is_err() {
+            k = StoreKey::new(
+                &format!("{key} without {}", file.display()),
+                &crate::mujoco::version(),
+            );
+        }
+    }
+    k.finish()
+}
 
 /// The linked MuJoCo as the split tier's document cache runs it ([`DocumentBackend`]):
 /// each model with its [`Plan`], patched as the model cache patches its models. The cache
@@ -37,9 +53,9 @@ impl Held for Working {
 
 /// A structure's snapshot on this face: the statistics as compiled (what the document
 /// fixes is kept at these values).
-struct Compiled(Statistics);
+struct AsCompiled(Statistics);
 
-impl Held for Compiled {
+impl Held for AsCompiled {
     fn nbytes(&self) -> usize {
         0
     }
@@ -48,7 +64,7 @@ impl Held for Compiled {
 impl DocumentBackend for LinkedDocs {
     type Model = CompiledModel;
     type Working = Working;
-    type Snapshot = Compiled;
+    type Snapshot = AsCompiled;
     type Error = Errors;
 
     fn id(model: &CompiledModel) -> u64 {
@@ -59,14 +75,14 @@ impl DocumentBackend for LinkedDocs {
         &working.model
     }
 
-    fn snapshot(&mut self, model: &CompiledModel) -> Result<Compiled, Errors> {
-        Ok(Compiled(self.0.stat(model)))
+    fn snapshot(&mut self, model: &CompiledModel) -> Result<AsCompiled, Errors> {
+        Ok(AsCompiled(self.0.stat(model)))
     }
 
     fn working(
         &mut self,
         mut model: CompiledModel,
-        snapshot: &Compiled,
+        snapshot: &AsCompiled,
         request: &Request<'_>,
     ) -> Result<Working, (CompiledModel, PatchFailure<Errors>)> {
         let plan = self.0.plan(&model, request.key, request.fixed, snapshot.0);
@@ -91,7 +107,7 @@ impl DocumentBackend for LinkedDocs {
     fn patch(
         &mut self,
         working: &mut Working,
-        _snapshot: &Compiled,
+        _snapshot: &AsCompiled,
         request: &Request<'_>,
     ) -> Result<(), PatchFailure<Errors>> {
         let Working { model, plan } = working;
@@ -137,6 +153,7 @@ pub struct DocumentCache {
     backend: LinkedDocs,
     /// The last compile that the cache could not keep (its structure's layout refused).
     alone: Option<CompiledModel>,
+    store: Option<DiskStore>,
 }
 
 impl DocumentCache {
@@ -147,6 +164,7 @@ impl DocumentCache {
             core: DocumentCore::new(max_models, max_bytes),
             backend: LinkedDocs(Linked::default()),
             alone: None,
+            store: None,
         }
     }
 
@@ -163,22 +181,61 @@ impl DocumentCache {
             fixed: fixed_statistics_mask(split.fixed_statistics.iter().copied()),
         };
         let key = &split.structure_key;
-        let step = self.core.model(&mut self.backend, &request, &[]);
-        let replace = match step.map_err(|e| cache_error(e, 0, key))? {
-            Step::Ready => return self.given(key),
-            Step::Compile { replace } => replace,
-            // This cache is `&mut`: no other call compiles meanwhile.
-            Step::Wait => return Err(internal(format!("structure {key} is being compiled"))),
-        };
-        let compiled = compile_document(doc).map_err(|e| Errors(vec![e]));
-        let kept = self
-            .core
-            .compiled(&mut self.backend, &request, compiled, replace)
-            .map_err(|e| cache_error(e, 0, key))?;
-        match kept {
-            Some(alone) => Ok(self.alone.insert(alone)),
-            None => self.given(key),
+        // At most three rounds: a miss, a stored model patched, a refused one compiled.
+        let mut use_store = true;
+        for _ in 0..3 {
+            let step = self.core.model(&mut self.backend, &request, &[]);
+            let replace = match step.map_err(|e| cache_error(e, 0, key))? {
+                Step::Ready => return self.given(key),
+                Step::Compile { replace } => replace,
+                // This cache is `&mut`: no other call compiles meanwhile.
+                Step::Wait => return Err(internal(format!("structure {key} is being compiled"))),
+            };
+            // A failed patch compiles the document itself: the store's model is what failed.
+            let store = self
+                .store
+                .as_ref()
+                .filter(|_| use_store && !replace)
+                .map(|s| (s, store_key(key, doc)));
+            let loaded = load_or_compile(
+                store.as_ref().map(|(s, k)| (*s, k.as_str())),
+                CompiledModel::from_bytes,
+                |m: &CompiledModel| Some(m.to_bytes()),
+                || compile_document(doc).map_err(|e| Errors(vec![e])),
+                &mut |w| eprintln!("mjcf-forge: {w}"),
+            );
+            let (model, stored) = match loaded {
+                Ok((m, stored)) => (Ok(m), stored),
+                Err(e) => (Err(e), false),
+            };
+            let kept = self
+                .core
+                .compiled(&mut self.backend, &request, model, replace, stored)
+                .map_err(|e| cache_error(e, 0, key))?;
+            match kept {
+                Compiled::Kept => return self.given(key),
+                Compiled::Alone(alone) => return Ok(self.alone.insert(alone)),
+                Compiled::Stored => {}
+                Compiled::Refused => use_store = false,
+            }
         }
+        Err(internal(format!(
+            "structure {key}: no model after three rounds"
+        )))
+    }
+
+    /// The same cache, keeping the structures it compiles in `store` across processes
+    /// ([`DiskStore`]): a structure another process compiled with this MuJoCo and these
+    /// files is a load and a patch here. A store that fails is reported on standard error
+    /// and the cache compiles as without it.
+    pub fn with_store(mut self, store: DiskStore) -> DocumentCache {
+        self.store = Some(store);
+        self
+    }
+
+    /// Misses so far that were loads from the store (of [`DocumentCache::compiles`]).
+    pub fn loads(&self) -> u64 {
+        self.core.loads()
     }
 
     fn given(&self, key: &str) -> Result<&CompiledModel, Errors> {
@@ -199,7 +256,7 @@ impl DocumentCache {
         self.model(&doc)
     }
 
-    /// Models compiled so far (misses).
+    /// Misses so far: models compiled, or loaded from the store.
     pub fn compiles(&self) -> u64 {
         self.core.compiles()
     }

@@ -64,6 +64,16 @@ pub use compile::{CompileError, compile_document, compile_file, compile_str};
 pub(crate) use inertia::{compiled_inertia, free_joint_qpos0};
 pub use inertia::{write_all_inertials, write_inertials};
 pub use model::{CompiledModel, Contact, ObjType, Sizes};
+
+/// The linked MuJoCo's version as it names itself, as `mujoco.__version__` does in Python
+/// (`3.17.0`): what the model store keys a compiled structure by, with its files.
+///
+/// ```
+/// assert!(mjcf_forge::mujoco::version().starts_with(|c: char| c.is_ascii_digit()));
+/// ```
+pub fn version() -> String {
+    sys::version_string()
+}
 // For the compiled tier's model cache, which patches models in place through its own C.
 pub(crate) use model::slice_or_empty;
 pub(crate) use sys::MjModel;

@@ -43,26 +43,38 @@ static SERIAL: AtomicU64 = AtomicU64::new(1);
 
 /// A deep copy (`mj_copyModel`): a model of the same structure, patched on its own.
 impl CompiledModel {
-    /// The model in MuJoCo's binary format (`mj_saveModel`): what the model store keeps
-    /// ([`crate::split::DiskStore`]), read back by [`CompiledModel::from_bytes`] to the
-    /// same model, every array and size.
+    /// The model as the model store keeps it ([`crate::split::DiskStore`]): its
+    /// `signature` (8 bytes, little-endian), which MuJoCo's binary format does not hold,
+    /// then that format (`mj_saveModel`); read back by [`CompiledModel::from_bytes`] to the
+    /// same model, every array and size and the signature.
     pub fn to_bytes(&self) -> Vec<u8> {
-        sys::save_model(self.raw())
+        let mut out = self.signature().to_le_bytes().to_vec();
+        out.extend(sys::save_model(self.raw()));
+        out
     }
 
-    /// A model from MuJoCo's binary format (what [`CompiledModel::to_bytes`] wrote, by
-    /// this MuJoCo), or `None` when MuJoCo cannot read it.
+    /// `mjModel.signature`: what the compile hashed its spec to (equal for two compiles of
+    /// one structure).
+    pub fn signature(&self) -> u64 {
+        sys::signature(self.raw())
+    }
+
+    /// The model [`CompiledModel::to_bytes`] wrote (by this MuJoCo), or `None` when MuJoCo
+    /// cannot read it.
     ///
     /// ```
     /// use mjcf_forge::mujoco::compile_str;
     /// let xml = "<mujoco><worldbody><geom size='1'/></worldbody></mujoco>";
     /// let m = compile_str(xml, std::path::Path::new("."))?;
     /// let back = mjcf_forge::mujoco::CompiledModel::from_bytes(&m.to_bytes()).unwrap();
-    /// assert!(m.differences(&back).is_empty());
+    /// assert!(m.differences(&back).is_empty() && back.signature() == m.signature());
     /// # Ok::<(), mjcf_forge::mujoco::CompileError>(())
     /// ```
     pub fn from_bytes(bytes: &[u8]) -> Option<CompiledModel> {
-        let ptr = NonNull::new(sys::load_model(bytes))?;
+        let (signature, mjb) = bytes.split_first_chunk::<8>()?;
+        let ptr = NonNull::new(sys::load_model(mjb))?;
+        // SAFETY: the model was just made and nothing else holds it.
+        unsafe { sys::set_signature(ptr.as_ptr(), u64::from_le_bytes(*signature)) };
         Some(CompiledModel::from_raw(ptr, None))
     }
 }

@@ -29,6 +29,10 @@ long long mjf_save_model(const mjModel* m, void* buffer, long long size) {
   return size;
 }
 
+// mjModel.signature, which MuJoCo's binary format does not hold, read and written.
+unsigned long long mjf_signature(const mjModel* m) { return m->signature; }
+void mjf_set_signature(mjModel* m, unsigned long long s) { m->signature = s; }
+
 // A model in MuJoCo's binary format read back (mj_loadModelBuffer), or NULL.
 mjModel* mjf_load_model(const void* buffer, long long size) {
   return mj_loadModelBuffer(buffer, (mjtSize)size);

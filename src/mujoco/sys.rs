@@ -24,6 +24,7 @@ struct RawVfs {
 
 unsafe extern "C" {
     fn mj_version() -> c_int;
+    fn mj_versionString() -> *const c_char;
     fn mj_deleteModel(m: *mut MjModel);
     fn mj_addBufferVFS(
         vfs: *mut RawVfs,
@@ -50,6 +51,8 @@ unsafe extern "C" {
     fn mjf_copy_model(m: *const MjModel) -> *mut MjModel;
     fn mjf_save_model(m: *const MjModel, buffer: *mut c_void, size: i64) -> i64;
     fn mjf_load_model(buffer: *const c_void, size: i64) -> *mut MjModel;
+    fn mjf_signature(m: *const MjModel) -> u64;
+    fn mjf_set_signature(m: *mut MjModel, signature: u64);
     fn mjf_vfs_new() -> *mut RawVfs;
     fn mjf_vfs_free(vfs: *mut RawVfs);
     fn mjf_obj_type(kind: *const c_char) -> c_int;
@@ -176,6 +179,21 @@ pub(super) fn save_model(m: &MjModel) -> Vec<u8> {
     out
 }
 
+/// `mjModel.signature`.
+pub(super) fn signature(m: &MjModel) -> u64 {
+    // SAFETY: `m` is live; only read.
+    unsafe { mjf_signature(m) }
+}
+
+/// Sets `mjModel.signature` of a model this process owns.
+///
+/// # Safety
+/// `m` is live and nothing else reads or writes it meanwhile.
+pub(super) unsafe fn set_signature(m: *mut MjModel, signature: u64) {
+    // SAFETY: see the contract.
+    unsafe { mjf_set_signature(m, signature) }
+}
+
 /// A model read back from MuJoCo's binary format (`mj_loadModelBuffer`), or null.
 pub(super) fn load_model(bytes: &[u8]) -> *mut MjModel {
     let Ok(size) = i64::try_from(bytes.len()) else {
@@ -195,6 +213,14 @@ pub(super) unsafe fn delete_model(m: *mut MjModel) {
 pub(super) fn linked_version() -> c_int {
     // SAFETY: `mj_version` only returns a constant.
     unsafe { mj_version() }
+}
+
+/// The linked MuJoCo's version as it names itself (`3.17.0`).
+pub(super) fn version_string() -> String {
+    // SAFETY: MuJoCo returns a static NUL-terminated string.
+    unsafe { CStr::from_ptr(mj_versionString()) }
+        .to_string_lossy()
+        .into_owned()
 }
 
 pub(super) fn header_version() -> c_int {

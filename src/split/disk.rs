@@ -323,6 +323,59 @@ impl DiskStore {
     }
 }
 
+/// The one rule both faces use a store by, on a miss: the entry of `key` loaded (`load`:
+/// the face's MuJoCo reading its binary model; `true` returned with it: a model of the
+/// structure, to be patched), or else `compile` run and its model stored (`save`: the
+/// binary model). A store that fails (a corrupt entry, an unwritable folder, a model
+/// MuJoCo cannot read back) is reported to `warn` and the compile stands; without a store
+/// (`None`) this is the compile.
+///
+/// ```
+/// use mjcf_forge::split::{DiskStore, StoreKey, load_or_compile};
+///
+/// let dir = tempfile::tempdir()?;
+/// let store = DiskStore::open(dir.path(), 1 << 20)?;
+/// let key = StoreKey::new("structure", "v").finish();
+/// let mut warnings = Vec::new();
+/// let mut run = || load_or_compile(Some((&store, key.as_str())),
+///     |b: &[u8]| Some(b.to_vec()), |m: &Vec<u8>| Some(m.clone()),
+///     || Ok::<_, String>(b"compiled".to_vec()), &mut |w| warnings.push(w));
+/// assert_eq!(run()?, (b"compiled".to_vec(), false)); // compiled, then stored
+/// assert_eq!(run()?, (b"compiled".to_vec(), true)); // loaded
+/// # drop(run);
+/// assert!(warnings.is_empty());
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn load_or_compile<M, E>(
+    store: Option<(&DiskStore, &str)>,
+    load: impl FnOnce(&[u8]) -> Option<M>,
+    save: impl FnOnce(&M) -> Option<Vec<u8>>,
+    compile: impl FnOnce() -> Result<M, E>,
+    warn: &mut dyn FnMut(String),
+) -> Result<(M, bool), E> {
+    let Some((store, key)) = store else {
+        return compile().map(|m| (m, false));
+    };
+    match store.get(key) {
+        Ok(Some(bytes)) => match load(&bytes) {
+            Some(model) => return Ok((model, true)),
+            None => warn(format!(
+                "{}: MuJoCo could not read this model store entry back: compiled instead",
+                store.path(key).display()
+            )),
+        },
+        Ok(None) => {}
+        Err(e) => warn(e.to_string()),
+    }
+    let model = compile()?;
+    if let Some(bytes) = save(&model)
+        && let Err(e) = store.put(key, &bytes)
+    {
+        warn(e.to_string());
+    }
+    Ok((model, false))
+}
+
 /// Whether `bytes` are a whole entry of `key`; what is wrong otherwise.
 fn check(bytes: &[u8], key: &str) -> Result<(), String> {
     if bytes.len() < HEADER {

@@ -21,8 +21,8 @@
 //! - the structures are bounded by count and bytes (the split tier's [`ModelStore`]).
 //!
 //! ```
-//! use mjcf_forge::split::{CacheError, DocumentBackend, DocumentCore, Held, PatchFailure,
-//!     Request, Step};
+//! use mjcf_forge::split::{CacheError, Compiled, DocumentBackend, DocumentCore, Held,
+//!     PatchFailure, Request, Step};
 //!
 //! // A backend whose "models" are counters: a compile gives 0, a patch adds one.
 //! struct Counting;
@@ -66,7 +66,8 @@
 //! let mut cache = DocumentCore::new(4, None);
 //! let request = Request { key: "a", entries: &[], parked: None, fixed: 0 };
 //! assert!(matches!(cache.model(&mut Counting, &request, &[])?, Step::Compile { replace: false }));
-//! assert!(cache.compiled(&mut Counting, &request, Ok(0), false)?.is_none()); // kept
+//! let kept = cache.compiled(&mut Counting, &request, Ok(0), false, false)?;
+//! assert!(matches!(kept, Compiled::Kept));
 //! assert_eq!(cache.given(), Some(&0));
 //! assert!(matches!(cache.model(&mut Counting, &request, &[])?, Step::Ready));
 //! assert_eq!(cache.given(), Some(&1)); // patched
@@ -142,6 +143,21 @@ pub enum Step {
     /// Another thread compiles the structure: wait until [`DocumentCore::compiling`] says
     /// it is done, then ask again.
     Wait,
+}
+
+/// What [`DocumentCore::compiled`] made of a model.
+#[derive(Debug)]
+pub enum Compiled<M> {
+    /// Kept as its structure's model, which is the document's: [`DocumentCore::given`].
+    Kept,
+    /// Not kept (the model cannot take its structure's layout): this model is the answer.
+    Alone(M),
+    /// A model of the structure from the store, kept: ask again ([`DocumentCore::model`]),
+    /// which patches it into the document.
+    Stored,
+    /// A model from the store that cannot take the layout: compile the document (without
+    /// the store) and hand that in with `replace`.
+    Refused,
 }
 
 /// A compiled structure: its snapshot, and per thread the models it was given.
@@ -228,6 +244,7 @@ pub struct DocumentCore<B: DocumentBackend> {
     /// The model the last call gave: its structure, pool and index.
     given: Option<(String, usize, usize)>,
     compiles: u64,
+    loads: u64,
     patches: u64,
 }
 
@@ -240,13 +257,19 @@ impl<B: DocumentBackend> DocumentCore<B> {
             compiling: Vec::new(),
             given: None,
             compiles: 0,
+            loads: 0,
             patches: 0,
         }
     }
 
-    /// Models compiled so far (misses).
+    /// Misses so far: models compiled, or loaded from a store.
     pub fn compiles(&self) -> u64 {
         self.compiles
+    }
+
+    /// Of the misses, the models loaded from a store ([`super::DiskStore`]).
+    pub fn loads(&self) -> u64 {
+        self.loads
     }
 
     /// Patches applied so far (hits).
@@ -361,16 +384,20 @@ impl<B: DocumentBackend> DocumentCore<B> {
     }
 
     /// The face's compile of `request`'s document (as [`Step::Compile`] asked; `replace`
-    /// as it said), kept as its structure's model ([`DocumentCore::given`], and `None`
-    /// returned); or, where the model cannot take the structure's layout, the model
-    /// itself, kept nowhere. Ends the compile that other threads wait on, failed or not.
+    /// as it said), kept as its structure's model ([`Compiled::Kept`]: the document's
+    /// model is [`DocumentCore::given`]); or, where the model cannot take the structure's
+    /// layout, the model itself, kept nowhere ([`Compiled::Alone`]). `stored`: the model
+    /// is one of the structure's from a store ([`super::load_or_compile`]), not the
+    /// document's compile ([`Compiled::Stored`], [`Compiled::Refused`]). Ends the compile
+    /// that other threads wait on, failed or not.
     pub fn compiled(
         &mut self,
         backend: &mut B,
         request: &Request<'_>,
         model: Result<B::Model, B::Error>,
         replace: bool,
-    ) -> Result<Option<B::Model>, CacheError<B::Error>> {
+        stored: bool,
+    ) -> Result<Compiled<B::Model>, CacheError<B::Error>> {
         let key = request.key;
         self.given = None;
         if !replace {
@@ -378,12 +405,16 @@ impl<B: DocumentBackend> DocumentCore<B> {
         }
         let model = model.map_err(CacheError::Backend)?;
         self.compiles += 1;
+        self.loads += u64::from(stored);
         let snapshot = backend.snapshot(&model).map_err(CacheError::Backend)?;
         let working = match backend.working(model, &snapshot, request) {
             Ok(w) => w,
+            // A stored model that cannot take the layout is no answer: the document's own
+            // compile is.
+            Err((_, PatchFailure::NotThisStructure(_))) if stored => return Ok(Compiled::Refused),
             // A layout this model cannot take (an element the split names that the compile
             // does not have): the compile is the answer, and nothing is kept.
-            Err((model, PatchFailure::NotThisStructure(_))) => return Ok(Some(model)),
+            Err((model, PatchFailure::NotThisStructure(_))) => return Ok(Compiled::Alone(model)),
             Err((_, PatchFailure::Backend(e))) => return Err(CacheError::Backend(e)),
         };
         let mut structure = Structure::<B> {
@@ -393,8 +424,11 @@ impl<B: DocumentBackend> DocumentCore<B> {
         let (p, i) = structure.keep(backend, thread(), working);
         self.store.insert(key, structure);
         self.store.trim(|_| 0, Structure::<B>::nbytes);
+        if stored {
+            return Ok(Compiled::Stored);
+        }
         self.given = Some((key.to_string(), p, i));
-        Ok(None)
+        Ok(Compiled::Kept)
     }
 }
 
@@ -473,7 +507,10 @@ mod tests {
             Step::Compile { replace } => {
                 b.next += 1;
                 let m = b.next;
-                core.compiled(b, &r, Ok(m), replace).unwrap().unwrap_or(m)
+                match core.compiled(b, &r, Ok(m), replace, false).unwrap() {
+                    Compiled::Alone(m) => m,
+                    _ => *core.given().unwrap(),
+                }
             }
             Step::Wait => panic!("no other thread compiles"),
         }
@@ -507,13 +544,50 @@ mod tests {
         assert_eq!(core.model(&mut b, &r, &[]).unwrap(), Step::Wait);
         assert!(core.compiling("a"));
         // The compile failed: the waiters are let go, and the next asker compiles.
-        assert!(core.compiled(&mut b, &r, Err("bad".into()), false).is_err());
+        assert!(
+            core.compiled(&mut b, &r, Err("bad".into()), false, false)
+                .is_err()
+        );
         assert!(!core.compiling("a") && core.is_empty());
         b.refuse = true;
         assert_eq!(ready(&mut core, &mut b, "a", &[]), 1);
         assert_eq!(ready(&mut core, &mut b, "a", &[]), 2);
         assert!(core.is_empty());
         assert_eq!((core.compiles(), core.patches()), (2, 0));
+    }
+
+    #[test]
+    fn a_stored_model_is_kept_and_patched_and_a_refused_one_is_compiled() {
+        let (mut core, mut b) = (DocumentCore::new(4, None), Numbered::default());
+        let r = request("a");
+        assert_eq!(
+            core.model(&mut b, &r, &[]).unwrap(),
+            Step::Compile { replace: false }
+        );
+        let stored = core.compiled(&mut b, &r, Ok(7), false, true).unwrap();
+        assert!(matches!(stored, Compiled::Stored) && core.given().is_none());
+        assert_eq!(core.model(&mut b, &r, &[]).unwrap(), Step::Ready);
+        assert_eq!(
+            (core.given(), core.compiles(), core.loads(), core.patches()),
+            (Some(&7), 1, 1, 1)
+        );
+        // A store's model whose layout is refused is no answer.
+        let (mut core, mut b) = (
+            DocumentCore::new(4, None),
+            Numbered {
+                refuse: true,
+                ..Default::default()
+            },
+        );
+        core.model(&mut b, &r, &[]).unwrap();
+        assert!(matches!(
+            core.compiled(&mut b, &r, Ok(7), false, true).unwrap(),
+            Compiled::Refused
+        ));
+        assert!(matches!(
+            core.compiled(&mut b, &r, Ok(8), true, false).unwrap(),
+            Compiled::Alone(8)
+        ));
     }
 
     #[test]

@@ -73,11 +73,12 @@ pub use body_copy::{
 pub use cache::{CacheBackend, CacheCore, CacheError, PatchFailure, Request};
 pub use disk::{
     DEFAULT_STORE_BYTES, DiskStore, STORE_MB_VAR, STORE_VAR, StoreEntry, StoreError, StoreKey,
+    load_or_compile,
 };
 pub use document::{
     DocumentPatch, PATCHABLE_OPTIONS, SplitOptions, split_document, split_document_with,
 };
-pub use documents::{DocumentBackend, DocumentCore, POOL, Refused, Step};
+pub use documents::{Compiled, DocumentBackend, DocumentCore, POOL, Refused, Step};
 pub use geom_masses::{
     BodyMass, FRAME_FLAGS, GeomMass, body_frame_flag, body_mass, frame_flag, write_frame_flags,
     write_geom_masses,
