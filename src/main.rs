@@ -59,6 +59,9 @@ enum Command {
     /// (EGL, else OSMesa), into one cell of a PNG grid, labelled with its index (needs the
     /// `mujoco` feature).
     Preview(cli::preview::Args),
+    /// The model store the caches keep compiled structures in across processes: `info`,
+    /// `list` its entries, or `clear` it.
+    Store(cli::store::Args),
 }
 
 fn main() -> ExitCode {
@@ -71,5 +74,6 @@ fn main() -> ExitCode {
         Command::Export(args) => cli::export::run(args),
         Command::Generate(args) => cli::generate::run(args),
         Command::Preview(args) => cli::preview::run(args),
+        Command::Store(args) => cli::store::run(args),
     }
 }

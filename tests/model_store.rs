@@ -154,3 +154,36 @@ fn a_changed_mesh_under_a_stored_structure_is_a_miss() {
     );
     assert_eq!(store().entries().unwrap().len(), 2);
 }
+
+#[test]
+fn the_command_line_tells_and_clears_the_store() {
+    let dir = tempfile::tempdir().unwrap();
+    let store = DiskStore::open(dir.path(), 1 << 20).unwrap();
+    let key = StoreKey::new("structure", "test").finish();
+    store.put(&key, &[7; 1000]).unwrap();
+    let run = |args: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_mjcf-forge"))
+            .arg("store")
+            .arg("--dir")
+            .arg(dir.path())
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    assert!(run(&[]).contains(": 1 entries, 0.0 MB"), "{}", run(&[]));
+    assert!(run(&["list"]).starts_with(&key));
+    assert!(run(&["clear"]).contains("1 entries removed"));
+    assert!(store.entries().unwrap().is_empty());
+    let off = std::process::Command::new(env!("CARGO_BIN_EXE_mjcf-forge"))
+        .args(["store"])
+        .env("MJCF_FORGE_STORE", "off")
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&off.stdout).starts_with("no model store"));
+}

@@ -16,6 +16,7 @@ pub mod merge;
 pub mod prefix;
 pub mod preview;
 pub mod progress;
+pub mod store;
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
