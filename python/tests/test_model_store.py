@@ -150,7 +150,7 @@ def test_a_folder_that_is_a_file_compiles_with_a_warning(tmp_path):
     blocked = tmp_path / "file"
     blocked.write_text("")
     with pytest.warns(RuntimeWarning, match="model store"):
-        cache = mjcf_forge.DocumentCache(store=blocked / "models")
+        cache = mjcf_forge.DocumentCache(store=blocked / "models")  # a folder under a file
     assert cache.store is None
     doc = lift_docs(1)[0]
     exact(doc, cache.model(doc), "without a store")
@@ -163,8 +163,19 @@ def test_the_environment_moves_or_turns_off_the_store(tmp_path, monkeypatch):
     assert mjcf_forge.DocumentCache().store is None
     monkeypatch.delenv("MJCF_FORGE_STORE")
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
-    assert mjcf_forge.DocumentCache().store == tmp_path / "xdg" / "mjcf-forge" / "models"
+    # Unset: no store unless asked for; True: the user cache folder.
+    assert mjcf_forge.DocumentCache().store is None
+    assert mjcf_forge.DocumentCache(store=True).store == tmp_path / "xdg" / "mjcf-forge" / "models"
     assert mjcf_forge.DocumentCache(store=False).store is None
+    # The switch's cache keeps none, whatever the environment says.
+    monkeypatch.setenv("MJCF_FORGE_STORE", str(tmp_path / "env"))
+    from mjcf_forge import _settings
+
+    previous = _settings.set_model_cache(True)
+    try:
+        assert _settings.model_cache().store is None
+    finally:
+        _settings.set_model_cache(previous)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         mjcf_forge.DocumentCache(store=tmp_path / "given")
