@@ -201,7 +201,7 @@ fn store_key(py: Python<'_>, doc: &PyDocument, key: &str, mujoco: &Py<PyAny>) ->
         let mut k = StoreKey::new(key, &version);
         for file in doc.files() {
             if k.file(&file).is_err() {
-                k = StoreKey::new(&format!("{key} without {}", file.display()), &version);
+                k.missing(&file);
             }
         }
         Ok(k.finish())

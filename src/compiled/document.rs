@@ -24,10 +24,7 @@ fn store_key(key: &str, doc: &Document) -> String {
     let mut k = StoreKey::new(key, &crate::mujoco::version());
     for file in doc.files() {
         if k.file(&file).is_err() {
-            k = StoreKey::new(
-                &format!("{key} without {}", file.display()),
-                &crate::mujoco::version(),
-            );
+            k.missing(&file);
         }
     }
     k.finish()

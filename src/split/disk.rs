@@ -85,6 +85,16 @@ impl StoreKey {
         Ok(self)
     }
 
+    /// Adds a file the model names that cannot be read now (its path, marked missing):
+    /// a key of its own, which a later read of the file does not share.
+    pub fn missing(&mut self, path: &Path) -> &mut StoreKey {
+        let name = path.to_string_lossy();
+        self.hasher.update(&u64::MAX.to_le_bytes());
+        self.hasher.update(&(name.len() as u64).to_le_bytes());
+        self.hasher.update(name.as_bytes());
+        self
+    }
+
     /// The key: 64 hex digits.
     pub fn finish(&self) -> String {
         self.hasher.finalize().to_hex().to_string()
@@ -417,6 +427,8 @@ mod tests {
         fs::write(&mesh, b"two").unwrap();
         let b = StoreKey::new("s", "v").file(&mesh).unwrap().finish();
         assert_ne!(a, b);
+        let gone = StoreKey::new("s", "v").missing(&mesh).finish();
+        assert!(gone != a && gone != b);
         assert!(
             StoreKey::new("s", "v")
                 .file(&dir.path().join("gone"))
