@@ -197,14 +197,11 @@ fn warn(py: Python<'_>, message: &str) {
 fn store_key(py: Python<'_>, doc: &PyDocument, key: &str, mujoco: &Py<PyAny>) -> PyResult<String> {
     let version: String = mujoco.bind(py).getattr("__version__")?.extract()?;
     run(py, || {
-        let doc = doc.doc.read_detached();
-        let mut k = StoreKey::new(key, &version);
-        for file in doc.files() {
-            if k.file(&file).is_err() {
-                k.missing(&file);
-            }
-        }
-        Ok(k.finish())
+        Ok(StoreKey::of_document(
+            key,
+            &version,
+            &doc.doc.read_detached(),
+        ))
     })
 }
 

@@ -18,18 +18,6 @@ use crate::split::{
     split_document_with,
 };
 
-/// The store key of structure `key` of `doc` compiled by the linked MuJoCo: its version and
-/// every file the document reads (a file that cannot be read is keyed by its absence).
-fn store_key(key: &str, doc: &Document) -> String {
-    let mut k = StoreKey::new(key, &crate::mujoco::version());
-    for file in doc.files() {
-        if k.file(&file).is_err() {
-            k.missing(&file);
-        }
-    }
-    k.finish()
-}
-
 /// The linked MuJoCo as the split tier's document cache runs it ([`DocumentBackend`]):
 /// each model with its [`Plan`], patched as the model cache patches its models. The cache
 /// lends its models (`&CompiledModel`), so no caller holds or changes one: nothing is
@@ -193,7 +181,12 @@ impl DocumentCache {
                 .store
                 .as_ref()
                 .filter(|_| use_store && !replace)
-                .map(|s| (s, store_key(key, doc)));
+                .map(|s| {
+                    (
+                        s,
+                        StoreKey::of_document(key, &crate::mujoco::version(), doc),
+                    )
+                });
             let loaded = load_or_compile(
                 store.as_ref().map(|(s, k)| (*s, k.as_str())),
                 CompiledModel::from_bytes,

@@ -95,6 +95,19 @@ impl StoreKey {
         self
     }
 
+    /// The key of structure `structure` of `doc` compiled by `mujoco`: every file the
+    /// document reads added ([`StoreKey::file`], or [`StoreKey::missing`] when it cannot be
+    /// read). What both faces' document caches key their entries by.
+    pub fn of_document(structure: &str, mujoco: &str, doc: &crate::Document) -> String {
+        let mut k = StoreKey::new(structure, mujoco);
+        for file in doc.files() {
+            if k.file(&file).is_err() {
+                k.missing(&file);
+            }
+        }
+        k.finish()
+    }
+
     /// The key: 64 hex digits.
     pub fn finish(&self) -> String {
         self.hasher.finalize().to_hex().to_string()
