@@ -44,14 +44,14 @@ class DocumentCache:
     and ``model.vis`` are written back as compiled. The bulk data is shared between a
     structure's models as compiled: change it (a texture's pixels) in a ``copy.copy``.
 
-    Across processes, a structure compiled once can be kept in a store, a folder
-    (``store``: a folder; ``True`` the user cache folder, ``$XDG_CACHE_HOME/mjcf-forge/models``;
-    ``False`` none; ``None``, the default, the environment's ``MJCF_FORGE_STORE``, a folder,
-    or none when it is unset or ``off``), keyed by the structure, the MuJoCo version and the
-    bytes of every file the model reads: a later process loads it and patches it (``loads``
-    counts those misses). A corrupt entry or an unwritable folder gives a
-    ``RuntimeWarning`` and a compile. The robosuite and LIBERO switch keeps no store: a
-    loaded model leaves MuJoCo's last loaded XML model unlike stock's.
+    Across processes, a structure compiled once is kept in a store, a folder (``store``: a
+    folder; ``False`` none; ``None``, the default, or ``True``: the environment's
+    ``MJCF_FORGE_STORE``, a folder or ``off``, and when it is unset the user cache folder,
+    ``$XDG_CACHE_HOME/mjcf-forge/models``), keyed by the structure, the MuJoCo version and
+    the bytes of every file the model reads: a later process loads it and patches it
+    (``loads`` counts those misses). A corrupt entry or an unwritable folder gives a
+    ``RuntimeWarning`` and a compile. The process's model cache (``get_model``, the
+    robosuite and LIBERO switch) keeps its structures in the environment's store too.
 
     Two threads asking for one structure compile it once; each gets a model of its own.
     MuJoCo's error, when it refuses a document, comes as an :class:`MjcfError` at the

@@ -53,6 +53,7 @@ from typing import Any, Callable, Optional, Union
 
 import numpy as np
 
+from . import _asset_cache
 from ._copied_back import copied_back, rewrites_as
 from ._mujoco import VISUAL, restored_arrays, struct_fields
 
@@ -86,6 +87,11 @@ class _Slot:
         self.owed: Any = None  # the key stock's slot holds, where it differs from held
         # The statistics and _signature of the model served for it.
         self.owed_stat: Optional[tuple] = None
+        # The files the held load and the owed one read, and of those, the ones each read
+        # from disk rather than MuJoCo's asset cache (some MuJoCo versions write which).
+        self.held_cold: Optional[frozenset] = None
+        self.owed_files: frozenset = frozenset()
+        self.owed_cold: frozenset = frozenset()
         self.paid = 0  # loads made to pay what was owed
         self.rewritten = 0  # writes through the held load instead (see _rewrites_as)
         self.loading = 0  # wrapped loads running now
@@ -111,23 +117,42 @@ def _xml_key(xml: str, assets: Any) -> tuple:
     return ("xml", xml, None if assets is None else dict(assets))
 
 
-def _loaded(key: tuple, model: Any, began_alone: bool) -> None:
-    """A load of ``key`` finished (under the slot's lock)."""
+def _loaded(key: tuple, model: Any, began_alone: bool, reads: tuple) -> None:
+    """A load of ``key`` finished (under the slot's lock); ``reads``: its files, the ones
+    stock's load of it read from disk (``None`` for a load stock did not make) and ours."""
     slot = _SLOT
     slot.loading -= 1
+    files, stock_cold, our_cold = reads
     if began_alone and not slot.overlapped:
         slot.held, slot.fresh, slot.stat = key, True, _stat(model)
         slot.signature = _signature(model)
+        slot.held_cold = our_cold
     else:
         slot.held, slot.fresh, slot.stat, slot.signature = _UNKNOWN, False, None, None
+        slot.held_cold = None
     if slot.loading == 0:
         slot.overlapped = False
     slot.owed = None
+    if stock_cold is not None and stock_cold != our_cold and slot.held is key:
+        # Stock's load read other files from disk: the slot owes stock's load of it.
+        slot.owed, slot.owed_stat = key, None
+        slot.owed_files, slot.owed_cold = files, stock_cold
 
 
-def _load(loader: Any, key: tuple, *args: Any, **kwargs: Any) -> Any:
-    """MuJoCo's own ``loader(*args, **kwargs)``, recorded as the slot's last load."""
+def _files(key: tuple) -> frozenset:
+    kind, source, _assets = key
+    return _asset_cache.files_of(source) if kind == "xml" else _asset_cache.files_of_path(source)
+
+
+def _load(loader: Any, key: tuple, *args: Any, stock: bool = True, **kwargs: Any) -> Any:
+    """MuJoCo's own ``loader(*args, **kwargs)``, recorded as the slot's last load (one
+    stock's process makes too, unless ``stock`` is false: a load that pays what is owed)."""
     slot = _SLOT
+    files = _files(key)
+    if stock:
+        stock_cold, our_cold = _asset_cache.both_read(files)
+    else:
+        stock_cold, our_cold = None, _asset_cache.our_reads(files)
     with slot.lock:
         began_alone = slot.loading == 0
         slot.loading += 1
@@ -142,7 +167,7 @@ def _load(loader: Any, key: tuple, *args: Any, **kwargs: Any) -> Any:
                 slot.overlapped = False
         raise
     with slot.lock:
-        _loaded(key, model, began_alone)
+        _loaded(key, model, began_alone, (files, stock_cold, our_cold))
     return model
 
 
@@ -214,18 +239,25 @@ def _installed() -> bool:
     return True
 
 
-def owe(source: Source, assets: Any = None, served: Any = None) -> None:
+def owe(source: Source, assets: Any = None, served: Any = None, files: Any = None) -> None:
     """Records that stock would have loaded ``source`` (MJCF text, or a function that
     writes it, called only if the slot is read) with ``mujoco.MjModel.from_xml_string``
     now, and that the model cache served that load instead (``served``: the model it
-    gave, MuJoCo's compile of ``source``, when the caller has it)."""
+    gave, MuJoCo's compile of ``source``, when the caller has it; ``files``: the files
+    the model reads, ``Document.files()``, read from the text when not given)."""
     if not _installed():
         return
+    if files is None:
+        files = _asset_cache.files_of(source) if isinstance(source, str) else frozenset()
+    files = frozenset(files)
+    cold = _asset_cache.stock_reads(files)
     slot = _SLOT
     with slot.lock:
+        slot.owed_files, slot.owed_cold = files, cold
         if isinstance(source, str):
             key = _xml_key(source, assets)
-            slot.owed = None if (slot.fresh and _same(slot.held, key)) else key
+            same = slot.fresh and _same(slot.held, key) and slot.held_cold == cold
+            slot.owed = None if same else key
         else:
             slot.owed = ("lazy", source, None if assets is None else dict(assets))
         slot.owed_stat = (
@@ -245,6 +277,7 @@ def _pay(api: str, model: Any = None) -> Any:
     with slot.lock:
         owed, owed_stat = slot.owed, slot.owed_stat
         held, fresh, held_stat, held_signature = slot.held, slot.fresh, slot.stat, slot.signature
+        files, cold, same_reads = slot.owed_files, slot.owed_cold, slot.held_cold == slot.owed_cold
     if owed is None:
         return model
     if owed is _LOST:
@@ -265,11 +298,11 @@ def _pay(api: str, model: Any = None) -> Any:
             if slot.owed is lazy:  # written once: later writes compare the text itself
                 slot.owed = owed
     with slot.lock:
-        if slot.fresh and _same(slot.held, owed):
+        if slot.fresh and _same(slot.held, owed) and slot.held_cold == cold:
             slot.owed = None
             return model
     if (
-        model is not None and fresh and owed_stat is not None and held_stat is not None
+        model is not None and fresh and same_reads and owed_stat is not None and held_stat is not None
         and held[0] == owed[0] == "xml" and held[2] is None and owed[2] is None
         and _stat(model) == owed_stat[0] and _signature(model) == owed_stat[1]
         and owed_stat[1] == held_signature and _rewrites_as(held[1], owed[1])
@@ -285,7 +318,12 @@ def _pay(api: str, model: Any = None) -> Any:
     loader = _ORIGINAL["from_xml_string" if kind == "xml" else "from_xml_path"]
     args = (text,) if assets is None else (text, assets)
     try:
-        _load(loader, owed, *args)
+        # MuJoCo's asset cache as stock's held it for that load, then the load.
+        _asset_cache.match(files, cold, lambda: _spec_compile(sys.modules["mujoco"], kind, text))
+    except RuntimeError as e:
+        raise LastXmlError(f"{api}: {e}") from None
+    try:
+        _load(loader, owed, *args, stock=False)
         with slot.lock:
             slot.paid += 1
     except ValueError as e:
@@ -406,6 +444,7 @@ def compile_xml(mujoco: Any, xml: str) -> Any:
     1
     """
     if _spec_compiles(mujoco):
+        _asset_cache.our_reads(_asset_cache.files_of(xml))
         return mujoco.MjSpec.from_string(xml).compile()
     # No MjSpec: the loader replaces the slot; it is owed what it held, where that can be
     # loaded again to what stock's holds (a load, or nothing, written to only as loaded).
@@ -417,10 +456,18 @@ def compile_xml(mujoco: Any, xml: str) -> Any:
             restorable = held is _EMPTY or (held[0] in ("xml", "path") and slot.fresh)
             slot.owed = held if restorable else _LOST
     loader = _ORIGINAL.get("from_xml_string") or mujoco.MjModel.from_xml_string
+    _asset_cache.our_reads(_asset_cache.files_of(xml))
     model = loader(xml)
     with slot.lock:
         slot.held, slot.fresh, slot.stat = _OURS, False, None
     return model
+
+
+def _spec_compile(mujoco: Any, kind: str, source: str) -> None:
+    """Compiles the text ``source`` (or the file, for ``kind`` ``"path"``) without
+    touching the slot: what fills MuJoCo's asset cache with the model's files."""
+    spec = mujoco.MjSpec.from_string(source) if kind == "xml" else mujoco.MjSpec.from_file(source)
+    spec.compile()
 
 
 @functools.lru_cache(maxsize=None)

@@ -77,9 +77,9 @@ def model_cache() -> Optional[Any]:
         else:
             from ._doc_cache import DocumentCache
 
-            # No model store: a model loaded from one leaves MuJoCo's last loaded XML
-            # model (robosuite's get_xml) unlike stock's (docs/compiled.md).
-            _model_cache = DocumentCache(max_models=8, store=False)
+            # With the environment's model store (MJCF_FORGE_STORE, else the user
+            # cache folder): a structure compiled by any process is a load and a patch.
+            _model_cache = DocumentCache(max_models=8)
     return _model_cache
 
 
@@ -129,7 +129,7 @@ def set_model_cache(cache: Any) -> Optional[Any]:
     from ._doc_cache import DocumentCache
 
     if cache is True:
-        cache = DocumentCache(max_models=8, store=False)
+        cache = DocumentCache(max_models=8)
     elif cache is False:
         cache = None
     elif cache is not None and not isinstance(cache, DocumentCache):

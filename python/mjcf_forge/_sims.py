@@ -45,6 +45,7 @@ import numpy as np
 from . import _settings
 from ._mujoco import VISUAL
 from ._last_xml import owe
+from ._mjcf_forge import Document
 
 _KEPT = threading.local()
 # Simulations a forked child inherited kept: never used (their OpenGL contexts belong to
@@ -174,13 +175,14 @@ def keep_simulations(sim_class: Any) -> None:
                 release(*kept.pop())
             return compile_sim(cls, xml)
         candidates = [sim for sim, _ in kept if type(sim) is cls]
+        doc = Document.from_string(xml)
         if not candidates:
-            model = cache.model(xml)
+            model = cache.model(doc)
             # Stock loaded ``xml`` here: MuJoCo's last loaded XML model is owed it.
-            owe(xml, served=model)
+            owe(xml, served=model, files=doc.files())
             return cls(model)
-        model = cache.model(xml, into=[sim.model._model for sim in candidates])
-        owe(xml, served=model)
+        model = cache.model(doc, into=[sim.model._model for sim in candidates])
+        owe(xml, served=model, files=doc.files())
         for i, (sim, _) in enumerate(kept):
             if sim.model._model is model:
                 del kept[i]

@@ -242,8 +242,7 @@ impl PyDocumentCore {
         store: Option<Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let store = match store {
-            // Asked for by the environment only (MJCF_FORGE_STORE a folder).
-            None if std::env::var_os(split::STORE_VAR).is_none() => None,
+            // The environment's: MJCF_FORGE_STORE, else the user cache folder.
             None => DiskStore::from_env(),
             Some(s) if s.is_instance_of::<PyBool>() => {
                 if s.extract::<bool>()? {

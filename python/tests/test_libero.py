@@ -34,7 +34,15 @@ SCRIPT = Path(__file__).parent / "drivers" / "libero_run.py"
 TASKS = ["libero_spatial:0", "libero_object:0", "libero_goal:1", "libero_10:2", "libero_90:20"]
 
 
-def run(mode: str, out: Path, tmp: Path) -> subprocess.Popen:
+@pytest.fixture(scope="module")
+def store(tmp_path_factory):
+    """The model store the switch's processes share (MJCF_FORGE_STORE): empty when the
+    records' switch process starts (every structure compiled and stored), then read by the
+    evaluations (their task's structure loaded from it, by two processes at once)."""
+    return tmp_path_factory.mktemp("store")
+
+
+def run(mode: str, out: Path, tmp: Path, store: Path) -> subprocess.Popen:
     assert LIBERO_PY.exists(), f"{LIBERO_PY} missing: run scripts/setup_libero_env.sh"
     only = tmp / "path"
     only.mkdir(exist_ok=True)
@@ -42,6 +50,7 @@ def run(mode: str, out: Path, tmp: Path) -> subprocess.Popen:
         (only / "mjcf_forge").symlink_to(Path(mjcf_forge.__file__).resolve().parent)
     env = dict(os.environ, PYTHONPATH=str(only), PYTHONHASHSEED="0", LIBERO_CONFIG_PATH=str(CONFIG))
     env.setdefault("MUJOCO_GL", "egl")
+    env["MJCF_FORGE_STORE"] = str(store) if mode == "switch" else "off"
     return subprocess.Popen(
         [str(LIBERO_PY), str(SCRIPT), mode, str(out), *TASKS, "--cameras", "--steps", "20", "--resets", "1"],
         cwd=tmp, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
@@ -49,9 +58,9 @@ def run(mode: str, out: Path, tmp: Path) -> subprocess.Popen:
 
 
 @pytest.fixture(scope="module")
-def records(tmp_path_factory):
+def records(tmp_path_factory, store):
     tmp = tmp_path_factory.mktemp("libero")
-    procs = {mode: run(mode, tmp / mode, tmp) for mode in ("stock", "switch")}
+    procs = {mode: run(mode, tmp / mode, tmp, store) for mode in ("stock", "switch")}
     for mode, proc in procs.items():
         out, err = proc.communicate(timeout=1800)
         assert proc.returncode == 0, err[-3000:]
@@ -121,16 +130,18 @@ EVAL_TASK = "libero_object:0"
 
 
 @pytest.fixture(scope="module")
-def evaluations(tmp_path_factory):
+def evaluations(tmp_path_factory, store):
     """libero_eval.py on one task: twice on the switch (two processes, each with two
     evaluations in one environment and one in LIBERO's SubprocVectorEnv of two workers),
-    and once stock without the vector environment."""
+    and once stock without the vector environment. The switch's processes share the
+    records' store (``store``), which holds the task's structure after them."""
     tmp = tmp_path_factory.mktemp("libero_eval")
     only = tmp / "path"
     only.mkdir()
     (only / "mjcf_forge").symlink_to(Path(mjcf_forge.__file__).resolve().parent)
     env = dict(os.environ, PYTHONPATH=str(only), LIBERO_CONFIG_PATH=str(CONFIG))
     env.setdefault("MUJOCO_GL", "egl")
+    env["MJCF_FORGE_STORE"] = str(store)
     runs = {"switch-a": [], "switch-b": [], "stock": ["--stock", "--no-vector"]}
     procs = {
         name: subprocess.Popen(
@@ -170,3 +181,15 @@ def test_evaluations_with_the_same_seeds_roll_out_bit_equal_on_the_switch(evalua
         assert differing(episodes(stock, source), by_seed[seed], "") == [], source
     assert int(stock["kept"]) == 0
     assert differing(by_seed[0], by_seed[1], "") != []
+
+
+def test_evaluations_load_the_task_from_the_records_store(records, evaluations, store):
+    """Every structure the records' switch process compiled went into the shared store
+    (written whole, keyed by the structure, MuJoCo and the files); the two evaluation
+    processes, starting together, then had every miss of theirs loaded from it, none
+    compiled. Their rollouts above are stock's bit for bit."""
+    assert len(list(store.glob("*.mjfs"))) >= len(TASKS)
+    assert not [p for p in store.iterdir() if p.suffix != ".mjfs"]  # no half-written entry
+    for name in ("switch-a", "switch-b"):
+        loads, compiles = (int(v) for v in evaluations[name]["loads"])
+        assert loads >= 1 and loads == compiles, (name, loads, compiles)

@@ -163,17 +163,18 @@ def test_the_environment_moves_or_turns_off_the_store(tmp_path, monkeypatch):
     assert mjcf_forge.DocumentCache().store is None
     monkeypatch.delenv("MJCF_FORGE_STORE")
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
-    # Unset: no store unless asked for; True: the user cache folder.
-    assert mjcf_forge.DocumentCache().store is None
-    assert mjcf_forge.DocumentCache(store=True).store == tmp_path / "xdg" / "mjcf-forge" / "models"
+    # Unset: the user cache folder, by default or asked for.
+    xdg = tmp_path / "xdg" / "mjcf-forge" / "models"
+    assert mjcf_forge.DocumentCache().store == xdg
+    assert mjcf_forge.DocumentCache(store=True).store == xdg
     assert mjcf_forge.DocumentCache(store=False).store is None
-    # The switch's cache keeps none, whatever the environment says.
+    # The switch's cache keeps the environment's store.
     monkeypatch.setenv("MJCF_FORGE_STORE", str(tmp_path / "env"))
     from mjcf_forge import _settings
 
     previous = _settings.set_model_cache(True)
     try:
-        assert _settings.model_cache().store is None
+        assert _settings.model_cache().store == tmp_path / "env"
     finally:
         _settings.set_model_cache(previous)
     with warnings.catch_warnings():

@@ -533,6 +533,28 @@ impl PyDocument {
         run(py, || Ok(self.doc.read_detached().validate()?))
     }
 
+    /// Every file MuJoCo reads when it compiles this document (meshes, textures, height
+    /// fields, skins), as absolute paths once loaded, each once, in document order: what
+    /// the model store keys a structure by, and what MuJoCo's asset cache holds after a
+    /// compile of it.
+    ///
+    /// >>> import mjcf_forge
+    /// >>> doc = mjcf_forge.Document.from_string(
+    /// ...     "<mujoco><asset><mesh file='/m/a.obj'/><texture file='/m/t.png'/></asset></mujoco>")
+    /// >>> doc.files()
+    /// ['/m/a.obj', '/m/t.png']
+    fn files(&self, py: Python<'_>) -> PyResult<Vec<String>> {
+        run(py, || {
+            Ok(self
+                .doc
+                .read_detached()
+                .files()
+                .iter()
+                .map(|p| p.to_string_lossy().into_owned())
+                .collect())
+        })
+    }
+
     /// The document's structure key (32 hex digits): equal for two documents exactly
     /// when MuJoCo compiles them to models that differ only in the values of
     /// :attr:`patch` (and what ``mj_setConst`` derives from them). Found by reading the

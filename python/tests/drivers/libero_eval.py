@@ -119,6 +119,13 @@ for e, seed in enumerate(SEEDS):
     for k, ep in enumerate(episodes):
         record.update({f"single/{e}/{k}/{key}": v for key, v in ep.items()})
 record["kept"] = np.array(kept)
+if "--stock" not in sys.argv:
+    # This process's misses that loaded the structure from the model store, and the
+    # compiles: a warm store (MJCF_FORGE_STORE) leaves no compile of the task.
+    from mjcf_forge import base
+
+    cache = base.model_cache()
+    record["loads"] = np.array([cache.loads, cache.compiles])
 env.close()
 
 np.savez(args.out, **record)
