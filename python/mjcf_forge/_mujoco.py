@@ -156,9 +156,10 @@ def model_bytes(mujoco: Any, model: Any) -> bytes:
     return int(model.signature).to_bytes(8, "little") + buffer.tobytes()
 
 
-def model_from_bytes(mujoco: Any, data: bytes) -> Any:
+def model_from_bytes(mujoco: Any, data: bytes, signature: Optional[int] = None) -> Any:
     """The model :func:`model_bytes` wrote, read back by ``mujoco`` (through its VFS) with
-    its signature, or ``None``.
+    its signature, or ``None``. With ``signature`` given, ``data`` is MuJoCo's binary
+    model alone (the store's reader splits them: no copy of the model's bytes here).
 
     >>> import mujoco
     >>> m = mujoco.MjModel.from_xml_string("<mujoco><worldbody><geom size='1'/></worldbody></mujoco>")
@@ -169,10 +170,13 @@ def model_from_bytes(mujoco: Any, data: bytes) -> Any:
     import ctypes
 
     offset = signature_offset(mujoco)
-    if offset is None or len(data) < 8:
+    if signature is None:
+        if offset is None or len(data) < 8:
+            return None
+        signature, data = int.from_bytes(data[:8], "little"), data[8:]
+    if offset is None:
         return None
-    signature = int.from_bytes(data[:8], "little")
-    model = mujoco.MjModel.from_binary_path("model.mjb", {"model.mjb": data[8:]})
+    model = mujoco.MjModel.from_binary_path("model.mjb", {"model.mjb": data})
     ctypes.c_uint64.from_address(model._address + offset).value = signature
     return model if model.signature == signature else None
 

@@ -358,10 +358,16 @@ impl PyDocumentCore {
                     let loaded = load_or_compile(
                         Some((store, key.as_str())),
                         |bytes| {
+                            // The signature apart: the model's bytes copied once, not twice.
+                            let (signature, mjb) = bytes.split_at_checked(8)?;
+                            let signature = u64::from_le_bytes(signature.try_into().ok()?);
                             upcalls::get(py, "model_from_bytes")
-                                .and_then(|f| f.call1((mujoco.bind(py), PyBytes::new(py, bytes))))
-                                .map(Bound::unbind)
+                                .and_then(|f| {
+                                    f.call1((mujoco.bind(py), PyBytes::new(py, mjb), signature))
+                                })
                                 .ok()
+                                .filter(|m| !m.is_none())
+                                .map(Bound::unbind)
                         },
                         |model: &Py<PyAny>| {
                             upcalls::get(py, "model_bytes")

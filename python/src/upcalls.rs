@@ -13,7 +13,7 @@
 //! make_inertia(mujoco, model, data) that version's mj_makeM (or mj_crb)
 //! snapshot_fields(mujoco, model)    what DocumentCache writes back before a patch
 //! model_bytes(mujoco, model)        a model as MuJoCo's binary format (the model store)
-//! model_from_bytes(mujoco, data)    and read back
+//! model_from_bytes(mujoco, data, signature)  and read back
 //! signature_offset(mujoco)          where mjModel.signature sits (None: no model store)
 //! ```
 //!

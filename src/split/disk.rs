@@ -245,9 +245,9 @@ impl DiskStore {
     }
 
     /// The model stored under `key`, or `None`; a corrupt entry is removed and reported.
-    pub fn get(&self, key: &str) -> Result<Option<Vec<u8>>, StoreError> {
+    pub fn get(&self, key: &str) -> Result<Option<Stored>, StoreError> {
         let path = self.path(key);
-        let mut bytes = match fs::read(&path) {
+        let bytes = match fs::read(&path) {
             Ok(b) => b,
             Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(None),
             Err(e) => return Err(io(format!("reading {}", path.display()))(e)),
@@ -262,8 +262,11 @@ impl DiskStore {
         if let Ok(f) = fs::File::options().append(true).open(&path) {
             let _ = f.set_modified(SystemTime::now());
         }
-        bytes.drain(..HEADER);
-        Ok(Some(bytes))
+        // The header is skipped, not moved out: an entry can be hundreds of megabytes.
+        Ok(Some(Stored {
+            bytes,
+            start: HEADER,
+        }))
     }
 
     /// Stores `model` under `key`, whole or not at all, then keeps the store within its
@@ -279,7 +282,7 @@ impl DiskStore {
         header.extend_from_slice(key.as_bytes());
         header.push(b'\n');
         header.extend_from_slice(&(model.len() as u64).to_le_bytes());
-        header.extend_from_slice(blake3::hash(model).as_bytes());
+        header.extend_from_slice(hash(model).as_bytes());
         let written = tmp
             .write_all(&header)
             .and_then(|()| tmp.write_all(model))
@@ -399,6 +402,31 @@ pub fn load_or_compile<M, E>(
     Ok((model, false))
 }
 
+/// The BLAKE3 hash of `bytes`, on every core for a large model.
+fn hash(bytes: &[u8]) -> blake3::Hash {
+    if bytes.len() < 1 << 20 {
+        return blake3::hash(bytes);
+    }
+    let mut hasher = blake3::Hasher::new();
+    hasher.update_rayon(bytes);
+    hasher.finalize()
+}
+
+/// A stored model's bytes, as [`DiskStore::get`] read them (the entry's header skipped).
+#[derive(Debug)]
+pub struct Stored {
+    bytes: Vec<u8>,
+    start: usize,
+}
+
+impl std::ops::Deref for Stored {
+    type Target = [u8];
+
+    fn deref(&self) -> &[u8] {
+        &self.bytes[self.start..]
+    }
+}
+
 /// Whether `bytes` are a whole entry of `key`; what is wrong otherwise.
 fn check(bytes: &[u8], key: &str) -> Result<(), String> {
     if bytes.len() < HEADER {
@@ -417,7 +445,7 @@ fn check(bytes: &[u8], key: &str) -> Result<(), String> {
     if body.len() as u64 != len {
         return Err(format!("{} bytes of a {len}-byte model", body.len()));
     }
-    if blake3::hash(body).as_bytes() != &bytes[at + 8..HEADER] {
+    if hash(body).as_bytes() != &bytes[at + 8..HEADER] {
         return Err("its bytes do not have its hash".into());
     }
     Ok(())
@@ -525,14 +553,14 @@ mod tests {
             s.spawn(|| {
                 for _ in 0..200 {
                     match store.get(&k) {
-                        Ok(Some(got)) => assert!(got == model),
+                        Ok(Some(got)) => assert!(*got == model[..]),
                         Ok(None) => {}
                         Err(e) => panic!("a reader saw {e}"),
                     }
                 }
             });
         });
-        assert_eq!(store.get(&k).unwrap().unwrap(), model);
+        assert_eq!(&*store.get(&k).unwrap().unwrap(), &model[..]);
         // No temporary file is left behind.
         assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1);
     }

@@ -73,7 +73,7 @@ pub use body_copy::{
 pub use cache::{CacheBackend, CacheCore, CacheError, PatchFailure, Request};
 pub use disk::{
     DEFAULT_STORE_BYTES, DiskStore, STORE_MB_VAR, STORE_VAR, StoreEntry, StoreError, StoreKey,
-    load_or_compile,
+    Stored, load_or_compile,
 };
 pub use document::{
     DocumentPatch, PATCHABLE_OPTIONS, SplitOptions, split_document, split_document_with,
