@@ -148,12 +148,15 @@ def signature_offset(mujoco: Any) -> Optional[int]:
     return _SIGNATURE_AT[version]
 
 
-def model_bytes(mujoco: Any, model: Any) -> bytes:
+def model_bytes(mujoco: Any, model: Any) -> bytearray:
     """``model`` as the model store keeps it: its signature (8 bytes, little-endian), then
     MuJoCo's binary format (``mj_saveModel``), which does not hold the signature."""
-    buffer = np.empty(mujoco.mj_sizeModel(model), dtype=np.uint8)
-    mujoco.mj_saveModel(model, None, buffer)
-    return int(model.signature).to_bytes(8, "little") + buffer.tobytes()
+    out = bytearray(8 + mujoco.mj_sizeModel(model))
+    out[:8] = int(model.signature).to_bytes(8, "little")
+    # Written in place after the signature: the model's bytes made once (a store entry of
+    # LIBERO's is 270 MB).
+    mujoco.mj_saveModel(model, None, np.frombuffer(out, dtype=np.uint8, offset=8))
+    return out
 
 
 def model_from_bytes(mujoco: Any, data: bytes, signature: Optional[int] = None) -> Any:
@@ -173,7 +176,7 @@ def model_from_bytes(mujoco: Any, data: bytes, signature: Optional[int] = None) 
     if signature is None:
         if offset is None or len(data) < 8:
             return None
-        signature, data = int.from_bytes(data[:8], "little"), data[8:]
+        signature, data = int.from_bytes(data[:8], "little"), bytes(data[8:])
     if offset is None:
         return None
     model = mujoco.MjModel.from_binary_path("model.mjb", {"model.mjb": data})

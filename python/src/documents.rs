@@ -12,7 +12,7 @@ use std::sync::{Condvar, Mutex, MutexGuard};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::sync::MutexExt;
-use pyo3::types::{PyBool, PyBytes, PyList, PyTuple};
+use pyo3::types::{PyBool, PyByteArray, PyBytes, PyList, PyTuple};
 
 use crate::cache::statistics_of;
 use crate::document::PyDocument;
@@ -372,8 +372,11 @@ impl PyDocumentCore {
                         |model: &Py<PyAny>| {
                             upcalls::get(py, "model_bytes")
                                 .and_then(|f| f.call1((mujoco.bind(py), model.bind(py))))
-                                .and_then(|b| b.extract::<Vec<u8>>())
                                 .ok()
+                                .and_then(|b| match b.cast::<PyByteArray>() {
+                                    Ok(a) => Some(a.to_vec()),
+                                    Err(_) => Some(b.cast::<PyBytes>().ok()?.as_bytes().to_vec()),
+                                })
                         },
                         || self.compile(py, doc, &mujoco),
                         &mut |w| warn(py, &w),

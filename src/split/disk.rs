@@ -283,10 +283,9 @@ impl DiskStore {
         header.push(b'\n');
         header.extend_from_slice(&(model.len() as u64).to_le_bytes());
         header.extend_from_slice(hash(model).as_bytes());
-        let written = tmp
-            .write_all(&header)
-            .and_then(|()| tmp.write_all(model))
-            .and_then(|()| tmp.as_file().sync_data());
+        // Not synced to the disk: a crash that leaves the entry torn leaves it unlike its
+        // hash, and a torn entry is removed and compiled again, never loaded.
+        let written = tmp.write_all(&header).and_then(|()| tmp.write_all(model));
         written.map_err(io(format!("writing {}", path.display())))?;
         tmp.persist(&path)
             .map_err(|e| io(format!("writing {}", path.display()))(e.error))?;
