@@ -4,7 +4,7 @@ test_libero.py and benches/compare/bench_libero.py in the LIBERO venv (.cache/ve
 LIBERO 0.1.1, robosuite 1.4.0, MuJoCo 3.3.1; scripts/setup_libero_env.sh).
 
     python libero_run.py {stock|switch} OUT_DIR SUITE:INDEX [SUITE:INDEX ...]
-        [--steps N] [--resets N] [--cameras] [--model-only] [--digest]
+        [--steps N] [--resets N] [--cameras] [--model-only] [--digest] [--again]
 
 Per task, ``OUT_DIR/<suite>-<index>.npz`` holds:
 
@@ -22,6 +22,13 @@ Per task, ``OUT_DIR/<suite>-<index>.npz`` holds:
 - ``xml/first`` and ``xml/reset<i>``: ``env.sim.model.get_xml()`` (robosuite's, which is
   ``mujoco.mj_saveLastXML``: what a dataset saves with each demo) after the first reset
   and after each later hard reset;
+- with ``--again``, after the environment is closed, a second environment of the task
+  made in the same process (what an evaluation worker making the task again gets):
+  ``second/model/<field>`` (each array's SHA-256, as with ``--digest``), the observations
+  after ``set_init_state`` and 5 steps of the same actions (``second/obs/<key>``), and
+  whether it runs on the first environment's simulation (``second/kept``: the switch
+  keeps a closed environment's simulation, its model patched and its render context as
+  it was, for the next one of its structure);
 - ``error``: the exception's type and message, if LIBERO's code raised.
 
 With ``--digest`` each ``model/`` array is its SHA-256 instead (of its dtype, shape and
@@ -49,6 +56,7 @@ ap.add_argument("--resets", type=int, default=1)
 ap.add_argument("--cameras", action="store_true")
 ap.add_argument("--model-only", action="store_true")
 ap.add_argument("--digest", action="store_true")
+ap.add_argument("--again", action="store_true")
 args = ap.parse_args()
 
 if args.mode == "switch":
@@ -69,7 +77,7 @@ def _digest(value: np.ndarray) -> np.ndarray:
     return np.frombuffer(h.digest(), dtype=np.uint8)
 
 
-def model_arrays(model) -> dict:
+def model_arrays(model, digest: bool = False) -> dict:
     out = {}
     sizes = {}
     for name in dir(model):
@@ -80,7 +88,7 @@ def model_arrays(model) -> dict:
             out["model/" + name] = value.copy()
         elif name.startswith("n") and isinstance(value, int):
             sizes[name] = value
-    if args.digest:
+    if args.digest or digest:
         out = {k: _digest(v) for k, v in out.items()}
     out["model/sizes"] = np.array([sizes[k] for k in sorted(sizes)], dtype=np.int64)
     out["model/size_names"] = np.array(sorted(sizes))
@@ -138,7 +146,24 @@ def run(suite: str, index: int) -> dict:
         out["reset/" + key] = np.stack([np.asarray(f[key]) for f in first])
     # Hard resets that kept the simulation (the switch's, when the structure is the same).
     out["kept"] = np.array(kept)
+    sim = env.sim
     env.close()
+    if args.again:
+        env = OffScreenRenderEnv(
+            bddl_file_name=bddl, camera_heights=size, camera_widths=size,
+            has_offscreen_renderer=args.cameras, use_camera_obs=args.cameras,
+        )
+        env.seed(0)
+        env.reset()
+        out.update({"second/" + k: v for k, v in model_arrays(env.sim.model, digest=True).items()})
+        out["second/kept"] = np.array(env.sim is sim)
+        frames = [env.set_init_state(state0)]
+        for a in actions[:5]:
+            obs, *_ = env.step(a)
+            frames.append(obs)
+        for key in frames[0]:
+            out["second/obs/" + key] = np.stack([np.asarray(f[key]) for f in frames])
+        env.close()
     return out
 
 
