@@ -1,18 +1,19 @@
 """MuJoCo's asset cache, as stock's process would hold it: what the last loaded XML model
 (``mj_saveLastXML``, robosuite's ``get_xml()``) depends on besides the text loaded.
 
-MuJoCo keeps one asset cache per process (500 MB): a mesh, texture or height field read
-from a file by any compile is kept, and a later compile of a model naming the same file
-takes it from there. On some MuJoCo versions (3.3.1 and 3.9.0 among them, not 3.17.0 or
-4.0.0) where an asset came from is written: a mesh read from its file gets a
-``content_type`` in MuJoCo's parsed model, one taken from the cache does not, and
-``mj_saveLastXML`` writes what the parsed model holds. So the text stock saves depends on
-which of the model's files an earlier compile had read.
+MuJoCo keeps one asset cache per process (500 MB): a mesh read from its file by any
+compile is kept, and a later compile of a model naming the same file takes it from there.
+On some MuJoCo versions (3.3.1 and 3.9.0 among them, not 3.17.0 or 4.0.0) where a mesh
+came from is written: one read from its file gets a ``content_type`` in MuJoCo's parsed
+model, one taken from the cache does not, and ``mj_saveLastXML`` writes what the parsed
+model holds. So the text stock saves depends on which of the model's mesh files an earlier
+compile had read. (Textures and height fields are read from their files by every compile
+of those versions, and written alike either way: only mesh files are kept here.)
 
 The package compiles otherwise than stock (a structure once, a model loaded from the model
 store and compiled by no one), so its process's cache can hold other files than stock's.
-This module keeps both: the files stock's compiles would have read by now (every load
-stock made, including those the model cache served instead) and the files this process's
+This module keeps both: the mesh files stock's compiles would have read by now (every load
+stock made, including those the model cache served instead) and those this process's
 MuJoCo has read (every compile and load here). Before the last loaded XML model is loaded
 again to give stock's text (``_last_xml``), :func:`match` makes this process's cache hold
 the model's files as stock's did at that load: it compiles the model first (without
@@ -38,14 +39,14 @@ _WRITES_WHERE: list = []  # [bool]: whether this MuJoCo writes where an asset ca
 
 
 def files_of(text: str) -> frozenset:
-    """The files a model written as ``text`` reads (``Document.files``); none where it
-    cannot be read (MuJoCo then refuses it, and caches nothing)."""
+    """The mesh files a model written as ``text`` reads (``Document.files("mesh")``); none
+    where it cannot be read (MuJoCo then refuses it, and caches nothing)."""
     files = _FILES.get(text)
     if files is None:
         from ._mjcf_forge import Document
 
         try:
-            files = frozenset(Document.from_string(text).files())
+            files = frozenset(Document.from_string(text).files("mesh"))
         except Exception:  # noqa: BLE001 - MuJoCo's own load says what is wrong
             files = frozenset()
         if len(_FILES) >= 8:
@@ -55,11 +56,11 @@ def files_of(text: str) -> frozenset:
 
 
 def files_of_path(path: Any) -> frozenset:
-    """The files the model file ``path`` reads (see :func:`files_of`)."""
+    """The mesh files the model file ``path`` reads (see :func:`files_of`)."""
     from ._mjcf_forge import Document
 
     try:
-        return frozenset(Document.load(os.fspath(path)).files())
+        return frozenset(Document.load(os.fspath(path)).files("mesh"))
     except Exception:  # noqa: BLE001 - as files_of
         return frozenset()
 
@@ -113,7 +114,7 @@ def match(files: frozenset, stock_cold: frozenset, warm: Callable[[], Any]) -> N
     else:
         raise RuntimeError(
             f"MuJoCo's asset cache held {len(files) - len(stock_cold)} of this model's "
-            f"{len(files)} files in stock's process when it was loaded (the others, such as "
+            f"{len(files)} mesh files in stock's process when it was loaded (the others, such as "
             f"{sorted(stock_cold)[0]!r}, were read from disk), and this MuJoCo writes which "
             "into the XML; this process's cache cannot be brought to that state"
         )

@@ -243,8 +243,9 @@ def owe(source: Source, assets: Any = None, served: Any = None, files: Any = Non
     """Records that stock would have loaded ``source`` (MJCF text, or a function that
     writes it, called only if the slot is read) with ``mujoco.MjModel.from_xml_string``
     now, and that the model cache served that load instead (``served``: the model it
-    gave, MuJoCo's compile of ``source``, when the caller has it; ``files``: the files
-    the model reads, ``Document.files()``, read from the text when not given)."""
+    gave, MuJoCo's compile of ``source``, when the caller has it; ``files``: the mesh
+    files the model reads, ``Document.files("mesh")``, read from the text when not
+    given)."""
     if not _installed():
         return
     if files is None:

@@ -179,10 +179,10 @@ def keep_simulations(sim_class: Any) -> None:
         if not candidates:
             model = cache.model(doc)
             # Stock loaded ``xml`` here: MuJoCo's last loaded XML model is owed it.
-            owe(xml, served=model, files=doc.files())
+            owe(xml, served=model, files=doc.files("mesh"))
             return cls(model)
         model = cache.model(doc, into=[sim.model._model for sim in candidates])
-        owe(xml, served=model, files=doc.files())
+        owe(xml, served=model, files=doc.files("mesh"))
         for i, (sim, _) in enumerate(kept):
             if sim.model._model is model:
                 del kept[i]

@@ -276,7 +276,7 @@ class MujocoXML(object):
             if cache is not None:
                 model = cache.model(self.document)
                 # Stock loads the text here: MuJoCo's last loaded XML model is owed it.
-                _last_xml.owe(self.document.copy().to_xml, served=model, files=self.document.files())
+                _last_xml.owe(self.document.copy().to_xml, served=model, files=self.document.files("mesh"))
                 return model
             import mujoco
 

@@ -131,7 +131,7 @@ def _lazy_robot_model(robot_class: Any) -> None:
             self.mujoco_model = pending
             # Stock compiles the robot here with mujoco.MjModel.from_xml_string: MuJoCo's
             # last loaded XML model is owed it (written only if read before the next load).
-            _last_xml.owe(pending.document.to_xml, files=pending.document.files())
+            _last_xml.owe(pending.document.to_xml, files=pending.document.files("mesh"))
 
     set_mujoco_model.__doc__ = (
         "Sets ``mujoco_model``: the model given, or else this robot compiled alone, "

@@ -115,8 +115,26 @@ impl Document {
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn files(&self) -> Vec<std::path::PathBuf> {
+        self.files_where(|_| true)
+    }
+
+    /// The files of [`Document::files`] that elements named `tag` read (`"mesh"`: the
+    /// mesh files, what MuJoCo's asset cache keeps).
+    ///
+    /// ```
+    /// use mjcf_forge::Document;
+    /// let xml = r#"<mujoco><asset><mesh file="/m/a.obj"/><texture type="2d" file="/m/t.png"/></asset></mujoco>"#;
+    /// let doc = Document::from_str(xml, "/")?;
+    /// assert_eq!(doc.files_of("mesh"), vec![std::path::PathBuf::from("/m/a.obj")]);
+    /// # Ok::<(), mjcf_forge::Error>(())
+    /// ```
+    pub fn files_of(&self, tag: &str) -> Vec<std::path::PathBuf> {
+        self.files_where(|node| self.tag(node) == tag)
+    }
+
+    fn files_where(&self, keep: impl Fn(Node) -> bool) -> Vec<std::path::PathBuf> {
         let mut out: Vec<std::path::PathBuf> = Vec::new();
-        for r in file_refs(self) {
+        for r in file_refs(self).into_iter().filter(|r| keep(r.node)) {
             let value = self.attr_sym(r.node, r.attr).unwrap_or_default();
             let path = std::path::PathBuf::from(value);
             if !out.contains(&path) {

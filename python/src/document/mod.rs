@@ -535,20 +535,25 @@ impl PyDocument {
 
     /// Every file MuJoCo reads when it compiles this document (meshes, textures, height
     /// fields, skins), as absolute paths once loaded, each once, in document order: what
-    /// the model store keys a structure by, and what MuJoCo's asset cache holds after a
-    /// compile of it.
+    /// the model store keys a structure by; ``tag``: only those elements of that tag read
+    /// (``"mesh"``: what MuJoCo's asset cache keeps of a compile).
     ///
     /// >>> import mjcf_forge
     /// >>> doc = mjcf_forge.Document.from_string(
     /// ...     "<mujoco><asset><mesh file='/m/a.obj'/><texture file='/m/t.png'/></asset></mujoco>")
     /// >>> doc.files()
     /// ['/m/a.obj', '/m/t.png']
-    fn files(&self, py: Python<'_>) -> PyResult<Vec<String>> {
+    /// >>> doc.files("mesh")  # those of the elements of one tag
+    /// ['/m/a.obj']
+    #[pyo3(signature = (tag=None))]
+    fn files(&self, py: Python<'_>, tag: Option<&str>) -> PyResult<Vec<String>> {
         run(py, || {
-            Ok(self
-                .doc
-                .read_detached()
-                .files()
+            let doc = self.doc.read_detached();
+            let files = match tag {
+                Some(tag) => doc.files_of(tag),
+                None => doc.files(),
+            };
+            Ok(files
                 .iter()
                 .map(|p| p.to_string_lossy().into_owned())
                 .collect())
