@@ -29,6 +29,11 @@ Usage: python benches/compare/bench_doc_cache.py [--scene S] [--runs N] [--compi
 """
 from __future__ import annotations
 
+import os
+
+# Misses are timed as compiles: no model store unless the caller sets one.
+os.environ.setdefault("MJCF_FORGE_STORE", "off")
+
 import argparse
 import copy
 import json

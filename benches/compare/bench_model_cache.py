@@ -28,6 +28,11 @@ Usage: python benches/compare/bench_model_cache.py [--scene S] [--runs N] [--com
 """
 from __future__ import annotations
 
+import os
+
+# Misses are timed as compiles: no model store unless the caller sets one.
+os.environ.setdefault("MJCF_FORGE_STORE", "off")
+
 import argparse
 import json
 import sys

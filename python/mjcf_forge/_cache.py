@@ -43,9 +43,15 @@ class ModelCache:
     batched simulators (MJX, MuJoCo Warp, MuJoCo's batch API) take
     (:class:`mjcf_forge.batch.WorldBatch` gives them in each simulator's own form).
 
+    Across processes, a structure compiled once is kept in the model store as
+    :class:`DocumentCache` keeps it (``store``: a folder, ``False`` none, ``None`` or
+    ``True`` the environment's ``MJCF_FORGE_STORE``, else the user cache folder; never
+    for a superset): a later process's miss loads it and patches it into the variant
+    asked for (``loads`` counts those misses).
+
     >>> import mjcf_forge
     >>> scene = mjcf_forge.Scene.demo()
-    >>> cache = mjcf_forge.ModelCache(scene, max_models=4)
+    >>> cache = mjcf_forge.ModelCache(scene, max_models=4, store=False)
     >>> model = cache.model(scene.variant(0))
     >>> model.nbody > 1
     True
@@ -57,6 +63,8 @@ class ModelCache:
         max_models: int = 8,
         max_bytes: int | None = None,
         superset: bool = False,
+        *,
+        store: Any = None,
     ) -> None:
         import mujoco
 
@@ -78,7 +86,7 @@ class ModelCache:
         # worlds derived tree by tree) are the split tier's cache core, the C face's too;
         # this class is its face.
         self._core = CacheCore(
-            mujoco, max_models, max_bytes, list(scene.fixed_statistics), self.superset
+            mujoco, max_models, max_bytes, list(scene.fixed_statistics), self.superset, store
         )
 
     def __len__(self) -> int:
@@ -91,8 +99,18 @@ class ModelCache:
 
     @property
     def compiles(self) -> int:
-        """Models compiled (misses) so far."""
+        """Models compiled (misses) so far: compiled, or loaded from the store."""
         return self._core.compiles
+
+    @property
+    def loads(self) -> int:
+        """Of the misses, the models loaded from the store (another process compiled them)."""
+        return self._core.loads
+
+    @property
+    def store(self) -> Any:
+        """The folder structures are kept in across processes, or ``None``."""
+        return self._core.store
 
     @property
     def patches(self) -> int:

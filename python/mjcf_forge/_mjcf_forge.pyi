@@ -100,6 +100,8 @@ class CacheCore:
     ``ModelCache`` is its face."""
 
     compiles: int
+    loads: int
+    store: Optional[Path]
     patches: int
     nbytes: int
     by_tree: int
@@ -111,6 +113,7 @@ class CacheCore:
         max_bytes: Optional[int],
         fixed: Sequence[str],
         superset: Optional[Superset] = None,
+        store: Any = None,
     ) -> None: ...
     def __len__(self) -> int: ...
     def model(self, variant: Any) -> Any: ...

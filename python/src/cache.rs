@@ -7,6 +7,8 @@
 //! user's `mujoco`.
 
 use std::borrow::Cow;
+use std::cell::Cell;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Mutex, MutexGuard, TryLockError};
 
 use pyo3::exceptions::PyRuntimeError;
@@ -17,12 +19,13 @@ use crate::document::patch::patch_entry;
 use crate::errors::mjcf_error;
 use crate::scene::{PySuperset, PyVariant};
 use crate::split::{PyPatchPlan, signature_of};
-use crate::upcalls;
-use mjcf_forge::ErrorKind;
+use crate::{store, upcalls};
+use mjcf_forge::split::DiskStore;
 use mjcf_forge::split::{
     self, CacheBackend, CacheError, Held, PatchEntry, PatchFailure, Request, STATISTIC_NAMES,
     Signature, Statistics,
 };
+use mjcf_forge::{Document, ErrorKind};
 
 /// The user's `mujoco` as the cache core runs it: whether a superset's patches derive
 /// tree by tree where their layout allows (`mjcf_forge::split::Derivations`), and how many
@@ -139,6 +142,11 @@ pub(crate) struct PyCacheCore {
     inner: Mutex<Inner>,
     superset: Option<Py<PySuperset>>,
     fixed: u32,
+    /// Where structures are kept across processes (never for a superset: its one model
+    /// is the superset's own compile).
+    store: Option<DiskStore>,
+    /// Of the misses, the models loaded from the store.
+    loads: AtomicU64,
 }
 
 impl PyCacheCore {
@@ -223,7 +231,13 @@ impl PyCacheCore {
         let Inner { core, backend } = inner;
         let mujoco = backend.mujoco.clone_ref(py);
         let request = asked.request(self.fixed);
-        match core.plan_for(backend, &request, model, asked.compile(&mujoco)) {
+        let loaded = Cell::new(false);
+        match core.plan_for(
+            backend,
+            &request,
+            model,
+            asked.compile(&mujoco, None, &loaded),
+        ) {
             Ok(plan) => Ok(plan.0.clone_ref(py)),
             Err(e) => Err(asked.error(e)),
         }
@@ -249,13 +263,35 @@ impl Asked<'_> {
         }
     }
 
-    /// The compile of the variant's structure with the user's `mujoco`.
-    fn compile<'a>(&'a self, mujoco: &'a Py<PyAny>) -> impl FnMut() -> PyResult<Py<PyAny>> + 'a {
+    /// The compile of the variant's structure with the user's `mujoco`; with a `store`,
+    /// its first call loads the structure's model from there when another process
+    /// stored it (`loaded` says so: that model is another variant's compile, to be
+    /// patched), and stores what it compiles.
+    fn compile<'a>(
+        &'a self,
+        mujoco: &'a Py<PyAny>,
+        mut store: Option<&'a DiskStore>,
+        loaded: &'a Cell<bool>,
+    ) -> impl FnMut() -> PyResult<Py<PyAny>> + 'a {
         move || {
             Python::attach(|py| {
-                let model =
-                    upcalls::get(py, "compile_xml")?.call1((mujoco.bind(py), &*self.xml))?;
-                Ok(model.unbind())
+                let compile = || {
+                    let model =
+                        upcalls::get(py, "compile_xml")?.call1((mujoco.bind(py), &*self.xml))?;
+                    Ok(model.unbind())
+                };
+                // Relative file names resolve as MuJoCo resolves them in a string's model.
+                let doc = store
+                    .take()
+                    .zip(std::env::current_dir().ok())
+                    .and_then(|(s, dir)| Some((s, Document::from_str(&self.xml, &dir).ok()?)));
+                let Some((store, doc)) = doc else {
+                    return compile();
+                };
+                let key = store::key(py, &doc, &self.key, mujoco)?;
+                let (model, stored) = store::load_or(py, store, &key, mujoco, compile)?;
+                loaded.set(stored);
+                Ok(model)
             })
         }
     }
@@ -280,16 +316,22 @@ impl Asked<'_> {
 #[pymethods]
 impl PyCacheCore {
     #[new]
-    #[pyo3(signature = (mujoco, max_models, max_bytes, fixed, superset=None))]
+    #[pyo3(signature = (mujoco, max_models, max_bytes, fixed, superset=None, store=None))]
     fn new(
+        py: Python<'_>,
         mujoco: Py<PyAny>,
         max_models: usize,
         max_bytes: Option<usize>,
         fixed: Vec<String>,
         superset: Option<Py<PySuperset>>,
-    ) -> Self {
+        store: Option<Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
         let core = split::CacheCore::new(max_models, max_bytes, superset.is_some());
-        PyCacheCore {
+        let store = match &superset {
+            Some(_) => None,
+            None => store::open(py, store, &mujoco)?,
+        };
+        Ok(PyCacheCore {
             inner: Mutex::new(Inner {
                 core,
                 backend: UserBackend {
@@ -300,7 +342,9 @@ impl PyCacheCore {
             }),
             superset,
             fixed: split::fixed_statistics_mask(fixed.iter().map(String::as_str)),
-        }
+            store,
+            loads: AtomicU64::new(0),
+        })
     }
 
     /// The model of ``variant`` (see ``ModelCache.model``).
@@ -309,8 +353,19 @@ impl PyCacheCore {
         let mut inner = self.inner()?;
         let Inner { core, backend } = &mut *inner;
         let mujoco = backend.mujoco.clone_ref(py);
-        let r = core.model(backend, &asked.request(self.fixed), asked.compile(&mujoco));
-        match r {
+        let request = asked.request(self.fixed);
+        let loaded = Cell::new(false);
+        let compile = asked.compile(&mujoco, self.store.as_ref(), &loaded);
+        let model = match core.model(backend, &request, compile) {
+            Ok(model) => model.clone_ref(py),
+            Err(e) => return Err(asked.error(e)),
+        };
+        if !loaded.get() {
+            return Ok(model);
+        }
+        // Another variant's compile, from the store: now a hit, patched into this one.
+        self.loads.fetch_add(1, Ordering::Relaxed);
+        match core.model(backend, &request, asked.compile(&mujoco, None, &loaded)) {
             Ok(model) => Ok(model.clone_ref(py)),
             Err(e) => Err(asked.error(e)),
         }
@@ -328,13 +383,19 @@ impl PyCacheCore {
         let Inner { core, backend } = &mut *inner;
         let mujoco = backend.mujoco.clone_ref(py);
         let mut target = model.clone_ref(py);
+        // The structure's first sight may load its model from the store: kept, and
+        // patched before it is given out, as every cached model is.
+        let loaded = Cell::new(false);
         core.apply(
             backend,
             &asked.request(self.fixed),
             &mut target,
-            asked.compile(&mujoco),
+            asked.compile(&mujoco, self.store.as_ref(), &loaded),
         )
         .map_err(|e| asked.error(e))?;
+        if loaded.get() {
+            self.loads.fetch_add(1, Ordering::Relaxed);
+        }
         Ok(model)
     }
 
@@ -400,6 +461,18 @@ impl PyCacheCore {
     fn models(&self, py: Python<'_>) -> PyResult<Py<PyList>> {
         let inner = self.inner()?;
         Ok(PyList::new(py, inner.core.models().map(|m| m.clone_ref(py)))?.unbind())
+    }
+
+    /// Of the misses, the models loaded from the store (another process compiled them).
+    #[getter]
+    fn loads(&self) -> u64 {
+        self.loads.load(Ordering::Relaxed)
+    }
+
+    /// The folder structures are kept in across processes, or ``None``.
+    #[getter]
+    fn store(&self) -> Option<std::path::PathBuf> {
+        self.store.as_ref().map(|s| s.dir().to_path_buf())
     }
 
     /// Models compiled so far (misses).

@@ -12,16 +12,16 @@ use std::sync::{Condvar, Mutex, MutexGuard};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::sync::MutexExt;
-use pyo3::types::{PyBool, PyByteArray, PyBytes, PyList, PyTuple};
+use pyo3::types::{PyList, PyTuple};
 
 use crate::cache::statistics_of;
 use crate::document::PyDocument;
 use crate::errors::{mjcf_error, run};
 use crate::split::{PyPatchPlan, Snapshot, Views, references};
-use crate::upcalls;
+use crate::{store, upcalls};
 use mjcf_forge::split::{
     self, CacheError, Compiled, DiskStore, DocumentBackend, Held, PatchEntry, PatchFailure,
-    Request, SplitOptions, Step, StoreKey, load_or_compile, split_document_with,
+    Request, SplitOptions, Step, split_document_with,
 };
 
 /// The user's `mujoco` as the document core runs it.
@@ -182,29 +182,6 @@ impl PyDocumentCore {
     }
 }
 
-/// `message` as a Python `RuntimeWarning` (the store's failures: the cache compiles).
-fn warn(py: Python<'_>, message: &str) {
-    let warned = upcalls::python(py, "warnings", "warn")
-        .and_then(|w| w.call1((message, py.get_type::<pyo3::exceptions::PyRuntimeWarning>())));
-    if let Err(e) = warned {
-        // A filter that turns warnings into errors: the store's failure is not the call's.
-        e.print(py);
-    }
-}
-
-/// The store key of structure `key` of `doc` compiled by the user's `mujoco`: its version
-/// and every file the document reads (hashed with the GIL released).
-fn store_key(py: Python<'_>, doc: &PyDocument, key: &str, mujoco: &Py<PyAny>) -> PyResult<String> {
-    let version: String = mujoco.bind(py).getattr("__version__")?.extract()?;
-    run(py, || {
-        Ok(StoreKey::of_document(
-            key,
-            &version,
-            &doc.doc.read_detached(),
-        ))
-    })
-}
-
 /// The core's error as Python's.
 fn error(e: CacheError<PyErr>) -> PyErr {
     match e {
@@ -241,41 +218,7 @@ impl PyDocumentCore {
         max_bytes: Option<usize>,
         store: Option<Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let store = match store {
-            // The environment's: MJCF_FORGE_STORE, else the user cache folder.
-            None => DiskStore::from_env(),
-            Some(s) if s.is_instance_of::<PyBool>() => {
-                if s.extract::<bool>()? {
-                    DiskStore::from_env()
-                } else {
-                    None
-                }
-            }
-            Some(s) => {
-                let dir: std::path::PathBuf = s.extract()?;
-                Some(DiskStore::open(dir, split::DEFAULT_STORE_BYTES))
-            }
-        };
-        let mut store = match store.transpose() {
-            Ok(store) => store,
-            Err(e) => {
-                warn(py, &e.to_string());
-                None
-            }
-        };
-        // A stored model must get its signature back (MuJoCo's binary format drops it).
-        if store.is_some()
-            && upcalls::get(py, "signature_offset")?
-                .call1((mujoco.bind(py),))?
-                .is_none()
-        {
-            warn(
-                py,
-                "model store: this mujoco's mjModel layout is not known, so a stored model \
-                 could not carry its signature: no store",
-            );
-            store = None;
-        }
+        let store = store::open(py, store, &mujoco)?;
         Ok(PyDocumentCore {
             inner: Mutex::new(Inner {
                 core: split::DocumentCore::new(max_models, max_bytes),
@@ -354,34 +297,13 @@ impl PyDocumentCore {
             let store = self.store.as_ref().filter(|_| use_store && !replace);
             let (compiled, stored) = match store {
                 Some(store) => {
-                    let key = store_key(py, doc, request.key, &mujoco)?;
-                    let loaded = load_or_compile(
-                        Some((store, key.as_str())),
-                        |bytes| {
-                            // The signature apart: the model's bytes copied once, not twice.
-                            let (signature, mjb) = bytes.split_at_checked(8)?;
-                            let signature = u64::from_le_bytes(signature.try_into().ok()?);
-                            upcalls::get(py, "model_from_bytes")
-                                .and_then(|f| {
-                                    f.call1((mujoco.bind(py), PyBytes::new(py, mjb), signature))
-                                })
-                                .ok()
-                                .filter(|m| !m.is_none())
-                                .map(Bound::unbind)
-                        },
-                        |model: &Py<PyAny>| {
-                            upcalls::get(py, "model_bytes")
-                                .and_then(|f| f.call1((mujoco.bind(py), model.bind(py))))
-                                .ok()
-                                .and_then(|b| match b.cast::<PyByteArray>() {
-                                    Ok(a) => Some(a.to_vec()),
-                                    Err(_) => Some(b.cast::<PyBytes>().ok()?.as_bytes().to_vec()),
-                                })
-                        },
-                        || self.compile(py, doc, &mujoco),
-                        &mut |w| warn(py, &w),
-                    );
-                    match loaded {
+                    let key = {
+                        let read = doc.doc.read(py);
+                        store::key(py, &read, request.key, &mujoco)?
+                    };
+                    match store::load_or(py, store, &key, &mujoco, || {
+                        self.compile(py, doc, &mujoco)
+                    }) {
                         Ok((m, stored)) => (Ok(m), stored),
                         Err(e) => (Err(e), false),
                     }

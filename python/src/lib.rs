@@ -28,6 +28,7 @@ mod model;
 mod scene;
 mod sheet;
 mod split;
+mod store;
 mod testing;
 mod upcalls;
 

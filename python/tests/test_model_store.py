@@ -55,6 +55,30 @@ def test_a_new_process_loads_what_another_stored_and_patches_it_exactly(tmp_path
     assert len(list(tmp_path.glob("*.mjfs"))) == 1
 
 
+def test_a_model_cache_loads_a_structure_another_stored_and_patches_each_variant(tmp_path):
+    scene = mjcf_forge.Scene.load(ROOT / "benches" / "scenes" / "lift5_fixed.toml")
+    variants = [scene.variant(i) for i in range(4)]
+    assert len({v.structure_key for v in variants}) == 1
+    first = mjcf_forge.ModelCache(scene, store=tmp_path)
+    first.model(variants[0])
+    assert (first.compiles, first.loads, first.store) == (1, 0, tmp_path)
+    # A new cache (as a new process): every miss a load, each variant MuJoCo's compile.
+    second = mjcf_forge.ModelCache(scene, store=tmp_path)
+    for k in (2, 1, 3):
+        got = second.model(variants[k])
+        want = mujoco.MjModel.from_xml_string(variants[k].xml)
+        assert judge.compare_models(want, got) == [], f"variant {k}"
+    assert (second.compiles, second.loads) == (1, 1)
+    # apply() of a caller's model on a cache that never compiled: the structure loaded.
+    third = mjcf_forge.ModelCache(scene, store=tmp_path)
+    own = mujoco.MjModel.from_xml_string(variants[0].xml)
+    third.apply(variants[3], own)
+    assert judge.compare_models(mujoco.MjModel.from_xml_string(variants[3].xml), own) == []
+    assert third.loads == 1
+    # A superset keeps no store: its one model is the superset's own compile.
+    assert mjcf_forge.ModelCache(mjcf_forge.Scene.demo(), superset=True, store=tmp_path).store is None
+
+
 def test_a_changed_mesh_is_a_miss(tmp_path):
     work, store = tmp_path / "model", tmp_path / "store"
     work.mkdir()
