@@ -38,11 +38,14 @@ from libero.libero.envs import OffScreenRenderEnv
 from libero_tasks import bddl_file, task_name
 suite, _, index = task.partition(":")
 bddl = bddl_file(suite, task_name(suite, int(index)))
+def make_env():
+    env = OffScreenRenderEnv(bddl_file_name=bddl, camera_heights=128, camera_widths=128,
+                             has_offscreen_renderer=cameras, use_camera_obs=cameras)
+    env.seed(0)
+    env.reset()
+    return env
 t = time.perf_counter()
-env = OffScreenRenderEnv(bddl_file_name=bddl, camera_heights=128, camera_widths=128,
-                         has_offscreen_renderer=cameras, use_camera_obs=cameras)
-env.seed(0)
-env.reset()
+env = make_env()
 make = time.perf_counter() - t
 times = []
 for _ in range(resets):
@@ -51,10 +54,7 @@ for _ in range(resets):
     times.append(time.perf_counter() - t)
 env.close()
 t = time.perf_counter()
-env = OffScreenRenderEnv(bddl_file_name=bddl, camera_heights=128, camera_widths=128,
-                         has_offscreen_renderer=cameras, use_camera_obs=cameras)
-env.seed(0)
-env.reset()
+env = make_env()
 second = time.perf_counter() - t
 print(json.dumps({"make": make, "resets": times, "second": second}))
 """

@@ -65,24 +65,24 @@ def files_of_path(path: Any) -> frozenset:
         return frozenset()
 
 
+def _reads(record: set, files: Iterable[str]) -> frozenset:
+    files = frozenset(files)
+    with _LOCK:
+        cold = files - record
+        record.update(files)
+    return cold
+
+
 def stock_reads(files: Iterable[str]) -> frozenset:
     """Stock's process compiles a model reading ``files`` now: returns those it reads from
     disk (no earlier compile read them), and records them read."""
-    files = frozenset(files)
-    with _LOCK:
-        cold = files - _STOCK
-        _STOCK.update(files)
-    return cold
+    return _reads(_STOCK, files)
 
 
 def our_reads(files: Iterable[str]) -> frozenset:
     """This process's MuJoCo compiles a model reading ``files`` now: returns those it reads
     from disk, and records them read."""
-    files = frozenset(files)
-    with _LOCK:
-        cold = files - _OURS
-        _OURS.update(files)
-    return cold
+    return _reads(_OURS, files)
 
 
 def both_read(files: Iterable[str]) -> tuple:
