@@ -66,7 +66,9 @@ def model_cache() -> Optional[Any]:
 
     On by default: made on first use (at most 8 structures, least recently used out), unless
     the environment variable ``MJCF_FORGE_MODEL_CACHE`` is ``0``, ``off``, ``false`` or
-    ``no``. :func:`set_model_cache` replaces it or turns it off.
+    ``no``; it keeps its structures in the environment's model store
+    (``MJCF_FORGE_STORE``, else the user cache folder), so a structure any process compiled
+    is a load and a patch. :func:`set_model_cache` replaces it or turns it off.
     """
     global _model_cache
     if _model_cache is _UNSET:
