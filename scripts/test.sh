@@ -231,7 +231,9 @@ package_lane() {
   local only
   only="$(mktemp -d)"
   ln -s "$(.cache/venv/bin/python -c 'import mjcf_forge, os; print(os.path.dirname(mjcf_forge.__file__))')" "$only/mjcf_forge"
-  PYTHONPATH="$only:python/tests" .cache/venv-libero/bin/python -m pytest python/tests/test_last_xml.py -q -p no:cacheprovider
+  # And the model store (loaded against compiled, bit for bit) on that client's MuJoCo.
+  PYTHONPATH="$only:python/tests" .cache/venv-libero/bin/python -m pytest python/tests/test_last_xml.py \
+    python/tests/test_model_store.py -q -p no:cacheprovider
   rm -rf "$only"
   # robosuite's task XMLs (written by the robosuite venv) through a DocumentCache, judged by 4.0.0.
   .cache/venv-mj4/bin/python -m pytest python/tests/test_robosuite_resets.py -k task_xmls -q -p no:cacheprovider

@@ -4,7 +4,7 @@ compiles from the document (every array, bit for bit); a changed mesh under a st
 structure is a miss; two processes racing on one entry each get an exact model and leave
 one whole entry; a corrupt or truncated entry is never loaded (a ``RuntimeWarning``, then
 a compile); a folder that cannot be written degrades to compiling with a warning. Under
-3.17.0 and 4.0.0 (scripts/test.sh)."""
+3.17.0, 4.0.0 and LIBERO's 3.3.1 (scripts/test.sh)."""
 
 from __future__ import annotations
 
