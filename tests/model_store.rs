@@ -187,3 +187,44 @@ fn the_command_line_tells_and_clears_the_store() {
         .unwrap();
     assert!(String::from_utf8_lossy(&off.stdout).starts_with("no model store"));
 }
+
+#[test]
+fn a_model_cache_loads_a_structure_another_stored_and_patches_each_variant() {
+    use mjcf_forge::compiled::ModelCache;
+    use mjcf_forge::mujoco::compile_str;
+
+    let scene = Scene::load(root().join("benches/scenes/lift5_fixed.toml")).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let store = || DiskStore::open(dir.path(), 1 << 30).unwrap();
+    let mut first = ModelCache::new(&scene, 4, None).with_store(store());
+    first.model(0).unwrap();
+    assert_eq!((first.compiles(), first.loads()), (1, 0));
+    // A new cache knows nothing of the first but the store, as a new process would.
+    let mut second = ModelCache::new(&scene, 4, None).with_store(store());
+    for i in [2, 1, 3] {
+        let xml = scene.variant_xml(i).unwrap().0;
+        let want = compile_str(&xml, scene.template().model_dir()).unwrap();
+        let diffs = second.model(i).unwrap().differences(&want);
+        assert!(
+            diffs.is_empty(),
+            "variant {i}: {:?}",
+            &diffs[..diffs.len().min(3)]
+        );
+    }
+    assert_eq!((second.compiles(), second.loads()), (1, 1));
+    // apply() on a cache that never compiled: the structure loaded, the model patched.
+    let mut third = ModelCache::new(&scene, 4, None).with_store(store());
+    let mut own = compile_str(
+        &scene.variant_xml(0).unwrap().0,
+        scene.template().model_dir(),
+    )
+    .unwrap();
+    third.apply(3, &mut own).unwrap();
+    let want = compile_str(
+        &scene.variant_xml(3).unwrap().0,
+        scene.template().model_dir(),
+    )
+    .unwrap();
+    assert!(own.differences(&want).is_empty());
+    assert_eq!(third.loads(), 1);
+}

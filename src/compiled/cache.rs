@@ -7,12 +7,14 @@
 //! a caller's model checked, the bound) are the split tier's cache core, run over the
 //! linked MuJoCo by `store.rs`, which [`super::DocumentCache`] shares.
 
+use std::cell::Cell;
+
 use super::store::{Core, Linked, cache_error};
 use super::sys::{mjf_patch_array, mjf_patch_array_name, mjf_patch_get_stat};
 use crate::mujoco::{CompileError, CompiledModel, compile_str};
 use crate::scene::{Scene, Superset, VariantPatch};
-use crate::split::{Request, fixed_statistics_mask};
-use crate::{ErrorKind, Errors};
+use crate::split::{DiskStore, Request, StoreKey, fixed_statistics_mask, load_or_compile};
+use crate::{Document, ErrorKind, Errors};
 
 use super::bare;
 
@@ -162,6 +164,9 @@ pub struct ModelCache<'s> {
     core: Core,
     linked: Linked,
     max: (usize, Option<usize>),
+    /// With [`ModelCache::with_store`]: where structures are kept across processes.
+    store: Option<DiskStore>,
+    loads: u64,
 }
 
 impl<'s> ModelCache<'s> {
@@ -176,7 +181,24 @@ impl<'s> ModelCache<'s> {
             core: Core::new(max_models, max_bytes, false),
             linked: Linked::default(),
             max: (max_models, max_bytes),
+            store: None,
+            loads: 0,
         }
+    }
+
+    /// The same cache, keeping the structures it compiles in `store` across processes
+    /// ([`DiskStore`]): a miss whose structure another process compiled with this MuJoCo
+    /// and these files loads that model and patches it into the variant. Never for a
+    /// superset (its one model is the superset's own compile). A store that fails is
+    /// reported on standard error and the cache compiles as without it.
+    pub fn with_store(mut self, store: DiskStore) -> Self {
+        self.store = Some(store);
+        self
+    }
+
+    /// Misses so far that were loads from the store (of [`ModelCache::compiles`]).
+    pub fn loads(&self) -> u64 {
+        self.loads
     }
 
     /// Compiles variants with relative file names resolved against `dir` (a scene whose
@@ -265,10 +287,36 @@ impl<'s> ModelCache<'s> {
     pub fn model(&mut self, index: u64) -> Result<&CompiledModel, Errors> {
         let (patch, parked) = self.patch_of(index)?;
         let request = self.request(&patch, parked.as_deref());
-        let compile = compiler(self.scene, &self.superset, self.dir.as_deref(), index);
+        let key = &patch.structure_key;
+        let loaded = Cell::new(false);
+        let store = self.store.as_ref().filter(|_| self.superset.is_none());
+        let compile = stored_compiler(
+            self.scene,
+            &self.superset,
+            self.dir.as_deref(),
+            index,
+            store.map(|s| (s, key.as_str())),
+            &loaded,
+        );
         self.core
             .model(&mut self.linked, &request, compile)
-            .map_err(|e| cache_error(e, index, &patch.structure_key))
+            .map_err(|e| cache_error(e, index, key))?;
+        if loaded.get() {
+            // Another variant's compile, from the store: now a hit, patched into this one.
+            self.loads += 1;
+            let compile = stored_compiler(
+                self.scene,
+                &self.superset,
+                self.dir.as_deref(),
+                index,
+                None,
+                &loaded,
+            );
+            self.core
+                .model(&mut self.linked, &request, compile)
+                .map_err(|e| cache_error(e, index, key))?;
+        }
+        self.core.last().map_err(|e| cache_error(e, index, key))
     }
 
     /// Patches `model`, a model of variant `index`'s structure, in place into variant
@@ -276,10 +324,24 @@ impl<'s> ModelCache<'s> {
     pub fn apply(&mut self, index: u64, model: &mut CompiledModel) -> Result<(), Errors> {
         let (patch, parked) = self.patch_of(index)?;
         let request = self.request(&patch, parked.as_deref());
-        let compile = compiler(self.scene, &self.superset, self.dir.as_deref(), index);
+        let key = &patch.structure_key;
+        // The structure's first sight may load its model: kept, and patched before it is
+        // given out, as every cached model is.
+        let loaded = Cell::new(false);
+        let store = self.store.as_ref().filter(|_| self.superset.is_none());
+        let compile = stored_compiler(
+            self.scene,
+            &self.superset,
+            self.dir.as_deref(),
+            index,
+            store.map(|s| (s, key.as_str())),
+            &loaded,
+        );
         self.core
             .apply(&mut self.linked, &request, model, compile)
-            .map_err(|e| cache_error(e, index, &patch.structure_key))
+            .map_err(|e| cache_error(e, index, key))?;
+        self.loads += u64::from(loaded.get());
+        Ok(())
     }
 
     fn request<'a>(&self, patch: &'a VariantPatch, parked: Option<&'a [String]>) -> Request<'a> {
@@ -289,6 +351,40 @@ impl<'s> ModelCache<'s> {
             parked,
             fixed: self.fixed,
         }
+    }
+}
+
+/// [`compiler`] through `store` (with the structure key given with it), on its first call:
+/// a stored model is loaded (`loaded` says so), a compiled one stored.
+fn stored_compiler<'a>(
+    scene: &'a Scene,
+    superset: &'a Option<SupersetState>,
+    dir: Option<&'a std::path::Path>,
+    index: u64,
+    store: Option<(&'a DiskStore, &'a str)>,
+    loaded: &'a Cell<bool>,
+) -> impl FnMut() -> Result<CompiledModel, Errors> + 'a {
+    let mut compile = compiler(scene, superset, dir, index);
+    let mut store = store;
+    let dir = dir.unwrap_or_else(|| scene.template().model_dir());
+    move || {
+        let Some((store, key)) = store.take() else {
+            return compile();
+        };
+        let xml = scene.variant_xml(index)?.0;
+        let Ok(doc) = Document::from_str(&xml, dir) else {
+            return compile();
+        };
+        let key = StoreKey::of_document(key, &crate::mujoco::version(), &doc);
+        let (model, stored) = load_or_compile(
+            Some((store, key.as_str())),
+            CompiledModel::from_bytes,
+            |m: &CompiledModel| Some(m.to_bytes()),
+            &mut compile,
+            &mut |w| eprintln!("mjcf-forge: {w}"),
+        )?;
+        loaded.set(stored);
+        Ok(model)
     }
 }
 

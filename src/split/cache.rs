@@ -373,7 +373,8 @@ impl<B: CacheBackend> CacheCore<B> {
         }
     }
 
-    fn last(&self) -> Result<&B::Model, CacheError<B::Error>> {
+    /// The model the last call gave or kept.
+    pub fn last(&self) -> Result<&B::Model, CacheError<B::Error>> {
         self.store
             .last()
             .ok_or_else(|| CacheError::NotThisStructure("the cache holds no model".into()))
