@@ -41,7 +41,8 @@ _WRITES_WHERE: list = []  # [bool]: whether this MuJoCo writes where an asset ca
 def files_of(text: str) -> frozenset:
     """The mesh files a model written as ``text`` reads (``Document.files("mesh")``); none
     where it cannot be read (MuJoCo then refuses it, and caches nothing)."""
-    files = _FILES.get(text)
+    with _LOCK:
+        files = _FILES.get(text)
     if files is None:
         from ._mjcf_forge import Document
 
@@ -49,9 +50,10 @@ def files_of(text: str) -> frozenset:
             files = frozenset(Document.from_string(text).files("mesh"))
         except Exception:  # noqa: BLE001 - MuJoCo's own load says what is wrong
             files = frozenset()
-        if len(_FILES) >= 8:
-            _FILES.pop(next(iter(_FILES)))
-        _FILES[text] = files
+        with _LOCK:
+            if len(_FILES) >= 8:
+                _FILES.pop(next(iter(_FILES)))
+            _FILES[text] = files
     return files
 
 
