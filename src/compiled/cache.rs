@@ -304,14 +304,7 @@ impl<'s> ModelCache<'s> {
         if loaded.get() {
             // Another variant's compile, from the store: now a hit, patched into this one.
             self.loads += 1;
-            let compile = stored_compiler(
-                self.scene,
-                &self.superset,
-                self.dir.as_deref(),
-                index,
-                None,
-                &loaded,
-            );
+            let compile = compiler(self.scene, &self.superset, self.dir.as_deref(), index);
             self.core
                 .model(&mut self.linked, &request, compile)
                 .map_err(|e| cache_error(e, index, key))?;
