@@ -126,7 +126,7 @@ impl Document {
     /// let xml = r#"<mujoco><asset><mesh file="/m/a.obj"/><texture type="2d" file="/m/t.png"/></asset></mujoco>"#;
     /// let doc = Document::from_str(xml, "/")?;
     /// assert_eq!(doc.files_of("mesh"), vec![std::path::PathBuf::from("/m/a.obj")]);
-    /// # Ok::<(), mjcf_forge::Error>(())
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn files_of(&self, tag: &str) -> Vec<std::path::PathBuf> {
         self.files_where(|node| self.tag(node) == tag)
