@@ -179,6 +179,8 @@ def writes_where_assets_came_from() -> bool:
             save(out, model)
             with open(out) as f:
                 written.append("content_type" in f.read())
+    # MuJoCo's slot now holds the probe: known to hold nothing of anyone's.
+    _last_xml.forget_held()
     _WRITES_WHERE.append(written[0] != written[1])
     return _WRITES_WHERE[0]
 

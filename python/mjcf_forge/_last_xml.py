@@ -139,6 +139,15 @@ def _loaded(key: tuple, model: Any, began_alone: bool, reads: tuple) -> None:
         slot.owed_files, slot.owed_cold = files, stock_cold
 
 
+def forget_held() -> None:
+    """MuJoCo's slot was loaded by no one's load the bookkeeping knows (the asset cache's
+    probe): what it holds is unknown from now on."""
+    slot = _SLOT
+    with slot.lock:
+        slot.held, slot.fresh, slot.stat, slot.signature = _UNKNOWN, False, None, None
+        slot.held_cold = None
+
+
 def _files(key: tuple) -> frozenset:
     kind, source, _assets = key
     return _asset_cache.files_of(source) if kind == "xml" else _asset_cache.files_of_path(source)
