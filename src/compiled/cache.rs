@@ -289,13 +289,12 @@ impl<'s> ModelCache<'s> {
         let request = self.request(&patch, parked.as_deref());
         let key = &patch.structure_key;
         let loaded = Cell::new(false);
-        let store = self.store.as_ref().filter(|_| self.superset.is_none());
         let compile = stored_compiler(
             self.scene,
             &self.superset,
             self.dir.as_deref(),
             index,
-            store.map(|s| (s, key.as_str())),
+            (self.store.as_ref(), key),
             &loaded,
         );
         self.core
@@ -321,13 +320,12 @@ impl<'s> ModelCache<'s> {
         // The structure's first sight may load its model: kept, and patched before it is
         // given out, as every cached model is.
         let loaded = Cell::new(false);
-        let store = self.store.as_ref().filter(|_| self.superset.is_none());
         let compile = stored_compiler(
             self.scene,
             &self.superset,
             self.dir.as_deref(),
             index,
-            store.map(|s| (s, key.as_str())),
+            (self.store.as_ref(), key),
             &loaded,
         );
         self.core
@@ -347,18 +345,19 @@ impl<'s> ModelCache<'s> {
     }
 }
 
-/// [`compiler`] through `store` (with the structure key given with it), on its first call:
+/// [`compiler`] through `store` under structure key `key` (no superset), on its first call:
 /// a stored model is loaded (`loaded` says so), a compiled one stored.
 fn stored_compiler<'a>(
     scene: &'a Scene,
     superset: &'a Option<SupersetState>,
     dir: Option<&'a std::path::Path>,
     index: u64,
-    store: Option<(&'a DiskStore, &'a str)>,
+    (store, key): (Option<&'a DiskStore>, &'a str),
     loaded: &'a Cell<bool>,
 ) -> impl FnMut() -> Result<CompiledModel, Errors> + 'a {
     let mut compile = compiler(scene, superset, dir, index);
-    let mut store = store;
+    // Never for a superset: its one model is the superset's own compile.
+    let mut store = store.filter(|_| superset.is_none()).map(|s| (s, key));
     let dir = dir.unwrap_or_else(|| scene.template().model_dir());
     move || {
         let Some((store, key)) = store.take() else {
